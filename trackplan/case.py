@@ -1,0 +1,145 @@
+"""A validated case: robot, path, task, placement bounds, objective and optimizer settings.
+
+Pure data. :func:`trackplan.io.case_file.load_case` builds it from a YAML file;
+a notebook can build it directly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from trackplan.paths.specs import SegmentSpec
+from trackplan.robots.model import Robot
+
+PLACEMENT_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
+
+
+@dataclass(frozen=True, eq=False)
+class Task:
+    """Process requirements.
+
+    Attributes
+    ----------
+    rated_speed
+        Tool speed on straight pieces, v_r, m/s.
+    corner_speed
+        Highest tool speed on arcs and corner blends, v_t^max, m/s.
+    tolerance
+        Largest distance of the tool point from the nominal path, ρ, m.
+    sample_time
+        Controller period Ts, s.
+    tool_rpy
+        Tool orientation in the definition frame (roll, pitch, yaw), shape (3,), rad.
+    timing
+        ``"smooth"`` (jerk-limited, G2 blends) or ``"paper"`` (Section 3.1 as written).
+    """
+
+    rated_speed: float
+    corner_speed: float
+    tolerance: float
+    sample_time: float
+    tool_rpy: np.ndarray
+    timing: str = "smooth"
+
+
+@dataclass(frozen=True, eq=False)
+class PlacementBounds:
+    """Search ranges of X = (x, y, z, roll, pitch, yaw) and the reach constraint (Eq. 28, 32).
+
+    Attributes
+    ----------
+    lower, upper
+        Shape (6,), metres and radians.
+    reach
+        (min, max) distance of (x, y, z) from the base origin, m.
+    example
+        A placement known to work (shape (6,)), or None.
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    reach: tuple[float, float]
+    example: np.ndarray | None = None
+
+    @property
+    def center(self) -> np.ndarray:
+        """Centre of the box, shape (6,)."""
+        return 0.5 * (self.lower + self.upper)
+
+
+@dataclass(frozen=True, eq=False)
+class Objective:
+    """Fitness settings (Eq. 8 and Eq. 30).
+
+    Attributes
+    ----------
+    weights
+        C_i of Eq. 8, shape (n,).
+    time_weight
+        Added to J per second of duration (0: the paper's objective).
+    penalty
+        ``"graded"``: infeasible candidates rank by distance from feasibility;
+        ``"flat"``: the paper's constant M.
+    flat_penalty
+        The constant M of Eq. 30 for ``penalty="flat"``.
+    """
+
+    weights: np.ndarray
+    time_weight: float = 0.0
+    penalty: str = "graded"
+    flat_penalty: float = 1.0e6
+
+
+@dataclass(frozen=True)
+class OptimizerSettings:
+    """Placement search settings.
+
+    Attributes
+    ----------
+    method
+        ``ga``, ``cmaes``, ``de`` or ``random``.
+    population
+        Population size (candidates evaluated per batch).
+    seed
+        Fixes every random choice.
+    budget
+        Largest number of placement evaluations, or None for the method's own stop rule.
+    """
+
+    method: str = "ga"
+    population: int = 30
+    seed: int = 0
+    budget: int | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Case:
+    """Everything needed to plan and optimize one path-following task.
+
+    Attributes
+    ----------
+    name
+        Case name.
+    robot
+        The robot.
+    start
+        First point of the path in the definition frame, shape (3,), m.
+    segments
+        The path segments, in order.
+    task, bounds, objective, optimizer
+        See the classes.
+    source
+        The case file, if the case came from one.
+    """
+
+    name: str
+    robot: Robot
+    start: np.ndarray
+    segments: tuple[SegmentSpec, ...]
+    task: Task
+    bounds: PlacementBounds
+    objective: Objective
+    optimizer: OptimizerSettings = field(default_factory=OptimizerSettings)
+    source: str | None = None

@@ -1,0 +1,79 @@
+"""Built-in robots: the paper's PUMA560 (Tables I and II) and a UR5.
+
+The robot file format (YAML, see the README) describes the same data for other arms.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from trackplan.errors import CaseError
+from trackplan.robots.model import Robot
+
+HALF_PI = np.pi / 2
+
+
+def puma560() -> Robot:
+    """PUMA560 of the paper: DH of Table I (α = ±π/2 exactly), limits of Table II."""
+    return Robot(
+        name="puma560",
+        d=np.array([0.0, 0.0, 0.15, 0.4318, 0.0, 0.0]),
+        a=np.array([0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0]),
+        alpha=np.array([HALF_PI, 0.0, -HALF_PI, HALF_PI, -HALF_PI, 0.0]),
+        offset=np.zeros(6),
+        q_min=-np.array([np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi]),
+        q_max=np.array([np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi]),
+        v_max=np.array([8.0, 10.0, 10.0, 5.0, 5.0, 5.0]),
+        a_max=np.array([10.0, 12.0, 12.0, 8.0, 8.0, 8.0]),
+        j_max=np.array([30.0, 40.0, 40.0, 20.0, 20.0, 20.0]),
+        source="Reference paper, Tables I (DH, alpha = ±pi/2) and II (limits); base frame at the shoulder (d1 = 0).",
+    )
+
+
+def ur5() -> Robot:
+    """UR5 (CB3): a 6R arm without a spherical wrist, so it takes the numerical IK path.
+
+    DH: Universal Robots, "DH parameters for calculations of kinematics and dynamics"
+    (UR5: d1 = 0.089159, a2 = -0.425, a3 = -0.39225, d4 = 0.10915, d5 = 0.09465,
+    d6 = 0.0823, alpha = (π/2, 0, 0, π/2, -π/2, 0)).
+    Limits: UR5 technical specifications: every joint ±360°, 180 °/s. The datasheet gives no
+    acceleration or jerk limits; 15 rad/s² and 150 rad/s³ are conservative values
+    chosen here for process motion (state your own in a robot file if they differ).
+    """
+    two_pi = 2 * np.pi
+    return Robot(
+        name="ur5",
+        d=np.array([0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823]),
+        a=np.array([0.0, -0.425, -0.39225, 0.0, 0.0, 0.0]),
+        alpha=np.array([HALF_PI, 0.0, 0.0, HALF_PI, -HALF_PI, 0.0]),
+        offset=np.zeros(6),
+        q_min=-np.full(6, two_pi),
+        q_max=np.full(6, two_pi),
+        v_max=np.full(6, np.pi),
+        a_max=np.full(6, 15.0),
+        j_max=np.full(6, 150.0),
+        source=(
+            "Universal Robots UR5 (CB3) published DH table and technical specifications "
+            "(±360°, 180°/s); acceleration 15 rad/s² and jerk 150 rad/s³ are assumptions."
+        ),
+    )
+
+
+BUILTIN_ROBOTS = {"puma560": puma560, "ur5": ur5}
+
+
+def builtin_robot(name: str) -> Robot:
+    """The built-in robot called ``name``.
+
+    Raises
+    ------
+    CaseError
+        When no built-in robot has that name.
+    """
+    try:
+        return BUILTIN_ROBOTS[name.lower()]()
+    except KeyError:
+        known = ", ".join(sorted(BUILTIN_ROBOTS))
+        raise CaseError(
+            f"unknown robot {name!r}: use one of {known} or a path to a robot file", key="robot"
+        ) from None
