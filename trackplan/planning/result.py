@@ -1,0 +1,235 @@
+"""Results of planning and checking: frozen dataclasses, never None on failure."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from trackplan.robots.model import LIMIT_KINDS
+
+TASK_KINDS = ("tracking", "orientation", "speed", "coverage")
+
+
+class PlanStatus(enum.Enum):
+    """Outcome of planning one placement."""
+
+    FEASIBLE = "feasible"
+    LIMITS_VIOLATED = "limits_violated"  # a trajectory exists but breaks a limit
+    UNREACHABLE = "unreachable"  # some path pose has no IK solution
+    BRANCH_SWITCH = "branch_switch"  # the path crosses a singularity
+    POSITION_LIMITS = "position_limits"  # every branch leaves the joint range
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """Joint trajectory sampled at the controller period, from rest to rest.
+
+    Attributes
+    ----------
+    sample_time
+        Ts, s.
+    t
+        Sample times, shape (N,), s; ``t[k] = k · Ts``.
+    s
+        Arc length on the planned path at each sample, shape (N,), m.
+    q
+        Joint positions, shape (N, n), rad.
+    qd, qdd, qddd
+        Backward differences of ``q`` at Ts with the robot at rest before the first
+        sample (design.md), shape (N, n), rad/s, rad/s², rad/s³.
+    tool_position
+        Tool point by FK in the base frame, shape (N, 3), m.
+    speed
+        Cartesian speed of the tool point (backward difference), shape (N,), m/s.
+    """
+
+    sample_time: float
+    t: np.ndarray
+    s: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    qddd: np.ndarray
+    tool_position: np.ndarray
+    speed: np.ndarray
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples N."""
+        return len(self.t)
+
+    @property
+    def duration(self) -> float:
+        """Time of the last sample, s."""
+        return float(self.t[-1])
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One limit broken over a time window.
+
+    Attributes
+    ----------
+    limit
+        A joint limit kind (``position``, ``velocity``, ``acceleration``, ``jerk``) or a
+        task kind (``tracking``, ``orientation``, ``speed``, ``coverage``).
+    joint
+        1-based joint number for joint limits, None for task limits.
+    t_first, t_last
+        First and last sample time at which the limit is exceeded, s.
+    worst
+        The worst value (signed for joint limits), in the limit's unit.
+    bound
+        The limit it exceeds (same unit).
+    message
+        One line: "joint 6 jerk 31.2 rad/s³ exceeds 20 at t = 2.415 s".
+    """
+
+    limit: str
+    joint: int | None
+    t_first: float
+    t_last: float
+    worst: float
+    bound: float
+    message: str
+
+
+@dataclass(frozen=True, eq=False)
+class CheckReport:
+    """What the checker found, sample by sample.
+
+    Attributes
+    ----------
+    ok
+        True when nothing is violated.
+    joint_margins
+        Per joint limit kind, shape (n,): the smallest unused fraction of the limit
+        over all samples (1 = unused, 0 = reached, negative = exceeded). G <= 0 style:
+        ``-margin`` is the normalised constraint value.
+    task_margins
+        Per task kind, the unused fraction of the task bound (tracking: of ρ; speed: of
+        the speed cap; orientation: of the orientation tolerance; coverage: 1 or < 0).
+    violations
+        Every violation, in time order within each kind.
+    max_tracking_error
+        Largest distance of the tool point from the nominal path, m.
+    max_orientation_error
+        Largest tool orientation error, rad.
+    binding
+        For each joint limit kind, the (joint, time) at which it is closest to binding.
+    """
+
+    ok: bool
+    joint_margins: dict[str, np.ndarray]
+    task_margins: dict[str, float]
+    violations: tuple[Violation, ...]
+    max_tracking_error: float
+    max_orientation_error: float
+    binding: dict[str, tuple[int, float]] = field(default_factory=dict)
+
+    def worst_margin(self) -> float:
+        """The smallest margin over every limit (negative when infeasible)."""
+        values = [float(np.min(m)) for m in self.joint_margins.values()]
+        values += list(self.task_margins.values())
+        return min(values)
+
+
+@dataclass(frozen=True)
+class SlowDown:
+    """A stretch of a straight piece run below the rated speed.
+
+    Attributes
+    ----------
+    s_start, s_end
+        Arc length on the planned path, m.
+    speed
+        Plateau speed held there, m/s.
+    rated_speed
+        The rated speed, m/s.
+    limit
+        What forced it (e.g. ``"joint 4 velocity"``).
+    """
+
+    s_start: float
+    s_end: float
+    speed: float
+    rated_speed: float
+    limit: str
+
+
+@dataclass(frozen=True, eq=False)
+class PlanResult:
+    """One placement planned end to end.
+
+    Attributes
+    ----------
+    case_name
+        Name of the case.
+    placement
+        X = (x, y, z, roll, pitch, yaw), shape (6,).
+    feasible
+        True when the checker found no violation.
+    status
+        See :class:`PlanStatus`.
+    message
+        One line saying what happened (the first violation when infeasible).
+    timing
+        ``smooth`` or ``paper``.
+    branch
+        IK branch used (closed form: 0-7; numeric: the seed index).
+    trajectory
+        The sampled trajectory (empty arrays when no trajectory could be built).
+    check
+        The checker's report on ``trajectory``.
+    objective
+        J of Eq. 8 from the written q.
+    duration
+        s.
+    path_length
+        Length of the nominal path, m.
+    rated_speed_fraction
+        Share of the straight-piece length run at the rated speed.
+    min_corner_speed
+        Lowest plateau speed on arcs and blends, m/s (rated speed when there are none).
+    slowdowns
+        Where straight pieces run below the rated speed.
+    references
+        Reference durations when computed: ``toppra_duration``, ``topp3_duration`` (s).
+    planned_path
+        The planned (blended) path, :class:`trackplan.paths.Path`.
+    nominal_path
+        The path as the user gave it, :class:`trackplan.paths.NominalPath`.
+    """
+
+    case_name: str
+    placement: np.ndarray
+    feasible: bool
+    status: PlanStatus
+    message: str
+    timing: str
+    branch: int
+    trajectory: Trajectory
+    check: CheckReport
+    objective: float
+    duration: float
+    path_length: float
+    rated_speed_fraction: float
+    min_corner_speed: float
+    slowdowns: tuple[SlowDown, ...]
+    references: dict[str, float]
+    planned_path: object
+    nominal_path: object
+
+
+__all__ = [
+    "LIMIT_KINDS",
+    "TASK_KINDS",
+    "CheckReport",
+    "PlanResult",
+    "PlanStatus",
+    "SlowDown",
+    "Trajectory",
+    "Violation",
+]
