@@ -1,0 +1,264 @@
+"""The one checker: every sample against every limit, with where and how much.
+
+It serves the planner, the optimizer, the tests and ``trackplan check``. It never returns a
+bare bool: a :class:`~trackplan.planning.result.CheckReport` carries margins per limit and
+joint, and every violation with its time window and worst value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.planning.derivatives import backward_derivatives
+from trackplan.planning.result import CheckReport, Violation
+from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.model import Robot
+
+UNITS = {
+    "position": "rad",
+    "velocity": "rad/s",
+    "acceleration": "rad/s²",
+    "jerk": "rad/s³",
+    "tracking": "m",
+    "orientation": "rad",
+    "speed": "m/s",
+    "coverage": "m",
+}
+RELATIVE_SLACK = 1e-9
+"""Values within this relative amount of a limit count as meeting it (float round-off)."""
+ORIENTATION_TOLERANCE = 1e-3
+"""Largest tool orientation error accepted, rad."""
+
+
+@dataclass(frozen=True, eq=False)
+class TrackingReference:
+    """What the tool must do, for the task checks.
+
+    Attributes
+    ----------
+    nominal
+        The path as the user gave it (:class:`trackplan.paths.NominalPath`), definition frame.
+    T_base_part
+        Placement of the definition frame, shape (4, 4).
+    R_part_tool
+        Tool orientation in the definition frame, shape (3, 3).
+    tolerance
+        ρ, m.
+    rated_speed, corner_speed
+        Speed caps on straight pieces and at corners, m/s.
+    corner_intervals
+        Arc-length intervals of the nominal path where the corner speed applies, shape (K, 2), m.
+    orientation_tolerance
+        Largest tool orientation error, rad.
+    """
+
+    nominal: object
+    T_base_part: np.ndarray
+    R_part_tool: np.ndarray
+    tolerance: float
+    rated_speed: float
+    corner_speed: float
+    corner_intervals: np.ndarray
+    orientation_tolerance: float = ORIENTATION_TOLERANCE
+
+
+def check_trajectory(
+    robot: Robot,
+    q: np.ndarray,
+    sample_time: float,
+    reference: TrackingReference | None = None,
+) -> CheckReport:
+    """Check a sampled joint trajectory against the robot's limits and the task.
+
+    Derivatives are backward differences at Ts with the robot at rest before the first and
+    after the last sample (design.md), exactly what a controller consuming the samples sees.
+
+    Parameters
+    ----------
+    robot
+        The robot (limits and kinematics).
+    q
+        Joint positions, shape (N, n), rad, one row per controller period.
+    sample_time
+        Ts, s.
+    reference
+        The task to check against (tracking, orientation, Cartesian speed, coverage);
+        None checks joint limits only.
+
+    Returns
+    -------
+    CheckReport
+        Margins, violations and the worst tracking and orientation errors.
+    """
+    q = np.asarray(q, dtype=float)
+    t = np.arange(len(q) + 3) * sample_time
+    qd, qdd, qddd = backward_derivatives(q, sample_time, pad_end=True)
+    violations: list[Violation] = []
+    margins: dict[str, np.ndarray] = {}
+    binding: dict[str, tuple[int, float]] = {}
+
+    # position: distance to the nearer bound as a fraction of the half range
+    half_range = 0.5 * (robot.q_max - robot.q_min)
+    centre = 0.5 * (robot.q_max + robot.q_min)
+    position_use = np.abs(q - centre) / half_range
+    signals = {
+        "position": (q, position_use, None),
+        "velocity": (qd, np.abs(qd) / robot.v_max, robot.v_max),
+        "acceleration": (qdd, np.abs(qdd) / robot.a_max, robot.a_max),
+        "jerk": (qddd, np.abs(qddd) / robot.j_max, robot.j_max),
+    }
+    for kind, (values, use, bound) in signals.items():
+        margins[kind] = 1.0 - use.max(axis=0)
+        worst_joint = int(np.argmax(use.max(axis=0)))
+        binding[kind] = (worst_joint + 1, float(t[int(np.argmax(use[:, worst_joint]))]))
+        for j in np.flatnonzero(use.max(axis=0) > 1.0 + RELATIVE_SLACK):
+            limit = (
+                robot.q_max[j]
+                if kind == "position" and values[np.argmax(use[:, j]), j] > centre[j]
+                else robot.q_min[j]
+                if kind == "position"
+                else bound[j]
+            )
+            violations.append(_violation(kind, j + 1, t, values[:, j], use[:, j], float(limit)))
+
+    task_margins: dict[str, float] = {}
+    max_tracking = 0.0
+    max_orientation = 0.0
+    if reference is not None:
+        task, max_tracking, max_orientation = _check_task(robot, q, sample_time, reference)
+        task_margins, task_violations = task
+        violations.extend(task_violations)
+
+    return CheckReport(
+        ok=not violations,
+        joint_margins=margins,
+        task_margins=task_margins,
+        violations=tuple(violations),
+        max_tracking_error=max_tracking,
+        max_orientation_error=max_orientation,
+        binding=binding,
+    )
+
+
+def _violation(
+    kind: str, joint: int | None, t: np.ndarray, values: np.ndarray, use: np.ndarray, bound: float
+) -> Violation:
+    """Summarise the samples where ``use > 1`` into one :class:`Violation`."""
+    bad = np.flatnonzero(use > 1.0 + RELATIVE_SLACK)
+    worst = int(bad[np.argmax(use[bad])])
+    value = float(values[worst])
+    who = f"joint {joint} {kind}" if joint is not None else kind
+    message = (
+        f"{who} {abs(value):.4g} {UNITS[kind]} exceeds {abs(bound):.4g} at t = {t[worst]:.3f} s"
+        f" ({len(bad)} samples from t = {t[bad[0]]:.3f} to {t[bad[-1]]:.3f} s)"
+    )
+    return Violation(kind, joint, float(t[bad[0]]), float(t[bad[-1]]), value, bound, message)
+
+
+def _check_task(
+    robot: Robot, q: np.ndarray, sample_time: float, ref: TrackingReference
+) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
+    """Tracking, orientation, Cartesian speed and coverage checks."""
+    T_base_tool = forward_kinematics(robot, q)
+    R_part_base = ref.T_base_part[:3, :3].T
+    p_part = (T_base_tool[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
+    t = np.arange(len(q)) * sample_time
+    violations: list[Violation] = []
+    margins: dict[str, float] = {}
+
+    # tool orientation: angle of R_expected^T R_actual
+    R_expected = ref.T_base_part[:3, :3] @ ref.R_part_tool
+    R_err = np.einsum("ji,njk->nik", R_expected, T_base_tool[:, :3, :3])
+    cos_angle = np.clip((np.trace(R_err, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    orientation_error = np.arccos(cos_angle)
+    margins["orientation"] = float(1.0 - orientation_error.max() / ref.orientation_tolerance)
+    if margins["orientation"] < -RELATIVE_SLACK:
+        use = orientation_error / ref.orientation_tolerance
+        violations.append(
+            _violation("orientation", None, t, orientation_error, use, ref.orientation_tolerance)
+        )
+
+    # tracking error and the position along the nominal path, in order of travel
+    velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
+    s_nominal, distance, piece = ref.nominal.locate(p_part, velocity, ref.tolerance)
+    margins["tracking"] = float(1.0 - distance.max() / ref.tolerance)
+    if margins["tracking"] < -RELATIVE_SLACK:
+        violations.append(
+            _violation("tracking", None, t, distance, distance / ref.tolerance, ref.tolerance)
+        )
+
+    # Cartesian speed against the cap that applies where the tool is
+    speed = np.linalg.norm(velocity, axis=1)
+    in_corner = np.zeros(len(q), dtype=bool)
+    for s0, s1 in np.asarray(ref.corner_intervals).reshape(-1, 2):
+        in_corner |= (s_nominal >= s0) & (s_nominal <= s1)
+    cap = np.where(in_corner, ref.corner_speed, ref.rated_speed)
+    margins["speed"] = float(1.0 - (speed / cap).max())
+    if margins["speed"] < -1e-6:  # speed is a task bound: allow ppm-level round-off
+        violations.append(
+            _violation("speed", None, t, speed, speed / cap * (1 - 1e-6), float(cap.min()))
+        )
+
+    coverage = _coverage_violations(ref, t, s_nominal, piece, speed, sample_time)
+    margins["coverage"] = 1.0 if not coverage else -1.0
+    violations.extend(coverage)
+    return (margins, violations), float(distance.max()), float(orientation_error.max())
+
+
+def _coverage_violations(
+    ref: TrackingReference,
+    t: np.ndarray,
+    s: np.ndarray,
+    piece: np.ndarray,
+    speed: np.ndarray,
+    sample_time: float,
+) -> list[Violation]:
+    """The whole nominal path covered from start to end, in order, with no jump."""
+    nominal = ref.nominal
+    tol = 2.0 * ref.tolerance
+    found: list[Violation] = []
+
+    def add(k: int, value: float, bound: float, text: str) -> None:
+        found.append(Violation("coverage", None, float(t[k]), float(t[k]), value, bound, text))
+
+    if s[0] > tol:
+        add(
+            0,
+            float(s[0]),
+            tol,
+            f"coverage: the trajectory starts {s[0]:.4g} m into the path, not at its start",
+        )
+    if s[-1] < nominal.length - tol:
+        add(
+            len(s) - 1,
+            float(s[-1]),
+            nominal.length,
+            f"coverage: the trajectory ends {nominal.length - s[-1]:.4g} m before the end of the path",
+        )
+    step = np.diff(s)
+    backwards = np.flatnonzero(step < -tol)
+    if backwards.size:
+        k = int(backwards[0]) + 1
+        add(
+            k,
+            float(step[k - 1]),
+            0.0,
+            f"coverage: the path is run backwards at t = {t[k]:.3f} s ({backwards.size} steps)",
+        )
+    allowance = nominal.jump_allowance(ref.tolerance)  # (P,) extra jump allowed after piece p
+    step_cap = 2.0 * max(ref.rated_speed, ref.corner_speed, float(speed.max())) * sample_time + tol
+    allowed = step_cap + np.where(piece[1:] != piece[:-1], allowance[piece[:-1]], 0.0)
+    jumps = np.flatnonzero(step > allowed)
+    if jumps.size:
+        k = int(jumps[0]) + 1
+        skipped = np.unique(piece[jumps + 1] - piece[jumps] - 1)
+        what = "segment skipped" if np.any(skipped > 0) else "jump along the path"
+        add(
+            k,
+            float(step[k - 1]),
+            float(allowed[k - 1]),
+            f"coverage: {what} at t = {t[k]:.3f} s: {step[k - 1]:.4g} m in one sample",
+        )
+    return found

@@ -1,0 +1,44 @@
+"""Joint derivatives exactly as a controller consuming the samples sees them (design.md)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+REST_PADDING = 3
+"""Samples at rest appended after the last one: the robot stays still after the trajectory,
+so the first three backward differences past the end are checked too."""
+
+
+def backward_derivatives(
+    q: np.ndarray, sample_time: float, pad_end: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Velocity, acceleration and jerk by backward differences at Ts, at rest before the start.
+
+    ``qd[k] = (q[k] - q[k-1]) / Ts`` with ``q[-1] = q[0]``, and likewise for the higher
+    differences (``np.diff(q, n) / Ts**n`` of the sequence padded with the rest state).
+
+    Parameters
+    ----------
+    q
+        Positions, shape (N, n) (or (N,) for a scalar signal).
+    sample_time
+        Ts, s.
+    pad_end
+        Also return the :data:`REST_PADDING` samples after the end, where the robot holds
+        ``q[-1]`` (shape (N + 3, n) instead of (N, n)).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(qd, qdd, qddd)`` in unit/s, unit/s², unit/s³.
+    """
+    q = np.asarray(q, dtype=float)
+    head = np.repeat(q[:1], REST_PADDING, axis=0)
+    parts = [head, q]
+    if pad_end:
+        parts.append(np.repeat(q[-1:], REST_PADDING, axis=0))
+    padded = np.concatenate(parts, axis=0)
+    qd = np.diff(padded, 1, axis=0) / sample_time
+    qdd = np.diff(padded, 2, axis=0) / sample_time**2
+    qddd = np.diff(padded, 3, axis=0) / sample_time**3
+    return qd[REST_PADDING - 1 :], qdd[REST_PADDING - 2 :], qddd
