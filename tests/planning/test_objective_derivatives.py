@@ -1,0 +1,35 @@
+"""Eq. 8 and the checker's backward differences."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from trackplan.planning.derivatives import backward_derivatives
+from trackplan.planning.objective import joint_travel
+
+
+def test_joint_travel_matches_definition(rng):
+    q = rng.normal(size=(50, 6))
+    weights = np.array([0.3, 0.2, 0.2, 0.1, 0.1, 0.1])
+    expected = sum(
+        weights[i] * abs(q[k, i] - q[k - 1, i]) for k in range(1, 50) for i in range(6)
+    )
+    assert joint_travel(q, weights) == pytest.approx(expected)
+    batched = joint_travel(np.stack([q, 2 * q]), weights)
+    assert batched == pytest.approx([expected, 2 * expected])
+
+
+def test_backward_differences_at_rest_before_and_after(rng):
+    Ts = 0.01
+    q = np.cumsum(rng.normal(size=(20, 2)), axis=0)
+    qd, qdd, qddd = backward_derivatives(q, Ts)
+    padded = np.vstack([q[:1]] * 3 + [q])
+    np.testing.assert_allclose(qd, np.diff(padded, 1, axis=0)[2:] / Ts)
+    np.testing.assert_allclose(qdd, np.diff(padded, 2, axis=0)[1:] / Ts**2)
+    np.testing.assert_allclose(qddd, np.diff(padded, 3, axis=0) / Ts**3)
+    assert np.all(qd[0] == 0)
+    qd_end, _, qddd_end = backward_derivatives(q, Ts, pad_end=True)
+    assert len(qd_end) == len(q) + 3
+    np.testing.assert_allclose(qd_end[-3:], 0.0)
+    assert np.abs(qddd_end[-3:]).max() > 0  # stopping abruptly shows up after the end

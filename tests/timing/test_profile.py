@@ -1,0 +1,70 @@
+"""Jerk-limited speed changes and phase integration."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from trackplan.planning.derivatives import backward_derivatives
+from trackplan.timing.profile import (
+    SpeedProfile,
+    speed_change_distance,
+    speed_change_phases,
+    speed_change_time,
+)
+
+speeds = st.floats(0.0, 0.5)
+bounds = st.floats(0.05, 20.0)
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(v_from=speeds, v_to=speeds, accel=bounds, jerk=bounds)
+def test_speed_change_reaches_target_within_bounds(v_from, v_to, accel, jerk):
+    phases = speed_change_phases(v_from, v_to, accel, jerk)
+    profile = SpeedProfile.from_phases([(0.0, 0.0), *phases], length=np.inf)
+    t = np.linspace(0.0, profile.duration, 400)
+    v_start = v_from  # SpeedProfile starts at rest: shift by v_from
+    _, v, a = profile.evaluate(t)
+    assert v[-1] + v_start == pytest.approx(v_to, abs=1e-12)
+    assert np.all(np.abs(a) <= accel * (1 + 1e-9))
+    assert np.all(np.abs(np.array([j for _, j in phases])) <= jerk * (1 + 1e-12))
+    assert profile.duration == pytest.approx(speed_change_time(abs(v_to - v_from), accel, jerk))
+    assert a[-1] == pytest.approx(0.0, abs=1e-9 * max(accel, 1.0))
+
+
+def test_distance_is_mean_speed_times_duration():
+    v_from, v_to, accel, jerk = 0.05, 0.15, 1.0, 10.0
+    phases = speed_change_phases(0.0, v_to - v_from, accel, jerk)
+    profile = SpeedProfile.from_phases(phases, length=np.inf)
+    distance_from_rest = profile.s0[-1] + 0  # integrate explicitly below
+    t = np.linspace(0, profile.duration, 20001)
+    _, v, _ = profile.evaluate(t)
+    moved = np.trapezoid(v + v_from, t)
+    assert moved == pytest.approx(speed_change_distance(v_from, v_to, accel, jerk), rel=1e-6)
+    assert distance_from_rest >= 0
+
+
+def test_sampled_jerk_bounded_by_continuous_jerk():
+    """Backward differences of a profile with bounded jerk stay within that bound."""
+    accel, jerk = 0.8, 5.0
+    phases = [*speed_change_phases(0.0, 0.15, accel, jerk), (1.0, 0.0)]
+    phases += speed_change_phases(0.15, 0.0, accel, jerk)
+    profile = SpeedProfile.from_phases(phases, length=10.0)
+    Ts = 1e-3
+    t = np.arange(int(profile.duration / Ts) + 1) * Ts
+    s, _, _ = profile.evaluate(t)
+    _, sdd, sddd = backward_derivatives(s[:, None], Ts)
+    assert np.abs(sdd).max() <= accel * (1 + 1e-6)
+    assert np.abs(sddd).max() <= jerk * (1 + 1e-6)
+
+
+def test_acceleration_step_breaks_sampled_jerk():
+    """The paper's constant-acceleration start: a step in acceleration is a jerk spike."""
+    Ts = 1e-3
+    t = np.arange(200) * Ts
+    s = 0.5 * 1.0 * t**2
+    _, _, sddd = backward_derivatives(s[:, None], Ts)
+    # the unit acceleration step is spread over two samples: 0.5/Ts each
+    assert np.abs(sddd).max() == pytest.approx(0.5 / Ts, rel=1e-6)
