@@ -1,0 +1,89 @@
+"""Robot files: round trips through YAML, the example file, and robot names in case files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from trackplan.errors import CaseError
+from trackplan.io.robot_file import (
+    is_robot_file,
+    load_robot,
+    load_robot_spec,
+    load_robot_text,
+    robot_to_yaml,
+)
+from trackplan.planning.placement import pose_matrix, rpy_matrix
+from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot, puma560
+from trackplan.robots.model import Robot
+
+ROBOTS = Path(__file__).resolve().parents[2] / "robots"
+ARRAYS = ("d", "a", "alpha", "offset", "q_min", "q_max", "v_max", "a_max", "j_max")
+
+
+def assert_same_robot(actual: Robot, expected: Robot, atol: float = 0.0) -> None:
+    """Same name, source, DH table, limits and tool."""
+    assert (actual.name, actual.source) == (expected.name, expected.source)
+    for key in ARRAYS:
+        np.testing.assert_array_equal(getattr(actual, key), getattr(expected, key), err_msg=key)
+    np.testing.assert_allclose(actual.T_flange_tool, expected.T_flange_tool, rtol=0, atol=atol)
+
+
+@pytest.mark.parametrize("name", sorted(BUILTIN_ROBOTS))
+def test_builtin_robots_round_trip_exactly(tmp_path: Path, name: str) -> None:
+    robot = builtin_robot(name)
+    file = tmp_path / f"{name}.yaml"
+    file.write_text(robot_to_yaml(robot), encoding="utf-8")
+    assert_same_robot(load_robot(file), robot)
+
+
+def test_robot_with_a_tool_round_trips(rng: np.random.Generator) -> None:
+    base = puma560()
+    for _ in range(20):
+        xyz = rng.uniform(-0.2, 0.2, 3)
+        rpy = rng.uniform([-np.pi, -np.pi / 2, -np.pi], [np.pi, np.pi / 2, np.pi])
+        robot = Robot(
+            **{key: getattr(base, key) for key in ("name", "source", *ARRAYS)},
+            T_flange_tool=pose_matrix(xyz, rpy_matrix(rpy)),
+        )
+        assert_same_robot(load_robot_text(robot_to_yaml(robot)), robot, atol=1e-12)
+
+
+def test_example_robot_file_is_the_builtin_puma560() -> None:
+    file = ROBOTS / "puma560.yaml"
+    assert file.read_text(encoding="utf-8") == robot_to_yaml(puma560())
+    assert_same_robot(load_robot(file), puma560())
+
+
+def test_tool_and_offset_default_to_zero() -> None:
+    robot = load_robot_text(
+        "name: one\njoints:\n  - {d: 0.1, a: 0.2, alpha: 0, position: [-1, 1],"
+        " velocity: 1, acceleration: 2, jerk: 3}\n"
+    )
+    assert robot.n_dof == 1 and not robot.has_tool
+    np.testing.assert_array_equal(robot.offset, [0.0])
+    np.testing.assert_array_equal([robot.q_min[0], robot.q_max[0]], [-1.0, 1.0])
+
+
+def test_robot_names_and_files_in_case_files(tmp_path: Path) -> None:
+    assert not is_robot_file("puma560")
+    assert is_robot_file("arm.yaml") and is_robot_file("robots/arm") and is_robot_file("ARM.YML")
+    assert load_robot_spec("UR5", tmp_path).name == "ur5"
+    (tmp_path / "robots").mkdir()
+    (tmp_path / "robots" / "arm.yaml").write_text(robot_to_yaml(puma560()), encoding="utf-8")
+    assert_same_robot(load_robot_spec("robots/arm.yaml", tmp_path), puma560())
+    with pytest.raises(CaseError) as error:
+        load_robot_spec("kuka", tmp_path, case_file="case.yaml")
+    assert (error.value.file, error.value.key) == ("case.yaml", "robot")
+
+
+def test_errors_inside_a_robot_file_name_that_file(tmp_path: Path) -> None:
+    file = tmp_path / "arm.yaml"
+    file.write_text(robot_to_yaml(puma560()).replace("jerk: 20.0}", "jerk: 20.0, mass: 3}", 1))
+    with pytest.raises(CaseError) as error:
+        load_robot(file)
+    assert error.value.file == str(file)
+    assert error.value.key == "joints[3].mass"
+    assert "unknown key" in error.value.message

@@ -1,0 +1,155 @@
+"""The command line: exit codes, one-line errors, and the output of each command."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import trackplan
+from trackplan import cli
+from trackplan.cli import ExitCode, main
+from trackplan.io.robot_file import load_robot_text
+from trackplan.robots.builtin import ur5
+
+REPO = Path(__file__).resolve().parents[1]
+CASES = REPO / "cases"
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    code = main(list(args))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_validate_prints_length_and_corner_angle(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "validate", str(CASES / "paper-corner.yaml"))
+    assert (code, err) == (0, "")
+    assert f"length {0.5 + math.sqrt(0.29):.4f} m" in out
+    corner = math.degrees(math.acos(0.2 / math.sqrt(0.29)))  # between (-1, 0, 0) and (-0.2, 0, 0.5)
+    assert f"{corner:.1f}°" in out and "68.2°" in out
+    assert "2 segments" in out and "puma560" in out
+
+
+def test_validate_reports_each_bad_case_and_goes_on(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: bad\n", encoding="utf-8")
+    code, out, err = run(capsys, "validate", str(bad), str(CASES / "paper-line.yaml"))
+    assert code == ExitCode.BAD_INPUT
+    assert err.strip() == f"{bad}: path: required key is missing"
+    assert "paper-line" in out and "length 0.5831 m" in out
+
+
+def test_robots_table_and_yaml(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "robots")
+    assert code == 0
+    assert "puma560" in out and "ur5" in out and "[-135, 135]" in out and "0.089159" in out
+    code, out, _ = run(capsys, "robots", "--yaml", "ur5")
+    assert code == 0
+    assert load_robot_text(out).name == ur5().name
+
+
+def test_robots_yaml_of_an_unknown_robot(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "robots", "--yaml", "kuka")
+    assert code == 2 and err.startswith("robot: unknown robot 'kuka'")
+
+
+def test_cases_lists_the_shipped_cases(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.shipped_cases_dir() == CASES
+    code, out, err = run(capsys, "cases")
+    assert (code, err) == (0, "")
+    for name in ("paper-line", "paper-circle", "paper-corner", "ur5-bead"):
+        assert name in out
+    assert "1.0385" in out and "68.2°" in out
+
+
+@pytest.mark.parametrize(
+    ("args", "code"),
+    [
+        ((), 2),
+        (("--help",), 0),
+        (("validate",), 2),
+        (("bogus",), 2),
+        (("validate", "--nope", "x"), 2),
+    ],
+)
+def test_usage(capsys: pytest.CaptureFixture[str], args: tuple[str, ...], code: int) -> None:
+    actual, out, err = run(capsys, *args)
+    assert actual == code
+    assert "Traceback" not in out + err
+    assert "Usage" in out + err
+
+
+def test_internal_error_is_one_line_without_traceback(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def broken(file: object) -> None:
+        raise RuntimeError("boom\nsecond line")
+
+    monkeypatch.setattr(cli, "load_case", broken)
+    monkeypatch.delenv(cli.DEBUG_ENV, raising=False)
+    code, _, err = run(capsys, "validate", "any.yaml")
+    assert code == ExitCode.INTERNAL_ERROR
+    assert err == "internal error: RuntimeError: boom second line\n"
+
+
+@pytest.mark.parametrize("how", ["option", "environment"])
+def test_debug_prints_the_traceback(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, how: str
+) -> None:
+    def broken(file: object) -> None:
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(cli, "load_case", broken)
+    if how == "environment":
+        monkeypatch.setenv(cli.DEBUG_ENV, "1")
+        args: tuple[str, ...] = ("validate", "any.yaml")
+    else:
+        monkeypatch.delenv(cli.DEBUG_ENV, raising=False)
+        args = ("--debug", "validate", "any.yaml")
+    code, _, err = run(capsys, *args)
+    assert code == ExitCode.INTERNAL_ERROR
+    assert "Traceback" in err and err.rstrip().endswith("internal error: RuntimeError: boom")
+
+
+def test_public_api() -> None:
+    assert trackplan.__version__
+    for name in trackplan.__all__:
+        assert getattr(trackplan, name) is not None
+    case = trackplan.load_case(CASES / "paper-corner.yaml")
+    assert isinstance(case, trackplan.Case) and isinstance(case.robot, trackplan.Robot)
+    assert trackplan.forward_kinematics(case.robot, [0.0] * 6).shape == (4, 4)
+    assert trackplan.jacobian(case.robot, [0.0] * 6).shape == (6, 6)
+    with pytest.raises(AttributeError):
+        trackplan.no_such_name  # noqa: B018
+
+
+def test_installed_command_validates_a_shipped_case() -> None:
+    command = Path(sys.executable).parent / "trackplan"
+    result = subprocess.run(
+        [str(command), "validate", "cases/paper-corner.yaml"],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "68.2°" in result.stdout
+
+
+def test_python_dash_m_reports_bad_input(tmp_path: Path) -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "trackplan", "validate", str(tmp_path / "missing.yaml")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert result.returncode == 2
+    assert result.stderr == f"{tmp_path / 'missing.yaml'}: case file not found\n"

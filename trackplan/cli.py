@@ -1,0 +1,306 @@
+"""The ``trackplan`` command line.
+
+Commands: ``validate`` (check case files and their robots), ``robots`` (built-in robots
+and their limits), ``cases`` (the cases shipped in the repository's ``cases/`` folder).
+
+Exit codes: 0 ok, 1 internal error, 2 bad input, 3 infeasible (:class:`ExitCode`).
+:func:`main` never raises: a :class:`~trackplan.errors.CaseError` becomes one line on
+stderr and exit code 2; any other exception one line ``internal error: ...`` and exit
+code 1, with the traceback only under ``trackplan --debug`` or ``TRACKPLAN_DEBUG=1``.
+
+Adding a command
+----------------
+A command is a thin function on :data:`app` that returns an :class:`ExitCode`:
+parse (typer does it from the signature) → load (:mod:`trackplan.io`) → compute (the
+pure API) → save (:mod:`trackplan.io`) → exit code. It raises ``CaseError`` for bad input
+and lets :func:`main` report it; it prints results with :func:`_console` or
+``typer.echo``::
+
+    @app.command()
+    def plan(
+        case: Annotated[Path, typer.Argument(help="Case file.")],
+        out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
+    ) -> ExitCode:
+        \"\"\"Plan the trajectory of one placement.\"\"\"
+        loaded = load_case(case)
+        result = plan_placement(loaded, loaded.bounds.example)
+        save_plan(result, out)
+        return ExitCode.OK if result.success else ExitCode.INFEASIBLE
+"""
+
+from __future__ import annotations
+
+import enum
+import os
+import sys
+import traceback
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+import trackplan
+from trackplan.case import Case
+from trackplan.errors import CaseError
+from trackplan.io.case_file import load_case
+from trackplan.io.robot_file import robot_to_yaml
+from trackplan.paths import NominalPath
+from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot
+from trackplan.robots.model import Robot
+
+
+class ExitCode(enum.IntEnum):
+    """Process exit codes of every command."""
+
+    OK = 0
+    INTERNAL_ERROR = 1
+    BAD_INPUT = 2
+    INFEASIBLE = 3
+
+
+PIPE_WIDTH = 160
+"""Width of tables written to something other than a terminal, characters."""
+
+DEBUG_ENV = "TRACKPLAN_DEBUG"
+"""Set to 1 to print tracebacks of internal errors."""
+
+app = typer.Typer(
+    name="trackplan",
+    help="Offline trajectory planning for robots following a path, with placement search.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+@app.callback()
+def _options(
+    debug: Annotated[
+        bool,
+        typer.Option("--debug", help=f"Print tracebacks of internal errors (or {DEBUG_ENV}=1)."),
+    ] = False,
+) -> None:
+    """Offline trajectory planning for robots following a path, with placement search."""
+    # main() reads --debug from the arguments itself: it must know before parsing succeeds.
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line and return its exit code; never raises.
+
+    Parameters
+    ----------
+    argv
+        The arguments after the program name; ``sys.argv[1:]`` when None.
+
+    Returns
+    -------
+    int
+        An :class:`ExitCode` value (130 on Ctrl-C).
+    """
+    args = sys.argv[1:] if argv is None else list(argv)
+    debug = "--debug" in args or os.environ.get(DEBUG_ENV, "") not in ("", "0")
+    try:
+        command = typer.main.get_command(app)
+        result = command.main(args=args, prog_name="trackplan", standalone_mode=False)
+    except CaseError as exc:
+        _error(exc.one_line())
+        return ExitCode.BAD_INPUT
+    except typer.TyperException as exc:
+        # Usage errors (unknown option, missing argument): typer prints usage and hint.
+        show = getattr(exc, "show", None)
+        if callable(show):
+            show()
+        else:
+            _error(exc.format_message())
+        return exc.exit_code
+    except typer.Abort:
+        _error("aborted")
+        return ExitCode.INTERNAL_ERROR
+    except KeyboardInterrupt:
+        _error("interrupted")
+        return 130
+    except Exception as exc:
+        if debug:
+            traceback.print_exc()
+        _error(f"internal error: {type(exc).__name__}: {exc}".replace("\n", " "))
+        return ExitCode.INTERNAL_ERROR
+    return int(result) if isinstance(result, int) else ExitCode.OK
+
+
+def _error(line: str) -> None:
+    """One line on stderr."""
+    print(line, file=sys.stderr, flush=True)
+
+
+def _console() -> Console:
+    """A console on the current stdout (created per command, so tests can capture it).
+
+    Output that is not a terminal (a pipe, a file, a test) is laid out 160 columns wide
+    rather than rich's 80, so that tables keep their numbers whole.
+    """
+    return Console(highlight=False, width=None if sys.stdout.isatty() else PIPE_WIDTH)
+
+
+# --------------------------------------------------------------------------- commands
+
+
+@app.command()
+def validate(
+    cases: Annotated[list[Path], typer.Argument(help="Case files to check.", show_default=False)],
+) -> ExitCode:
+    """Check case files and their robots; print a summary of each valid case."""
+    loaded = _load_each(cases)
+    for file, case in loaded:
+        if case is not None:
+            typer.echo("\n".join(describe_case(case, file)))
+    return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT
+
+
+@app.command()
+def robots(
+    as_yaml: Annotated[
+        str | None,
+        typer.Option(
+            "--yaml",
+            metavar="NAME",
+            help="Print the built-in robot NAME as a robot file, to start your own from.",
+        ),
+    ] = None,
+) -> ExitCode:
+    """Show the built-in robots and their limits."""
+    if as_yaml is not None:
+        typer.echo(robot_to_yaml(builtin_robot(as_yaml)), nl=False)
+        return ExitCode.OK
+    console = _console()
+    for name in sorted(BUILTIN_ROBOTS):
+        console.print(robot_table(builtin_robot(name)))
+    return ExitCode.OK
+
+
+@app.command()
+def cases() -> ExitCode:
+    """List the cases shipped in the repository's cases/ folder."""
+    folder = shipped_cases_dir()
+    files = sorted(folder.glob("*.yaml")) if folder.is_dir() else []
+    if not files:
+        _error(f"no shipped cases found in {folder}")
+        return ExitCode.OK
+    table = Table(title=f"Cases in {folder}")
+    for column in ("case", "robot", "segments", "length m", "corners", "file"):
+        table.add_column(column, justify="right" if column in ("segments", "length m") else "left")
+    loaded = _load_each(files)
+    for file, case in loaded:
+        if case is None:
+            table.add_row(escape(file.stem), "", "", "", "invalid", escape(file.name))
+            continue
+        path = NominalPath.from_specs(case.start, case.segments)
+        table.add_row(
+            escape(case.name),
+            escape(case.robot.name),
+            str(len(case.segments)),
+            f"{path.length:.4f}",
+            ", ".join(f"{angle:.1f}°" for _, angle in segment_corners(path)) or "none",
+            escape(file.name),
+        )
+    _console().print(table)
+    return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT
+
+
+def _load_each(files: list[Path]) -> list[tuple[Path, Case | None]]:
+    """Load case files one by one; a bad one is reported on stderr and comes with None."""
+    loaded: list[tuple[Path, Case | None]] = []
+    for file in files:
+        try:
+            loaded.append((file, load_case(file)))
+        except CaseError as exc:
+            _error(exc.one_line())
+            loaded.append((file, None))
+    return loaded
+
+
+# --------------------------------------------------------------------------- output
+
+
+def shipped_cases_dir() -> Path:
+    """The ``cases/`` folder next to the package (present in a source checkout)."""
+    return Path(trackplan.__file__).resolve().parents[1] / "cases"
+
+
+def describe_case(case: Case, file: Path | str) -> list[str]:
+    """Summary lines of a valid case: name, robot, path length, segments, corner angles."""
+    path = NominalPath.from_specs(case.start, case.segments)
+    task = case.task
+    corners = "; ".join(
+        f"{angle:.1f}° between segments[{segment - 1}] and segments[{segment}]"
+        for segment, angle in segment_corners(path)
+    )
+    return [
+        f"{file}: ok",
+        f"  name      {case.name}",
+        f"  robot     {case.robot.name} ({case.robot.n_dof} joints)",
+        f"  path      {_count(len(case.segments), 'segment')}, length {path.length:.4f} m",
+        f"  corners   {corners or 'none'}",
+        f"  task      rated speed {task.rated_speed:g} m/s, corner speed "
+        f"{task.corner_speed:g} m/s, tolerance {task.tolerance * 1e3:g} mm, "
+        f"sample time {task.sample_time * 1e3:g} ms, timing {task.timing}",
+    ]
+
+
+def segment_corners(path: NominalPath) -> list[tuple[int, float]]:
+    """The corners where one segment meets the next, as the user sees them.
+
+    Returns
+    -------
+    list of (int, float)
+        Per corner: the index of the segment that starts there, and the angle between
+        the two legs in degrees (180 for no turn; the β of the paper's Eq. 9). The turns
+        between the points of one ``points`` segment are left out: they sample a curve.
+    """
+    owner = path.segment_index
+    return [
+        (int(owner[corner.junction + 1]), float(np.degrees(np.pi - corner.angle)))
+        for corner in path.corners
+        if owner[corner.junction] != owner[corner.junction + 1]
+    ]
+
+
+def robot_table(robot: Robot) -> Table:
+    """A table of one robot's DH parameters and joint limits."""
+    table = Table(
+        title=escape(f"{robot.name} ({robot.n_dof} joints)"),
+        caption=escape(robot.source) or None,
+    )
+    headers = (
+        "joint",
+        "d m",
+        "a m",
+        "alpha °",
+        "offset °",
+        "position °",
+        "velocity rad/s",
+        "acceleration rad/s²",
+        "jerk rad/s³",
+    )
+    for header in headers:
+        table.add_column(header, justify="right")
+    for i, joint in enumerate(robot.joint_names):
+        table.add_row(
+            joint,
+            f"{robot.d[i]:g}",
+            f"{robot.a[i]:g}",
+            f"{np.degrees(robot.alpha[i]):g}",
+            f"{np.degrees(robot.offset[i]):g}",
+            f"[{np.degrees(robot.q_min[i]):g}, {np.degrees(robot.q_max[i]):g}]",
+            f"{robot.v_max[i]:g}",
+            f"{robot.a_max[i]:g}",
+            f"{robot.j_max[i]:g}",
+        )
+    return table
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"

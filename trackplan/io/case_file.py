@@ -1,0 +1,463 @@
+"""Case files (YAML): the robot, the path, the task and the search settings of one job.
+
+The format, every key with its unit and default, and the validation rules are in
+``docs/files.md``. :func:`load_case` reads a file into the pure dataclasses of
+:mod:`trackplan.case`; every problem becomes one :class:`~trackplan.errors.CaseError`
+naming the file, the key path (``path.segments[2].arc.normal``) and what is expected.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import Discriminator, Field, Tag, model_validator
+from pydantic_core import PydanticCustomError
+
+from trackplan.case import (
+    PLACEMENT_KEYS,
+    Case,
+    Objective,
+    OptimizerSettings,
+    PlacementBounds,
+    Task,
+)
+from trackplan.errors import CaseError
+from trackplan.io.robot_file import load_robot_spec
+from trackplan.io.yaml_input import (
+    NonEmptyStr,
+    NonNegative,
+    Positive,
+    Problem,
+    Range,
+    StrictModel,
+    Vec3,
+    Vec6,
+    key_path,
+    list_default,
+    parse_key_path,
+    parse_yaml,
+    raise_first,
+    read_text,
+    show,
+    validate_model,
+)
+from trackplan.paths import check_segments
+from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
+from trackplan.robots.model import Robot
+
+PAPER_WEIGHTS = (0.3, 0.2, 0.2, 0.1, 0.1, 0.1)
+"""C_i of the paper's Eq. 8 for a 6-joint arm (the paper prints five; the sixth is 0.1)."""
+
+POSITION_RANGE = (-0.87, 0.87)
+"""Default search range of x, y, z, m (the paper's Eq. 31)."""
+
+ANGLE_RANGE = (-1.57, 1.57)
+"""Default search range of roll, pitch, yaw, rad (the paper's Eq. 31)."""
+
+REACH = (0.150333, 0.853756)
+"""Default reach range, m: sqrt(0.0226) and sqrt(0.7289) of the paper's Eq. 32, rounded inwards."""
+
+MIN_POINTS = 2
+"""Fewest points of a ``points`` segment (one point is a ``line``)."""
+
+
+# --------------------------------------------------------------------------- schema
+
+
+class LineModel(StrictModel):
+    """``line: {to: [x, y, z]}``, m."""
+
+    to: Vec3
+
+
+class ArcModel(StrictModel):
+    """``arc: {center, normal, angle}``: rotation of the current point by ``angle`` (rad)."""
+
+    center: Vec3
+    normal: Vec3
+    angle: float
+
+
+class PointsFileModel(StrictModel):
+    """``points: {file: seam.csv}``: x, y, z rows, relative to the case file."""
+
+    file: NonEmptyStr
+
+
+def _points_kind(value: Any) -> str | None:
+    if isinstance(value, list):
+        return "<list>"
+    if isinstance(value, dict):
+        return "<file>"
+    return None
+
+
+PointsModel = Annotated[
+    Annotated[list[Vec3], Field(min_length=MIN_POINTS), Tag("<list>")]
+    | Annotated[PointsFileModel, Tag("<file>")],
+    Discriminator(
+        _points_kind,
+        custom_error_type="points_type",
+        custom_error_message="expected a list of [x, y, z] points or {file: name.csv}",
+    ),
+]
+
+
+class SegmentModel(StrictModel):
+    """One path segment: exactly one of ``line``, ``arc``, ``points``."""
+
+    line: LineModel | None = None
+    arc: ArcModel | None = None
+    points: PointsModel | None = None
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> SegmentModel:
+        given = [kind for kind in ("line", "arc", "points") if getattr(self, kind) is not None]
+        if len(given) != 1:
+            raise PydanticCustomError(
+                "segment_kind",
+                "expected exactly one of line, arc, points, got {given}",
+                {"given": ", ".join(given) or "none"},
+            )
+        return self
+
+
+class PathModel(StrictModel):
+    """``path``: start point and segments in the definition frame, m."""
+
+    start: Vec3
+    segments: Annotated[list[SegmentModel], Field(min_length=1)]
+
+
+class TaskModel(StrictModel):
+    """``task``: speeds (m/s), tolerance (m), sample time (s), tool orientation (rad)."""
+
+    rated_speed: Positive
+    corner_speed: Positive | None = None
+    tolerance: Positive = 0.001
+    sample_time: Positive = 0.001
+    tool_rpy: Vec3 = list_default(0.0, 0.0, 0.0)
+    timing: Literal["smooth", "paper"] = "smooth"
+
+
+class PlacementModel(StrictModel):
+    """``placement``: search ranges [min, max] of X and the reach range, m and rad."""
+
+    x: Range = list_default(*POSITION_RANGE)
+    y: Range = list_default(*POSITION_RANGE)
+    z: Range = list_default(*POSITION_RANGE)
+    roll: Range = list_default(*ANGLE_RANGE)
+    pitch: Range = list_default(*ANGLE_RANGE)
+    yaw: Range = list_default(*ANGLE_RANGE)
+    reach: Range = list_default(*REACH)
+    example: Vec6 | None = None
+
+
+class ObjectiveModel(StrictModel):
+    """``objective``: joint weights of Eq. 8, time weight (1/s) and penalty."""
+
+    weights: list[NonNegative] | None = None
+    time_weight: NonNegative = 0.0
+    penalty: Literal["graded", "flat"] = "graded"
+    flat_penalty: Positive = 1.0e6
+
+
+class OptimizerModel(StrictModel):
+    """``optimizer``: method, population, seed and evaluation budget."""
+
+    method: Literal["ga", "cmaes", "de", "random"] = "ga"
+    population: Annotated[int, Field(ge=2)] = 30
+    seed: Annotated[int, Field(ge=0)] = 0
+    budget: Annotated[int, Field(ge=1)] | None = None
+
+
+class CaseModel(StrictModel):
+    """Schema of a case file."""
+
+    name: NonEmptyStr
+    robot: NonEmptyStr = "puma560"
+    path: PathModel
+    task: TaskModel
+    placement: PlacementModel = PlacementModel()
+    objective: ObjectiveModel = ObjectiveModel()
+    optimizer: OptimizerModel = OptimizerModel()
+
+
+# --------------------------------------------------------------------------- loading
+
+
+def load_case(file: str | Path) -> Case:
+    """Read a case file.
+
+    Parameters
+    ----------
+    file
+        Path of the YAML case file. Robot files and points files it names are read
+        relative to its folder.
+
+    Returns
+    -------
+    Case
+
+    Raises
+    ------
+    CaseError
+        The first problem found: an unreadable file, a YAML syntax error, a schema
+        problem (in file order), an unknown robot or a bad robot file, an unreadable
+        points file, then bad values (in file order).
+    """
+    text = read_text(file, what="case file")
+    return load_case_text(text, file=str(file), base_dir=Path(file).parent)
+
+
+def load_case_text(text: str, file: str | None = None, base_dir: str | Path | None = None) -> Case:
+    """Build a case from the text of a case file.
+
+    Parameters
+    ----------
+    text
+        YAML text in the case file format.
+    file
+        The file the text came from, for messages and :attr:`Case.source`.
+    base_dir
+        Folder that relative robot and points file names start from; by default the
+        folder of ``file``, else the working directory.
+
+    Returns
+    -------
+    Case
+
+    Raises
+    ------
+    CaseError
+        See :func:`load_case`.
+    """
+    base = Path(base_dir) if base_dir is not None else Path(file).parent if file else Path()
+    data = parse_yaml(text, file)
+    model = validate_model(CaseModel, data, file)
+    robot = load_robot_spec(model.robot, base, case_file=file)
+    start = _array(model.path.start)
+    segments = tuple(
+        _segment(segment, base, file, ("path", "segments", k))
+        for k, segment in enumerate(model.path.segments)
+    )
+    problems = [
+        *_path_problems(start, segments, model, base),
+        *_placement_problems(model.placement),
+        *_objective_problems(model.objective, robot),
+    ]
+    raise_first(problems, data, file)
+    return _case(model, robot, start, segments, file)
+
+
+def _case(
+    model: CaseModel,
+    robot: Robot,
+    start: np.ndarray,
+    segments: tuple[SegmentSpec, ...],
+    file: str | None,
+) -> Case:
+    task, placement, objective, optimizer = (
+        model.task,
+        model.placement,
+        model.objective,
+        model.optimizer,
+    )
+    weights = objective.weights
+    if weights is None:
+        weights = list(PAPER_WEIGHTS) if robot.n_dof == len(PAPER_WEIGHTS) else [1.0] * robot.n_dof
+    ranges = np.array([getattr(placement, key) for key in PLACEMENT_KEYS], dtype=float)
+    return Case(
+        name=model.name,
+        robot=robot,
+        start=start,
+        segments=segments,
+        task=Task(
+            rated_speed=task.rated_speed,
+            corner_speed=task.rated_speed if task.corner_speed is None else task.corner_speed,
+            tolerance=task.tolerance,
+            sample_time=task.sample_time,
+            tool_rpy=_array(task.tool_rpy),
+            timing=task.timing,
+        ),
+        bounds=PlacementBounds(
+            lower=_array(ranges[:, 0]),
+            upper=_array(ranges[:, 1]),
+            reach=(placement.reach[0], placement.reach[1]),
+            example=None if placement.example is None else _array(placement.example),
+        ),
+        objective=Objective(
+            weights=_array(weights),
+            time_weight=objective.time_weight,
+            penalty=objective.penalty,
+            flat_penalty=objective.flat_penalty,
+        ),
+        optimizer=OptimizerSettings(
+            method=optimizer.method,
+            population=optimizer.population,
+            seed=optimizer.seed,
+            budget=optimizer.budget,
+        ),
+        source=file,
+    )
+
+
+def _array(values: Any) -> np.ndarray:
+    """A read-only float64 copy."""
+    array = np.array(values, dtype=float)
+    array.flags.writeable = False
+    return array
+
+
+def _segment(
+    segment: SegmentModel, base: Path, file: str | None, loc: tuple[str | int, ...]
+) -> SegmentSpec:
+    if segment.line is not None:
+        return LineSpec(to=_array(segment.line.to))
+    if segment.arc is not None:
+        arc = segment.arc
+        return ArcSpec(center=_array(arc.center), normal=_array(arc.normal), angle=arc.angle)
+    if isinstance(segment.points, PointsFileModel):
+        key = key_path((*loc, "points", "file"))
+        return PointsSpec(points=_array(load_points_csv(base / segment.points.file, file, key)))
+    return PointsSpec(points=_array(segment.points))
+
+
+def load_points_csv(
+    file: str | Path, case_file: str | None = None, key: str | None = None
+) -> np.ndarray:
+    """Read the points of a sampled curve from a CSV file.
+
+    One point per row: ``x,y,z`` in metres, comma separated. Blank lines and lines
+    starting with ``#`` are skipped; the first row may be a header (``x,y,z``).
+
+    Parameters
+    ----------
+    file
+        The CSV file.
+    case_file, key
+        The case file and key that name the CSV, where a missing file is reported.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (K, 3), m, K ≥ 2.
+
+    Raises
+    ------
+    CaseError
+        When the file is missing or unreadable (reported at ``key`` of the case file),
+        or a row is not three finite numbers, or there are fewer than two points
+        (reported against the CSV file, with its line number as the key).
+    """
+    text = read_text(file, what="points file", referrer=case_file, key=key)
+    points: list[list[float]] = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        row = line.strip()
+        if not row or row.startswith("#"):
+            continue
+        fields = [field.strip() for field in row.split(",")]
+        try:
+            point = [float(field) for field in fields]
+        except ValueError:
+            if not points and not any(_is_number(field) for field in fields):
+                continue  # a header row
+            point = []
+        if len(point) != 3 or not all(math.isfinite(value) for value in point):
+            raise CaseError(
+                f"expected three finite numbers x,y,z, got {row!r}",
+                file=str(file),
+                key=f"line {number}",
+            )
+        points.append(point)
+    if len(points) < MIN_POINTS:
+        raise CaseError(
+            f"expected at least {MIN_POINTS} rows x,y,z, got {len(points)}", file=str(file)
+        )
+    return np.array(points, dtype=float)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+# --------------------------------------------------------------------------- value checks
+
+
+def _path_problems(
+    start: np.ndarray, segments: tuple[SegmentSpec, ...], model: CaseModel, base: Path
+) -> list[Problem]:
+    """Degenerate geometry (:func:`trackplan.paths.check_segments`), located in the file."""
+    problems: list[Problem] = []
+    for key, message in check_segments(start, segments):
+        loc = parse_key_path(key)
+        csv = _points_file(model, loc)
+        problems.append((loc, f"{message} (in {base / csv})" if csv else message))
+    return problems
+
+
+def _points_file(model: CaseModel, loc: tuple[str | int, ...]) -> str | None:
+    """The CSV file a problem location points into, if any."""
+    if len(loc) > 2 and loc[1] == "segments" and isinstance(loc[2], int):
+        points = model.path.segments[loc[2]].points
+        if isinstance(points, PointsFileModel):
+            return points.file
+    return None
+
+
+def _placement_problems(placement: PlacementModel) -> list[Problem]:
+    problems: list[Problem] = []
+    for key in PLACEMENT_KEYS:
+        low, high = getattr(placement, key)
+        if low > high:
+            problems.append(
+                (("placement", key), f"expected [min, max] with min ≤ max, got {show([low, high])}")
+            )
+    low, high = placement.reach
+    if not 0.0 <= low <= high:
+        problems.append(
+            (
+                ("placement", "reach"),
+                f"expected [min, max] distances with 0 ≤ min ≤ max, m, got {show([low, high])}",
+            )
+        )
+    if placement.example is not None:
+        outside = [
+            (
+                ("placement", "example", i),
+                f"expected {key} within placement.{key} {show(getattr(placement, key))}, "
+                f"got {show(value)}",
+            )
+            for i, (key, value) in enumerate(zip(PLACEMENT_KEYS, placement.example, strict=True))
+            if not getattr(placement, key)[0] <= value <= getattr(placement, key)[1]
+        ]
+        problems.extend(outside)
+        distance = math.dist(placement.example[:3], (0.0, 0.0, 0.0))
+        if not outside and not placement.reach[0] <= distance <= placement.reach[1]:
+            problems.append(
+                (
+                    ("placement", "example"),
+                    f"expected a distance from the base origin within placement.reach "
+                    f"{show(placement.reach)}, got {distance:.6g} m",
+                )
+            )
+    return problems
+
+
+def _objective_problems(objective: ObjectiveModel, robot: Robot) -> list[Problem]:
+    if objective.weights is None or len(objective.weights) == robot.n_dof:
+        return []
+    return [
+        (
+            ("objective", "weights"),
+            f"expected {robot.n_dof} weights (one per joint of {robot.name}), "
+            f"got {len(objective.weights)}: {show(objective.weights)}",
+        )
+    ]

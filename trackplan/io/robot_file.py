@@ -1,0 +1,261 @@
+"""Robot files (YAML): a standard-DH serial chain with per-joint limits.
+
+Format (see ``docs/files.md``)::
+
+    name: puma560
+    source: "where the numbers come from"      # optional
+    joints:                                    # one entry per joint, base to flange
+      - {d: 0, a: 0, alpha: 1.5707963267948966, offset: 0,
+         position: [-3.141592653589793, 3.141592653589793],
+         velocity: 8, acceleration: 10, jerk: 30}
+    tool: {xyz: [0, 0, 0], rpy: [0, 0, 0]}     # optional
+
+Lengths in metres, angles in radians, limits in rad/s, rad/s², rad/s³.
+``T_flange_tool = Trans(xyz) · RPY(rpy)`` with ``RPY = Rz(yaw) · Ry(pitch) · Rx(roll)``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import yaml
+from pydantic import Field
+
+from trackplan.errors import CaseError
+from trackplan.io.yaml_input import (
+    NonEmptyStr,
+    Positive,
+    Problem,
+    Range,
+    StrictModel,
+    Vec3,
+    list_default,
+    parse_yaml,
+    raise_first,
+    read_text,
+    show,
+    validate_model,
+)
+from trackplan.planning.placement import pose_matrix, rpy_from_matrix, rpy_matrix
+from trackplan.robots.builtin import builtin_robot
+from trackplan.robots.model import Robot
+
+ROBOT_FILE_SUFFIXES = (".yaml", ".yml")
+
+
+class JointModel(StrictModel):
+    """One joint: DH parameters (m, rad) and limits (rad, rad/s, rad/s², rad/s³)."""
+
+    d: float
+    a: float
+    alpha: float
+    offset: float = 0.0
+    position: Range
+    velocity: Positive
+    acceleration: Positive
+    jerk: Positive
+
+
+class ToolModel(StrictModel):
+    """Tool transform in the flange: ``Trans(xyz) · RPY(rpy)`` (m, rad)."""
+
+    xyz: Vec3 = list_default(0.0, 0.0, 0.0)
+    rpy: Vec3 = list_default(0.0, 0.0, 0.0)
+
+
+class RobotFileModel(StrictModel):
+    """Schema of a robot file."""
+
+    name: NonEmptyStr
+    source: str = ""
+    joints: Annotated[list[JointModel], Field(min_length=1)]
+    tool: ToolModel | None = None
+
+
+def load_robot(file: str | Path) -> Robot:
+    """Read a robot file.
+
+    Parameters
+    ----------
+    file
+        Path of the YAML robot file.
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    CaseError
+        When the file is missing or unreadable, is not valid YAML, or any value is
+        wrong; the error names the file and the key (``joints[2].velocity``).
+    """
+    return load_robot_text(read_text(file, what="robot file"), file=str(file))
+
+
+def load_robot_text(text: str, file: str | None = None) -> Robot:
+    """Build a robot from the text of a robot file.
+
+    Parameters
+    ----------
+    text
+        YAML text in the robot file format.
+    file
+        The file the text came from, for error messages.
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    CaseError
+        On the first problem in the text.
+    """
+    data = parse_yaml(text, file)
+    model = validate_model(RobotFileModel, data, file)
+    problems: list[Problem] = [
+        (
+            ("joints", i, "position"),
+            f"expected [min, max] with min < max, got {show(joint.position)}",
+        )
+        for i, joint in enumerate(model.joints)
+        if joint.position[0] >= joint.position[1]
+    ]
+    raise_first(problems, data, file)
+    tool = model.tool or ToolModel()
+    columns = {
+        key: np.array([getattr(joint, key) for joint in model.joints], dtype=float)
+        for key in ("d", "a", "alpha", "offset", "velocity", "acceleration", "jerk")
+    }
+    position = np.array([joint.position for joint in model.joints], dtype=float)
+    return Robot(
+        name=model.name,
+        d=columns["d"],
+        a=columns["a"],
+        alpha=columns["alpha"],
+        offset=columns["offset"],
+        q_min=position[:, 0],
+        q_max=position[:, 1],
+        v_max=columns["velocity"],
+        a_max=columns["acceleration"],
+        j_max=columns["jerk"],
+        T_flange_tool=pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy))),
+        source=model.source,
+    )
+
+
+def is_robot_file(name_or_path: str) -> bool:
+    """True when a case file's ``robot`` value names a file rather than a built-in robot.
+
+    A value naming a file ends in ``.yaml`` or ``.yml`` or contains a path separator.
+    """
+    return name_or_path.lower().endswith(ROBOT_FILE_SUFFIXES) or any(
+        separator in name_or_path for separator in ("/", "\\")
+    )
+
+
+def load_robot_spec(
+    name_or_path: str, base_dir: str | Path, *, case_file: str | None = None
+) -> Robot:
+    """The robot a case file names: a built-in robot or a robot file.
+
+    Parameters
+    ----------
+    name_or_path
+        A built-in robot name (``puma560``, ``ur5``) or the path of a robot file,
+        relative to ``base_dir`` unless absolute (see :func:`is_robot_file`).
+    base_dir
+        The folder of the case file.
+    case_file
+        The case file, so that an unknown name or a missing robot file is reported
+        at its ``robot`` key.
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    CaseError
+        For an unknown robot name, a missing robot file, or a problem inside the robot
+        file (then reported against the robot file).
+    """
+    if is_robot_file(name_or_path):
+        path = Path(base_dir) / name_or_path
+        text = read_text(path, what="robot file", referrer=case_file, key="robot")
+        return load_robot_text(text, file=str(path))
+    try:
+        return builtin_robot(name_or_path)
+    except CaseError as exc:
+        raise CaseError(exc.message, file=case_file, key="robot") from None
+
+
+class _FlowMapping(dict[str, Any]):
+    """A mapping written on one line (``{d: 0.0, a: 0.4318, ...}``)."""
+
+
+class _Dumper(yaml.SafeDumper):
+    """Safe dumper that writes :class:`_FlowMapping` in flow style and indents list items."""
+
+    def increase_indent(self, flow: bool = False, indentless: bool = False) -> None:
+        """Indent block sequences inside mappings (``joints:`` then ``  - {...}``)."""
+        super().increase_indent(flow, False)
+
+
+_Dumper.add_representer(
+    _FlowMapping,
+    lambda dumper, data: dumper.represent_mapping(
+        "tag:yaml.org,2002:map", list(data.items()), flow_style=True
+    ),
+)
+
+_HEADER = """\
+# trackplan robot file: standard DH, A_i = Rz(q_i + offset) · Tz(d) · Tx(a) · Rx(alpha).
+# Units: m and rad; per joint: position [min, max] rad, velocity rad/s,
+# acceleration rad/s², jerk rad/s³. tool: T_flange_tool = Trans(xyz) · RPY(rpy).
+"""
+
+
+def robot_to_yaml(robot: Robot) -> str:
+    """The robot file text of a robot, e.g. to start a new file from a built-in robot.
+
+    Numbers are written with full precision: :func:`load_robot_text` of the result
+    gives the same robot (the tool rotation up to rounding).
+
+    Parameters
+    ----------
+    robot
+        Any robot.
+
+    Returns
+    -------
+    str
+        YAML text in the robot file format, with a comment header.
+    """
+    joints = [
+        _FlowMapping(
+            d=float(robot.d[i]),
+            a=float(robot.a[i]),
+            alpha=float(robot.alpha[i]),
+            offset=float(robot.offset[i]),
+            position=[float(robot.q_min[i]), float(robot.q_max[i])],
+            velocity=float(robot.v_max[i]),
+            acceleration=float(robot.a_max[i]),
+            jerk=float(robot.j_max[i]),
+        )
+        for i in range(robot.n_dof)
+    ]
+    data: dict[str, Any] = {"name": robot.name}
+    if robot.source:
+        data["source"] = robot.source
+    data["joints"] = joints
+    if robot.has_tool:
+        data["tool"] = _FlowMapping(
+            xyz=[float(value) for value in robot.T_flange_tool[:3, 3]],
+            rpy=[float(value) for value in rpy_from_matrix(robot.T_flange_tool[:3, :3])],
+        )
+    body = yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=1_000_000)
+    return _HEADER + body

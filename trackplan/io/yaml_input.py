@@ -1,0 +1,371 @@
+"""Reading YAML input files, and turning every problem in them into one :class:`CaseError`.
+
+Shared by the case and robot file loaders. The rules, in the order they are applied:
+
+1. The file must exist and be UTF-8 text.
+2. It must be valid YAML (YAML 1.1 as PyYAML reads it, plus YAML 1.2 floats such as
+   ``1e-3``; a key given twice in one mapping is an error). Syntax errors name the line
+   and column.
+3. It must match the pydantic schema of the file. Of all schema problems, the one that
+   comes first in the file is reported.
+4. Checks that need more than one value (bounds, geometry, robot joint count) are
+   collected by the loaders as :data:`Problem` entries and the first in file order is
+   reported, through :func:`raise_first`.
+
+One problem is reported at a time, as one line ``file: key.path[i]: message``, where the
+message says what is expected and what was found.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+import types
+import typing
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
+import yaml
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
+from pydantic_core import ErrorDetails, PydanticCustomError
+
+from trackplan.errors import CaseError
+
+Loc = tuple[str | int, ...]
+"""A location inside a loaded YAML document: mapping keys and list indices."""
+
+Problem = tuple[Loc, str]
+"""A problem found after schema validation: where it is, and the message."""
+
+ModelT = TypeVar("ModelT", bound=BaseModel)
+
+
+class StrictModel(BaseModel):
+    """Base of every input schema: unknown keys, type coercion and nan/inf are errors."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
+
+
+def _fixed_length(n: int, names: str) -> Any:
+    """An after-validator that requires a list of exactly ``n`` entries named ``names``."""
+
+    def check(value: list[float]) -> list[float]:
+        if len(value) != n:
+            raise PydanticCustomError(
+                "vector_length",
+                "expected {n} numbers [{names}], got {actual}",
+                {"n": n, "names": names, "actual": len(value)},
+            )
+        return value
+
+    return AfterValidator(check)
+
+
+def list_default(*values: float) -> Any:
+    """A field default that is a fresh list of ``values`` for each model."""
+    return Field(default_factory=lambda: list(values))
+
+
+# Numbers are floats; an integer is accepted, and StrictModel forbids nan and inf.
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+NonEmptyStr = Annotated[str, Field(min_length=1)]
+Vec3 = Annotated[list[float], _fixed_length(3, "x, y, z")]
+Vec6 = Annotated[list[float], _fixed_length(6, "x, y, z, roll, pitch, yaw")]
+Range = Annotated[list[float], _fixed_length(2, "min, max")]
+
+
+# --------------------------------------------------------------------------- files and YAML
+
+
+def read_text(
+    file: str | Path, *, what: str, referrer: str | None = None, key: str | None = None
+) -> str:
+    """The text of an input file.
+
+    Parameters
+    ----------
+    file
+        The file to read.
+    what
+        What the file is, for messages (``"case file"``, ``"robot file"``, ``"points file"``).
+    referrer, key
+        The file and key that name ``file``, if another file does; a missing file is then
+        reported there. Otherwise the problem is reported against ``file`` itself.
+
+    Raises
+    ------
+    CaseError
+        When the file is missing, is a directory, cannot be read or is not UTF-8 text.
+    """
+    path = Path(file)
+    if referrer is None:  # the line starts with the file's name: do not repeat it
+        where, at, name = str(path), None, what
+    else:
+        where, at, name = referrer, key, f"{what} {str(path)!r}"
+    if not path.exists():
+        raise CaseError(f"{name} not found", file=where, key=at)
+    if path.is_dir():
+        raise CaseError(f"{name} is a directory, expected a file", file=where, key=at)
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise CaseError(
+            f"{what} is not UTF-8 text (byte {exc.start} cannot be decoded)", file=str(path)
+        ) from None
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise CaseError(f"cannot read {what}: {reason.lower()}", file=str(path)) from None
+
+
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader, with YAML 1.2 floats (``1e-3``) and duplicate keys refused."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        """Build a mapping, refusing a key that occurs twice."""
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if isinstance(key, typing.Hashable) and key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r}", key_node.start_mark
+                )
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+# Copy the resolver table before adding to it: it is a class attribute of SafeLoader.
+_Loader.yaml_implicit_resolvers = {
+    first: list(resolvers) for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
+
+
+def parse_yaml(text: str, file: str | None) -> Any:
+    """The data of a YAML document.
+
+    Raises
+    ------
+    CaseError
+        On a syntax error (the message names line and column, counted from 1), a
+        duplicate key, or an empty document.
+    """
+    try:
+        # _Loader derives from SafeLoader: no arbitrary Python objects.
+        data = yaml.load(text, Loader=_Loader)
+    except yaml.MarkedYAMLError as exc:
+        message = "YAML syntax error" + _at(exc.problem_mark or exc.context_mark)
+        message += f": {exc.problem or exc.context or 'invalid YAML'}"
+        if exc.problem and exc.context and exc.context_mark:
+            message += f" ({exc.context}{_at(exc.context_mark)})"
+        raise CaseError(message, file=file) from None
+    except yaml.YAMLError as exc:
+        raise CaseError(f"YAML syntax error: {exc}", file=file) from None
+    if data is None:
+        raise CaseError("the file is empty, expected a mapping of keys", file=file)
+    return data
+
+
+def _at(mark: yaml.Mark | None) -> str:
+    """`` at line L, column C`` (counted from 1) of a YAML mark, or nothing."""
+    return f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+
+
+# --------------------------------------------------------------------------- key paths
+
+
+def key_path(loc: Sequence[str | int]) -> str:
+    """The key path of a location: ``("path", "segments", 2, "arc")`` → ``path.segments[2].arc``.
+
+    Union tags added by pydantic (written ``<name>`` in our schemas) are left out.
+    """
+    text = ""
+    for part in loc:
+        if isinstance(part, int):
+            text += f"[{part}]"
+        elif not part.startswith("<"):
+            text += f".{part}" if text else part
+    return text
+
+
+def parse_key_path(key: str) -> Loc:
+    """The location of a key path (inverse of :func:`key_path`)."""
+    loc: list[str | int] = []
+    for name, index in re.findall(r"([^.\[\]]+)|\[(\d+)\]", key):
+        loc.append(int(index) if index else name)
+    return tuple(loc)
+
+
+def file_position(data: Any, loc: Loc) -> tuple[int, ...]:
+    """Where a location comes in the file, for ordering problems as they appear.
+
+    Mapping keys keep the file's order (PyYAML builds insertion-ordered dicts); a key
+    that is missing sorts after the keys present in its mapping.
+    """
+    position: list[int] = []
+    node = data
+    for part in loc:
+        if isinstance(node, dict):
+            keys = list(node)
+            position.append(keys.index(part) if part in node else len(keys))
+            node = node.get(part)
+        elif isinstance(node, list) and isinstance(part, int):
+            position.append(part)
+            node = node[part] if 0 <= part < len(node) else None
+        else:
+            position.append(0)
+            node = None
+    return tuple(position)
+
+
+def raise_first(problems: Sequence[Problem], data: Any, file: str | None) -> None:
+    """Raise the problem that comes first in the file, if there is any.
+
+    Raises
+    ------
+    CaseError
+        With the key path and message of the first problem.
+    """
+    if problems:
+        loc, message = min(problems, key=lambda problem: file_position(data, problem[0]))
+        raise CaseError(message, file=file, key=key_path(loc) or None)
+
+
+# --------------------------------------------------------------------------- schema
+
+
+def validate_model(model: type[ModelT], data: Any, file: str | None) -> ModelT:
+    """Validate ``data`` against a schema.
+
+    Raises
+    ------
+    CaseError
+        The schema problem that comes first in the file, with its key path.
+    """
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        errors = exc.errors(include_url=False)
+        problems = [(_clean_loc(error["loc"]), _message(model, error)) for error in errors]
+        raise_first(problems, data, file)
+        raise CaseError(str(exc), file=file) from None  # a ValidationError has errors
+
+
+def _clean_loc(loc: Sequence[str | int]) -> Loc:
+    return tuple(part for part in loc if isinstance(part, int) or not part.startswith("<"))
+
+
+def _message(model: type[BaseModel], error: ErrorDetails) -> str:
+    """Our wording of one pydantic error: what is expected, and the value found."""
+    kind = error["type"]
+    ctx = error.get("ctx", {})
+    got = f", got {show(error['input'])}"
+    loc = _clean_loc(error["loc"])
+    if kind == "missing":
+        return "required key is missing"
+    if kind == "extra_forbidden":
+        return _unknown_key_message(model, loc)
+    if not loc and kind in ("model_type", "model_attributes_type", "dict_type"):
+        return f"expected a mapping of keys at the top level{got}"
+    simple = {
+        "float_type": "expected a number",
+        "float_parsing": "expected a number",
+        "int_type": "expected an integer",
+        "int_parsing": "expected an integer",
+        "int_from_float": "expected an integer",
+        "finite_number": "expected a finite number",
+        "string_type": "expected a string",
+        "string_too_short": "expected a non-empty string",
+        "list_type": "expected a list",
+        "model_type": "expected a mapping of keys",
+        "model_attributes_type": "expected a mapping of keys",
+        "dict_type": "expected a mapping of keys",
+    }
+    if kind in simple:
+        return simple[kind] + got
+    bounds = {
+        "greater_than": ("gt", ">"),
+        "greater_than_equal": ("ge", "≥"),
+        "less_than": ("lt", "<"),
+        "less_than_equal": ("le", "≤"),
+    }
+    if kind in bounds:
+        name, sign = bounds[kind]
+        return f"expected a number {sign} {ctx[name]:g}{got}"
+    if kind == "literal_error":
+        return f"expected one of {ctx['expected']}{got}"
+    if kind == "too_short":
+        return f"expected at least {_entries(ctx['min_length'])}, got {ctx['actual_length']}"
+    if kind == "too_long":
+        return f"expected at most {_entries(ctx['max_length'])}, got {ctx['actual_length']}"
+    if kind == "vector_length":
+        return f"{error['msg']}: {show(error['input'])}"
+    if kind in CUSTOM_ERRORS:
+        return error["msg"]
+    return error["msg"] + got
+
+
+CUSTOM_ERRORS = frozenset({"segment_kind", "points_type"})
+"""Error types raised by our schemas whose message already says everything."""
+
+
+def _entries(n: int) -> str:
+    return f"{n} entry" if n == 1 else f"{n} entries"
+
+
+def _unknown_key_message(model: type[BaseModel], loc: Loc) -> str:
+    names = [part for part in loc if isinstance(part, str)]
+    parent = _model_at(model, names[:-1])
+    if parent is None:
+        return "unknown key"
+    allowed = list(parent.model_fields)
+    close = difflib.get_close_matches(str(names[-1]), allowed, n=1)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    return f"unknown key; {hint}expected one of: {', '.join(allowed)}"
+
+
+def _model_at(model: type[BaseModel], names: Sequence[str]) -> type[BaseModel] | None:
+    """The schema of the mapping at a path of field names (list indices left out)."""
+    current: type[BaseModel] | None = model
+    for name in names:
+        if current is None or name not in current.model_fields:
+            return None
+        current = _find_model(current.model_fields[name].annotation)
+    return current
+
+
+def _find_model(annotation: Any) -> type[BaseModel] | None:
+    """The first pydantic model inside an annotation (through list, Optional, Union, Annotated)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    if isinstance(annotation, types.UnionType) or typing.get_origin(annotation) is not None:
+        for argument in typing.get_args(annotation):
+            found = _find_model(argument)
+            if found is not None:
+                return found
+    return None
+
+
+def show(value: Any, limit: int = 60) -> str:
+    """A short YAML-like rendering of an input value for messages."""
+    if isinstance(value, bool):
+        text = "true" if value else "false"
+    elif value is None:
+        text = "null"
+    elif isinstance(value, float):
+        text = repr(value) if math.isfinite(value) else str(value)
+    elif isinstance(value, str):
+        text = repr(value)
+    elif isinstance(value, dict):
+        text = "{" + ", ".join(f"{key}: {show(item, limit)}" for key, item in value.items()) + "}"
+    elif isinstance(value, list | tuple):
+        text = "[" + ", ".join(show(item, limit) for item in value) + "]"
+    else:
+        text = str(value)
+    return text if len(text) <= limit else text[: limit - 1] + "…"
