@@ -304,3 +304,136 @@ def robot_table(robot: Robot) -> Table:
 
 def _count(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
+
+# --------------------------------------------------------------------------- planning
+
+PlacementOption = Annotated[
+    tuple[float, float, float, float, float, float] | None,
+    typer.Option(
+        "--placement",
+        help="X Y Z ROLL PITCH YAW of the path's frame in the robot base frame (m, rad); "
+        "default: the case's placement.example.",
+        show_default=False,
+    ),
+]
+TimingOption = Annotated[
+    str | None,
+    typer.Option("--timing", help="smooth or paper (default: the case's task.timing)."),
+]
+
+
+def _placement(case: Case, values: tuple[float, ...] | None) -> np.ndarray:
+    """The placement given on the command line, else the case's example placement."""
+    if values is not None:
+        return np.asarray(values, dtype=float)
+    if case.bounds.example is None:
+        raise CaseError(
+            "no placement: give --placement X Y Z ROLL PITCH YAW or set placement.example",
+            file=case.source,
+            key="placement.example",
+        )
+    return np.asarray(case.bounds.example, dtype=float)
+
+
+def _timing(value: str | None) -> str | None:
+    """Validate the --timing value."""
+    if value is not None and value not in ("smooth", "paper"):
+        raise CaseError(f"--timing must be smooth or paper, got {value!r}", key="--timing")
+    return value
+
+
+@app.command()
+def plan(
+    case: Annotated[Path, typer.Argument(help="Case file.", show_default=False)],
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/plan"),
+    placement: PlacementOption = None,
+    timing: TimingOption = None,
+    branch: Annotated[
+        int | None, typer.Option("--branch", help="Force an IK branch (closed form: 0-7).")
+    ] = None,
+    reference: Annotated[
+        bool, typer.Option("--reference", help="Also compute toppra and TOPP3 durations.")
+    ] = False,
+    report: Annotated[bool, typer.Option(help="Write plots and report.html.")] = True,
+) -> ExitCode:
+    """Plan the case at one placement; write trajectory.csv, result.json, plots, report."""
+    from trackplan.outputs import write_run
+    from trackplan.planning.plan import plan_placement
+
+    loaded = load_case(case)
+    X = _placement(loaded, placement)
+    result = plan_placement(loaded, X, timing=_timing(timing), branch=branch)
+    if reference and result.trajectory.n_samples:
+        from trackplan.timing.references import reference_durations
+
+        result = _with_references(result, reference_durations(loaded, X, result))
+    write_run(out, result, loaded, report=report)
+    _print_summary(result, out)
+    return ExitCode.OK if result.feasible else ExitCode.INFEASIBLE
+
+
+def _with_references(result, references: dict[str, float]):
+    """The result with reference durations attached."""
+    from dataclasses import replace
+
+    return replace(result, references={**result.references, **references})
+
+
+@app.command()
+def check(
+    case: Annotated[Path, typer.Argument(help="Case file.", show_default=False)],
+    run: Annotated[Path, typer.Argument(help="Folder with trajectory.csv (or the CSV itself).")],
+    placement: PlacementOption = None,
+    timing: TimingOption = None,
+) -> ExitCode:
+    """Re-check any trajectory.csv, whoever wrote it, against the case's limits and path."""
+    from trackplan.io.results import read_trajectory_csv
+    from trackplan.planning.checker import check_trajectory
+    from trackplan.planning.plan import PathGeometry, tracking_reference
+
+    loaded = load_case(case)
+    X = _placement(loaded, placement)
+    csv = run / "trajectory.csv" if run.is_dir() else run
+    t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
+    sample_time = float(np.median(np.diff(t)))
+    if not np.allclose(np.diff(t), sample_time, rtol=1e-6, atol=1e-9):
+        raise CaseError("samples are not evenly spaced in t", file=str(csv), key="t")
+    geometry = PathGeometry.from_case(loaded, _timing(timing))
+    report = check_trajectory(loaded.robot, q, sample_time, tracking_reference(loaded, geometry, X))
+    console = _console()
+    console.print(f"{escape(str(csv))}: {len(t)} samples at Ts = {sample_time:g} s")
+    for kind, margin in report.joint_margins.items():
+        cells = "  ".join(f"{m:+.3f}" for m in margin)
+        console.print(f"  {kind:<13} margin per joint: {cells}")
+    for kind, margin in report.task_margins.items():
+        console.print(f"  {kind:<13} margin: {margin:+.3f}")
+    console.print(f"  max tracking error {report.max_tracking_error * 1e3:.4f} mm")
+    for violation in report.violations:
+        console.print(f"  VIOLATION {escape(violation.message)}")
+    console.print("feasible" if report.ok else f"infeasible: {len(report.violations)} violations")
+    return ExitCode.OK if report.ok else ExitCode.INFEASIBLE
+
+
+def _print_summary(result, out: Path) -> None:
+    """A few lines on what a plan achieved and where its files are."""
+    console = _console()
+    state = "feasible" if result.feasible else f"INFEASIBLE ({result.status.value})"
+    console.print(f"{escape(result.case_name)}: {state}: {escape(result.message)}")
+    if result.trajectory.n_samples:
+        console.print(
+            f"  J = {result.objective:.4f}  duration = {result.duration:.3f} s  "
+            f"rated speed on {100 * result.rated_speed_fraction:.1f} % of the path  "
+            f"min corner speed = {result.min_corner_speed:.4f} m/s  "
+            f"max tracking error = {result.check.max_tracking_error * 1e3:.4f} mm  "
+            f"branch {result.branch}"
+        )
+        for slow in result.slowdowns:
+            console.print(
+                f"  slow-down: s = {slow.s_start:.4f}..{slow.s_end:.4f} m at "
+                f"{slow.speed:.4f} m/s ({100 * (1 - slow.speed / slow.rated_speed):.1f} % below "
+                f"rated): {escape(slow.limit)}"
+            )
+        for key, value in result.references.items():
+            console.print(f"  {key} = {value:.4f} s")
+    console.print(f"  results in {escape(str(out))}/")

@@ -1,4 +1,4 @@
-"""Run outputs: ``trajectory.csv``, ``result.json``, ``history.csv``; and reading a trajectory back."""
+"""Run outputs (trajectory.csv, result.json, history.csv) and reading a trajectory back."""
 
 from __future__ import annotations
 

@@ -235,7 +235,7 @@ def _coverage_violations(
             len(s) - 1,
             float(s[-1]),
             nominal.length,
-            f"coverage: the trajectory ends {nominal.length - s[-1]:.4g} m before the end of the path",
+            f"coverage: the trajectory ends {nominal.length - s[-1]:.4g} m before the path end",
         )
     step = np.diff(s)
     backwards = np.flatnonzero(step < -tol)

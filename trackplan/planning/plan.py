@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -81,7 +82,7 @@ class PathGeometry:
         edges = np.array([z[0] for z in self.planned.zones] + [self.planned.length])
         parts = [
             np.linspace(a, b, max(2, int(np.ceil((b - a) / step)) + 1), endpoint=False)
-            for a, b in zip(edges[:-1], edges[1:], strict=True)
+            for a, b in itertools.pairwise(edges)
             if b > a
         ]
         return np.concatenate([*parts, [self.planned.length]])
