@@ -13,6 +13,7 @@ import numpy as np
 
 from trackplan.planning.derivatives import backward_derivatives
 from trackplan.planning.result import CheckReport, Violation
+from trackplan.planning.tracking import jump_allowance, locate_on_nominal
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 
@@ -182,7 +183,7 @@ def _check_task(
 
     # tracking error and the position along the nominal path, in order of travel
     velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
-    s_nominal, distance, piece = ref.nominal.locate(p_part, velocity, ref.tolerance)
+    s_nominal, distance, piece = locate_on_nominal(ref.nominal, p_part, velocity, ref.tolerance)
     margins["tracking"] = float(1.0 - distance.max() / ref.tolerance)
     if margins["tracking"] < -RELATIVE_SLACK:
         violations.append(
@@ -247,7 +248,7 @@ def _coverage_violations(
             0.0,
             f"coverage: the path is run backwards at t = {t[k]:.3f} s ({backwards.size} steps)",
         )
-    allowance = nominal.jump_allowance(ref.tolerance)  # (P,) extra jump allowed after piece p
+    allowance = jump_allowance(nominal, ref.tolerance)  # (P,) extra jump allowed after piece p
     step_cap = 2.0 * max(ref.rated_speed, ref.corner_speed, float(speed.max())) * sample_time + tol
     allowed = step_cap + np.where(piece[1:] != piece[:-1], allowance[piece[:-1]], 0.0)
     jumps = np.flatnonzero(step > allowed)

@@ -1,0 +1,131 @@
+"""Where each tool sample is along the nominal path, in the order of travel.
+
+The nearest point alone is ambiguous where the path folds back on itself (a reversal, or a
+closed circle whose end meets its start). Each sample is assigned to a nominal piece whose
+direction agrees with the tool's motion, moving forward through the pieces; the checker
+then sees a path run backwards or a skipped segment as what it is.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+DIRECTION_SLACK = 0.2
+"""A piece agrees with the motion when tangent · velocity ≥ −slack · |velocity|."""
+
+
+def locate_on_nominal(
+    nominal, points: np.ndarray, velocity: np.ndarray, tolerance: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Arc length along the nominal path of each sample, its distance, and its piece.
+
+    Parameters
+    ----------
+    nominal
+        :class:`trackplan.paths.NominalPath`.
+    points
+        Tool points in the definition frame, shape (N, 3), m, in time order.
+    velocity
+        Their velocities, shape (N, 3), m/s (only the direction is used).
+    tolerance
+        ρ, m: pieces within ρ of the nearest one are candidates.
+
+    Returns
+    -------
+    s
+        Arc length on the nominal path, shape (N,), m (periodic arcs unwrapped).
+    distance
+        Distance to the nearest point of the nominal path, shape (N,), m.
+    piece
+        Index of the nominal piece each sample is assigned to, shape (N,).
+    """
+    pieces = nominal.pieces
+    n = len(points)
+    sigma = np.empty((n, len(pieces)))
+    dist = np.empty((n, len(pieces)))
+    agrees = np.empty((n, len(pieces)), dtype=bool)
+    speed = np.linalg.norm(velocity, axis=1)
+    for p, piece in enumerate(pieces):  # loop over pieces, vectorised over samples
+        sigma[:, p], dist[:, p] = piece.curve.project(points)
+        tangent = piece.curve.evaluate(sigma[:, p]).tangent
+        agrees[:, p] = np.einsum("nk,nk->n", tangent, velocity) >= -DIRECTION_SLACK * speed
+    nearest = dist.min(axis=1)
+    close = dist <= nearest[:, None] + max(tolerance, 1e-12)
+    candidates = close & agrees
+    candidates[~candidates.any(axis=1)] = close[~candidates.any(axis=1)]
+    assigned = _monotone_assignment(candidates)
+    rows = np.arange(n)
+    local = sigma[rows, assigned]
+    for p, piece in enumerate(pieces):
+        if piece.kind == "arc" and piece.curve.angle >= 2 * np.pi - 1e-9:
+            local = _unwrap_periodic(
+                local, assigned == p, 2 * np.pi * piece.curve.radius, piece.length
+            )
+    s_start = np.array([piece.s_start for piece in pieces])
+    return s_start[assigned] + local, nearest, assigned
+
+
+def _monotone_assignment(candidates: np.ndarray) -> np.ndarray:
+    """Pick one candidate piece per sample, staying on a piece while it remains a candidate
+    and otherwise moving to the next candidate ahead (behind only when none is ahead).
+
+    Parameters
+    ----------
+    candidates
+        Shape (N, P) bool, at least one True per row.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N,), piece indices.
+    """
+    n = len(candidates)
+    assigned = np.empty(n, dtype=int)
+    k = 0
+    piece = int(np.argmax(candidates[0]))
+    while k < n:  # one iteration per change of piece
+        leaving = np.flatnonzero(~candidates[k:, piece])
+        end = n if leaving.size == 0 else k + int(leaving[0])
+        assigned[k:end] = piece
+        k = end
+        if k < n:
+            options = np.flatnonzero(candidates[k])
+            ahead = options[options > piece]
+            piece = int(ahead[0]) if ahead.size else int(options[0])
+    return assigned
+
+
+def _unwrap_periodic(
+    local: np.ndarray, mask: np.ndarray, period: float, length: float
+) -> np.ndarray:
+    """Undo the wrap of a closed arc's arc length within the samples on it."""
+    idx = np.flatnonzero(mask)
+    if idx.size < 2:
+        return local
+    values = local[idx]
+    wraps = np.concatenate([[0.0], np.cumsum(np.diff(values) < -0.5 * period)]) * period
+    out = local.copy()
+    out[idx] = np.minimum(values + wraps, length)
+    return out
+
+
+def jump_allowance(nominal, tolerance: float) -> np.ndarray:
+    """How far the nominal arc length may jump when leaving each piece, m.
+
+    Near a corner of turning angle θ a point within ρ of both legs projects to feet up to
+    ρ·tan(θ/2) from the vertex on each leg, so crossing a blended corner may skip
+    2ρ·tan(θ/2) of nominal arc length (capped by the pieces' lengths).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (P,), m; entry p applies to the step from piece p to the next.
+    """
+    lengths = np.array([piece.length for piece in nominal.pieces])
+    allowance = np.zeros(len(lengths))
+    for corner in nominal.corners:
+        p = corner.junction
+        half = min(np.pi / 2 - 1e-6, corner.angle / 2)
+        cap = lengths[p] + (lengths[p + 1] if p + 1 < len(lengths) else 0.0)
+        allowance[p] = min(2.0 * tolerance * np.tan(half), cap)
+    return allowance
