@@ -220,7 +220,7 @@ def _finish(
     """Check the sampled trajectory and assemble the result."""
     robot = case.robot
     Ts = case.task.sample_time
-    if q is None:
+    if q is None or len(q) == 0:  # nothing planned (paper mode returns empty arrays)
         check = CheckReport(False, {}, {}, (), float("nan"), float("nan"))
         trajectory = empty_trajectory(robot.n_dof, Ts)
         return PlanResult(
