@@ -1,0 +1,85 @@
+"""Pieces: curves laid end to end on one arc-length parameter s."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.paths.geometry import Curve, CurveJet
+
+
+@dataclass(frozen=True, eq=False)
+class Piece:
+    """One curve of a path and where it starts on the path's arc length.
+
+    Attributes
+    ----------
+    curve
+        A :class:`~trackplan.paths.geometry.Line`, :class:`~trackplan.paths.geometry.Arc`
+        or :class:`~trackplan.paths.geometry.QuinticBlend`.
+    s_start
+        Arc length of the path at the start of the piece, m.
+    """
+
+    curve: Curve
+    s_start: float
+
+    @property
+    def kind(self) -> str:
+        """``"line"``, ``"arc"`` or ``"blend"``."""
+        return self.curve.kind
+
+    @property
+    def length(self) -> float:
+        """Arc length of the piece, m."""
+        return self.curve.length
+
+    @property
+    def s_end(self) -> float:
+        """Arc length of the path at the end of the piece, m."""
+        return self.s_start + self.curve.length
+
+    @property
+    def straight(self) -> bool:
+        """True for lines (rated speed applies), False for arcs and blends."""
+        return self.curve.straight
+
+
+def chain(curves: Sequence[Curve]) -> tuple[Piece, ...]:
+    """Lay ``curves`` end to end from s = 0."""
+    starts = np.concatenate([[0.0], np.cumsum([curve.length for curve in curves])])
+    return tuple(Piece(curve, float(s)) for curve, s in zip(curves, starts[:-1], strict=True))
+
+
+def evaluate_pieces(pieces: Sequence[Piece], s: np.ndarray) -> tuple[CurveJet, np.ndarray]:
+    """Position and arc-length derivatives of a chain of pieces at path arc lengths ``s``.
+
+    Parameters
+    ----------
+    pieces
+        Consecutive pieces, as made by :func:`chain`.
+    s
+        Arc lengths (M,), m, within [0, total length]; a value on a junction belongs to the
+        later piece, the total length to the last one.
+
+    Returns
+    -------
+    jet
+        Position (M, 3), m; unit tangent (M, 3); curvature vector (M, 3), 1/m; its
+        derivative (M, 3), 1/m².
+    piece
+        Index of the piece of each sample, shape (M,).
+    """
+    s = np.asarray(s, dtype=float)
+    starts = np.array([piece.s_start for piece in pieces])
+    index = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(pieces) - 1)
+    fields = [np.empty((s.size, 3)) for _ in range(4)]
+    for k in np.unique(index):
+        mask = index == k
+        piece = pieces[k]
+        sigma = np.clip(s[mask] - piece.s_start, 0.0, piece.length)
+        for out, value in zip(fields, piece.curve.evaluate(sigma), strict=True):
+            out[mask] = value
+    return CurveJet(*fields), index
