@@ -22,7 +22,7 @@ BAD_CASES = [
     pytest.param(
         [GOOD_LINE, LineSpec(np.array([0.1, 0.0, 0.2])), LineSpec(np.array([0.1, 0.0, 0.2]))],
         "path.segments[2].line.to",
-        "zero-length line",
+        "zero length",
         id="zero-length-line",
     ),
     pytest.param(

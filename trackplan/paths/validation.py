@@ -44,7 +44,7 @@ def _check_line(key: str, spec: LineSpec, current: np.ndarray) -> tuple[list, np
     if to is None:
         return [(f"{key}.line.to", "must be 3 finite numbers (x, y, z) in m")], current
     if np.linalg.norm(to - current) <= LENGTH_TOLERANCE:
-        message = f"zero-length line: to = {_format(to)} m is the current point"
+        message = f"line of zero length: to = {_format(to)} m is the current point"
         return [(f"{key}.line.to", message)], to
     return [], to
 
