@@ -1,0 +1,237 @@
+"""Path IK: continuity, branch choice, switch detection, limits, batching, numeric mode."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from trackplan.errors import CaseError
+from trackplan.planning.placement import placement_transform, pose_matrix, rpy_matrix
+from trackplan.robots.ik_closed_form import solve_ik_closed_form
+from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.path_ik import PathIKStatus, numeric_seeds, solve_path_ik
+
+# A 1 m line with constant tool orientation that the PUMA follows within its limits.
+LINE_CENTRE = np.array([0.403, -0.159, 0.081])
+LINE_DIRECTION = np.array([0.5758, 0.7321, -0.3639])
+LINE_RPY = np.array([0.027, -0.128, -0.671])
+SAMPLE_TIME = 1e-3
+SPEED = 0.15
+
+
+def line(centre, direction, rotation, length, n_poses):
+    """Poses along a straight line with a constant orientation, shape (n_poses, 4, 4)."""
+    direction = direction / np.linalg.norm(direction)
+    s = np.linspace(-0.5 * length, 0.5 * length, n_poses)[:, None]
+    return pose_matrix(centre + s * direction, rotation)
+
+
+def feasible_line(n_poses):
+    return line(LINE_CENTRE, LINE_DIRECTION, rpy_matrix(LINE_RPY), 1.0, n_poses)
+
+
+def wrapped(angle):
+    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
+
+
+def assert_follows(robot, result, T, tol=1e-9):
+    """The joint paths reach the poses where they say so."""
+    reached = forward_kinematics(robot, result.q)
+    error = np.abs(reached - T).max(axis=(-1, -2))
+    assert np.all(error[result.reachable] < tol)
+
+
+def test_line_at_process_speed_is_continuous(puma):
+    n_poses = round(1.0 / (SPEED * SAMPLE_TIME)) + 1  # poses 0.15 mm apart
+    T = feasible_line(n_poses)[None]
+    result = solve_path_ik(puma, T)
+    assert result.ok[0] and result.status[0] is PathIKStatus.OK
+    assert result.first_problem[0] == -1 and not result.switch.any()
+    assert_follows(puma, result, T)
+    steps = np.abs(np.diff(result.q[0], axis=0))
+    assert np.all(steps <= puma.v_max * SAMPLE_TIME)
+    assert np.all((result.q >= puma.q_min) & (result.q <= puma.q_max))
+    margin = np.minimum(result.q[0] - puma.q_min, puma.q_max - result.q[0]).min()
+    assert result.margin[0] == pytest.approx(margin)
+    assert "follows all" in result.message[0]
+
+
+def test_default_branch_is_the_ok_one_with_the_largest_margin(puma):
+    T = feasible_line(200)[None]
+    chosen = solve_path_ik(puma, T)
+    forced = [solve_path_ik(puma, T, branch=b) for b in range(8)]
+    ok = [f.ok[0] for f in forced]
+    margins = [f.margin[0] if f.ok[0] else -np.inf for f in forced]
+    assert any(ok)
+    assert chosen.branch[0] == int(np.argmax(margins))
+    assert chosen.margin[0] == max(margins)
+
+
+def test_forced_branch_is_honoured_and_is_that_closed_form_branch(puma):
+    T = feasible_line(200)
+    closed = solve_ik_closed_form(puma, T).q
+    candidates = np.stack([T, T, T])
+    branches = np.array([5, 0, 3])
+    result = solve_path_ik(puma, candidates, branch=branches)
+    np.testing.assert_array_equal(result.branch, branches)
+    for c, b in enumerate(branches):
+        assert np.abs(wrapped(result.q[c] - closed[:, b])).max() < 1e-12
+    single = solve_path_ik(puma, T[None], branch=6)
+    assert single.branch[0] == 6
+    assert np.abs(wrapped(single.q[0] - closed[:, 6])).max() < 1e-12
+
+
+def test_batched_equals_loop_of_single_candidates(puma, rng):
+    base = feasible_line(150)
+    X = np.zeros((6, 6))
+    X[:, :3] = rng.normal(0.0, 0.1, (6, 3))
+    X[:, 3:] = rng.normal(0.0, 0.3, (6, 3))
+    X[5, :3] = (0.6, 0.0, 0.0)  # pushed out of reach
+    T = placement_transform(X)[:, None] @ base[None]
+    batched = solve_path_ik(puma, T)
+    assert len(set(batched.status)) > 1  # the batch mixes outcomes
+    for c in range(len(X)):
+        single = solve_path_ik(puma, T[c : c + 1])
+        for field in ("q", "branch", "reachable", "switch", "ok", "margin", "first_problem"):
+            np.testing.assert_array_equal(getattr(batched, field)[c], getattr(single, field)[0])
+        assert batched.status[c] == single.status[0]
+        assert batched.message[c] == single.message[0]
+
+
+def wrist_singular_line(robot, n_poses):
+    """A line with fixed orientation along which q5 crosses 0 at the middle pose."""
+    q_singular = np.array([0.1, -0.5, 0.3, 0.4, 0.0, 0.2])
+    T_mid = forward_kinematics(robot, q_singular)
+    T = line(T_mid[:3, 3], np.array([0.0, 1.0, 0.2]), T_mid[:3, :3], 0.1, n_poses)
+    branch = int(
+        np.argmin(np.abs(wrapped(solve_ik_closed_form(robot, T_mid).q - q_singular)).max(-1))
+    )
+    return T, branch
+
+
+def test_wrist_singularity_crossing_is_a_branch_switch(puma):
+    n_poses = 201
+    T, branch = wrist_singular_line(puma, n_poses)
+    for b in (branch, branch ^ 1):  # both wrist labels of the singular arm
+        result = solve_path_ik(puma, T[None], branch=b)
+        assert result.status[0] is PathIKStatus.BRANCH_SWITCH and not result.ok[0]
+        flagged = np.flatnonzero(result.switch[0])
+        assert flagged.min() >= 99 and flagged.max() <= 101
+        assert result.first_problem[0] <= flagged.min()  # the flipped wrist: limits first
+        assert (
+            f"joint 5 crosses the wrist singularity near pose {flagged.min()}" in result.message[0]
+        )
+    # On one closed-form label, q5 touches 0 there and q4 turns by about π in one step.
+    q = solve_ik_closed_form(puma, T).q[:, branch]
+    assert np.abs(q[99:102, 4]).min() < 0.01
+    assert np.abs(wrapped(np.diff(q[:, 3]))).max() > 2.0
+
+
+def test_elbow_and_shoulder_singularities_are_branch_switches(puma):
+    beta = np.arctan2(puma.d[3], puma.a[2])
+    t = np.linspace(-0.1, 0.1, 101)[:, None]
+    q = np.array([0.3, -0.4, -beta, 0.2, 0.9, 0.1]) + t * np.array([0.2, 0.3, 3.0, 0.4, 0.1, 0.2])
+    stretched = forward_kinematics(puma, q)  # the elbow angle crosses 0 at t = 0
+    tangent = line(
+        np.array([0.15, 0.0, 0.3]),
+        np.array([0.0, 1.0, 0.0]),
+        rpy_matrix(np.array([0.3, 0.5, 0.2])),
+        0.2,
+        101,
+    )  # touches r = 0
+    for T, words in ((stretched, "elbow singularity"), (tangent, "shoulder singularity")):
+        result = solve_path_ik(puma, T[None])
+        assert result.status[0] is PathIKStatus.BRANCH_SWITCH
+        assert words in result.message[0]
+        assert 49 <= result.first_problem[0] <= 51
+
+
+def test_unreachable_pose_is_reported(puma):
+    direction = LINE_DIRECTION / np.linalg.norm(LINE_DIRECTION)
+    start = LINE_CENTRE - 0.5 * direction  # the feasible line, continued 0.6 m further
+    T = line(start + 0.8 * direction, direction, rpy_matrix(LINE_RPY), 1.6, 101)
+    reachable = solve_ik_closed_form(puma, T).reachable
+    first_out = int(np.argmin(reachable))
+    assert 0 < first_out < 100
+    result = solve_path_ik(puma, T[None])
+    assert result.status[0] is PathIKStatus.UNREACHABLE
+    np.testing.assert_array_equal(result.reachable[0], reachable)
+    assert result.first_problem[0] == first_out
+    assert (
+        f"pose {first_out} of 101 is out of reach ({(~reachable).sum()} poses in all)"
+        in (result.message[0])
+    )
+    # Unreachable poses hold the last reachable configuration.
+    np.testing.assert_array_equal(
+        result.q[0, first_out:],
+        np.broadcast_to(result.q[0, first_out - 1], result.q[0, first_out:].shape),
+    )
+
+
+def test_position_limits_and_jumps_are_reported(puma):
+    T = feasible_line(200)[None]
+    limited = [
+        b
+        for b in range(8)
+        if solve_path_ik(puma, T, branch=b).status[0] is PathIKStatus.POSITION_LIMITS
+    ]
+    assert limited
+    result = solve_path_ik(puma, T, branch=limited[0])
+    assert result.margin[0] < 0 and not result.ok[0]
+    assert "leaves [" in result.message[0]
+    k = result.first_problem[0]
+    outside = (result.q[0, k] < puma.q_min) | (result.q[0, k] > puma.q_max)
+    assert outside.any()
+    jumpy = solve_path_ik(puma, T, max_step=1e-4)
+    assert jumpy.status[0] is PathIKStatus.BRANCH_SWITCH and "jumps" in jumpy.message[0]
+    assert jumpy.first_problem[0] == 1
+
+
+def test_bad_arguments_raise(puma):
+    T = feasible_line(10)[None]
+    for kwargs in (
+        {"branch": 8},
+        {"branch": np.array([1, 2])},
+        {"max_step": -1.0},
+        {"max_step": np.ones(4)},
+        {"method": "magic"},
+    ):
+        with pytest.raises(CaseError):
+            solve_path_ik(puma, T, **kwargs)
+    with pytest.raises(CaseError):
+        solve_path_ik(puma, T[0])
+
+
+def test_ur5_numeric_path_is_continuous_on_a_line(ur):
+    q_mid = np.array([0.3, -1.2, 1.4, -1.6, -1.5, 0.2])
+    T_mid = forward_kinematics(ur, q_mid)
+    T = line(T_mid[:3, 3], np.array([0.3, 1.0, -0.2]), T_mid[:3, :3], 0.4, 400)[None]
+    result = solve_path_ik(ur, T)
+    assert result.method == "numeric"
+    assert result.ok[0], result.message[0]
+    assert_follows(ur, result, T, tol=1e-9)
+    assert np.abs(np.diff(result.q[0], axis=0)).max() < 0.02
+    forced = solve_path_ik(ur, T, branch=int(result.branch[0]))
+    np.testing.assert_array_equal(forced.q, result.q)
+    assert numeric_seeds(ur).shape == (8, 6)
+
+
+def test_numeric_mode_agrees_with_closed_form(puma):
+    T = feasible_line(300)[None]
+    closed = solve_path_ik(puma, T, method="closed_form")
+    numeric = solve_path_ik(puma, T, method="numeric")
+    assert numeric.ok[0]
+    assert_follows(puma, numeric, T)
+    # The numeric branch is one of the closed-form branches along the whole path.
+    branches = solve_ik_closed_form(puma, T[0]).q
+    gap = np.abs(wrapped(numeric.q[0][:, None] - branches)).max(axis=(0, 2))
+    assert gap.min() < 1e-8
+    assert numeric.margin[0] <= closed.margin[0] + 1e-9
+
+
+def test_numeric_mode_flags_a_singularity_crossing(puma):
+    T, _ = wrist_singular_line(puma, 201)
+    statuses = {
+        solve_path_ik(puma, T[None], branch=b, method="numeric").status[0] for b in range(8)
+    }
+    assert PathIKStatus.BRANCH_SWITCH in statuses
