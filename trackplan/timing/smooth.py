@@ -28,7 +28,12 @@ import numpy as np
 
 from trackplan.planning.derivatives import backward_derivatives
 from trackplan.robots.model import Robot
-from trackplan.timing.profile import SpeedProfile, speed_change_distance, speed_change_phases
+from trackplan.timing.profile import (
+    SpeedProfile,
+    speed_change_distance,
+    speed_change_phases,
+    speed_change_time,
+)
 
 JointPath = Callable[[np.ndarray], np.ndarray]
 """Maps path arc lengths s (M,) in increasing order to joint positions (M, n) on one branch."""
@@ -110,11 +115,34 @@ class TimeLaw:
 
 @dataclass(frozen=True, eq=False)
 class _ZoneDemand:
-    """Largest |dq/ds|, |d²q/ds²|, |d³q/ds³| over a zone, each shape (n,)."""
+    """|dq/ds|, |d²q/ds²|, |d³q/ds³| on a zone's grid.
 
+    Attributes
+    ----------
+    s
+        Grid, shape (G,), m.
+    q1, q2, q3
+        Absolute derivatives at the grid points, shape (G, n).
+    """
+
+    s: np.ndarray
     q1: np.ndarray
     q2: np.ndarray
     q3: np.ndarray
+
+    def peaks(
+        self, s_from: float | None = None, s_to: float | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Largest |q'|, |q''|, |q'''| per joint over the zone, or over [s_from, s_to]."""
+        if s_from is None or s_to is None or len(self.s) < 2:
+            return self.q1.max(axis=0), self.q2.max(axis=0), self.q3.max(axis=0)
+        step = self.s[1] - self.s[0]
+        inside = (self.s >= s_from - step) & (self.s <= s_to + step)
+        return (
+            self.q1[inside].max(axis=0),
+            self.q2[inside].max(axis=0),
+            self.q3[inside].max(axis=0),
+        )
 
 
 def plan_smooth_time_law(
@@ -144,19 +172,16 @@ def plan_smooth_time_law(
     Returns
     -------
     TimeLaw
+        Sampled at Ts from rest to rest; the last sample is the end of the path.
     """
     demands = _zone_demands(zones, joint_path)
-    n_zones = len(zones)
-    cap_scale = np.ones(n_zones)
-    change_scale = np.ones(n_zones)
+    planner = _ZonePlanner(robot, zones, demands, rated_speed, corner_speed)
     length = zones[-1][1]
     for iteration in range(1, MAX_ITERATIONS + 1):
-        plans = _plan_zones(
-            robot, zones, demands, rated_speed, corner_speed, cap_scale, change_scale
-        )
-        profile = _build_profile(robot, plans, demands, change_scale, length)
+        plans = planner.plan()
+        profile = planner.profile(plans, length, sample_time)
         n_steps = max(1, int(np.ceil(profile.duration / sample_time - 1e-9)))
-        time_scale = n_steps * sample_time / profile.duration
+        time_scale = max(1.0, n_steps * sample_time / profile.duration)
         t = np.arange(n_steps + 1) * sample_time
         s = profile.evaluate(t / time_scale)[0]
         s[-1] = length
@@ -164,39 +189,72 @@ def plan_smooth_time_law(
         worst = _worst_rate_violations(robot, q, sample_time)
         if not worst:
             return TimeLaw(profile, time_scale, tuple(plans), sample_time, s, q, iteration, True)
-        _tighten(worst, s, t / time_scale, profile, plans, cap_scale, change_scale)
+        planner.tighten(worst, s, t / time_scale, profile)
     return TimeLaw(profile, time_scale, tuple(plans), sample_time, s, q, MAX_ITERATIONS, False)
+
+
+STENCIL_POINTS = 5
+"""Points of the local stencil that differentiates q(s) at each grid point."""
+
+
+def _stencil_weights(offset: int, spacing: float) -> np.ndarray:
+    """Weights of the 1st, 2nd and 3rd derivative at stencil point ``offset`` (0…4).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3, STENCIL_POINTS); exact for polynomials of degree 4.
+    """
+    x = (np.arange(STENCIL_POINTS) - offset) * spacing
+    powers = np.vander(x, STENCIL_POINTS, increasing=True).T  # row k: x**k
+    weights = np.empty((3, STENCIL_POINTS))
+    for order, factorial in ((1, 1.0), (2, 2.0), (3, 6.0)):
+        rhs = np.zeros(STENCIL_POINTS)
+        rhs[order] = factorial
+        weights[order - 1] = np.linalg.solve(powers, rhs)
+    return weights
 
 
 def _zone_demands(
     zones: list[tuple[float, float, str]], joint_path: JointPath
 ) -> list[_ZoneDemand]:
-    """Differentiate q(s) on a uniform grid per zone (one batched IK call for all zones)."""
-    grids = []
+    """Differentiate q(s) at grid points of each zone with small local stencils.
+
+    Each grid point gets a 5-point stencil of spacing ``h`` (a tenth of the grid step)
+    kept inside its zone: one-sided at the zone ends, where a G2 blend has its largest
+    |q'''| and a wide centred difference would smear the jump of q''' at the junction.
+    One batched IK call serves every zone.
+    """
+    grids, stencils, spacings = [], [], []
     for s0, s1, kind in zones:
         span = s1 - s0
         if kind == "straight":
             n = int(np.clip(np.ceil(span / STRAIGHT_GRID_STEP), 8, 2000)) + 1
         else:
             n = max(CURVED_GRID_POINTS, int(np.ceil(span / STRAIGHT_GRID_STEP))) + 1
-        grids.append(np.linspace(s0, s1, n) if span > 0 else np.array([s0]))
-    q_all = joint_path(np.concatenate(grids))
+        grid = np.linspace(s0, s1, n) if span > 0 else np.array([s0])
+        h = span / (n - 1) / 10.0 if span > 0 else 0.0
+        first = np.clip(grid - 2 * h, s0, s1 - (STENCIL_POINTS - 1) * h)
+        stencils.append(first[:, None] + h * np.arange(STENCIL_POINTS))
+        grids.append(grid)
+        spacings.append(h)
+    q_all = joint_path(np.concatenate([st.ravel() for st in stencils]))
     demands = []
     start = 0
-    for grid in grids:
-        q = q_all[start : start + len(grid)]
-        start += len(grid)
-        if len(grid) < 4:
-            zero = np.zeros(q.shape[1])
-            demands.append(_ZoneDemand(zero, zero, zero))
+    for grid, stencil, h in zip(grids, stencils, spacings, strict=True):
+        q = q_all[start : start + stencil.size].reshape(*stencil.shape, -1)  # (G, 5, n)
+        start += stencil.size
+        if h == 0.0:
+            zero = np.zeros((1, q.shape[-1]))
+            demands.append(_ZoneDemand(grid, zero, zero, zero))
             continue
-        h = grid[1] - grid[0]
-        q1 = np.gradient(q, h, axis=0, edge_order=2)
-        q2 = np.gradient(q1, h, axis=0, edge_order=2)
-        q3 = np.gradient(q2, h, axis=0, edge_order=2)
-        demands.append(
-            _ZoneDemand(np.abs(q1).max(axis=0), np.abs(q2).max(axis=0), np.abs(q3).max(axis=0))
-        )
+        offsets = np.rint((grid - stencil[:, 0]) / h).astype(int)
+        derivatives = np.empty((3, len(grid), q.shape[-1]))
+        for offset in np.unique(offsets):
+            rows = offsets == offset
+            derivatives[:, rows] = np.einsum("dk,gkn->dgn", _stencil_weights(offset, h), q[rows])
+        q1, q2, q3 = np.abs(derivatives)
+        demands.append(_ZoneDemand(grid, q1, q2, q3))
     return demands
 
 
@@ -207,12 +265,13 @@ def _safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
     return out
 
 
-def _cruise_cap(robot: Robot, demand: _ZoneDemand, share: float) -> tuple[float, str]:
+def _cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
     """Highest constant path speed the joint limits allow on a zone, and what binds."""
+    q1, q2, q3 = peaks
     candidates = [
-        (_safe_ratio(share * robot.v_max, demand.q1), "velocity"),
-        (np.sqrt(_safe_ratio(share * robot.a_max, demand.q2)), "acceleration"),
-        (np.cbrt(_safe_ratio(share * robot.j_max, demand.q3)), "jerk"),
+        (_safe_ratio(share * robot.v_max, q1), "velocity"),
+        (np.sqrt(_safe_ratio(share * robot.a_max, q2)), "acceleration"),
+        (np.cbrt(_safe_ratio(share * robot.j_max, q3)), "jerk"),
     ]
     best, reason = np.inf, ""
     for values, kind in candidates:
@@ -222,121 +281,210 @@ def _cruise_cap(robot: Robot, demand: _ZoneDemand, share: float) -> tuple[float,
     return best, reason
 
 
+MAX_PATH_ACCELERATION = 50.0
+"""Upper bound on |s̈|, m/s², where no joint bounds it (a joint path that does not move)."""
+MAX_PATH_JERK = 5000.0
+"""Upper bound on |s⃛|, m/s³, likewise."""
+
+
 def _change_bounds(
-    robot: Robot, demand: _ZoneDemand, top_speed: float, share: float
+    robot: Robot, peaks: tuple, top_speed: float, share: float
 ) -> tuple[float, float]:
-    """Path acceleration and jerk bounds for a speed change up to ``top_speed`` on a zone."""
-    accel_room = share * robot.a_max - demand.q2 * top_speed**2
-    jerk_room = share * robot.j_max - demand.q3 * top_speed**3
-    accel = float(np.min(_safe_ratio(accel_room, demand.q1)))
-    # the 3 |q''| v s̈ term couples acceleration and jerk: keep half the jerk room at least
-    coupling = 3.0 * demand.q2 * top_speed
-    accel_for_half = float(np.min(_safe_ratio(0.5 * jerk_room, coupling)))
-    accel = min(accel, accel_for_half)
-    jerk = float(np.min(_safe_ratio(jerk_room - coupling * accel, demand.q1)))
-    if not (np.isfinite(accel) and np.isfinite(jerk)):
-        accel = min(accel, 1e3)
-        jerk = min(jerk, 1e5)
-    return accel, jerk
+    """Path acceleration and jerk bounds for a speed change up to ``top_speed``.
+
+    From ``|q'| s̈ + |q''| v² ≤ q̈max`` and ``|q'| s⃛ + 3 |q''| v s̈ + |q'''| v³ ≤ q⃛max``,
+    with the acceleration bound lowered where needed to leave half the jerk room to ``s⃛``.
+    """
+    q1, q2, q3 = peaks
+    accel_room = share * robot.a_max - q2 * top_speed**2
+    jerk_room = share * robot.j_max - q3 * top_speed**3
+    coupling = 3.0 * q2 * top_speed
+    accel = min(
+        float(np.min(_safe_ratio(accel_room, q1))),
+        float(np.min(_safe_ratio(0.5 * jerk_room, coupling))),
+    )
+    jerk = float(np.min(_safe_ratio(jerk_room - coupling * accel, q1)))
+    return min(accel, MAX_PATH_ACCELERATION), min(jerk, MAX_PATH_JERK)
 
 
-def _plan_zones(
-    robot: Robot,
-    zones: list[tuple[float, float, str]],
-    demands: list[_ZoneDemand],
-    rated_speed: float,
-    corner_speed: float,
-    cap_scale: np.ndarray,
-    change_scale: np.ndarray,
-) -> list[ZonePlan]:
-    """Caps per zone, then plateaus lowered until every zone fits its speed changes."""
-    n = len(zones)
-    caps = np.zeros(n)
-    reasons = [""] * n
-    for z, ((_, _, kind), demand) in enumerate(zip(zones, demands, strict=True)):
-        if kind == "stop":
-            caps[z], reasons[z] = 0.0, "stop"
-            continue
-        task_cap = rated_speed if kind == "straight" else corner_speed
-        joint_cap, joint_reason = _cruise_cap(robot, demand, LIMIT_SHARE * cap_scale[z])
-        if joint_cap < task_cap:
-            caps[z], reasons[z] = joint_cap, joint_reason
-        else:
-            caps[z] = task_cap
-            reasons[z] = "rated speed" if kind == "straight" else "corner speed"
-    lengths = np.array([s1 - s0 for s0, s1, _ in zones])
-    plateau = caps.copy()
+class _ZonePlanner:
+    """Plateaus and speed changes over the zones, with per-zone safety scales."""
 
-    def distance(z: int, v_from: float, v_to: float) -> float:
-        accel, jerk = _change_bounds(
-            robot, demands[z], max(v_from, v_to), LIMIT_SHARE * change_scale[z]
-        )
+    def __init__(
+        self,
+        robot: Robot,
+        zones: list[tuple[float, float, str]],
+        demands: list[_ZoneDemand],
+        rated_speed: float,
+        corner_speed: float,
+    ) -> None:
+        self.robot = robot
+        self.zones = zones
+        self.demands = demands
+        self.rated_speed = rated_speed
+        self.corner_speed = corner_speed
+        self.cap_scale = np.ones(len(zones))
+        self.change_scale = np.ones(len(zones))
+
+    def change(self, z: int, v_from: float, v_to: float) -> tuple[float, float, float]:
+        """Distance, acceleration and jerk bounds of a speed change inside zone z.
+
+        A rise starts at the zone's start, a fall ends at its end. The bounds come from the
+        joint demand over the stretch the change covers: first over the whole zone, then
+        over the shorter stretch that needs, which stays valid because it lies inside.
+        """
+        s0, s1, _ = self.zones[z]
+        top = max(v_from, v_to)
+        share = LIMIT_SHARE * self.change_scale[z]
+        demand = self.demands[z]
+        accel, jerk = _change_bounds(self.robot, demand.peaks(), top, share)
         if accel <= 0.0 or jerk <= 0.0:
-            return np.inf
-        return speed_change_distance(v_from, v_to, accel, jerk)
+            return np.inf, accel, jerk
+        distance = speed_change_distance(v_from, v_to, accel, jerk)
+        if distance < s1 - s0:
+            stretch = (s0, s0 + distance) if v_to > v_from else (s1 - distance, s1)
+            local = _change_bounds(self.robot, demand.peaks(*stretch), top, share)
+            accel, jerk = max(accel, local[0]), max(jerk, local[1])
+            distance = speed_change_distance(v_from, v_to, accel, jerk)
+        return distance, accel, jerk
 
-    def needed(z: int, v: float) -> float:
-        before = plateau[z - 1] if z > 0 else 0.0
-        after = plateau[z + 1] if z < n - 1 else 0.0
-        total = distance(z, before, v) if before < v else 0.0
-        return total + (distance(z, v, after) if after < v else 0.0)
-
-    for _ in range(10 * n + 10):  # look-ahead passes until every zone fits
-        changed = False
-        for z in range(n):
-            if plateau[z] == 0.0 or needed(z, plateau[z]) <= lengths[z]:
+    def plan(self) -> list[ZonePlan]:
+        """Caps per zone, then plateaus lowered until every zone fits its speed changes."""
+        zones = self.zones
+        n = len(zones)
+        caps = np.zeros(n)
+        reasons = [""] * n
+        for z, (_, _, kind) in enumerate(zones):
+            if kind == "stop":
+                caps[z], reasons[z] = 0.0, "stop"
                 continue
-            low, high = 0.0, plateau[z]
-            for _ in range(60):
-                mid = 0.5 * (low + high)
-                low, high = (mid, high) if needed(z, mid) <= lengths[z] else (low, mid)
-            plateau[z] = low
-            reasons[z] = f"{reasons[z]}; speed changes need {_change_limit_name(robot, demands[z])}"
-            changed = True
-        if not changed:
-            break
-    return [
-        ZonePlan(s0, s1, kind, float(caps[z]), float(plateau[z]), reasons[z])
-        for z, (s0, s1, kind) in enumerate(zones)
-    ]
+            task_cap = self.rated_speed if kind == "straight" else self.corner_speed
+            share = LIMIT_SHARE * self.cap_scale[z]
+            joint_cap, joint_reason = _cruise_cap(self.robot, self.demands[z].peaks(), share)
+            if joint_cap < task_cap:
+                caps[z], reasons[z] = joint_cap, joint_reason
+            else:
+                caps[z] = task_cap
+                reasons[z] = "rated speed" if kind == "straight" else "corner speed"
+        lengths = np.array([s1 - s0 for s0, s1, _ in zones])
+        plateau = caps.copy()
+
+        def needed(z: int, v: float) -> float:
+            before = plateau[z - 1] if z > 0 else 0.0
+            after = plateau[z + 1] if z < n - 1 else 0.0
+            total = self.change(z, before, v)[0] if before < v else 0.0
+            return total + (self.change(z, v, after)[0] if after < v else 0.0)
+
+        for _ in range(10 * n + 10):  # look-ahead passes until every zone fits
+            changed = False
+            for z in range(n):
+                if plateau[z] == 0.0 or needed(z, plateau[z]) <= lengths[z]:
+                    continue
+                low, high = 0.0, plateau[z]
+                for _ in range(50):
+                    mid = 0.5 * (low + high)
+                    low, high = (mid, high) if needed(z, mid) <= lengths[z] else (low, mid)
+                plateau[z] = low
+                if "speed changes" not in reasons[z]:
+                    reasons[z] += "; too short for its speed changes under the joint limits"
+                changed = True
+            if not changed:
+                break
+        return [
+            ZonePlan(s0, s1, kind, float(caps[z]), float(plateau[z]), reasons[z])
+            for z, (s0, s1, kind) in enumerate(zones)
+        ]
+
+    def profile(self, plans: list[ZonePlan], length: float, sample_time: float) -> SpeedProfile:
+        """Jerk phases zone by zone (change in, cruise, change out), lasting whole periods.
+
+        The fraction of a period left over is absorbed by the final stop, made slightly
+        gentler (lower jerk), so that every cruise keeps its exact speed.
+        """
+        phases = self._phases(plans, stretch=0.0)
+        assert phases is not None  # without stretch every zone fits by construction
+        duration = sum(d for d, _ in phases)
+        slack = np.ceil(duration / sample_time - 1e-9) * sample_time - duration
+        if slack > 1e-12:
+            phases = self._phases(plans, stretch=slack) or phases
+        return SpeedProfile.from_phases(phases, length)
+
+    def _phases(self, plans: list[ZonePlan], stretch: float) -> list[tuple[float, float]] | None:
+        """Jerk phases of the plan, the final stop ``stretch`` s longer in total.
+
+        Returns None when the last zone has no cruise left to give the longer stop.
+        """
+        phases: list[tuple[float, float]] = []
+        n = len(plans)
+        last = max((z for z, p in enumerate(plans) if p.plateau > 0.0), default=-1)
+        for z, plan in enumerate(plans):
+            v = plan.plateau
+            if v == 0.0:
+                continue
+            before = plans[z - 1].plateau if z > 0 else 0.0
+            after = plans[z + 1].plateau if z < n - 1 else 0.0
+            cruise = plan.s_end - plan.s_start
+            change_in: list[tuple[float, float]] = []
+            change_out: list[tuple[float, float]] = []
+            if before < v:
+                distance, accel, jerk = self.change(z, before, v)
+                change_in = speed_change_phases(before, v, accel, jerk)
+                cruise -= distance
+            if after < v:
+                distance, accel, jerk = self.change(z, v, after)
+                if z == last and stretch > 0.0:
+                    # a stop lasting δ longer covers v·δ/2 more: the cruise gives it, and the
+                    # whole motion then lasts δ/2 longer: stretch the stop by 2·stretch.
+                    longer = speed_change_time(v - after, accel, jerk) + 2.0 * stretch
+                    jerk = _jerk_for_duration(v - after, accel, jerk, longer)
+                    distance = speed_change_distance(v, after, accel, jerk)
+                change_out = speed_change_phases(v, after, accel, jerk)
+                cruise -= distance
+            if cruise < 0.0:
+                if stretch > 0.0:
+                    return None
+                cruise = 0.0
+            phases.extend(change_in)
+            phases.append((cruise / v, 0.0))
+            phases.extend(change_out)
+        return phases
+
+    def tighten(
+        self,
+        worst: list[tuple[int, str, float]],
+        s: np.ndarray,
+        t_profile: np.ndarray,
+        profile: SpeedProfile,
+    ) -> None:
+        """Lower the plateau or the speed-change bounds of every zone that broke a limit."""
+        starts = np.array([z[0] for z in self.zones])
+        power = {"velocity": 1.0, "acceleration": 2.0, "jerk": 3.0}
+        phase = profile.phase_index(t_profile)
+        cruising = (profile.jerk[phase] == 0.0) & (np.abs(profile.a0[phase]) < 1e-12)
+        new_cap = np.ones(len(self.zones))
+        new_change = np.ones(len(self.zones))
+        for k, kind, ratio in worst:
+            z = int(np.clip(np.searchsorted(starts, s[k], side="right") - 1, 0, len(starts) - 1))
+            if np.all(cruising[max(0, k - 3) : k + 1]):
+                new_cap[z] = min(new_cap[z], 0.98 * ratio ** (-1.0 / power[kind]))
+            else:
+                new_change[z] = min(new_change[z], 0.95 / ratio)
+                if z + 1 < len(starts):  # a change at a zone edge also feels the neighbour
+                    new_change[z + 1] = min(new_change[z + 1], 0.95 / ratio)
+        self.cap_scale *= new_cap
+        self.change_scale *= new_change
 
 
-def _change_limit_name(robot: Robot, demand: _ZoneDemand) -> str:
-    """The joint whose acceleration and jerk limits bound speed changes on a zone."""
-    j = int(np.argmax(_safe_ratio(demand.q1, robot.j_max)))
-    return f"joint {j + 1} acceleration/jerk (zone too short to reach the cap)"
-
-
-def _build_profile(
-    robot: Robot,
-    plans: list[ZonePlan],
-    demands: list[_ZoneDemand],
-    change_scale: np.ndarray,
-    length: float,
-) -> SpeedProfile:
-    """Jerk phases zone by zone: change in, cruise, change out."""
-    phases: list[tuple[float, float]] = []
-    n = len(plans)
-    for z, plan in enumerate(plans):
-        v = plan.plateau
-        if v == 0.0:
-            continue
-        before = plans[z - 1].plateau if z > 0 else 0.0
-        after = plans[z + 1].plateau if z < n - 1 else 0.0
-        accel, jerk = _change_bounds(robot, demands[z], v, LIMIT_SHARE * change_scale[z])
-        cruise = plan.s_end - plan.s_start
-        change_in: list[tuple[float, float]] = []
-        change_out: list[tuple[float, float]] = []
-        if before < v:
-            change_in = speed_change_phases(before, v, accel, jerk)
-            cruise -= speed_change_distance(before, v, accel, jerk)
-        if after < v:
-            change_out = speed_change_phases(v, after, accel, jerk)
-            cruise -= speed_change_distance(v, after, accel, jerk)
-        phases.extend(change_in)
-        phases.append((max(cruise, 0.0) / v, 0.0))
-        phases.extend(change_out)
-    return SpeedProfile.from_phases(phases, length)
+def _jerk_for_duration(delta: float, accel: float, jerk: float, duration: float) -> float:
+    """The (lower) jerk bound that makes a speed change of ``delta`` last ``duration``."""
+    low, high = 0.0, jerk
+    for _ in range(80):
+        mid = 0.5 * (low + high)
+        if mid > 0.0 and speed_change_time(delta, accel, mid) > duration:
+            low = mid
+        else:
+            high = mid
+    return high
 
 
 def _worst_rate_violations(
@@ -362,33 +510,3 @@ def _worst_rate_violations(
             for k in bad:
                 found.append((min(int(k), len(q) - 1), kind, float(ratio[k, j])))
     return found
-
-
-def _tighten(
-    worst: list[tuple[int, str, float]],
-    s: np.ndarray,
-    t_profile: np.ndarray,
-    profile: SpeedProfile,
-    plans: list[ZonePlan],
-    cap_scale: np.ndarray,
-    change_scale: np.ndarray,
-) -> None:
-    """Lower the plateau or the speed-change bounds of every zone that broke a limit."""
-    starts = np.array([p.s_start for p in plans])
-    power = {"velocity": 1.0, "acceleration": 2.0, "jerk": 3.0}
-    phase = profile.phase_index(t_profile)
-    cruising = (profile.jerk[phase] == 0.0) & (np.abs(profile.a0[phase]) < 1e-12)
-    new_cap = np.ones(len(plans))
-    new_change = np.ones(len(plans))
-    for k, kind, ratio in worst:
-        z = int(np.clip(np.searchsorted(starts, s[k], side="right") - 1, 0, len(plans) - 1))
-        window = slice(max(0, k - 3), k + 1)
-        if np.all(cruising[window]):
-            new_cap[z] = min(new_cap[z], 0.97 * ratio ** (-1.0 / power[kind]))
-        else:
-            new_change[z] = min(new_change[z], 0.9 / ratio)
-            # a change near a zone edge may also be bounded by the neighbour's demand
-            if z + 1 < len(plans):
-                new_change[z + 1] = min(new_change[z + 1], 0.9 / ratio)
-    cap_scale *= new_cap
-    change_scale *= new_change
