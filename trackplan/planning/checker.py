@@ -122,7 +122,9 @@ def check_trajectory(
                 if kind == "position"
                 else bound[j]
             )
-            violations.append(_violation(kind, int(j) + 1, t, values[:, j], use[:, j], float(limit)))
+            violations.append(
+                _violation(kind, int(j) + 1, t, values[:, j], use[:, j], float(limit))
+            )
 
     task_margins: dict[str, float] = {}
     max_tracking = 0.0
