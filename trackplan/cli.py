@@ -418,8 +418,8 @@ def check(
 def _print_summary(result, out: Path) -> None:
     """A few lines on what a plan achieved and where its files are."""
     console = _console()
-    state = "feasible" if result.feasible else f"INFEASIBLE ({result.status.value})"
-    console.print(f"{escape(result.case_name)}: {state}: {escape(result.message)}")
+    state = "" if result.feasible else f"INFEASIBLE ({result.status.value}): "
+    console.print(f"{escape(result.case_name)}: {state}{escape(result.message)}")
     if result.trajectory.n_samples:
         console.print(
             f"  J = {result.objective:.4f}  duration = {result.duration:.3f} s  "

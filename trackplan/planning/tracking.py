@@ -100,12 +100,13 @@ def _unwrap_periodic(
 ) -> np.ndarray:
     """Undo the wrap of a closed arc's arc length within the samples on it."""
     idx = np.flatnonzero(mask)
-    if idx.size < 2:
+    if idx.size == 0:
         return local
-    values = local[idx]
-    wraps = np.concatenate([[0.0], np.cumsum(np.diff(values) < -0.5 * period)]) * period
+    values = np.unwrap(local[idx], period=period)
+    # the start and the end of a closed arc are one point: begin on the first turn
+    values -= period * np.round(values.min() / period)
     out = local.copy()
-    out[idx] = np.minimum(values + wraps, length)
+    out[idx] = np.clip(values, 0.0, length)
     return out
 
 

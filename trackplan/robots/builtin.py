@@ -21,8 +21,12 @@ def puma560() -> Robot:
         a=np.array([0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0]),
         alpha=np.array([HALF_PI, 0.0, -HALF_PI, HALF_PI, -HALF_PI, 0.0]),
         offset=np.zeros(6),
-        q_min=-np.array([np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi]),
-        q_max=np.array([np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi]),
+        q_min=-np.array(
+            [np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi]
+        ),
+        q_max=np.array(
+            [np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi]
+        ),
         v_max=np.array([8.0, 10.0, 10.0, 5.0, 5.0, 5.0]),
         a_max=np.array([10.0, 12.0, 12.0, 8.0, 8.0, 8.0]),
         j_max=np.array([30.0, 40.0, 40.0, 20.0, 20.0, 20.0]),

@@ -175,6 +175,7 @@ def plan_smooth_time_law(
         Sampled at Ts from rest to rest; the last sample is the end of the path.
     """
     demands = _zone_demands(zones, joint_path)
+    zones, demands = _slow_down_windows(robot, zones, demands, rated_speed, corner_speed)
     planner = _ZonePlanner(robot, zones, demands, rated_speed, corner_speed)
     length = zones[-1][1]
     for iteration in range(1, MAX_ITERATIONS + 1):
@@ -256,6 +257,82 @@ def _zone_demands(
         q1, q2, q3 = np.abs(derivatives)
         demands.append(_ZoneDemand(grid, q1, q2, q3))
     return demands
+
+
+WINDOW_LEVEL = 0.9
+"""Ratio between successive speed levels of slow-down windows."""
+WINDOW_MIN_LENGTH = 5e-3
+"""Shortest slow-down window, m: shorter runs join their slower neighbour."""
+
+
+def _local_caps(robot: Robot, demand: _ZoneDemand) -> np.ndarray:
+    """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s."""
+    share = LIMIT_SHARE
+    caps = np.minimum(
+        _safe_ratio(share * robot.v_max, demand.q1).min(axis=1),
+        np.sqrt(_safe_ratio(share * robot.a_max, demand.q2)).min(axis=1),
+    )
+    return np.minimum(caps, np.cbrt(_safe_ratio(share * robot.j_max, demand.q3)).min(axis=1))
+
+
+def _slow_down_windows(
+    robot: Robot,
+    zones: list[tuple[float, float, str]],
+    demands: list[_ZoneDemand],
+    rated_speed: float,
+    corner_speed: float,
+) -> tuple[list[tuple[float, float, str]], list[_ZoneDemand]]:
+    """Split zones where the joint limits force a lower speed on only part of them.
+
+    Along a zone the local cap (the speed the joints allow at each grid point) is rounded
+    down to levels ``task cap · 0.9^k``; runs of one level become windows of their own, so a
+    straight piece slows down only where it must and runs at the rated speed elsewhere.
+    Windows shorter than WINDOW_MIN_LENGTH join the slower neighbour (never raising a cap).
+    """
+    out_zones: list[tuple[float, float, str]] = []
+    out_demands: list[_ZoneDemand] = []
+    for (s0, s1, kind), demand in zip(zones, demands, strict=True):
+        task_cap = rated_speed if kind == "straight" else corner_speed
+        local = _local_caps(robot, demand) if kind != "stop" and len(demand.s) > 2 else None
+        if local is None or local.min() >= task_cap:
+            out_zones.append((s0, s1, kind))
+            out_demands.append(demand)
+            continue
+        ratio = np.minimum(local, task_cap) / task_cap
+        level = np.ceil(np.log(np.maximum(ratio, 1e-12)) / np.log(WINDOW_LEVEL) - 1e-9)
+        level = np.maximum(level, 0).astype(int)
+        runs = _level_runs(demand.s, level)
+        for first, last in runs:
+            lo = max(first - 1, 0)
+            hi = min(last + 2, len(demand.s))
+            a = s0 if first == 0 else 0.5 * (demand.s[first - 1] + demand.s[first])
+            b = s1 if last == len(demand.s) - 1 else 0.5 * (demand.s[last] + demand.s[last + 1])
+            out_zones.append((float(a), float(b), kind))
+            out_demands.append(
+                _ZoneDemand(demand.s[lo:hi], demand.q1[lo:hi], demand.q2[lo:hi], demand.q3[lo:hi])
+            )
+    return out_zones, out_demands
+
+
+def _level_runs(s: np.ndarray, level: np.ndarray) -> list[tuple[int, int]]:
+    """Runs (first, last grid index) of equal level, short runs merged into slower ones."""
+    level = level.copy()
+    while True:
+        edges = np.flatnonzero(np.diff(level)) + 1
+        starts = np.concatenate([[0], edges])
+        ends = np.concatenate([edges - 1, [len(level) - 1]])
+        lengths = s[ends] - s[starts]
+        short = np.flatnonzero(lengths < WINDOW_MIN_LENGTH)
+        if short.size == 0 or len(starts) == 1:
+            return list(zip(starts.tolist(), ends.tolist(), strict=True))
+        k = int(short[np.argmin(lengths[short])])
+        own = int(level[starts[k]])
+        neighbours = [j for j in (k - 1, k + 1) if 0 <= j < len(starts)]
+        slower = max(neighbours, key=lambda j: int(level[starts[j]]))
+        if int(level[starts[slower]]) >= own:  # join the slower neighbour
+            level[starts[k] : ends[k] + 1] = level[starts[slower]]
+        else:  # the short run is the slowest: its slower neighbour slows down to it
+            level[starts[slower] : ends[slower] + 1] = own
 
 
 def _safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
