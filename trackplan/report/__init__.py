@@ -1,0 +1,29 @@
+"""Plots and the HTML report of a planned placement.
+
+``write_plots`` writes the PNG plots of a run, ``write_report`` the self-contained
+``report.html`` (plots embedded, interactive 3D view of the robot). The ``*_figure``
+functions return the figures themselves. matplotlib and plotly are imported only when
+a figure is built, so importing this package is cheap.
+"""
+
+from trackplan.report.figures import (
+    convergence_figure,
+    joints_figure,
+    path_figure,
+    speed_figure,
+    write_plots,
+)
+from trackplan.report.html import REPORT_FILE, write_report
+from trackplan.report.robot_view import VIEW_ID, robot_view_figure
+
+__all__ = [
+    "REPORT_FILE",
+    "VIEW_ID",
+    "convergence_figure",
+    "joints_figure",
+    "path_figure",
+    "robot_view_figure",
+    "speed_figure",
+    "write_plots",
+    "write_report",
+]

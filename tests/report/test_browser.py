@@ -1,0 +1,132 @@
+"""report.html in headless Chromium: it loads offline, without errors, and the 3D view animates.
+
+Needs Debian's Chromium (``make browser`` installs it) and the ``playwright`` package, used
+only to drive that browser (``playwright install`` is never run: it would download one).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.report.conftest import REPORT_FRAMES
+from trackplan.report import VIEW_ID
+from trackplan.report.robot_view import ROBOT_TRACE, frame_name
+from trackplan.report.scene import chain_points, frame_indices
+
+pytestmark = pytest.mark.browser
+
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+ROBOT_XYZ = (
+    "(name) => { const trace = document.getElementById('"
+    + VIEW_ID
+    + "').data.find((t) => t.name === name);"
+    " return [Array.from(trace.x), Array.from(trace.y), Array.from(trace.z)]; }"
+)
+
+
+ACTIVE_STEP = f"() => document.getElementById('{VIEW_ID}').layout.sliders[0].active"
+
+
+# true once the slider left step `later` and the robot drawn is the active step's frame
+SHOWS_ACTIVE_STEP = """([id, name, later]) => {
+    const gd = document.getElementById(id);
+    const step = gd.layout.sliders[0].active;
+    if (step >= later) return false;
+    const frame = gd._transitionData._frames[step];
+    const drawn = gd.data.find((t) => t.name === name);
+    const wanted = frame.data[0];
+    return drawn.x.every((x, i) => x === wanted.x[i]) && drawn.z.every((z, i) => z === wanted.z[i]);
+}"""
+
+
+@pytest.fixture(scope="module")
+def browser():
+    sync_api = pytest.importorskip(
+        "playwright.sync_api", reason="BROWSER TEST SKIPPED: the playwright package is missing"
+    )
+    if not CHROMIUM.exists():
+        pytest.skip(f"BROWSER TEST SKIPPED: no Chromium at {CHROMIUM}; run `make browser`")
+    with sync_api.sync_playwright() as playwright:
+        try:
+            chromium = playwright.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
+        except sync_api.Error as error:
+            pytest.skip(f"BROWSER TEST SKIPPED: Chromium at {CHROMIUM} did not start: {error}")
+        yield chromium
+        chromium.close()
+
+
+def test_report_view_animates_without_errors(browser, report_file, tmp_path, corner, corner_result):
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    page.set_default_timeout(120_000)  # a loaded CI machine parses 5 MB of plotly.js slowly
+    problems: list[str] = []
+    page.on("console", lambda m: problems.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda error: problems.append(str(error)))
+    page.on(
+        "request",
+        lambda r: problems.append(f"network request {r.url}") if r.url.startswith("http") else None,
+    )
+    page.goto(report_file.as_uri())
+    page.wait_for_function(
+        f"() => {{ const gd = document.getElementById('{VIEW_ID}');"
+        " return gd && gd.data && gd._transitionData && gd._transitionData._frames.length > 0; }"
+    )
+    names = page.evaluate(f"() => document.getElementById('{VIEW_ID}').data.map((t) => t.name)")
+    assert ROBOT_TRACE in names and "planned path" in names
+    n_frames = page.evaluate(
+        f"() => document.getElementById('{VIEW_ID}')._transitionData._frames.length"
+    )
+    assert n_frames == REPORT_FRAMES
+
+    idx = frame_indices(corner_result.trajectory.n_samples, REPORT_FRAMES)
+    start = np.array(page.evaluate(ROBOT_XYZ, ROBOT_TRACE)).T
+    expected = chain_points(corner.robot, corner_result.trajectory.q[idx])
+    np.testing.assert_allclose(start, expected[0], atol=1e-5)
+
+    # the slider's own action: animate to a later frame
+    later = REPORT_FRAMES * 3 // 4
+    page.evaluate(
+        "async ([id, name]) => { await Plotly.animate(document.getElementById(id), [name],"
+        " {mode: 'immediate', frame: {duration: 0, redraw: true}, transition: {duration: 0}}); }",
+        [VIEW_ID, frame_name(later)],
+    )
+    moved = np.array(page.evaluate(ROBOT_XYZ, ROBOT_TRACE)).T
+    assert np.max(np.abs(moved - start)) > 0.01
+    np.testing.assert_allclose(moved, expected[later], atol=1e-5)
+
+    # a click on the slider rail a quarter of the way along jumps to that frame
+    rail = page.locator(f"#{VIEW_ID} .slider-rail-touch-rect")
+    box = rail.bounding_box()
+    rail.click(position={"x": 0.25 * box["width"], "y": 0.5 * box["height"]})
+    page.wait_for_function(SHOWS_ACTIVE_STEP, arg=[VIEW_ID, ROBOT_TRACE, later])
+    clicked = page.evaluate(ACTIVE_STEP)
+    assert 0 < clicked < later
+    np.testing.assert_allclose(
+        np.array(page.evaluate(ROBOT_XYZ, ROBOT_TRACE)).T, expected[clicked], atol=1e-5
+    )
+
+    # play runs the animation on from there; pause stops it
+    page.locator(f"#{VIEW_ID} .updatemenu-button").filter(has_text="play").click()
+    page.wait_for_function(
+        f"() => document.getElementById('{VIEW_ID}').layout.sliders[0].active > {clicked}"
+    )
+    page.locator(f"#{VIEW_ID} .updatemenu-button").filter(has_text="pause").click()
+
+    screenshot = tmp_path / "report-view.png"
+    page.locator("#view").screenshot(path=str(screenshot))
+    assert screenshot.stat().st_size > 10_000
+    page.close()
+    assert not problems, problems

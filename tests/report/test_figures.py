@@ -1,0 +1,196 @@
+"""The static plots: what each figure holds, not only that a file appears."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from trackplan.planning.placement import placement_transform
+from trackplan.planning.result import LIMIT_KINDS, Violation
+from trackplan.report import (
+    convergence_figure,
+    joints_figure,
+    path_figure,
+    speed_figure,
+    write_plots,
+)
+from trackplan.report.scene import JOINT_QUANTITIES, joint_bounds, joint_series, transform_points
+
+
+def _by_gid(ax, gid):
+    return [line for line in ax.lines if line.get_gid() == gid]
+
+
+@pytest.fixture(scope="module")
+def joints(corner, corner_result):
+    return joints_figure(corner_result, corner)
+
+
+def test_joints_grid_has_one_panel_per_joint_and_derivative(joints, corner):
+    n = corner.robot.n_dof
+    assert len(joints.axes) == len(LIMIT_KINDS) * n
+
+
+def test_joints_every_panel_has_its_pair_of_limit_lines_and_one_series(
+    joints, corner, corner_result
+):
+    n = corner.robot.n_dof
+    grid = np.array(joints.axes).reshape(len(LIMIT_KINDS), n)
+    for row, kind in enumerate(LIMIT_KINDS):
+        lower, upper = joint_bounds(corner.robot, kind)
+        values = joint_series(corner_result.trajectory, kind)
+        for j in range(n):
+            ax = grid[row, j]
+            limits = _by_gid(ax, "limit")
+            assert len(limits) == 2, (kind, j)
+            drawn = sorted(float(line.get_ydata()[0]) for line in limits)
+            assert drawn == pytest.approx([lower[j], upper[j]])
+            assert all(line.get_linestyle() == "--" for line in limits)
+            series = [line for line in ax.lines if line.get_label() == corner.robot.joint_names[j]]
+            assert len(series) == 1
+            np.testing.assert_array_equal(series[0].get_ydata(), values[:, j])
+
+
+def test_joints_axis_labels_carry_units(joints, corner):
+    n = corner.robot.n_dof
+    grid = np.array(joints.axes).reshape(len(LIMIT_KINDS), n)
+    for row, kind in enumerate(LIMIT_KINDS):
+        assert f"[{JOINT_QUANTITIES[kind][1]}]" in grid[row, 0].get_ylabel()
+    assert all(ax.get_xlabel() == "time [s]" for ax in grid[-1])
+
+
+def test_joints_mark_the_planted_violation_and_nothing_else(joints, corner, corner_result):
+    (violation,) = corner_result.check.violations
+    assert (violation.limit, violation.joint) == ("jerk", 6)
+    n = corner.robot.n_dof
+    grid = np.array(joints.axes).reshape(len(LIMIT_KINDS), n)
+    for row, kind in enumerate(LIMIT_KINDS):
+        for j in range(n):
+            ax = grid[row, j]
+            markers = _by_gid(ax, "violation")
+            windows = [p for p in ax.patches if p.get_gid() == "violation-window"]
+            if (kind, j + 1) == (violation.limit, violation.joint):
+                (marker,) = markers
+                y = np.asarray(marker.get_ydata())
+                assert y.size > 0 and np.all(np.abs(y) > corner.robot.j_max[j])
+                assert np.max(np.abs(y)) == pytest.approx(abs(violation.worst))
+                assert marker.get_color() == "red"
+                assert len(windows) == 1
+                x0 = windows[0].get_x()
+                assert x0 <= violation.t_first <= x0 + windows[0].get_width()
+            else:
+                assert not markers and not windows, (kind, j)
+
+
+@pytest.fixture(scope="module")
+def path(corner, corner_result):
+    return path_figure(corner_result, corner)
+
+
+def test_path_holds_both_paths_in_their_frames(path, corner_result):
+    cell = path.axes[0]
+    (before,) = _by_gid(cell, "path-before")
+    (after,) = _by_gid(cell, "path-after")
+    assert before.get_linestyle() == "--" and after.get_linestyle() == "-"
+    tool = corner_result.trajectory.tool_position
+    np.testing.assert_allclose(np.column_stack(after.get_data_3d()), tool)
+    T_base_part = placement_transform(corner_result.placement)
+    definition = np.column_stack(before.get_data_3d())
+    np.testing.assert_allclose(transform_points(T_base_part, definition), tool, atol=1e-12)
+
+
+def test_path_draws_the_reach_shell_and_frames(path, corner, corner_result):
+    cell, close_up = path.axes
+    shells = _by_gid(cell, "reach-shell")
+    radii = []
+    for line in shells:
+        points = np.column_stack(line.get_data_3d()).astype(float)
+        finite = points[np.all(np.isfinite(points), axis=1)]
+        radius = np.linalg.norm(finite, axis=1)
+        np.testing.assert_allclose(radius, radius[0])
+        radii.append(radius[0])
+    assert sorted(radii) == pytest.approx(sorted(corner.bounds.reach))
+    assert len(_by_gid(cell, "base-frame")) == 3
+    assert len(_by_gid(cell, "robot")) == 1
+    assert len(_by_gid(close_up, "tool-frames")) == 3
+    assert len(_by_gid(close_up, "violation")) == 1
+
+
+def test_path_axes_have_equal_aspect(path):
+    for ax in path.axes:
+        widths = [np.ptp(ax.get_xlim()), np.ptp(ax.get_ylim()), np.ptp(ax.get_zlim())]
+        np.testing.assert_allclose(widths, widths[0])
+        assert ax.get_xlabel() == "x [m]" and ax.get_zlabel() == "z [m]"
+
+
+def test_speed_figure_bounds_and_series(corner, corner_result):
+    figure = speed_figure(corner_result, corner)
+    ax_speed, ax_error = figure.axes
+    (speed,) = _by_gid(ax_speed, "speed")
+    np.testing.assert_allclose(speed.get_ydata(), 1e3 * corner_result.trajectory.speed)
+    (rated,) = _by_gid(ax_speed, "rated-speed")
+    (corner_cap,) = _by_gid(ax_speed, "corner-speed")
+    assert rated.get_ydata()[0] == pytest.approx(1e3 * corner.task.rated_speed)
+    assert corner_cap.get_ydata()[0] == pytest.approx(1e3 * corner.task.corner_speed)
+    (error,) = _by_gid(ax_error, "tracking-error")
+    assert np.max(error.get_ydata()) == pytest.approx(1e3 * corner_result.check.max_tracking_error)
+    (tolerance,) = _by_gid(ax_error, "tolerance")
+    assert tolerance.get_ydata()[0] == pytest.approx(1e3 * corner.task.tolerance)
+    assert ax_speed.get_ylabel() == "tool speed [mm/s]"
+    assert ax_error.get_ylabel() == "tracking error [mm]"
+    assert ax_error.get_xlabel() == "time [s]"
+    assert len([p for p in ax_speed.patches if p.get_gid() == "slowdown"]) == 1
+    assert not _by_gid(ax_speed, "violation") and not _by_gid(ax_error, "violation")
+
+
+def test_speed_figure_marks_a_reported_speed_violation(corner, corner_result):
+    t = corner_result.trajectory.t
+    k = int(np.argmax(corner_result.trajectory.speed))
+    overspeed = Violation("speed", None, float(t[k - 2]), float(t[k + 2]), 0.16, 0.15, "speed")
+    check = dataclasses.replace(corner_result.check, violations=(overspeed,))
+    figure = speed_figure(dataclasses.replace(corner_result, check=check), corner)
+    (marker,) = _by_gid(figure.axes[0], "violation")
+    np.testing.assert_allclose(marker.get_xdata(), t[k - 2 : k + 3])
+
+
+def test_convergence_one_series_per_method_and_panel(history):
+    figure = convergence_figure(history)
+    assert len(figure.axes) == 3
+    for ax, key in zip(figure.axes, ("best", "mean", "feasible_share"), strict=True):
+        lines = [line for line in ax.lines if line.get_gid() in history]
+        assert sorted(line.get_gid() for line in lines) == sorted(history)
+        for line in lines:
+            table = history[line.get_gid()]
+            np.testing.assert_array_equal(line.get_xdata(), table["evaluations"])
+            scale = 100.0 if key == "feasible_share" else 1.0
+            np.testing.assert_allclose(line.get_ydata(), scale * table[key])
+    colors = {line.get_gid(): line.get_color() for line in figure.axes[0].lines}
+    assert len(set(colors.values())) == len(history)
+    assert figure.axes[0].get_yscale() == "log"
+    assert figure.axes[2].get_ylabel() == "feasible share [%]"
+
+
+def test_convergence_rejects_an_incomplete_history(history):
+    del history["ga"]["mean"]
+    with pytest.raises(ValueError, match="'ga' lacks mean"):
+        convergence_figure(history)
+
+
+def test_write_plots_writes_png_files(tmp_path, corner, corner_result, history):
+    written = write_plots(corner_result, corner, tmp_path / "run", history)
+    assert [p.name for p in written] == ["joints.png", "path.png", "speed.png", "convergence.png"]
+    for file in written:
+        assert file.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plots_without_a_trajectory(tmp_path, corner, unreachable_result):
+    joints = joints_figure(unreachable_result, corner)
+    assert "no trajectory" in joints.get_suptitle()
+    assert len(_by_gid(joints.axes[0], "limit")) == 2
+    path = path_figure(unreachable_result, corner)
+    assert len(_by_gid(path.axes[0], "path-after")) == 1
+    assert not _by_gid(path.axes[0], "robot")
+    written = write_plots(unreachable_result, corner, tmp_path)
+    assert [p.name for p in written] == ["joints.png", "path.png", "speed.png"]

@@ -1,0 +1,100 @@
+"""report.html: one self-contained offline page with tables, plots and the 3D view."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+from tests.report.conftest import REPORT_FRAMES
+from trackplan.report import VIEW_ID, robot_view_figure, write_report
+from trackplan.report.robot_view import ROBOT_TRACE, TRAIL_TRACE, frame_name
+from trackplan.report.scene import chain_points, frame_indices
+
+EMBEDDED_PNG = re.compile(r'<img[^>]*\bsrc="data:image/png;base64,[A-Za-z0-9+/=]+"')
+
+
+def plotly_call(page: str, function: str) -> list:
+    """The JSON arguments after the div id of ``Plotly.<function>('robot-view', ...)``."""
+    match = re.search(rf"Plotly\.{function}\(\s*['\"]{VIEW_ID}['\"],\s*", page)
+    assert match, f"no Plotly.{function} call for {VIEW_ID}"
+    decoder = json.JSONDecoder()
+    args, position = [], match.end()
+    while page[position] in "[{":
+        value, position = decoder.raw_decode(page, position)
+        args.append(value)
+        position = re.compile(r"\s*,?\s*").match(page, position).end()
+    return args
+
+
+@pytest.fixture(scope="module")
+def page(report_file) -> str:
+    return report_file.read_text(encoding="utf-8")
+
+
+def test_report_is_offline(page):
+    assert not re.search(r"<script[^>]*\bsrc\s*=", page, re.IGNORECASE)
+    assert not re.search(r"<link[^>]*\bhref\s*=\s*[\"']https?://", page, re.IGNORECASE)
+    assert not re.search(r"<img[^>]*\bsrc\s*=\s*[\"']https?://", page, re.IGNORECASE)
+    assert len(EMBEDDED_PNG.findall(page)) == 4  # joints, path, speed, convergence
+    # plotly.js itself is embedded, once
+    assert len(re.findall(r"^\* plotly\.js v\d", page, re.MULTILINE)) == 1
+
+
+def test_report_has_the_view_with_frames_and_slider(page):
+    assert f'id="{VIEW_ID}"' in page
+    data, layout = plotly_call(page, "newPlot")[:2]
+    names = [trace.get("name") for trace in data]
+    assert ROBOT_TRACE in names and TRAIL_TRACE in names
+    (frames,) = plotly_call(page, "addFrames")
+    assert len(frames) == REPORT_FRAMES
+    assert [f["name"] for f in frames] == [frame_name(k) for k in range(REPORT_FRAMES)]
+    (slider,) = layout["sliders"]
+    assert len(slider["steps"]) == REPORT_FRAMES
+    assert slider["steps"][-1]["args"][0] == [frame_name(REPORT_FRAMES - 1)]
+    labels = [button["label"] for button in layout["updatemenus"][0]["buttons"]]
+    assert any("play" in label for label in labels) and any("pause" in label for label in labels)
+
+
+def test_report_tables(page, corner_result):
+    for text in (
+        "paper-corner",
+        "puma560",
+        "limits_violated",
+        corner_result.check.violations[0].message,
+        "joint 4 velocity",  # the slow-down
+        "toppra",
+        "Margins",
+        "best_X",
+        "cmaes",
+        "-56.0 %",  # joint 6 jerk margin
+    ):
+        assert text in page, text
+
+
+def test_robot_view_animates_the_dh_chain(corner, corner_result):
+    figure = robot_view_figure(corner_result, corner, n_frames=25)
+    assert len(figure.frames) == 25
+    robot_index = [trace.name for trace in figure.data].index(ROBOT_TRACE)
+    idx = frame_indices(corner_result.trajectory.n_samples, 25)
+    for k in (0, 12, 24):
+        frame = figure.frames[k]
+        assert list(frame.traces) == [robot_index, robot_index + 1]
+        robot = frame.data[0]
+        expected = chain_points(corner.robot, corner_result.trajectory.q[idx[k]])
+        drawn = np.column_stack([robot.x, robot.y, robot.z])
+        np.testing.assert_allclose(drawn, expected, atol=1e-5)
+        assert len(frame.data[1].x) == k + 1  # the trail grows with time
+    ranges = [figure.layout.scene[f"{axis}axis"].range for axis in "xyz"]
+    widths = [high - low for low, high in ranges]
+    np.testing.assert_allclose(widths, widths[0])
+
+
+def test_report_without_a_trajectory(tmp_path, corner, unreachable_result):
+    page = write_report(unreachable_result, corner, tmp_path).read_text(encoding="utf-8")
+    assert "No trajectory to show" in page
+    assert unreachable_result.message in page
+    assert len(EMBEDDED_PNG.findall(page)) == 3
+    assert "Plotly.newPlot" not in page

@@ -1,0 +1,346 @@
+"""Export a run's trajectory for other tools: plain CSV, JSON, or a ROS 2 JointTrajectory.
+
+The source is a run directory (or its ``trajectory.csv``, header
+``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed``) or a
+:class:`~trackplan.planning.result.Trajectory` in memory. Joint names come from
+``result.json`` next to the CSV (key ``joint_names``) when it is there, else ``q1..qn``.
+
+Formats and default files (written next to ``trajectory.csv``):
+
+- ``csv`` → ``trajectory.export.csv``: ``t,<joint names>``, one row per sample (s, rad).
+- ``json`` → ``trajectory.json``: joint names, units and every column as arrays.
+- ``ros`` → ``trajectory.ros.yaml``: a ``trajectory_msgs/msg/JointTrajectory`` as YAML.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from trackplan.errors import CaseError
+from trackplan.io.results import trajectory_header
+from trackplan.planning.result import Trajectory
+
+EXPORT_FORMATS = ("csv", "json", "ros")
+EXPORT_FILES = {
+    "csv": "trajectory.export.csv",
+    "json": "trajectory.json",
+    "ros": "trajectory.ros.yaml",
+}
+TRAJECTORY_FILE = "trajectory.csv"
+RESULT_FILE = "result.json"
+UNITS = {
+    "t": "s",
+    "positions": "rad",
+    "velocities": "rad/s",
+    "accelerations": "rad/s^2",
+    "jerks": "rad/s^3",
+    "tool_position": "m",
+    "speed": "m/s",
+}
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectoryTable:
+    """The columns of a ``trajectory.csv`` with the joint names.
+
+    Attributes
+    ----------
+    joint_names
+        One name per joint, length n.
+    t
+        Sample times, shape (N,), s, increasing.
+    q, qd, qdd, qddd
+        Joint positions and their backward differences, shape (N, n): rad, rad/s, rad/s², rad/s³.
+    tool_position
+        Tool point in the base frame, shape (N, 3), m.
+    speed
+        Cartesian tool speed, shape (N,), m/s.
+    """
+
+    joint_names: tuple[str, ...]
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    qddd: np.ndarray
+    tool_position: np.ndarray
+    speed: np.ndarray
+
+    @classmethod
+    def from_trajectory(
+        cls, trajectory: Trajectory, joint_names: Sequence[str] | None = None
+    ) -> TrajectoryTable:
+        """The table of an in-memory trajectory (joint names ``q1..qn`` unless given)."""
+        n_dof = trajectory.q.shape[1]
+        return cls(
+            joint_names=_checked_names(joint_names, n_dof, "joint_names", None),
+            t=trajectory.t,
+            q=trajectory.q,
+            qd=trajectory.qd,
+            qdd=trajectory.qdd,
+            qddd=trajectory.qddd,
+            tool_position=trajectory.tool_position,
+            speed=trajectory.speed,
+        )
+
+
+def _checked_names(
+    names: Sequence[str] | None, n_dof: int, key: str, file: str | None
+) -> tuple[str, ...]:
+    """``names`` as a tuple of n distinct non-empty strings, or ``q1..qn`` when None."""
+    if names is None:
+        return tuple(f"q{i + 1}" for i in range(n_dof))
+    if (
+        isinstance(names, str)
+        or len(names) != n_dof
+        or not all(isinstance(name, str) and name for name in names)
+        or len(set(names)) != n_dof
+    ):
+        raise CaseError(
+            f"must be a list of {n_dof} distinct joint names, got {names!r}", file=file, key=key
+        )
+    return tuple(names)
+
+
+def _joint_names_next_to(csv_file: Path, n_dof: int) -> tuple[str, ...]:
+    """Joint names from ``result.json`` beside the CSV (key ``joint_names``), else ``q1..qn``."""
+    result_file = csv_file.parent / RESULT_FILE
+    if not result_file.is_file():
+        return _checked_names(None, n_dof, "joint_names", None)
+    try:
+        summary = json.loads(result_file.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise CaseError(f"cannot read the run summary: {error}", file=str(result_file)) from None
+    names = summary.get("joint_names") if isinstance(summary, dict) else None
+    return _checked_names(names, n_dof, "joint_names", str(result_file))
+
+
+def _trajectory_file(source: Path) -> Path:
+    """The CSV file itself, or ``trajectory.csv`` inside a run directory."""
+    if source.is_dir() or source.suffix.lower() != ".csv":
+        return source / TRAJECTORY_FILE
+    return source
+
+
+def read_trajectory_table(file: Path) -> TrajectoryTable:
+    """Read a run's ``trajectory.csv`` completely (every column), with its joint names.
+
+    Parameters
+    ----------
+    file
+        The CSV file, or the run directory holding ``trajectory.csv``.
+
+    Returns
+    -------
+    TrajectoryTable
+        Joint names from ``result.json`` beside the file when present.
+
+    Raises
+    ------
+    CaseError
+        Naming the file and what is wrong: missing, unreadable, a header that is not
+        ``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed``, a non-numeric or short
+        row, a non-finite value, no sample, or times that do not increase.
+    """
+    file = _trajectory_file(Path(file))
+    where = str(file)
+    try:
+        lines = file.read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        raise CaseError("no trajectory file: plan or optimize a case first", file=where) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise CaseError(f"cannot read the trajectory: {error}", file=where) from None
+    header = lines[0].strip().split(",") if lines else []
+    body = [line for line in lines[1:] if line.strip()]
+    if not body:
+        raise CaseError("the trajectory has no sample", file=where)
+    try:
+        rows = np.loadtxt(body, delimiter=",", ndmin=2)
+    except ValueError as error:
+        raise CaseError(f"malformed row: {error}", file=where) from None
+    n_dof, rest = divmod(len(header) - 5, 4)
+    if n_dof < 1 or rest or header != trajectory_header(n_dof):
+        raise CaseError(
+            "header must be t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed, "
+            f"got {','.join(header)!r}",
+            file=where,
+            key="header",
+        )
+    if rows.shape[1] != len(header):
+        raise CaseError(f"rows have {rows.shape[1]} columns, the header {len(header)}", file=where)
+    bad = np.argwhere(~np.isfinite(rows))
+    if bad.size:
+        line, column = int(bad[0, 0]) + 2, header[int(bad[0, 1])]
+        raise CaseError(f"non-finite {column} on line {line}", file=where)
+    t = rows[:, 0]
+    if t[0] < 0 or np.any(np.diff(t) <= 0):
+        raise CaseError(
+            "times must start at or after 0 s and increase from row to row", file=where, key="t"
+        )
+    q, qd, qdd, qddd = (rows[:, 1 + k * n_dof : 1 + (k + 1) * n_dof] for k in range(4))
+    return TrajectoryTable(
+        joint_names=_joint_names_next_to(file, n_dof),
+        t=t,
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        qddd=qddd,
+        tool_position=rows[:, -4:-1],
+        speed=rows[:, -1],
+    )
+
+
+def _duration_msg(t: float) -> dict[str, int]:
+    """A ``builtin_interfaces/Duration`` of t seconds: whole seconds and nanoseconds."""
+    sec, nanosec = divmod(round(t * 1e9), 1_000_000_000)
+    return {"sec": sec, "nanosec": nanosec}
+
+
+def joint_trajectory_msg(table: TrajectoryTable, frame_id: str = "") -> dict:
+    """A ROS 2 ``trajectory_msgs/msg/JointTrajectory`` as plain data.
+
+    Parameters
+    ----------
+    table
+        The trajectory.
+    frame_id
+        ``header.frame_id``; empty by default, as joint-space trajectories carry none.
+
+    Returns
+    -------
+    dict
+        ``{header: {stamp: {sec, nanosec}, frame_id}, joint_names, points: [{positions,
+        velocities, accelerations, effort: [], time_from_start: {sec, nanosec}}]}``; a zero
+        stamp means "start when received".
+    """
+    return {
+        "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": frame_id},
+        "joint_names": list(table.joint_names),
+        "points": [
+            {
+                "positions": q,
+                "velocities": qd,
+                "accelerations": qdd,
+                "effort": [],
+                "time_from_start": _duration_msg(t),
+            }
+            for t, q, qd, qdd in zip(
+                table.t.tolist(),
+                table.q.tolist(),
+                table.qd.tolist(),
+                table.qdd.tolist(),
+                strict=True,
+            )
+        ],
+    }
+
+
+def _write_csv(table: TrajectoryTable, output: Path) -> None:
+    lines = [",".join(["t", *table.joint_names])]
+    # repr of a Python float is the shortest text that reads back to the same float
+    lines += [",".join(map(repr, row)) for row in np.column_stack([table.t, table.q]).tolist()]
+    output.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def _write_json(table: TrajectoryTable, output: Path) -> None:
+    content = {
+        "joint_names": list(table.joint_names),
+        "units": UNITS,
+        "t": table.t.tolist(),
+        "positions": table.q.tolist(),
+        "velocities": table.qd.tolist(),
+        "accelerations": table.qdd.tolist(),
+        "jerks": table.qddd.tolist(),
+        "tool_position": table.tool_position.tolist(),
+        "speed": table.speed.tolist(),
+    }
+    # one key per line keeps the file readable without a line per number
+    body = ",\n".join(f"  {json.dumps(key)}: {json.dumps(value)}" for key, value in content.items())
+    output.write_text("{\n" + body + "\n}\n", encoding="utf-8")
+
+
+def _write_ros(table: TrajectoryTable, output: Path, frame_id: str) -> None:
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+    text = yaml.dump(
+        joint_trajectory_msg(table, frame_id),
+        Dumper=dumper,
+        sort_keys=False,
+        default_flow_style=None,
+        width=120,
+    )
+    output.write_text(text, encoding="utf-8")
+
+
+def export_trajectory(
+    source: Path | str | Trajectory,
+    fmt: str,
+    output: Path | str | None = None,
+    *,
+    joint_names: Sequence[str] | None = None,
+    frame_id: str = "",
+) -> Path:
+    """Export a trajectory as CSV, JSON or a ROS 2 JointTrajectory (YAML).
+
+    Parameters
+    ----------
+    source
+        A run directory, its ``trajectory.csv``, or a trajectory in memory.
+    fmt
+        ``csv``, ``json`` or ``ros``.
+    output
+        The file to write; by default ``trajectory.export.csv``, ``trajectory.json`` or
+        ``trajectory.ros.yaml`` next to ``trajectory.csv`` (an existing directory receives
+        the default name). Required when ``source`` is a :class:`Trajectory`.
+    joint_names
+        Overrides the joint names (else ``result.json``'s ``joint_names``, else ``q1..qn``).
+    frame_id
+        ``header.frame_id`` of the ROS message.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    CaseError
+        For an unknown format, a missing or malformed ``trajectory.csv`` or ``result.json``,
+        wrong joint names, or no ``output`` for an in-memory trajectory.
+    """
+    fmt = fmt.lower()
+    if fmt not in EXPORT_FORMATS:
+        raise CaseError(
+            f"unknown export format {fmt!r}: use one of {', '.join(EXPORT_FORMATS)}", key="format"
+        )
+    if isinstance(source, Trajectory):
+        if output is None:
+            raise CaseError(
+                "an output file is needed to export a trajectory held in memory", key="output"
+            )
+        if source.n_samples == 0:
+            raise CaseError("the trajectory has no sample", key="trajectory")
+        table = TrajectoryTable.from_trajectory(source, joint_names)
+        target = Path(output)
+    else:
+        csv_file = _trajectory_file(Path(source))
+        table = read_trajectory_table(csv_file)
+        if joint_names is not None:
+            names = _checked_names(joint_names, table.q.shape[1], "joint_names", None)
+            table = replace(table, joint_names=names)
+        target = csv_file.parent / EXPORT_FILES[fmt] if output is None else Path(output)
+    if target.is_dir():
+        target = target / EXPORT_FILES[fmt]
+    target.parent.mkdir(parents=True, exist_ok=True)
+    if fmt == "csv":
+        _write_csv(table, target)
+    elif fmt == "json":
+        _write_json(table, target)
+    else:
+        _write_ros(table, target, frame_id)
+    return target

@@ -1,0 +1,507 @@
+"""Static plots of a planned trajectory (matplotlib, Agg canvas, no pyplot state).
+
+Each ``*_figure`` function returns a :class:`matplotlib.figure.Figure`;
+:func:`write_plots` saves them as PNG files. Artists that tests and readers look for
+carry a ``gid`` (``limit``, ``violation``, ``path-before``, ``reach-shell``, …).
+matplotlib is imported inside the functions so that importing trackplan stays fast.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from trackplan.case import Case
+from trackplan.planning.placement import placement_transform
+from trackplan.planning.result import LIMIT_KINDS, PlanResult
+from trackplan.report.scene import (
+    JOINT_QUANTITIES,
+    chain_points,
+    equal_limits,
+    frame_indices,
+    joint_bounds,
+    joint_series,
+    path_points,
+    sphere_wireframe,
+    tracking_error,
+    triad_lines,
+    violation_samples,
+)
+from trackplan.robots.kinematics import forward_kinematics
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d import Axes3D
+
+HISTORY_KEYS = ("generation", "evaluations", "best", "mean", "feasible_share", "wall_time")
+DPI = 100
+AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")  # frame axes x, y, z
+BEFORE_COLOR = "tab:purple"
+AFTER_COLOR = "tab:orange"
+VIOLATION_COLOR = "red"
+_SYMBOLS = {
+    "position": "$q$",
+    "velocity": r"$\dot{q}$",
+    "acceleration": r"$\ddot{q}$",
+    "jerk": r"$\dddot{q}$",
+}
+
+
+def _new_figure(width: float, height: float) -> Figure:
+    """A figure on its own Agg canvas (no pyplot, no global figure registry)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _mark_violations(ax: Axes | Axes3D, coordinates: Sequence[np.ndarray], label: str) -> None:
+    """Red markers (``gid="violation"``) at the given x, y (and z) coordinates."""
+    ax.plot(
+        *coordinates,
+        ls="none",
+        marker="o",
+        ms=3.5,
+        color=VIOLATION_COLOR,
+        label=label,
+        gid="violation",
+    )
+
+
+def _status_line(result: PlanResult) -> str:
+    verdict = "feasible" if result.feasible else f"infeasible ({result.status.value})"
+    return f"{result.case_name}: {verdict}"
+
+
+def joints_figure(result: PlanResult, case: Case) -> Figure:
+    """Joint positions and their three derivatives against every joint limit.
+
+    A grid of 4 rows (q, q̇, q̈, q⃛) by one column per joint, so that each panel holds
+    one signal and its own limits: the limits differ per joint and would clutter a
+    shared panel. Limits are dashed lines (``gid="limit"``): ±limit, and q_min/q_max for
+    positions. Samples beyond a limit are red markers (``gid="violation"``) and every
+    violation window the checker reported is a red band (``gid="violation-window"``).
+    Each panel states its margin (unused fraction of the limit).
+
+    Parameters
+    ----------
+    result
+        The planned placement; time in s, joint data in rad, rad/s, rad/s², rad/s³.
+    case
+        The case (robot limits).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        4 × n axes.
+    """
+    trajectory = result.trajectory
+    robot = case.robot
+    n = robot.n_dof
+    figure = _new_figure(2.3 * n + 1.0, 9.0)
+    axes = figure.subplots(len(LIMIT_KINDS), n, sharex=True, squeeze=False)
+    half = 0.5 * trajectory.sample_time
+    for row, kind in enumerate(LIMIT_KINDS):
+        values = joint_series(trajectory, kind)
+        lower, upper = joint_bounds(robot, kind)
+        margins = result.check.joint_margins.get(kind)
+        for j in range(n):
+            ax = axes[row, j]
+            series = values[:, j]
+            ax.plot(trajectory.t, series, color=f"C{j}", lw=1.0, label=robot.joint_names[j])
+            for bound in (lower[j], upper[j]):
+                ax.axhline(bound, ls="--", lw=0.9, color="0.3", label="limit", gid="limit")
+            beyond = (series < lower[j]) | (series > upper[j])
+            if beyond.any():
+                _mark_violations(ax, (trajectory.t[beyond], series[beyond]), "beyond the limit")
+            for v in result.check.violations:
+                if v.limit == kind and v.joint == j + 1:
+                    ax.axvspan(
+                        v.t_first - half,
+                        v.t_last + half,
+                        color=VIOLATION_COLOR,
+                        alpha=0.18,
+                        lw=0,
+                        label="violation window",
+                        gid="violation-window",
+                    )
+            low = float(np.min(series, initial=lower[j]))
+            high = float(np.max(series, initial=upper[j]))
+            pad = 0.08 * (high - low)
+            ax.set_ylim(low - pad, high + pad)
+            if margins is not None and np.isfinite(margins[j]):
+                ax.text(
+                    0.98,
+                    0.04,
+                    f"margin {100 * margins[j]:.0f} %",
+                    transform=ax.transAxes,
+                    ha="right",
+                    va="bottom",
+                    fontsize=7,
+                    color=VIOLATION_COLOR if margins[j] < 0 else "0.35",
+                    bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0},
+                )
+            ax.tick_params(labelsize=7)
+            ax.grid(alpha=0.3, lw=0.5)
+            if row == 0:
+                ax.set_title(f"joint {j + 1}", fontsize=9)
+            if j == 0:
+                name, unit = JOINT_QUANTITIES[kind]
+                ax.set_ylabel(f"{name} {_SYMBOLS[kind]} [{unit}]", fontsize=8)
+            if row == len(LIMIT_KINDS) - 1:
+                ax.set_xlabel("time [s]", fontsize=8)
+    note = "" if trajectory.n_samples else f" — no trajectory: {result.message}"
+    figure.suptitle(f"{_status_line(result)}: joint trajectories and limits{note}", fontsize=10)
+    return figure
+
+
+def _plot_triads(ax: Axes3D, lines: np.ndarray, gid: str, label: str, lw: float = 1.2) -> None:
+    """Draw the output of :func:`triad_lines` (x red, y green, z blue)."""
+    for axis, color in enumerate(AXIS_COLORS):
+        ax.plot(*lines[axis].T, color=color, lw=lw, gid=gid, label=label if axis == 0 else None)
+
+
+def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
+    limits = equal_limits(points)
+    ax.set_xlim(*limits[0])
+    ax.set_ylim(*limits[1])
+    ax.set_zlim(*limits[2])
+    ax.set_box_aspect((1.0, 1.0, 1.0))
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+
+
+def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figure:
+    """The path before and after placement, in the robot's work cell (3D, equal aspect).
+
+    Left: the work cell in the base frame: the path in its definition frame (dashed,
+    ``gid="path-before"``), the placed path (solid, ``gid="path-after"``), base and part
+    frame axes, the reach shell of the placement origin (wireframe spheres of radius
+    ``case.bounds.reach``, ``gid="reach-shell"``) and the robot at the first sample.
+    Right: the placed path close up, with tool frames at a few samples
+    (``gid="tool-frames"``) and the samples inside violation windows in red.
+
+    Parameters
+    ----------
+    result
+        The planned placement (tool positions in m, base frame).
+    case
+        The case (robot, reach bounds, nominal path as fallback).
+    n_tool_frames
+        Number of tool frames drawn along the path.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two 3D axes.
+    """
+    trajectory = result.trajectory
+    points_part, points_base = path_points(result, case)
+    T_base_part = placement_transform(result.placement)
+    figure = _new_figure(13.0, 6.8)
+    ax_cell = figure.add_subplot(1, 2, 1, projection="3d")
+    ax_path = figure.add_subplot(1, 2, 2, projection="3d")
+
+    r_min, r_max = case.bounds.reach
+    shell = sphere_wireframe(r_max)
+    for radius, which in ((r_min, "min"), (r_max, "max")):
+        ax_cell.plot(
+            *sphere_wireframe(radius).T,
+            color="0.55" if which == "max" else "0.35",
+            lw=0.4,
+            alpha=0.45,
+            gid="reach-shell",
+            label=f"reach shell of the placement origin ({r_min:.3g}–{r_max:.3g} m)"
+            if which == "max"
+            else None,
+        )
+    triad_length = 0.25 * r_max
+    _plot_triads(
+        ax_cell, triad_lines(np.eye(4), triad_length), "base-frame", "base frame (x, y, z)", 2.0
+    )
+    _plot_triads(ax_cell, triad_lines(T_base_part, 0.5 * triad_length), "part-frame", "part frame")
+    ax_cell.plot(
+        *points_part.T,
+        ls="--",
+        color=BEFORE_COLOR,
+        lw=1.4,
+        gid="path-before",
+        label="path before placement (definition frame)",
+    )
+    ax_cell.plot(
+        *points_base.T, color=AFTER_COLOR, lw=2.0, gid="path-after", label="path after placement"
+    )
+    scene = [shell, points_part, points_base]
+    if trajectory.n_samples:
+        chain = chain_points(case.robot, trajectory.q[0])
+        ax_cell.plot(*chain.T, "o-", color="0.2", lw=3.0, ms=4, gid="robot", label="robot at t = 0")
+        scene.append(chain)
+    _set_equal(ax_cell, np.vstack(scene))
+    ax_cell.set_title("work cell (robot base frame)", fontsize=10)
+
+    ax_path.plot(*points_base.T, color=AFTER_COLOR, lw=2.0, gid="path-zoom")
+    ax_path.plot(*points_base[0], "o", color="tab:green", ms=6, label="start", gid="start")
+    ax_path.plot(*points_base[-1], "s", color="0.2", ms=6, label="end", gid="end")
+    extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
+    if trajectory.n_samples:
+        idx = frame_indices(trajectory.n_samples, n_tool_frames)
+        T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        _plot_triads(ax_path, triad_lines(T_tool, 0.08 * extent), "tool-frames", "tool frames")
+        bad = violation_samples(trajectory, result.check.violations)
+        if bad.any():
+            _mark_violations(ax_path, points_base[bad].T, "samples inside a violation window")
+    _set_equal(ax_path, points_base)
+    ax_path.set_title("placed path (close-up)", fontsize=10)
+
+    handles, labels = [], []
+    for ax in (ax_cell, ax_path):
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            if label not in labels:
+                handles.append(handle)
+                labels.append(label)
+    figure.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+    figure.suptitle(
+        f"{_status_line(result)}: placement X = {_format_placement(result)}", fontsize=10
+    )
+    return figure
+
+
+def _format_placement(result: PlanResult) -> str:
+    x = result.placement
+    return f"({x[0]:.4f}, {x[1]:.4f}, {x[2]:.4f}) m, rpy ({x[3]:.4f}, {x[4]:.4f}, {x[5]:.4f}) rad"
+
+
+def speed_figure(result: PlanResult, case: Case) -> Figure:
+    """Tool speed against v_r and v_t^max, and the tracking error against ρ, over time.
+
+    Top (``gid="speed"``): Cartesian speed of the tool point with the rated speed
+    (``gid="rated-speed"``) and the corner speed cap (``gid="corner-speed"``); slow-downs on
+    straight pieces shaded. Bottom (``gid="tracking-error"``): distance of the tool point
+    from the nominal path (sharp corners kept) with the tolerance ρ (``gid="tolerance"``).
+    Samples inside a speed or tracking violation window the checker reported are red
+    markers (``gid="violation"``).
+
+    Parameters
+    ----------
+    result
+        The planned placement (speed in m/s, shown in mm/s).
+    case
+        The case (task bounds, nominal path).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two axes sharing the time axis.
+    """
+    trajectory = result.trajectory
+    task = case.task
+    t = trajectory.t
+    figure = _new_figure(11.0, 6.5)
+    ax_speed, ax_error = figure.subplots(2, 1, sharex=True)
+
+    ax_speed.plot(
+        t, 1e3 * trajectory.speed, color="tab:blue", lw=1.2, label="tool speed", gid="speed"
+    )
+    ax_speed.axhline(
+        1e3 * task.rated_speed,
+        ls="--",
+        color="tab:green",
+        label=f"rated speed $v_r$ = {1e3 * task.rated_speed:.4g} mm/s",
+        gid="rated-speed",
+    )
+    ax_speed.axhline(
+        1e3 * task.corner_speed,
+        ls=":",
+        color="tab:orange",
+        lw=1.5,
+        label=rf"corner speed cap $v_t^{{max}}$ = {1e3 * task.corner_speed:.4g} mm/s",
+        gid="corner-speed",
+    )
+    if trajectory.n_samples:
+        for k, slowdown in enumerate(result.slowdowns):
+            t0, t1 = np.interp([slowdown.s_start, slowdown.s_end], trajectory.s, t)
+            ax_speed.axvspan(
+                t0,
+                t1,
+                color="tab:orange",
+                alpha=0.15,
+                lw=0,
+                gid="slowdown",
+                label="slow-down below $v_r$" if k == 0 else None,
+            )
+            ax_speed.annotate(
+                slowdown.limit,
+                (0.5 * (t0 + t1), 1e3 * slowdown.speed),
+                textcoords="offset points",
+                xytext=(0, -14),
+                ha="center",
+                fontsize=7,
+                color="tab:orange",
+            )
+    ax_speed.set_ylabel("tool speed [mm/s]")
+    top = max(task.rated_speed, task.corner_speed, float(np.max(trajectory.speed, initial=0.0)))
+    ax_speed.set_ylim(0.0, 1.15e3 * top)
+
+    error = tracking_error(result, case)
+    ax_error.plot(
+        t, 1e3 * error, color="tab:purple", lw=1.2, label="tracking error", gid="tracking-error"
+    )
+    ax_error.axhline(
+        1e3 * task.tolerance,
+        ls="--",
+        color="0.3",
+        label=f"tolerance ρ = {1e3 * task.tolerance:.4g} mm",
+        gid="tolerance",
+    )
+    ax_error.set_ylabel("tracking error [mm]")
+    ax_error.set_xlabel("time [s]")
+    ax_error.set_ylim(0.0, 1.15e3 * max(task.tolerance, float(np.max(error, initial=0.0))))
+
+    # the speed cap depends on where the tool is (corner or straight): mark what the
+    # checker reported rather than guess the cap here
+    for ax, values, kind in ((ax_speed, trajectory.speed, "speed"), (ax_error, error, "tracking")):
+        reported = [v for v in result.check.violations if v.limit == kind]
+        inside = violation_samples(trajectory, reported)
+        if inside.any():
+            _mark_violations(ax, (t[inside], 1e3 * values[inside]), f"{kind} violation")
+        ax.grid(alpha=0.3, lw=0.5)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    note = "" if trajectory.n_samples else f" — no trajectory: {result.message}"
+    figure.suptitle(f"{_status_line(result)}: tool speed and tracking error{note}", fontsize=10)
+    return figure
+
+
+def history_columns(
+    history: Mapping[str, Mapping[str, np.ndarray]],
+) -> dict[str, dict[str, np.ndarray]]:
+    """Check a history table and return it as float arrays of equal length per method."""
+    columns: dict[str, dict[str, np.ndarray]] = {}
+    for method, table in history.items():
+        missing = [key for key in HISTORY_KEYS if key not in table]
+        if missing:
+            raise ValueError(f"history of {method!r} lacks {', '.join(missing)}")
+        arrays = {key: np.asarray(table[key], dtype=float).ravel() for key in HISTORY_KEYS}
+        lengths = {len(a) for a in arrays.values()}
+        if len(lengths) != 1:
+            raise ValueError(
+                f"history of {method!r} has columns of different lengths {sorted(lengths)}"
+            )
+        columns[method] = arrays
+    return columns
+
+
+def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figure:
+    """Best and mean fitness and feasible share per generation, one colour per method.
+
+    Each generation is drawn at its cumulative number of placement evaluations, the
+    budget all methods share (their population sizes differ). Fitness axes are
+    logarithmic when every value is positive (penalised candidates sit decades above
+    feasible ones).
+
+    Parameters
+    ----------
+    history
+        ``{method: {"generation", "evaluations", "best", "mean", "feasible_share",
+        "wall_time"}}``, arrays of shape (G,) per method; fitness unitless, share in [0, 1],
+        wall time in s.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three axes (best, mean, feasible share), one line per method in each
+        (``gid=method``).
+    """
+    columns = history_columns(history)
+    figure = _new_figure(9.0, 8.0)
+    ax_best, ax_mean, ax_share = figure.subplots(3, 1, sharex=True)
+    for k, (method, c) in enumerate(columns.items()):
+        color = f"C{k}"
+        final = f"{method}: best {c['best'][-1]:.4g} after {c['evaluations'][-1]:.0f} evaluations"
+        final += f", {c['wall_time'][-1]:.3g} s"
+        ax_best.plot(
+            c["evaluations"], c["best"], "-", color=color, marker=".", gid=method, label=final
+        )
+        ax_mean.plot(
+            c["evaluations"], c["mean"], "--", color=color, marker=".", gid=method, label=method
+        )
+        ax_share.plot(
+            c["evaluations"],
+            100 * c["feasible_share"],
+            "-",
+            color=color,
+            marker=".",
+            gid=method,
+            label=method,
+        )
+    for ax, key, label in (
+        (ax_best, "best", "best fitness"),
+        (ax_mean, "mean", "mean fitness"),
+    ):
+        values = np.concatenate([c[key] for c in columns.values()])
+        if values.size and np.all(values > 0):
+            ax.set_yscale("log")
+        ax.set_ylabel(f"{label} [–]")
+    ax_share.set_ylabel("feasible share [%]")
+    ax_share.set_ylim(-2, 102)
+    ax_share.set_xlabel("placement evaluations (one marker per generation)")
+    for ax in (ax_best, ax_mean, ax_share):
+        ax.grid(alpha=0.3, lw=0.5, which="both")
+    ax_best.legend(fontsize=8)
+    figure.suptitle("placement search: convergence per method", fontsize=10)
+    return figure
+
+
+def plot_figures(
+    result: PlanResult, case: Case, history: Mapping[str, Mapping[str, np.ndarray]] | None = None
+) -> dict[str, Callable[[], Figure]]:
+    """The plots of a run as ``{file name: figure builder}``, in report order."""
+    builders: dict[str, Callable[[], Figure]] = {
+        "joints.png": lambda: joints_figure(result, case),
+        "path.png": lambda: path_figure(result, case),
+        "speed.png": lambda: speed_figure(result, case),
+    }
+    if history:
+        builders["convergence.png"] = lambda: convergence_figure(history)
+    return builders
+
+
+def write_plots(
+    result: PlanResult,
+    case: Case,
+    out_dir: Path,
+    history: Mapping[str, Mapping[str, np.ndarray]] | None = None,
+) -> list[Path]:
+    """Write ``joints.png``, ``path.png``, ``speed.png`` (and ``convergence.png``).
+
+    Parameters
+    ----------
+    result
+        The planned placement.
+    case
+        The case it was planned for.
+    out_dir
+        Directory to write into (created when missing).
+    history
+        Optimizer history per method (see :func:`convergence_figure`); when given,
+        ``convergence.png`` is written too.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, in report order.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, build in plot_figures(result, case, history).items():
+        path = out_dir / name
+        build().savefig(path, dpi=DPI)
+        written.append(path)
+    return written

@@ -1,0 +1,316 @@
+"""Geometry shared by the static plots and the interactive 3D view.
+
+Pure numpy: no plotting library is imported here. Lengths in metres, angles in radians,
+points as ``(..., 3)`` arrays with batch axes first. Polylines that hold several pieces
+separate them with a row of NaN, which both matplotlib and plotly draw as a gap.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from trackplan.case import Case
+from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
+from trackplan.planning.placement import placement_transform
+from trackplan.planning.result import PlanResult, Trajectory, Violation
+from trackplan.robots.kinematics import joint_frames
+from trackplan.robots.model import Robot
+
+#: Display name and unit of each joint limit kind.
+JOINT_QUANTITIES = {
+    "position": ("position", "rad"),
+    "velocity": ("velocity", "rad/s"),
+    "acceleration": ("acceleration", "rad/s²"),
+    "jerk": ("jerk", "rad/s³"),
+}
+
+
+def joint_series(trajectory: Trajectory, kind: str) -> np.ndarray:
+    """The trajectory's samples of one joint limit kind.
+
+    Parameters
+    ----------
+    trajectory
+        The trajectory.
+    kind
+        ``position``, ``velocity``, ``acceleration`` or ``jerk``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N, n): q (rad), q̇ (rad/s), q̈ (rad/s²) or q⃛ (rad/s³).
+    """
+    return {
+        "position": trajectory.q,
+        "velocity": trajectory.qd,
+        "acceleration": trajectory.qdd,
+        "jerk": trajectory.qddd,
+    }[kind]
+
+
+def joint_bounds(robot: Robot, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bound of one joint limit kind.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(lower, upper)``, each shape (n,), in the unit of :func:`joint_series`:
+        ``(q_min, q_max)`` for positions, ``(-limit, +limit)`` otherwise.
+    """
+    if kind == "position":
+        return robot.q_min, robot.q_max
+    limit = robot.limits(kind)
+    return -limit, limit
+
+
+def transform_points(T: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Apply a homogeneous transform to points.
+
+    Parameters
+    ----------
+    T
+        Transform, shape (4, 4).
+    points
+        Shape (..., 3), m, in the transform's source frame.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (..., 3), m, in the transform's target frame.
+    """
+    return points @ T[:3, :3].T + T[:3, 3]
+
+
+def _rotate(vectors: np.ndarray, axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rodrigues rotation of one vector (3,) about a unit axis (3,) by angles (M,)."""
+    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    return vectors * c + np.cross(axis, vectors) * s + axis * (axis @ vectors) * (1.0 - c)
+
+
+def nominal_polyline(
+    start: np.ndarray, segments: Sequence[SegmentSpec], chord_error: float = 1e-6
+) -> np.ndarray:
+    """The path as the user gave it (sharp corners kept), as a dense polyline.
+
+    Lines and sampled curves are exact; arcs are sampled so that no chord leaves the
+    arc by more than ``chord_error``.
+
+    Parameters
+    ----------
+    start
+        First point, shape (3,), m, definition frame.
+    segments
+        Line, arc and points segments in order.
+    chord_error
+        Largest distance of a chord from its arc, m.
+
+    Returns
+    -------
+    numpy.ndarray
+        Vertices, shape (K, 3), m, definition frame.
+    """
+    pieces = [np.asarray(start, dtype=float)[None, :]]
+    current = pieces[0][0]
+    for segment in segments:
+        if isinstance(segment, LineSpec):
+            piece = np.asarray(segment.to, dtype=float)[None, :]
+        elif isinstance(segment, ArcSpec):
+            axis = np.asarray(segment.normal, dtype=float)
+            axis = axis / np.linalg.norm(axis)
+            offset = current - np.asarray(segment.center, dtype=float)
+            radius = float(np.linalg.norm(offset - axis * (axis @ offset)))
+            ratio = min(chord_error / radius, 1.0) if radius > 0 else 1.0
+            step = 2.0 * np.arccos(1.0 - ratio)
+            n_pieces = max(1, int(np.ceil(abs(segment.angle) / step)))
+            angles = np.linspace(0.0, segment.angle, n_pieces + 1)[1:]
+            piece = segment.center + _rotate(offset, axis, angles)
+        elif isinstance(segment, PointsSpec):
+            piece = np.asarray(segment.points, dtype=float).reshape(-1, 3)
+        else:
+            raise TypeError(f"unknown segment type {type(segment).__name__}")
+        pieces.append(piece)
+        current = piece[-1]
+    return np.vstack(pieces)
+
+
+def distance_to_polyline(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
+    """Distance of each point from a polyline.
+
+    Parameters
+    ----------
+    points
+        Shape (N, 3), m.
+    polyline
+        Vertices, shape (K, 3), m, same frame as ``points``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N,), m.
+    """
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    if len(polyline) == 1:
+        return np.linalg.norm(points - polyline[0], axis=1)
+    a = polyline[:-1]
+    ab = np.diff(polyline, axis=0)
+    ab_sq = np.maximum(np.einsum("kj,kj->k", ab, ab), np.finfo(float).tiny)
+    distance = np.empty(len(points))
+    chunk = max(1, 2**20 // len(ab))  # bounds the (chunk, K, 3) scratch arrays
+    for lo in range(0, len(points), chunk):
+        rel = points[lo : lo + chunk, None, :] - a
+        u = np.clip(np.einsum("mkj,kj->mk", rel, ab) / ab_sq, 0.0, 1.0)
+        gap = rel - u[..., None] * ab
+        distance[lo : lo + chunk] = np.sqrt(np.min(np.einsum("mkj,mkj->mk", gap, gap), axis=1))
+    return distance
+
+
+def path_points(result: PlanResult, case: Case) -> tuple[np.ndarray, np.ndarray]:
+    """The tool path before and after placement.
+
+    The points come from ``trajectory.tool_position`` (after placement, base frame) and
+    ``inv(T_base_part)`` applied to them (before placement, definition frame), so they
+    need no path object. Without a trajectory, the nominal path stands in for both.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(points_part, points_base)``, each shape (N, 3), m: definition frame, base frame.
+    """
+    T_base_part = placement_transform(result.placement)
+    points_base = result.trajectory.tool_position
+    if len(points_base) == 0:
+        points_part = nominal_polyline(case.start, case.segments)
+        return points_part, transform_points(T_base_part, points_part)
+    return transform_points(np.linalg.inv(T_base_part), points_base), points_base
+
+
+def tracking_error(result: PlanResult, case: Case) -> np.ndarray:
+    """Distance of the tool point from the nominal path (sharp corners kept) per sample.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N,), m (empty without a trajectory).
+    """
+    if result.trajectory.n_samples == 0:
+        return np.zeros(0)
+    points_part, _ = path_points(result, case)
+    return distance_to_polyline(points_part, nominal_polyline(case.start, case.segments))
+
+
+def frame_indices(n_samples: int, n_frames: int) -> np.ndarray:
+    """Sample indices of ``n_frames`` evenly spread animation frames, first and last included.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (min(n_frames, n_samples),), increasing int indices.
+    """
+    count = max(1, min(n_frames, n_samples))
+    return np.unique(np.round(np.linspace(0, n_samples - 1, count)).astype(int))
+
+
+def chain_points(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Origins of the base, DH frames 1..n and the tool: the robot drawn as links.
+
+    Parameters
+    ----------
+    q
+        Joint positions, shape (..., n), rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (..., n + 2, 3), m, base frame.
+    """
+    return joint_frames(robot, q)[..., :3, 3]
+
+
+def sphere_wireframe(radius: float, n_meridians: int = 12, n_parallels: int = 7) -> np.ndarray:
+    """A wireframe sphere about the origin as NaN-separated circles.
+
+    Parameters
+    ----------
+    radius
+        m.
+    n_meridians, n_parallels
+        Number of meridian and parallel circles.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (K, 3), m.
+    """
+    theta = np.linspace(0.0, 2.0 * np.pi, 61)
+    circles = []
+    for phi in np.linspace(0.0, np.pi, n_meridians, endpoint=False):
+        circles.append(
+            np.stack([np.cos(theta) * np.cos(phi), np.cos(theta) * np.sin(phi), np.sin(theta)], 1)
+        )
+    for z in np.linspace(-1.0, 1.0, n_parallels + 2)[1:-1]:
+        r = np.sqrt(1.0 - z**2)
+        circles.append(np.stack([r * np.cos(theta), r * np.sin(theta), np.full_like(theta, z)], 1))
+    gap = np.full((1, 3), np.nan)
+    return radius * np.vstack([np.vstack([c, gap]) for c in circles])[:-1]
+
+
+def triad_lines(T: np.ndarray, length: float) -> np.ndarray:
+    """Axes of frames as NaN-separated line pieces, one polyline per axis.
+
+    Parameters
+    ----------
+    T
+        Frames, shape (F, 4, 4) or (4, 4).
+    length
+        Drawn axis length, m.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3, 3 F, 3), m: for x, y and z, the pieces origin → origin + length · axis.
+    """
+    T = np.asarray(T, dtype=float).reshape(-1, 4, 4)
+    origin = T[:, :3, 3]
+    gap = np.full_like(origin, np.nan)
+    return np.stack(
+        [np.stack([origin, origin + length * T[:, :3, i], gap], 1).reshape(-1, 3) for i in range(3)]
+    )
+
+
+def violation_samples(trajectory: Trajectory, violations: Sequence[Violation]) -> np.ndarray:
+    """Samples inside the time window of any of ``violations``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N,), bool.
+    """
+    inside = np.zeros(trajectory.n_samples, dtype=bool)
+    half = 0.5 * trajectory.sample_time
+    for v in violations:
+        inside |= (trajectory.t >= v.t_first - half) & (trajectory.t <= v.t_last + half)
+    return inside
+
+
+def equal_limits(points: np.ndarray, pad: float = 0.05) -> np.ndarray:
+    """Axis limits of a cube holding every finite point: equal aspect in 3D.
+
+    Parameters
+    ----------
+    points
+        Shape (M, 3), m (NaN rows ignored).
+    pad
+        Margin as a fraction of the cube's side.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3, 2): (low, high) per axis, m.
+    """
+    finite = points[np.all(np.isfinite(points), axis=1)]
+    low, high = finite.min(axis=0), finite.max(axis=0)
+    half = 0.5 * max(float(np.max(high - low)), 1e-3) * (1.0 + 2.0 * pad)
+    center = 0.5 * (low + high)
+    return np.stack([center - half, center + half], axis=1)
