@@ -30,7 +30,10 @@ def puma560() -> Robot:
         v_max=np.array([8.0, 10.0, 10.0, 5.0, 5.0, 5.0]),
         a_max=np.array([10.0, 12.0, 12.0, 8.0, 8.0, 8.0]),
         j_max=np.array([30.0, 40.0, 40.0, 20.0, 20.0, 20.0]),
-        source="Reference paper, Tables I (DH, alpha = ±pi/2) and II (limits); base frame at the shoulder (d1 = 0).",
+        source=(
+            "Reference paper, Tables I (DH, alpha = ±pi/2) and II (limits); "
+            "base frame at the shoulder (d1 = 0)."
+        ),
     )
 
 

@@ -122,9 +122,7 @@ def _forward_kinematics_flat(
                 T[r, 3] += (x * ct + y * st) * a[i] + z * d[i]
         for r in range(3):
             for c in range(4):
-                out[k, r, c] = (
-                    T[r, 0] * tool[0, c] + T[r, 1] * tool[1, c] + T[r, 2] * tool[2, c]
-                )
+                out[k, r, c] = T[r, 0] * tool[0, c] + T[r, 1] * tool[1, c] + T[r, 2] * tool[2, c]
             out[k, r, 3] += T[r, 3]
         out[k, 3, 3] = 1.0
     return out
