@@ -131,6 +131,53 @@ class PathIK:
     method: str
 
 
+@dataclass(frozen=True, eq=False)
+class PathIKBranches:
+    """Joint paths of B candidates along M poses each, on every branch.
+
+    The same paths, in the same form, as :class:`PathIK` gives for one branch (branch k of
+    candidate b is what ``solve_path_ik(robot, T, branch=k)`` returns for b), for a caller
+    that chooses the branch itself, e.g. by the objective.
+
+    Attributes
+    ----------
+    q
+        Joint paths, shape (B, K, M, n), rad (see :attr:`PathIK.q`; NaN where a branch
+        reaches no pose at all).
+    branches
+        The branch of each of the K columns, shape (K,), int (closed-form branch or numeric
+        seed index: 0 … 7).
+    reachable
+        Shape (B, K, M), bool: the branch has an IK solution at the pose.
+    switch
+        Shape (B, K, M), bool: a singularity crossing or jump between poses k − 1 and k.
+    ok
+        Shape (B, K), bool: reachable everywhere, no switch, inside the position limits.
+    margin
+        Smallest distance of the path to a joint position limit, shape (B, K), rad; negative
+        when outside, −inf when no pose is reachable.
+    first_problem
+        First pose with a problem, shape (B, K), int; −1 when ``ok``.
+    reachable_fraction
+        Share of the M poses the branch reaches, shape (B, K), in [0, 1].
+    n_switches
+        Number of poses at which the branch switches or jumps, shape (B, K), int.
+    method
+        ``"closed_form"`` or ``"numeric"``.
+    """
+
+    q: np.ndarray
+    branches: np.ndarray
+    reachable: np.ndarray
+    switch: np.ndarray
+    ok: np.ndarray
+    margin: np.ndarray
+    first_problem: np.ndarray
+    reachable_fraction: np.ndarray
+    n_switches: np.ndarray
+    method: str
+
+
 def numeric_seeds(robot: Robot) -> np.ndarray:
     """The eight seed configurations that define the numerical branches.
 
@@ -198,13 +245,113 @@ def solve_path_ik(
     CaseError
         When the shapes, the branch, max_step or the method are invalid.
     """
+    paths = _branch_paths(robot, T_base_tool, branch, max_step, method)
+    q, reach, switch, report, values, ok = paths[:6]
+    candidates, step, method = paths[6:]
+    n_cand, n_poses = reach.shape[0], reach.shape[2]
+    chosen = _choose(ok, report[..., _I_FIRST], values[..., _F_MARGIN])
+    rows = np.arange(n_cand)
+    report, values = report[rows, chosen], values[rows, chosen]
+    branches = candidates[rows, chosen]
+    statuses = tuple(_status(r, v) for r, v in zip(report, values, strict=True))
+    messages = tuple(
+        _message(robot, method, int(b), s, r, v, n_poses, step)
+        for b, s, r, v in zip(branches, statuses, report, values, strict=True)
+    )
+    return PathIK(
+        q=q[rows, chosen],
+        branch=branches,
+        reachable=reach[rows, chosen],
+        switch=switch[rows, chosen],
+        ok=ok[rows, chosen],
+        margin=values[:, _F_MARGIN],
+        first_problem=report[:, _I_FIRST],
+        status=statuses,
+        message=messages,
+        method=method,
+    )
+
+
+def solve_path_ik_branches(
+    robot: Robot,
+    T_base_tool: np.ndarray,
+    max_step: float | np.ndarray | None = None,
+    *,
+    method: str = "auto",
+) -> PathIKBranches:
+    """Joint paths of candidate pose paths on every IK branch, in one batched call.
+
+    Parameters
+    ----------
+    robot
+        The robot.
+    T_base_tool
+        Tool poses in the base frame, shape (B, M, 4, 4), metres.
+    max_step
+        As for :func:`solve_path_ik`.
+    method
+        As for :func:`solve_path_ik`.
+
+    Returns
+    -------
+    PathIKBranches
+
+    Raises
+    ------
+    CaseError
+        When the shapes, max_step or the method are invalid.
+    """
+    q, reach, switch, report, values, ok, _, _, method = _branch_paths(
+        robot, T_base_tool, None, max_step, method
+    )
+    return PathIKBranches(
+        q=q,
+        branches=np.arange(N_BRANCHES),
+        reachable=reach,
+        switch=switch,
+        ok=ok,
+        margin=values[..., _F_MARGIN],
+        first_problem=report[..., _I_FIRST],
+        reachable_fraction=1.0 - report[..., _I_N_UNREACH] / reach.shape[2],
+        n_switches=report[..., _I_N_SWITCH],
+        method=method,
+    )
+
+
+def _branch_paths(
+    robot: Robot,
+    T_base_tool: np.ndarray,
+    branch: int | np.ndarray | None,
+    max_step: float | np.ndarray | None,
+    method: str,
+) -> tuple[
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    str,
+]:
+    """The candidate branches' joint paths, analysed: the shared core of both solvers.
+
+    Parameters are those of :func:`solve_path_ik`.
+
+    Returns
+    -------
+    q, reach, switch, report, values, ok, candidates, step, method
+        Shapes (B, K, M, n), (B, K, M), (B, K, M), (B, K, _N_INT), (B, K, _N_FLOAT),
+        (B, K) bool; the branches tried (B, K), the step limit (n,) and the method used.
+    """
     T = np.ascontiguousarray(T_base_tool, dtype=float)
     if T.ndim != 4 or T.shape[-2:] != (4, 4) or T.shape[1] < 1:
         raise CaseError(f"T_base_tool must have shape (B, M, 4, 4), got {T.shape}")
+    candidates = _candidate_branches(branch, T.shape[0])
+    step = _max_step(max_step, robot.n_dof)
     n_cand, n_poses = T.shape[:2]
     n = robot.n_dof
-    candidates = _candidate_branches(branch, n_cand)
-    step = _max_step(max_step, n)
     if method == "auto":
         method = "closed_form" if has_closed_form(robot) else "numeric"
     if method == "closed_form":
@@ -236,27 +383,7 @@ def solve_path_ik(
     )
     ok = (report[..., _I_N_UNREACH] == 0) & (report[..., _I_N_SWITCH] == 0)
     ok &= values[..., _F_MARGIN] >= 0.0
-    chosen = _choose(ok, report[..., _I_FIRST], values[..., _F_MARGIN])
-    rows = np.arange(n_cand)
-    report, values = report[rows, chosen], values[rows, chosen]
-    branches = candidates[rows, chosen]
-    statuses = tuple(_status(r, v) for r, v in zip(report, values, strict=True))
-    messages = tuple(
-        _message(robot, method, int(b), s, r, v, n_poses, step)
-        for b, s, r, v in zip(branches, statuses, report, values, strict=True)
-    )
-    return PathIK(
-        q=q[rows, chosen],
-        branch=branches,
-        reachable=reach[rows, chosen],
-        switch=switch[rows, chosen],
-        ok=ok[rows, chosen],
-        margin=values[:, _F_MARGIN],
-        first_problem=report[:, _I_FIRST],
-        status=statuses,
-        message=messages,
-        method=method,
-    )
+    return q, reach, switch, report, values, ok, candidates, step, method
 
 
 def _candidate_branches(branch: int | np.ndarray | None, n_cand: int) -> np.ndarray:
