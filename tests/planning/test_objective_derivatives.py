@@ -12,9 +12,7 @@ from trackplan.planning.objective import joint_travel
 def test_joint_travel_matches_definition(rng):
     q = rng.normal(size=(50, 6))
     weights = np.array([0.3, 0.2, 0.2, 0.1, 0.1, 0.1])
-    expected = sum(
-        weights[i] * abs(q[k, i] - q[k - 1, i]) for k in range(1, 50) for i in range(6)
-    )
+    expected = sum(weights[i] * abs(q[k, i] - q[k - 1, i]) for k in range(1, 50) for i in range(6))
     assert joint_travel(q, weights) == pytest.approx(expected)
     batched = joint_travel(np.stack([q, 2 * q]), weights)
     assert batched == pytest.approx([expected, 2 * expected])

@@ -1,0 +1,155 @@
+"""Planning one placement: the paper cases, the smooth time law's promises, the outputs."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from trackplan.cli import main
+from trackplan.io.case_file import load_case
+from trackplan.io.results import read_trajectory_csv, write_trajectory_csv
+from trackplan.planning.checker import check_trajectory
+from trackplan.planning.plan import PathGeometry, plan_placement, tracking_reference
+from trackplan.planning.result import PlanStatus
+
+from .conftest import CASES
+
+
+@pytest.mark.parametrize("name", ["paper-line", "paper-circle", "paper-corner"])
+def test_paper_cases_plan_feasibly_in_smooth_mode(name):
+    case = load_case(CASES / f"{name}.yaml")
+    result = plan_placement(case, case.bounds.example)
+    assert result.feasible, result.message
+    # every output trajectory re-checked by the one checker, independently of the planner
+    geometry = PathGeometry.from_case(case)
+    report = check_trajectory(
+        case.robot,
+        result.trajectory.q,
+        case.task.sample_time,
+        tracking_reference(case, geometry, result.placement),
+    )
+    assert report.ok, [v.message for v in report.violations]
+    assert result.trajectory.q[0] == pytest.approx(result.trajectory.q[0])
+    lower_bound = result.path_length / case.task.rated_speed
+    assert lower_bound < result.duration < 1.15 * lower_bound
+
+
+def test_corner_passed_without_stopping(corner_plan):
+    traj = corner_plan.trajectory
+    path_speed = np.diff(traj.s) / traj.sample_time
+    middle = (traj.s[1:] > 0.1 * traj.s[-1]) & (traj.s[1:] < 0.9 * traj.s[-1])
+    assert path_speed[middle].min() > 0.02
+    assert corner_plan.min_corner_speed == pytest.approx(path_speed[middle].min(), rel=1e-2)
+
+
+def test_straight_pieces_run_at_exactly_the_rated_speed(corner_case, corner_plan):
+    traj = corner_plan.trajectory
+    rated = corner_case.task.rated_speed
+    path_speed = np.diff(traj.s) / traj.sample_time
+    assert path_speed.max() <= rated * (1 + 1e-9)
+    exact = np.abs(path_speed - rated) <= 1e-9 * rated
+    assert np.diff(traj.s)[exact].sum() / corner_plan.path_length > 0.85
+    assert corner_plan.rated_speed_fraction > 0.85
+    assert corner_plan.slowdowns == ()
+
+
+def test_rest_to_rest(corner_plan):
+    traj = corner_plan.trajectory
+    assert traj.s[0] == 0.0
+    assert traj.s[-1] == pytest.approx(corner_plan.planned_path.length, abs=1e-12)
+    assert np.all(traj.qd[0] == 0)
+    assert np.abs(traj.qd[-1]).max() < 1e-4  # rad/s: the last step of a jerk-limited stop
+    assert np.abs(traj.qdd[-1]).max() < 0.1
+
+
+def test_random_reachable_placements_always_meet_rate_limits(corner_case, corner_geometry):
+    """Whenever the geometric path is reachable, the smooth law meets every rate limit."""
+    rng = np.random.default_rng(3)
+    lower, upper = corner_case.bounds.lower, corner_case.bounds.upper
+    reach_min, reach_max = corner_case.bounds.reach
+    planned = 0
+    while planned < 6:
+        X = rng.uniform(lower, upper)
+        if not reach_min <= np.linalg.norm(X[:3]) <= reach_max:
+            continue
+        result = plan_placement(corner_case, X, geometry=corner_geometry)
+        if result.status in (PlanStatus.UNREACHABLE, PlanStatus.POSITION_LIMITS):
+            continue
+        planned += 1
+        assert result.feasible, (X, result.message)
+
+
+def test_unreachable_placement_reports_why(corner_case, corner_geometry):
+    result = plan_placement(corner_case, np.array([2.0, 0, 0, 0, 0, 0]), geometry=corner_geometry)
+    assert not result.feasible
+    assert result.status is PlanStatus.UNREACHABLE
+    assert "out of reach" in result.message
+    assert result.trajectory.n_samples == 0
+
+
+def test_trajectory_csv_round_trip(corner_plan, tmp_path):
+    file = tmp_path / "trajectory.csv"
+    write_trajectory_csv(corner_plan.trajectory, file)
+    t, q = read_trajectory_csv(file, 6)
+    np.testing.assert_array_equal(t, corner_plan.trajectory.t)
+    np.testing.assert_array_equal(q, corner_plan.trajectory.q)
+    header = file.read_text().splitlines()[0].split(",")
+    assert header[:2] == ["t", "q1"] and header[-4:] == ["x", "y", "z", "speed"]
+    assert len(header) == 1 + 4 * 6 + 4
+
+
+def test_cli_plan_exit_codes_and_check_round_trip(tmp_path, capsys):
+    case = str(CASES / "paper-corner.yaml")
+    assert main(["plan", case, "--out", str(tmp_path / "ok"), "--no-report"]) == 0
+    summary = json.loads((tmp_path / "ok" / "result.json").read_text())
+    for key in (
+        "placement",
+        "feasible",
+        "objective",
+        "duration",
+        "path_length",
+        "max_tracking_error",
+        "rated_speed_fraction",
+        "min_corner_speed",
+        "margins",
+        "violations",
+        "timing",
+        "branch",
+    ):
+        assert key in summary
+    assert summary["feasible"] is True and summary["timing"] == "smooth"
+    assert main(["check", case, str(tmp_path / "ok")]) == 0
+    paper = tmp_path / "paper"
+    assert main(["plan", case, "--timing", "paper", "--out", str(paper), "--no-report"]) == 3
+    summary = json.loads((paper / "result.json").read_text())
+    assert summary["feasible"] is False and summary["violations"]
+    assert summary["max_tracking_error"] == pytest.approx(2e-3, rel=1e-3)  # Eq. 10 arc
+    assert main(["check", case, str(paper)]) == 3
+    out = capsys.readouterr().out
+    assert "VIOLATION" in out and "tracking" in out
+
+
+def test_cli_plan_negative_placement_values(tmp_path):
+    case = str(CASES / "paper-line.yaml")
+    code = main(
+        [
+            "plan",
+            case,
+            "--placement",
+            "-0.1322",
+            "0.0610",
+            "0.1829",
+            "0.0312",
+            "-0.4124",
+            "0.5020",
+            "--out",
+            str(tmp_path),
+            "--no-report",
+        ]
+    )
+    assert code == 3  # the paper's Fig. 5 individual is out of reach for this PUMA
+    summary = json.loads((tmp_path / "result.json").read_text())
+    assert summary["placement"]["x"] == pytest.approx(-0.1322)
+    assert summary["status"] == "unreachable"

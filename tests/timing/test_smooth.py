@@ -1,0 +1,65 @@
+"""The smooth time law: steady speed where allowed, slow-down windows where not."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from trackplan.io.case_file import load_case
+from trackplan.planning.plan import plan_placement
+from trackplan.timing.smooth import WINDOW_MIN_LENGTH, _level_runs, _stencil_weights
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+
+
+def test_stencil_weights_are_exact_for_quartics():
+    h = 1e-3
+    x = (np.arange(5) - 0) * h
+    for offset in range(5):
+        w = _stencil_weights(offset, h)
+        x0 = x[offset]
+        f = 1 + 2 * x + 3 * x**2 + 4 * x**3 + 5 * x**4
+        d1 = 2 + 6 * x0 + 12 * x0**2 + 20 * x0**3
+        d2 = 6 + 24 * x0 + 60 * x0**2
+        d3 = 24 + 120 * x0
+        np.testing.assert_allclose(w @ f, [d1, d2, d3], rtol=1e-6)
+
+
+def test_level_runs_merge_short_runs_into_slower_ones():
+    s = np.linspace(0.0, 0.1, 101)  # 1 mm grid
+    level = np.zeros(101, dtype=int)
+    level[40:42] = 3  # a 1 mm dip: too short for a window of its own
+    level[60:90] = 1
+    runs = _level_runs(s, level)
+    for first, last in runs:
+        assert s[last] - s[first] >= WINDOW_MIN_LENGTH or len(runs) == 1
+    # the dip survives (merged into a slower neighbourhood, never sped up)
+    covering = [r for r in runs if r[0] <= 40 <= r[1]][0]
+    assert covering[1] - covering[0] >= 4
+
+
+def test_a_joint_limit_forces_a_reported_slow_down(tmp_path):
+    case = load_case(CASES / "paper-corner.yaml")
+    slow_robot = replace(case.robot, v_max=case.robot.v_max * np.array([1, 1, 1, 0.1, 1, 1]))
+    slow_case = replace(case, robot=slow_robot)
+    result = plan_placement(slow_case, case.bounds.example)
+    assert result.feasible, result.message
+    assert result.slowdowns, "joint 4 at 0.5 rad/s cannot keep 0.15 m/s on the whole path"
+    assert any("joint 4 velocity" in d.limit for d in result.slowdowns)
+    for slow in result.slowdowns:
+        assert slow.speed < slow.rated_speed and slow.s_end > slow.s_start
+    assert result.rated_speed_fraction < 0.85
+    qd = result.trajectory.qd[:, 3]
+    assert np.abs(qd).max() <= slow_robot.v_max[3]
+    assert np.abs(qd).max() > 0.9 * slow_robot.v_max[3]  # the binding limit is used
+
+
+def test_rated_speed_held_exactly_elsewhere(tmp_path):
+    case = load_case(CASES / "paper-line.yaml")
+    result = plan_placement(case, case.bounds.example)
+    traj = result.trajectory
+    path_speed = np.diff(traj.s) / traj.sample_time
+    assert path_speed.max() == pytest.approx(case.task.rated_speed, rel=1e-12)
