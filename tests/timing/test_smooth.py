@@ -37,7 +37,7 @@ def test_level_runs_merge_short_runs_into_slower_ones():
     for first, last in runs:
         assert s[last] - s[first] >= WINDOW_MIN_LENGTH or len(runs) == 1
     # the dip survives (merged into a slower neighbourhood, never sped up)
-    covering = [r for r in runs if r[0] <= 40 <= r[1]][0]
+    covering = next(r for r in runs if r[0] <= 40 <= r[1])
     assert covering[1] - covering[0] >= 4
 
 
