@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.planning.checker import RELATIVE_SLACK
 from trackplan.planning.placement import placement_transform
 from trackplan.planning.result import LIMIT_KINDS, PlanResult
 from trackplan.report.scene import (
@@ -117,7 +118,8 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
             ax.plot(trajectory.t, series, color=f"C{j}", lw=1.0, label=robot.joint_names[j])
             for bound in (lower[j], upper[j]):
                 ax.axhline(bound, ls="--", lw=0.9, color="0.3", label="limit", gid="limit")
-            beyond = (series < lower[j]) | (series > upper[j])
+            slack = RELATIVE_SLACK * np.abs([lower[j], upper[j]])  # the checker's round-off
+            beyond = (series < lower[j] - slack[0]) | (series > upper[j] + slack[1])
             if beyond.any():
                 _mark_violations(ax, (trajectory.t[beyond], series[beyond]), "beyond the limit")
             for v in result.check.violations:
