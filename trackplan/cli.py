@@ -437,3 +437,118 @@ def _print_summary(result, out: Path) -> None:
         for key, value in result.references.items():
             console.print(f"  {key} = {value:.4f} s")
     console.print(f"  results in {escape(str(out))}/")
+
+
+# --------------------------------------------------------------------------- placement search
+
+
+@app.command()
+def optimize(
+    case: Annotated[Path, typer.Argument(help="Case file.", show_default=False)],
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/optimize"),
+    method: Annotated[
+        str | None,
+        typer.Option("--method", help="ga, cmaes, de or random (default: optimizer.method)."),
+    ] = None,
+    seed: Annotated[
+        int | None, typer.Option("--seed", help="Random seed (default: optimizer.seed).")
+    ] = None,
+    budget: Annotated[
+        int | None,
+        typer.Option("--budget", help="Largest number of placement evaluations."),
+    ] = None,
+    timing: TimingOption = None,
+    report: Annotated[bool, typer.Option(help="Write plots and report.html.")] = True,
+) -> ExitCode:
+    """Search where to place the workpiece; write the best plan, history.csv and the report.
+
+    Writes what ``plan`` writes (trajectory.csv, result.json with the ``optimizer`` and
+    ``initial`` blocks, plots and report.html unless --no-report) plus history.csv. Ctrl-C
+    stops the search and still writes everything for the best placement found.
+    """
+    loaded = load_case(case)
+    result = _search(loaded, method=method, seed=seed, budget=budget, timing=_timing(timing))
+    _write_search(out, result, loaded, report=report)
+    _print_search(result, out)
+    return ExitCode.OK if result.success else ExitCode.INFEASIBLE
+
+
+@app.command()
+def demo(
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/demo"),
+) -> ExitCode:
+    """Optimize the paper's corner case (cases/paper-corner.yaml) end to end, with the report."""
+    file = shipped_cases_dir() / "paper-corner.yaml"
+    if not file.is_file():
+        raise CaseError("the shipped demo case is missing (run from a source checkout)", str(file))
+    loaded = load_case(file)
+    result = _search(loaded)
+    _write_search(out, result, loaded, report=True)
+    _print_search(result, out)
+    typer.echo(f"report: {(out / 'report.html').resolve()}")
+    return ExitCode.OK if result.success else ExitCode.INFEASIBLE
+
+
+def _search(case: Case, **options):  # type: ignore[no-untyped-def]
+    """Run the placement search, with a progress bar when stderr is a terminal."""
+    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    from trackplan.search import optimize_placement
+
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        return optimize_placement(case, **options)
+    columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=True) as bar:
+        task = bar.add_task("placement search: starting", total=None)
+
+        def show(record) -> None:  # type: ignore[no-untyped-def]
+            best = (
+                f"best J {record.best_objective:.4f}"
+                if np.isfinite(record.best_objective)
+                else f"best fitness {record.best:.4g} (none feasible yet)"
+            )
+            bar.update(
+                task,
+                description=f"generation {record.generation}  {record.evaluations} evaluations  "
+                f"{best}  feasible {100 * record.feasible_share:.0f} %",
+            )
+
+        return optimize_placement(case, progress=show, **options)
+
+
+def _write_search(out: Path, result, case: Case, *, report: bool) -> None:  # type: ignore[no-untyped-def]
+    """trackplan.outputs.write_run for the final plan, with the search blocks and history.csv."""
+    from trackplan.io.history import optimizer_summary, write_history
+    from trackplan.outputs import write_run
+
+    history = {result.method: result.history.as_columns()} if len(result.history) else None
+    extra = optimizer_summary(result, case.robot.joint_names)
+    write_run(out, result.final, case, history=history, extra=extra, report=report)
+    write_history(result, out)
+
+
+def _print_search(result, out: Path) -> None:  # type: ignore[no-untyped-def]
+    """The search summary, then the final plan's summary."""
+    console = _console()
+    initial = result.initial
+    before = (
+        f"J = {initial.objective:.4f}"
+        if initial.feasible
+        else f"infeasible ({initial.status.value})"
+    )
+    console.print(
+        f"{escape(result.method)} (seed {result.seed}): {result.evaluations} evaluations in "
+        f"{result.generations} generations, {result.wall_time_s:.2f} s, stopped: "
+        f"{escape(result.stop_reason)}"
+    )
+    console.print(f"  before (centre of the bounds, X = {_vector(initial.placement)}): {before}")
+    console.print(f"  after  (X = {_vector(result.X)}): {escape(result.message)}")
+    if not result.success:
+        for violation in result.final.check.violations[:8]:
+            console.print(f"  VIOLATION {escape(violation.message)}")
+    _print_summary(result.final, out)
+
+
+def _vector(values: np.ndarray) -> str:
+    return "(" + ", ".join(f"{v:.4f}" for v in values) + ")"

@@ -1,0 +1,171 @@
+"""optimize_placement: reproducibility, budget, Ctrl-C, the final re-check, impossible cases."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from trackplan.case import Case, PlacementBounds
+from trackplan.errors import CaseError
+from trackplan.io.case_file import load_case
+from trackplan.paths.specs import LineSpec
+from trackplan.planning.plan import PathGeometry, plan_placement
+from trackplan.search import GenerationRecord, OptimizeStatus, optimize_placement
+from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search.space import SearchSpace
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+
+
+@pytest.fixture(scope="module")
+def case() -> Case:
+    return load_case(CASES / "paper-corner.yaml")
+
+
+@pytest.fixture(scope="module")
+def geometry(case: Case) -> PathGeometry:
+    return PathGeometry.from_case(case)
+
+
+def test_same_seed_same_history_and_result(case: Case, geometry: PathGeometry) -> None:
+    runs = [optimize_placement(case, seed=7, budget=400, geometry=geometry) for _ in range(2)]
+    first, second = runs
+    for key, column in first.history.as_columns().items():
+        if key != "wall_time":
+            assert np.array_equal(column, second.history.as_columns()[key]), key
+    assert np.array_equal(first.X, second.X) and first.branch == second.branch
+    assert first.objective == second.objective
+    other = optimize_placement(case, seed=8, budget=400, geometry=geometry)
+    assert not np.array_equal(other.X, first.X)
+
+
+def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeometry) -> None:
+    result = optimize_placement(case, budget=100, geometry=geometry)
+    assert result.evaluations == 100 and result.stop_reason == "budget"
+    assert result.history.evaluations.tolist() == [30, 58, 86, 100]
+    assert result.generations == 4 and result.method == "ga" and result.seed == 0
+    assert result.success and result.status is OptimizeStatus.FEASIBLE
+    assert result.final.feasible and result.final.check.ok
+    assert np.array_equal(result.final.placement, result.X)
+    assert result.objective == pytest.approx(result.fitness, rel=5e-3)
+    assert np.all(np.diff(result.history.best) <= 0)
+    assert result.initial.placement == pytest.approx([case.bounds.reach[0], 0, 0, 0, 0, 0])
+
+
+@pytest.mark.parametrize("method", ["cmaes", "de", "random"])
+def test_other_methods(case: Case, geometry: PathGeometry, method: str) -> None:
+    result = optimize_placement(case, method=method, seed=3, budget=150, geometry=geometry)
+    assert result.method == method and result.evaluations == 150
+    assert result.success and result.final.check.ok
+
+
+def test_ctrl_c_keeps_the_best_placement(case: Case, geometry: PathGeometry) -> None:
+    seen: list[GenerationRecord] = []
+
+    def progress(record: GenerationRecord) -> None:
+        seen.append(record)
+        if record.generation == 3:
+            raise KeyboardInterrupt
+
+    result = optimize_placement(case, progress=progress, geometry=geometry)
+    assert result.stop_reason == "interrupted"
+    assert [r.generation for r in seen] == [1, 2, 3] and result.generations == 3
+    assert result.evaluations == seen[-1].evaluations == 86
+    assert result.success and result.final.feasible
+    assert result.fitness == pytest.approx(seen[-1].best)
+
+
+def test_final_recheck_catches_a_wrong_screening(
+    case: Case, geometry: PathGeometry, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Screening that calls an unreachable placement feasible with the best J: the final
+    re-check at full Ts rejects it and the next best distinct candidate is returned."""
+    planted = np.array([0.8, 0.2, 0.0, 0.0, 0.0, 0.0])  # the path leaves the workspace
+    assert not plan_placement(case, planted, geometry=geometry).feasible
+    screen = PlacementFitness._screen
+
+    def lying(self: PlacementFitness, X: np.ndarray):  # type: ignore[no-untyped-def]
+        objective, branch, violation, finding, bound = screen(self, X)
+        liar = np.all(np.isclose(X, planted), axis=1)
+        objective[liar], violation[liar], finding[liar] = 1e-3, 0.0, int(Finding.FEASIBLE)
+        return objective, branch, violation, finding, bound
+
+    monkeypatch.setattr(PlacementFitness, "_screen", lying)
+    sample = SearchSpace.sample
+
+    def planting(self: SearchSpace, rng: np.random.Generator, n: int) -> np.ndarray:
+        drawn = sample(self, rng, n)
+        drawn[0] = planted
+        return drawn
+
+    monkeypatch.setattr(SearchSpace, "sample", planting)
+    result = optimize_placement(case, budget=60, geometry=geometry)
+    assert result.rejected.shape == (1, 6) and np.allclose(result.rejected[0], planted)
+    assert result.success and result.final.check.ok
+    assert not np.allclose(result.X, planted)
+    assert "failed the final check" in result.message
+
+
+def test_no_candidate_passing_the_check_gives_infeasible(
+    case: Case, geometry: PathGeometry, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every screened-feasible candidate fails the check: the result says infeasible."""
+    screen = PlacementFitness._screen
+
+    def everything_feasible(self: PlacementFitness, X: np.ndarray):  # type: ignore[no-untyped-def]
+        objective, branch, violation, finding, bound = screen(self, X)
+        lie = finding != Finding.FEASIBLE
+        objective[lie], violation[lie], finding[lie] = 1e-3, 0.0, int(Finding.FEASIBLE)
+        objective[~lie] = 10.0  # the truly feasible rank last and stay out of the archive
+        return objective, branch, violation, finding, bound
+
+    monkeypatch.setattr(PlacementFitness, "_screen", everything_feasible)
+    result = optimize_placement(case, budget=30, seed=1, geometry=geometry)
+    assert not result.success and result.status is OptimizeStatus.INFEASIBLE
+    assert not result.final.feasible and len(result.rejected) >= 1
+
+
+def test_impossible_case_explains_the_closest_candidate(case: Case) -> None:
+    long_line = replace(case, segments=(LineSpec(np.array([3.0, 0.0, 0.0])),))
+    result = optimize_placement(long_line, budget=120)
+    assert not result.success and result.status is OptimizeStatus.INFEASIBLE
+    assert result.final.status.value == "unreachable"
+    assert "no feasible placement in 120 evaluations" in result.message
+    assert "out of reach" in result.message
+    assert np.all(result.history.feasible_share == 0.0)
+    assert result.fitness > case.objective.flat_penalty
+
+
+def test_empty_reach_is_bad_input(case: Case) -> None:
+    bounds = case.bounds
+    far = PlacementBounds(
+        np.r_[np.full(3, 0.9), bounds.lower[3:]],
+        np.r_[np.full(3, 1.0), bounds.upper[3:]],
+        bounds.reach,
+    )
+    with pytest.raises(CaseError, match="no placement satisfies the reach constraint"):
+        optimize_placement(replace(case, bounds=far))
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [({"method": "pso"}, "method must be one of"), ({"timing": "fast"}, "timing must be")],
+)
+def test_bad_options(case: Case, options: dict, match: str) -> None:
+    with pytest.raises(CaseError, match=match):
+        optimize_placement(case, **options)
+
+
+@pytest.mark.slow
+def test_corner_beats_the_papers_optimum(case: Case, geometry: PathGeometry) -> None:
+    """The default search finds a lower J than the paper's published X planned by us."""
+    paper = plan_placement(
+        case, np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522]), geometry=geometry
+    )
+    result = optimize_placement(case, geometry=geometry)
+    assert result.success and result.stop_reason == "stall"
+    assert result.objective < paper.objective
+    assert result.objective == pytest.approx(result.fitness, rel=5e-3)

@@ -1,0 +1,302 @@
+"""Batched fitness of placements (Eq. 30) with geometric screening (design.md items 5–7).
+
+Joint travel J (Eq. 8) and reachability depend only on the geometric path, not on the
+time law: J sums |Δq| along the joint path whatever the speed. So a whole population is
+screened at once on a coarse arc-length grid of the planned path: one batched IK call
+solves every candidate on all eight branches, and per candidate the feasible branch with
+the smallest J is chosen. The smooth time law always meets the rate limits by slowing
+down, so in smooth timing a geometrically feasible candidate is feasible; the time law
+runs only where the duration matters (``objective.time_weight > 0``) and the candidate
+can still beat the incumbent. In paper timing (Section 3.1 as written) every screened
+candidate is planned and checked, since that time law does not respect the limits.
+
+Fitness (Eq. 30, minimised)
+---------------------------
+- feasible: ``J + time_weight · duration``;
+- infeasible, ``penalty: flat``: the paper's constant ``M = objective.flat_penalty``;
+- infeasible, ``penalty: graded``: ``M + v`` with the violation ``v > 0`` below, so every
+  infeasible candidate ranks below every feasible one (M exceeds any J) and infeasible
+  candidates rank by how far they are from feasibility.
+
+Graded violation v (the smallest over the branches, in the order of the checks)
+-------------------------------------------------------------------------------
+- ``4 + e / 0.1 m``: the translation lies ``e`` outside the reach interval (Eq. 32);
+  the path is not solved;
+- ``0.5 + u + s + l`` (in [0.5, 2.5]): on the geometric path, ``u`` the share of poses out
+  of reach, ``s`` the share of poses where the branch switches (a singularity crossing)
+  or jumps, ``l = min(1, excess / π)`` with ``excess`` how far (rad) the joint path leaves
+  the position limits;
+- ``0.5 L / (1 + L)`` with ``L = ln(1 + x)`` (in (0, 0.5)): geometrically feasible but the
+  planned trajectory fails the checker, ``x`` being the worst excess over a limit as a
+  fraction of the limit (logarithmic: the paper's time law exceeds jerk limits 1000-fold).
+
+Duration bound
+--------------
+With ``time_weight > 0`` a candidate is timed only when ``J + time_weight · T_low`` is
+below the incumbent, ``T_low`` a lower bound of its duration from the screening grid: on
+each grid interval the tool needs at least ``Δs / v_cap`` (rated speed, corner speed on
+curved zones) and every joint at least ``|Δq_i| / q̇max_i``.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Callable, Iterable
+from concurrent.futures import Executor
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.case import Case
+from trackplan.planning.objective import joint_travel
+from trackplan.planning.plan import PathGeometry, plan_placement
+from trackplan.planning.poses import tool_poses
+from trackplan.planning.result import PlanResult
+from trackplan.robots.path_ik import solve_path_ik_branches
+from trackplan.search.space import SearchSpace
+
+SCREEN_POSES = 150
+"""Target number of poses of the screening grid along the planned path."""
+CURVED_POSES = 9
+"""Poses at least in every curved zone (arcs, corner blends) of the screening grid."""
+REACH_LEVEL = 4.0
+"""Graded violation of a placement outside the reach interval, before its excess."""
+REACH_SCALE = 0.1
+"""Reach excess that adds 1 to the graded violation, m."""
+GEOMETRY_LEVEL = 0.5
+"""Graded violation of a geometrically infeasible placement, before its shares."""
+
+
+class Finding(enum.IntEnum):
+    """What decided a candidate's feasibility (the first check it fails)."""
+
+    FEASIBLE = 0
+    REACH = 1  # translation outside the reach interval
+    UNREACHABLE = 2  # some pose has no IK solution on every branch
+    BRANCH_SWITCH = 3  # every reaching branch crosses a singularity or jumps
+    POSITION_LIMITS = 4  # every continuous branch leaves the joint range
+    CHECK = 5  # the planned trajectory fails the checker
+
+
+@dataclass(frozen=True, eq=False)
+class Screening:
+    """Fitness of a batch of B placements.
+
+    Attributes
+    ----------
+    X
+        Placements, shape (B, 6), metres and radians.
+    fitness
+        Eq. 30 as above, shape (B,).
+    objective
+        J of Eq. 8 on the screening grid of the chosen branch (paper timing: of the
+        planned trajectory), shape (B,), NaN when infeasible.
+    duration
+        Duration of the planned trajectory, s, shape (B,); NaN when not planned.
+    duration_bound
+        Lower bound of the duration from the screening grid, s, shape (B,); NaN when the
+        candidate is infeasible before timing.
+    feasible
+        Shape (B,), bool.
+    branch
+        The chosen IK branch, shape (B,), int: the feasible branch with the smallest J, or
+        the branch with the smallest violation.
+    violation
+        Graded violation v, shape (B,), 0 when feasible.
+    finding
+        :class:`Finding` code per candidate, shape (B,), int.
+    """
+
+    X: np.ndarray
+    fitness: np.ndarray
+    objective: np.ndarray
+    duration: np.ndarray
+    duration_bound: np.ndarray
+    feasible: np.ndarray
+    branch: np.ndarray
+    violation: np.ndarray
+    finding: np.ndarray
+
+
+def screening_grid(geometry: PathGeometry, n_poses: int = SCREEN_POSES) -> np.ndarray:
+    """Coarse arc lengths covering the planned path, shape (M,), m.
+
+    A grid of about ``n_poses`` points with every zone boundary
+    (:meth:`PathGeometry.grid`), plus :data:`CURVED_POSES` points across each curved zone
+    so that short corner blends are represented.
+    """
+    planned = geometry.planned
+    s = [geometry.grid(planned.length / max(n_poses - 1, 1))]
+    s += [np.linspace(s0, s1, CURVED_POSES) for s0, s1, kind in planned.zones if kind == "curved"]
+    return np.unique(np.concatenate(s))
+
+
+def plan_candidate(
+    args: tuple[Case, np.ndarray, str, int, PathGeometry],
+) -> PlanResult:
+    """:func:`plan_placement` of one ``(case, X, timing, branch, geometry)`` (for executors)."""
+    case, X, timing, branch, geometry = args
+    return plan_placement(case, X, timing=timing, branch=branch, geometry=geometry)
+
+
+class PlacementFitness:
+    """The batched fitness function of one case (see the module docstring).
+
+    Parameters
+    ----------
+    case
+        The case.
+    space
+        Its search space (for the reach constraint).
+    geometry
+        The case's paths for the timing used.
+    timing
+        ``smooth`` or ``paper``.
+    n_poses
+        Target size of the screening grid.
+    executor
+        Runs the time law of several candidates concurrently (``executor.map``); None
+        plans them one after the other in this process.
+    """
+
+    def __init__(
+        self,
+        case: Case,
+        space: SearchSpace,
+        geometry: PathGeometry,
+        timing: str,
+        *,
+        n_poses: int = SCREEN_POSES,
+        executor: Executor | None = None,
+    ):
+        self.case = case
+        self.space = space
+        self.geometry = geometry
+        self.timing = timing
+        self.s_grid = screening_grid(geometry, n_poses)
+        self.points = geometry.planned.sample(self.s_grid).position
+        self.weights = np.asarray(case.objective.weights, dtype=float)
+        self.flat = case.objective.penalty == "flat"
+        self.penalty = float(case.objective.flat_penalty)
+        self.time_weight = float(case.objective.time_weight)
+        middle = 0.5 * (self.s_grid[1:] + self.s_grid[:-1])
+        curved = np.zeros(len(middle), dtype=bool)
+        for s0, s1, kind in geometry.planned.zones:
+            if kind == "curved":
+                curved |= (middle >= s0) & (middle <= s1)
+        cap = np.where(curved, case.task.corner_speed, case.task.rated_speed)
+        self.tool_time = np.diff(self.s_grid) / cap  # (M - 1,), s
+        self._map: Callable[[Callable, Iterable], Iterable] = (
+            executor.map if executor is not None else map
+        )
+
+    def evaluate(self, X: np.ndarray, incumbent: float = np.inf) -> Screening:
+        """Fitness of a batch of placements.
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6), metres and radians.
+        incumbent
+            Best fitness found so far: with ``time_weight > 0`` a feasible candidate is
+            timed only when ``J + time_weight · T_low`` (its lowest possible fitness)
+            is below it; otherwise its fitness is that lower bound (``T_low`` instead of its
+            duration, see the module docstring).
+
+        Returns
+        -------
+        Screening
+        """
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        n = len(X)
+        fitness = np.full(n, np.nan)
+        objective = np.full(n, np.nan)
+        duration = np.full(n, np.nan)
+        bound = np.full(n, np.nan)
+        branch = np.zeros(n, dtype=int)
+        excess = self.space.reach_excess(X)
+        violation = REACH_LEVEL + excess / REACH_SCALE
+        finding = np.full(n, int(Finding.REACH))
+        inside = np.flatnonzero(excess == 0.0)
+        if len(inside):
+            geometric = self._screen(X[inside])
+            objective[inside], branch[inside], violation[inside], finding[inside] = geometric[:4]
+            bound[inside] = geometric[4]
+        feasible = finding == Finding.FEASIBLE
+        violation[feasible] = 0.0
+        fitness[feasible] = objective[feasible] + self.time_weight * bound[feasible]
+        if self.timing == "paper" or self.time_weight > 0.0:
+            self._time(X, incumbent, fitness, objective, duration, branch, violation, finding)
+            feasible = finding == Finding.FEASIBLE
+        infeasible = ~feasible
+        fitness[infeasible] = self.penalty + (0.0 if self.flat else violation[infeasible])
+        objective[infeasible] = np.nan
+        bound[~np.isin(finding, [Finding.FEASIBLE, Finding.CHECK])] = np.nan
+        return Screening(
+            X, fitness, objective, duration, bound, feasible, branch, violation, finding
+        )
+
+    def _screen(
+        self, X: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """J, branch, graded violation, finding and duration bound of placements inside the
+        reach interval."""
+        poses = tool_poses(X, self.points, self.case.task.tool_rpy)
+        paths = solve_path_ik_branches(self.case.robot, poses)
+        n_poses = len(self.s_grid)
+        with np.errstate(invalid="ignore"):
+            J = joint_travel(paths.q, self.weights)  # (B, K)
+        J = np.where(paths.ok, J, np.inf)
+        unreachable = 1.0 - paths.reachable_fraction
+        switches = paths.n_switches / n_poses
+        limits = np.minimum(1.0, np.maximum(0.0, -paths.margin) / np.pi)
+        graded = GEOMETRY_LEVEL + unreachable + switches + limits  # (B, K)
+        any_ok = paths.ok.any(axis=1)
+        choice = np.where(any_ok, np.argmin(J, axis=1), np.argmin(graded, axis=1))
+        rows = np.arange(len(X))
+        objective = np.where(any_ok, J[rows, choice], np.nan)
+        violation = np.where(any_ok, 0.0, graded[rows, choice])
+        finding = np.select(
+            [
+                any_ok,
+                unreachable[rows, choice] > 0.0,
+                paths.n_switches[rows, choice] > 0,
+            ],
+            [int(Finding.FEASIBLE), int(Finding.UNREACHABLE), int(Finding.BRANCH_SWITCH)],
+            int(Finding.POSITION_LIMITS),
+        )
+        steps = np.abs(np.diff(paths.q[rows, choice], axis=1))  # (B, M - 1, n)
+        with np.errstate(invalid="ignore"):
+            joint_time = np.max(steps / self.case.robot.v_max, axis=2)
+        bound = np.sum(np.maximum(self.tool_time, joint_time), axis=1)
+        return objective, paths.branches[choice], violation, finding, bound
+
+    def _time(
+        self,
+        X: np.ndarray,
+        incumbent: float,
+        fitness: np.ndarray,
+        objective: np.ndarray,
+        duration: np.ndarray,
+        branch: np.ndarray,
+        violation: np.ndarray,
+        finding: np.ndarray,
+    ) -> None:
+        """Plan and check the candidates whose time matters; update the arrays in place."""
+        candidates = finding == Finding.FEASIBLE
+        if self.timing != "paper":
+            candidates &= fitness < incumbent
+        index = np.flatnonzero(candidates)
+        if not len(index):
+            return
+        jobs = [(self.case, X[i], self.timing, int(branch[i]), self.geometry) for i in index]
+        for i, plan in zip(index, self._map(plan_candidate, jobs), strict=True):
+            duration[i] = plan.duration
+            if plan.feasible:
+                objective[i] = plan.objective if self.timing == "paper" else objective[i]
+                fitness[i] = objective[i] + self.time_weight * plan.duration
+            else:
+                finding[i] = int(Finding.CHECK)
+                worst = -plan.check.worst_margin() if plan.check.joint_margins else 1.0
+                level = np.log1p(max(worst, 1e-9))
+                violation[i] = GEOMETRY_LEVEL * level / (1.0 + level)

@@ -1,0 +1,377 @@
+"""Where to place the workpiece: the search facade (Problem + Algorithm + Termination).
+
+:func:`optimize_placement` wires a :class:`~trackplan.search.problem.PlacementProblem`,
+an algorithm of :mod:`trackplan.search.algorithms` and the shared termination, and runs
+them through pymoo's ask/tell interface so that it can report each generation, honour
+the evaluation budget exactly and stop cleanly on Ctrl-C. The best screened candidate is
+then planned at the full sample time by :func:`~trackplan.planning.plan.plan_placement`
+and checked by the checker; should that check fail, the next best distinct candidate of
+the archive is planned instead.
+"""
+
+from __future__ import annotations
+
+import enum
+import time
+from collections.abc import Callable
+from concurrent.futures import Executor
+from dataclasses import dataclass, field
+
+import numpy as np
+from pymoo.core.algorithm import Algorithm
+from pymoo.core.population import Population
+
+from trackplan.case import Case
+from trackplan.errors import CaseError
+from trackplan.planning.plan import PathGeometry, plan_placement
+from trackplan.planning.result import PlanResult
+from trackplan.search.algorithms import METHODS, make_algorithm, make_termination
+from trackplan.search.fitness import PlacementFitness
+from trackplan.search.problem import PlacementProblem
+from trackplan.search.space import SearchSpace
+
+TIMINGS = ("smooth", "paper")
+"""Time laws a search can plan with."""
+HISTORY_KEYS = ("generation", "evaluations", "best", "mean", "feasible_share", "wall_time")
+"""Columns of the search history (``history.csv`` and the report's convergence plot)."""
+
+
+class OptimizeStatus(enum.Enum):
+    """Outcome of a placement search."""
+
+    FEASIBLE = "feasible"  # the final plan passed the checker
+    INFEASIBLE = "infeasible"  # no candidate passed: the result is the closest one
+
+
+@dataclass(frozen=True)
+class GenerationRecord:
+    """One generation of a search, as passed to the progress callback.
+
+    Attributes
+    ----------
+    generation
+        1 for the initial population.
+    evaluations
+        Placements evaluated so far.
+    best
+        Best fitness found so far (Eq. 30).
+    mean
+        Mean fitness of the candidates evaluated in this generation.
+    feasible_share
+        Share of this generation's candidates screened feasible, in [0, 1].
+    wall_time
+        Seconds since the search started.
+    best_objective
+        J of the best candidate so far on the screening grid (NaN while none is feasible).
+    """
+
+    generation: int
+    evaluations: int
+    best: float
+    mean: float
+    feasible_share: float
+    wall_time: float
+    best_objective: float
+
+
+@dataclass(frozen=True, eq=False)
+class SearchHistory:
+    """Per-generation figures of a search, arrays of shape (G,).
+
+    Attributes
+    ----------
+    generation, evaluations, best, mean, feasible_share, wall_time
+        See :class:`GenerationRecord` (wall time in s).
+    """
+
+    generation: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+    evaluations: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+    best: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    mean: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    feasible_share: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    wall_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @classmethod
+    def from_records(cls, records: list[GenerationRecord]) -> SearchHistory:
+        """The history of a list of generation records."""
+        return cls(
+            **{
+                key: np.array([getattr(r, key) for r in records], dtype=float)
+                if key not in ("generation", "evaluations")
+                else np.array([getattr(r, key) for r in records], dtype=int)
+                for key in HISTORY_KEYS
+            }
+        )
+
+    def as_columns(self) -> dict[str, np.ndarray]:
+        """``{column: array}`` in :data:`HISTORY_KEYS` order (the report's history format)."""
+        return {key: getattr(self, key) for key in HISTORY_KEYS}
+
+    def __len__(self) -> int:
+        return len(self.generation)
+
+
+@dataclass(frozen=True, eq=False)
+class OptimizeResult:
+    """Outcome of :func:`optimize_placement`.
+
+    Attributes
+    ----------
+    success
+        True when the final plan is feasible.
+    status
+        :class:`OptimizeStatus`.
+    message
+        One line: what was found, or why nothing feasible was.
+    X
+        Best placement (x, y, z, roll, pitch, yaw), shape (6,), metres and radians.
+    branch
+        Its IK branch.
+    fitness
+        Its fitness (Eq. 30) as the search ranked it (screening grid).
+    objective
+        J (Eq. 8) of the final plan at the full sample time (NaN without a trajectory).
+    final
+        The plan at X, re-planned at the full sample time and re-checked.
+    initial
+        The plan at the centre of the bounds, or the admissible point nearest to it:
+        the "before" of the paper's Fig. 6b/7b.
+    history
+        Per-generation figures.
+    evaluations
+        Placements evaluated.
+    generations
+        Generations run (the initial population is generation 1).
+    stop_reason
+        ``stall``, ``max_generations``, ``budget``, ``converged`` (CMA-ES) or
+        ``interrupted`` (Ctrl-C).
+    wall_time_s
+        Wall time of the whole call, s.
+    method
+        The search method.
+    seed
+        The seed.
+    rejected
+        Candidates screened feasible that the final check rejected, best first, shape (R, 6).
+    """
+
+    success: bool
+    status: OptimizeStatus
+    message: str
+    X: np.ndarray
+    branch: int
+    fitness: float
+    objective: float
+    final: PlanResult
+    initial: PlanResult
+    history: SearchHistory
+    evaluations: int
+    generations: int
+    stop_reason: str
+    wall_time_s: float
+    method: str
+    seed: int
+    rejected: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+
+
+ProgressCallback = Callable[[GenerationRecord], None]
+"""Called after every generation; raising KeyboardInterrupt stops the search."""
+
+
+def optimize_placement(
+    case: Case,
+    *,
+    method: str | None = None,
+    seed: int | None = None,
+    budget: int | None = None,
+    progress: ProgressCallback | None = None,
+    geometry: PathGeometry | None = None,
+    timing: str | None = None,
+    executor: Executor | None = None,
+) -> OptimizeResult:
+    """Search the placement X of the workpiece with the least joint travel (Eq. 8, 30).
+
+    Parameters
+    ----------
+    case
+        The case: robot, path, task, bounds (Eq. 28, 29), objective and optimizer settings.
+    method
+        ``ga`` (the paper's configuration), ``cmaes``, ``de`` or ``random``; default the
+        case's ``optimizer.method``.
+    seed
+        Fixes every random choice; default the case's ``optimizer.seed``. The same seed
+        gives the same history and result.
+    budget
+        Largest number of placement evaluations; default the case's ``optimizer.budget``
+        (None: the method's own stopping rules only).
+    progress
+        Called with a :class:`GenerationRecord` after every generation. A
+        KeyboardInterrupt raised there (or anywhere in the search) stops the search; the
+        best placement found so far is still planned and returned (``stop_reason``
+        ``interrupted``).
+    geometry
+        The case's paths when already built for this timing.
+    timing
+        ``smooth`` or ``paper``; default the case's ``task.timing``. Paper timing plans
+        every screened candidate with Section 3.1's time law: slow.
+    executor
+        Plans several candidates concurrently when the time law runs during the search
+        (paper timing, or ``objective.time_weight > 0``); None: one after the other.
+
+    Returns
+    -------
+    OptimizeResult
+
+    Raises
+    ------
+    CaseError
+        For an unknown method or timing, a negative budget, or bounds with no placement
+        inside the reach interval.
+    """
+    start = time.perf_counter()
+    method = method or case.optimizer.method
+    seed = case.optimizer.seed if seed is None else int(seed)
+    budget = case.optimizer.budget if budget is None else int(budget)
+    timing = timing or case.task.timing
+    if method not in METHODS:
+        raise CaseError(f"method must be one of {', '.join(METHODS)}, got {method!r}", key="method")
+    if timing not in TIMINGS:
+        raise CaseError(f"timing must be smooth or paper, got {timing!r}", key="timing")
+    if budget is not None and budget < 1:
+        raise CaseError(f"budget must be ≥ 1 evaluation, got {budget}", key="budget")
+    space = SearchSpace.from_case(case)
+    geometry = geometry or PathGeometry.from_case(case, timing)
+    fitness = PlacementFitness(case, space, geometry, timing, executor=executor)
+    problem = PlacementProblem(space, fitness)
+    algorithm = make_algorithm(method, space, case.optimizer.population)
+    termination, parts = make_termination()
+    algorithm.setup(problem, termination=termination, seed=seed)
+    records, stop_reason = _run(algorithm, problem, parts, budget, progress, start)
+    initial = plan_placement(case, space.anchor, timing=timing, geometry=geometry)
+    final, rejected = _final_plan(case, problem, timing, geometry)
+    archive = problem.archive
+    chosen = int(np.flatnonzero(np.all(archive.X == final.placement, axis=1))[0])
+    success = bool(final.feasible)
+    return OptimizeResult(
+        success=success,
+        status=OptimizeStatus.FEASIBLE if success else OptimizeStatus.INFEASIBLE,
+        message=_message(final, problem, rejected, space),
+        X=final.placement,
+        branch=int(final.branch),
+        fitness=float(archive.fitness[chosen]),
+        objective=float(final.objective),
+        final=final,
+        initial=initial,
+        history=SearchHistory.from_records(records),
+        evaluations=problem.n_evaluations,
+        generations=len(records),
+        stop_reason=stop_reason,
+        wall_time_s=time.perf_counter() - start,
+        method=method,
+        seed=seed,
+        rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),
+    )
+
+
+def _run(
+    algorithm: Algorithm,
+    problem: PlacementProblem,
+    parts: dict,
+    budget: int | None,
+    progress: ProgressCallback | None,
+    start: float,
+) -> tuple[list[GenerationRecord], str]:
+    """Ask, evaluate, tell until a stopping rule fires; the records and the reason."""
+    records: list[GenerationRecord] = []
+    try:
+        while True:
+            infills = algorithm.ask()
+            remaining = None if budget is None else budget - problem.n_evaluations
+            truncated = remaining is not None and len(infills) > remaining
+            if truncated:
+                infills = infills[:remaining]
+            algorithm.evaluator.eval(problem, infills, algorithm=algorithm)
+            if not truncated:
+                algorithm.tell(infills=infills)
+            records.append(_record(len(records) + 1, problem, infills, start))
+            if progress is not None:
+                progress(records[-1])
+            if budget is not None and problem.n_evaluations >= budget:
+                return records, "budget"
+            if getattr(algorithm, "converged", None):
+                return records, "converged"
+            if algorithm.termination.has_terminated():
+                fired = [name for name, part in parts.items() if part.has_terminated()]
+                return records, fired[0] if fired else "stall"
+    except KeyboardInterrupt:
+        if problem.n_evaluations == 0:
+            raise
+        if problem.last is not None and (
+            not records or records[-1].evaluations < problem.n_evaluations
+        ):
+            records.append(_record(len(records) + 1, problem, problem.last.fitness, start))
+        return records, "interrupted"
+
+
+def _record(
+    generation: int, problem: PlacementProblem, batch: Population | np.ndarray, start: float
+) -> GenerationRecord:
+    """The figures of the latest generation (``batch``: its evaluated candidates' population
+    or their fitness)."""
+    fitness = batch.get("F")[:, 0] if isinstance(batch, Population) else np.asarray(batch)
+    best_objective = problem.archive.objective[0] if len(problem.archive.objective) else np.nan
+    return GenerationRecord(
+        generation=generation,
+        evaluations=problem.n_evaluations,
+        best=problem.best_fitness,
+        mean=float(np.mean(fitness)),
+        feasible_share=float(np.mean(fitness < problem.fitness.penalty)),
+        wall_time=time.perf_counter() - start,
+        best_objective=float(best_objective),
+    )
+
+
+def _final_plan(
+    case: Case, problem: PlacementProblem, timing: str, geometry: PathGeometry
+) -> tuple[PlanResult, list[np.ndarray]]:
+    """Plan the archive's candidates best first at full Ts until one passes the checker.
+
+    Returns the first feasible plan, or the plan of the best candidate when none passes;
+    and the placements screened feasible that the check rejected.
+    """
+    archive = problem.archive
+    rejected: list[np.ndarray] = []
+    first: PlanResult | None = None
+    for X, feasible, branch in zip(archive.X, archive.feasible, archive.branch, strict=True):
+        if first is not None and not feasible:
+            break
+        plan = plan_placement(case, X, timing=timing, branch=int(branch), geometry=geometry)
+        if plan.feasible:
+            return plan, rejected
+        first = first or plan
+        if feasible:
+            rejected.append(X)
+    if first is None:
+        raise CaseError("the search evaluated no placement (budget 0?)", key="budget")
+    return first, rejected
+
+
+def _message(
+    final: PlanResult, problem: PlacementProblem, rejected: list, space: SearchSpace
+) -> str:
+    """One line on the outcome."""
+    n = problem.n_evaluations
+    if final.feasible:
+        note = (
+            f" ({len(rejected)} better screened candidates failed the final check)"
+            if rejected
+            else ""
+        )
+        return (
+            f"feasible placement found in {n} evaluations: J = {final.objective:.4f}, "
+            f"duration {final.duration:.3f} s, branch {final.branch}{note}"
+        )
+    return (
+        f"no feasible placement in {n} evaluations; the closest, "
+        f"{space.describe(final.placement)}: {final.message}"
+    )

@@ -1,0 +1,125 @@
+"""The placement search as a pymoo Problem: vectorised evaluation and a record of the best.
+
+Every optimiser (GA, CMA-ES, DE, random) sees the same problem: six bounded variables
+and one objective, the fitness of Eq. 30 (:mod:`trackplan.search.fitness`). The whole
+population is evaluated in one call. The problem also keeps what the search needs
+whatever the algorithm does with its population: the number of evaluations, the best
+fitness so far, and an archive of the best distinct candidates (the fallbacks should the
+final re-check reject the best one).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pymoo.core.problem import Problem
+
+from trackplan.search.fitness import PlacementFitness, Screening
+from trackplan.search.space import N_VAR, SearchSpace
+
+ARCHIVE_SIZE = 8
+"""Distinct candidates kept for the final re-check."""
+DISTINCT = 1e-3
+"""Two placements are distinct when they differ by more than this share of a variable's range."""
+
+
+@dataclass(frozen=True, eq=False)
+class Archive:
+    """The best distinct candidates evaluated so far, best first.
+
+    Attributes
+    ----------
+    X
+        Placements, shape (K, 6).
+    fitness
+        Shape (K,).
+    objective
+        J on the screening grid, shape (K,) (NaN when infeasible).
+    feasible
+        Shape (K,), bool (as screened).
+    branch
+        Chosen IK branch, shape (K,), int.
+    """
+
+    X: np.ndarray
+    fitness: np.ndarray
+    objective: np.ndarray
+    feasible: np.ndarray
+    branch: np.ndarray
+
+    @classmethod
+    def empty(cls) -> Archive:
+        """An archive with no candidate."""
+        return cls(
+            np.zeros((0, N_VAR)), np.zeros(0), np.zeros(0), np.zeros(0, bool), np.zeros(0, int)
+        )
+
+    def merged(self, screening: Screening, span: np.ndarray, size: int = ARCHIVE_SIZE) -> Archive:
+        """This archive with a batch added: the ``size`` best, pairwise distinct.
+
+        Parameters
+        ----------
+        screening
+            The batch.
+        span
+            Ranges of the variables, shape (6,), for the distinctness test.
+        size
+            Largest number of candidates kept.
+        """
+        X = np.concatenate([self.X, screening.X])
+        fitness = np.concatenate([self.fitness, screening.fitness])
+        objective = np.concatenate([self.objective, screening.objective])
+        feasible = np.concatenate([self.feasible, screening.feasible])
+        branch = np.concatenate([self.branch, screening.branch])
+        keep: list[int] = []
+        scale = np.where(span > 0.0, span, 1.0)
+        for i in np.argsort(fitness, kind="stable"):
+            if len(keep) == size:
+                break
+            if all(np.max(np.abs(X[i] - X[j]) / scale) > DISTINCT for j in keep):
+                keep.append(int(i))
+        index = np.asarray(keep, dtype=int)
+        return Archive(X[index], fitness[index], objective[index], feasible[index], branch[index])
+
+
+class PlacementProblem(Problem):
+    """Six bounded variables X = (x, y, z, roll, pitch, yaw), one objective: Eq. 30.
+
+    Parameters
+    ----------
+    space
+        Bounds and reach constraint.
+    fitness
+        The batched fitness function.
+
+    Attributes
+    ----------
+    n_evaluations
+        Placements evaluated so far.
+    archive
+        The best distinct candidates (:class:`Archive`).
+    last
+        The screening of the latest batch, or None before the first.
+    """
+
+    def __init__(self, space: SearchSpace, fitness: PlacementFitness):
+        super().__init__(n_var=N_VAR, n_obj=1, xl=space.lower, xu=space.upper, vtype=float)
+        self.space = space
+        self.fitness = fitness
+        self.n_evaluations = 0
+        self.archive = Archive.empty()
+        self.last: Screening | None = None
+
+    @property
+    def best_fitness(self) -> float:
+        """Best fitness evaluated so far (inf before the first evaluation)."""
+        return float(self.archive.fitness[0]) if len(self.archive.fitness) else np.inf
+
+    def _evaluate(self, x: np.ndarray, out: dict, *args: object, **kwargs: object) -> None:
+        """Evaluate a batch, shape (B, 6), into ``out["F"]`` (B, 1)."""
+        screening = self.fitness.evaluate(x, incumbent=self.best_fitness)
+        self.n_evaluations += len(screening.X)
+        self.archive = self.archive.merged(screening, self.space.span)
+        self.last = screening
+        out["F"] = screening.fitness[:, None]

@@ -1,0 +1,278 @@
+"""The search space of placements: the box of Eq. 28/31 and the reach shell of Eq. 29/32.
+
+A placement X = (x, y, z, roll, pitch, yaw) is admissible when it lies inside the case's
+bounds ``[lower, upper]`` and its translation's distance from the base origin lies in the
+reach interval ``[r_min, r_max]``. The box is convex, the shell is not: sampling rejects,
+repair projects radially and falls back to a bisection towards a known admissible point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.case import PLACEMENT_KEYS, Case, PlacementBounds
+from trackplan.errors import CaseError
+
+N_VAR = 6
+"""Number of placement variables."""
+
+_REJECTION_ROUNDS = 200
+"""Batches of rejection sampling before the remaining samples are repaired instead."""
+_BISECTION_STEPS = 40
+"""Halvings of the segment towards the anchor when radial projection is not enough."""
+_INSIDE = 1e-12
+"""Relative amount by which projections land inside the reach radii (round-off)."""
+_GRID_NODES = 41
+"""Grid nodes per axis of the fallback search for the admissible point nearest the centre."""
+
+
+def box_distance_range(lower: np.ndarray, upper: np.ndarray) -> tuple[float, float]:
+    """Nearest and farthest distance of an axis-aligned box from the origin.
+
+    Parameters
+    ----------
+    lower, upper
+        Corners of the box, shape (3,), m.
+
+    Returns
+    -------
+    tuple of float
+        (nearest, farthest) distance, m.
+    """
+    lower = np.asarray(lower, dtype=float)
+    upper = np.asarray(upper, dtype=float)
+    nearest = np.clip(0.0, lower, upper)
+    farthest = np.where(np.abs(lower) > np.abs(upper), lower, upper)
+    return float(np.linalg.norm(nearest)), float(np.linalg.norm(farthest))
+
+
+@dataclass(frozen=True, eq=False)
+class SearchSpace:
+    """Admissible placements: a box and a reach shell.
+
+    Attributes
+    ----------
+    lower, upper
+        Bounds of X, shape (6,), metres and radians.
+    reach
+        (r_min, r_max): admissible distance of (x, y, z) from the base origin, m.
+    anchor
+        An admissible placement (the one nearest the box centre), shape (6,): the start of
+        the "before" plan and the fallback target of :meth:`repair`.
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    reach: tuple[float, float]
+    anchor: np.ndarray
+
+    @classmethod
+    def from_bounds(cls, bounds: PlacementBounds, file: str | None = None) -> SearchSpace:
+        """The search space of a case's bounds.
+
+        Raises
+        ------
+        CaseError
+            When no point of the box satisfies the reach constraint (checked analytically:
+            the box's nearest and farthest points from the origin against the interval).
+        """
+        lower = np.asarray(bounds.lower, dtype=float)
+        upper = np.asarray(bounds.upper, dtype=float)
+        r_min, r_max = (float(r) for r in bounds.reach)
+        if lower.shape != (N_VAR,) or upper.shape != (N_VAR,) or np.any(lower > upper):
+            raise CaseError(
+                f"placement bounds must be 6 ranges [min, max], got {lower} .. {upper}",
+                file=file,
+                key="placement",
+            )
+        nearest, farthest = box_distance_range(lower[:3], upper[:3])
+        if nearest > r_max or farthest < r_min or r_min > r_max:
+            raise CaseError(
+                f"no placement satisfies the reach constraint: the x, y, z box lies "
+                f"{nearest:.4g} to {farthest:.4g} m from the base origin, outside "
+                f"placement.reach [{r_min:.4g}, {r_max:.4g}] m",
+                file=file,
+                key="placement.reach",
+            )
+        centre = 0.5 * (lower + upper)
+        anchor = centre.copy()
+        anchor[:3] = _nearest_in_shell(centre[:3], lower[:3], upper[:3], r_min, r_max)
+        return cls(lower, upper, (r_min, r_max), anchor)
+
+    @classmethod
+    def from_case(cls, case: Case) -> SearchSpace:
+        """The search space of a case (see :meth:`from_bounds`)."""
+        return cls.from_bounds(case.bounds, case.source)
+
+    @property
+    def span(self) -> np.ndarray:
+        """``upper - lower``, shape (6,)."""
+        return self.upper - self.lower
+
+    def reach_excess(self, X: np.ndarray) -> np.ndarray:
+        """Distance of each translation outside the reach interval (0 inside).
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (B,), m.
+        """
+        r = np.linalg.norm(np.asarray(X, dtype=float)[:, :3], axis=1)
+        return np.maximum(0.0, np.maximum(self.reach[0] - r, r - self.reach[1]))
+
+    def contains(self, X: np.ndarray) -> np.ndarray:
+        """Inside the box and the reach shell, shape (B,) bool."""
+        X = np.asarray(X, dtype=float)
+        inside = np.all((X >= self.lower) & (X <= self.upper), axis=1)
+        return inside & (self.reach_excess(X) == 0.0)
+
+    def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """Uniform admissible placements by rejection sampling.
+
+        Placements are drawn uniformly in the box and kept when they satisfy the reach
+        constraint. Should the admissible share be so small that 200 batches do not
+        fill the sample, the rest is drawn in the box and repaired (no longer uniform).
+
+        Parameters
+        ----------
+        rng
+            The random generator.
+        n
+            Number of placements.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, 6).
+        """
+        kept: list[np.ndarray] = []
+        count = 0
+        batch = max(4 * n, 64)
+        for _ in range(_REJECTION_ROUNDS):
+            if count >= n:
+                break
+            X = rng.uniform(self.lower, self.upper, size=(batch, N_VAR))
+            X = X[self.reach_excess(X) == 0.0]
+            kept.append(X)
+            count += len(X)
+        if count < n:
+            kept.append(self.repair(rng.uniform(self.lower, self.upper, size=(n - count, N_VAR))))
+        return np.concatenate(kept)[:n]
+
+    def repair(self, X: np.ndarray) -> np.ndarray:
+        """Move placements into the box and the reach shell.
+
+        Angles are clipped to their bounds. The translation is clipped to the box and
+        scaled radially onto the nearest reach radius (three rounds); what is still
+        outside moves along the segment towards :attr:`anchor` to the admissible point
+        nearest to it (bisection). Admissible placements are returned unchanged.
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6).
+
+        Returns
+        -------
+        numpy.ndarray
+            Admissible placements, shape (B, 6).
+        """
+        X = np.clip(np.array(X, dtype=float), self.lower, self.upper)
+        bad = ~self.contains(X)
+        if not bad.any():
+            return X
+        r_min, r_max = self.reach
+        p = X[bad, :3]
+        for _ in range(3):
+            r = np.linalg.norm(p, axis=1, keepdims=True)
+            safe = np.where(r > 0.0, r, 1.0)
+            target = np.clip(r, r_min * (1 + _INSIDE), r_max * (1 - _INSIDE))
+            p = np.where(r > 0.0, p * target / safe, p)
+            p = np.clip(p, self.lower[:3], self.upper[:3])
+        X[bad, :3] = p
+        still = ~self.contains(X)
+        if still.any():
+            X[still] = self._bisect_to_anchor(X[still])
+        return X
+
+    def _bisect_to_anchor(self, X: np.ndarray) -> np.ndarray:
+        """For each row, the admissible point of the segment anchor → X nearest to X."""
+        inside = np.zeros(len(X))  # fraction of the way from the anchor known admissible
+        outside = np.ones(len(X))
+        for _ in range(_BISECTION_STEPS):
+            middle = 0.5 * (inside + outside)
+            ok = self.contains(self.anchor + middle[:, None] * (X - self.anchor))
+            inside = np.where(ok, middle, inside)
+            outside = np.where(ok, outside, middle)
+        return self.anchor + inside[:, None] * (X - self.anchor)
+
+    def describe(self, X: np.ndarray) -> str:
+        """``x = 0.1 m, ..., yaw = -0.2 rad`` for one placement, shape (6,)."""
+        units = ("m", "m", "m", "rad", "rad", "rad")
+        return ", ".join(
+            f"{key} = {value:.4f} {unit}"
+            for key, value, unit in zip(PLACEMENT_KEYS, X, units, strict=True)
+        )
+
+
+def _nearest_in_shell(
+    point: np.ndarray, lower: np.ndarray, upper: np.ndarray, r_min: float, r_max: float
+) -> np.ndarray:
+    """The point of ``box ∩ {r_min ≤ |p| ≤ r_max}`` nearest to ``point`` (a point of the box).
+
+    An admissible point is returned as it is. Otherwise the radial projection onto the
+    violated radius is the nearest point of the shell, hence of the admissible set when it
+    lies in the box; a point at the origin projects along +x, −x, +y, −y, +z, −z, the first
+    that lies in the box. When the projection leaves the box, the answer is the nearest
+    admissible node of a 41 × 41 × 41 grid over the box (within a grid step of the
+    optimum). The caller has checked that the box meets the shell.
+    """
+    r = float(np.linalg.norm(point))
+    if r_min <= r <= r_max:
+        return point.copy()
+    radius = r_min * (1 + _INSIDE) if r < r_min else r_max * (1 - _INSIDE)
+    if r > 0.0:
+        directions = [point / r]
+    else:
+        directions = [np.eye(3)[axis] * sign for axis in range(3) for sign in (1.0, -1.0)]
+    for direction in directions:
+        candidate = direction * radius
+        if np.all(candidate >= lower) and np.all(candidate <= upper):
+            return candidate
+    axes = np.linspace(lower, upper, _GRID_NODES).T
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    norm = np.linalg.norm(grid, axis=1)
+    grid = grid[(norm >= r_min) & (norm <= r_max)]
+    if len(grid) == 0:  # a shell thinner than the grid step
+        grid = _point_at_radius(lower, upper, r_min, r_max)[None]
+    return grid[np.argmin(np.linalg.norm(grid - point, axis=1))]
+
+
+def _point_at_radius(
+    lower: np.ndarray, upper: np.ndarray, r_min: float, r_max: float
+) -> np.ndarray:
+    """A point of the box whose distance from the origin lies in ``[r_min, r_max]``.
+
+    Along the segment from the box point nearest the origin to the farthest corner the
+    distance grows monotonically (it is convex and smallest at the start), so bisection
+    finds the middle of the admissible distances the box offers.
+    """
+    start = np.clip(0.0, lower, upper)
+    end = np.where(np.abs(lower) > np.abs(upper), lower, upper)
+    nearest, farthest = float(np.linalg.norm(start)), float(np.linalg.norm(end))
+    target = 0.5 * (max(r_min, nearest) + min(r_max, farthest))
+    low, high = 0.0, 1.0
+    for _ in range(_BISECTION_STEPS + 20):
+        middle = 0.5 * (low + high)
+        if np.linalg.norm(start + middle * (end - start)) < target:
+            low = middle
+        else:
+            high = middle
+    return start + 0.5 * (low + high) * (end - start)
