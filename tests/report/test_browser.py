@@ -52,6 +52,14 @@ SHOWS_ACTIVE_STEP = """([id, name, later]) => {
     return drawn.x.every((x, i) => x === wanted.x[i]) && drawn.z.every((z, i) => z === wanted.z[i]);
 }"""
 
+# true once the robot drawn is the pose of a frame after `step`
+SHOWS_A_LATER_FRAME = """([id, name, step]) => {
+    const gd = document.getElementById(id);
+    const drawn = gd.data.find((t) => t.name === name);
+    return gd._transitionData._frames.slice(step + 1).some((frame) =>
+        drawn.x.every((x, i) => x === frame.data[0].x[i]));
+}"""
+
 
 @pytest.fixture(scope="module")
 def browser():
@@ -96,7 +104,7 @@ def test_report_view_animates_without_errors(browser, report_file, tmp_path, cor
     expected = chain_points(corner.robot, corner_result.trajectory.q[idx])
     np.testing.assert_allclose(start, expected[0], atol=1e-5)
 
-    # the slider's own action: animate to a later frame
+    # what a slider step does: animate to a later frame
     later = REPORT_FRAMES * 3 // 4
     page.evaluate(
         "async ([id, name]) => { await Plotly.animate(document.getElementById(id), [name],"
@@ -110,19 +118,25 @@ def test_report_view_animates_without_errors(browser, report_file, tmp_path, cor
     # a click on the slider rail a quarter of the way along jumps to that frame
     rail = page.locator(f"#{VIEW_ID} .slider-rail-touch-rect")
     box = rail.bounding_box()
+    # let the animation the click starts finish before play interrupts anything
+    page.evaluate(
+        "(id) => { window.sliderDone = false; document.getElementById(id)"
+        ".on('plotly_animated', () => { window.sliderDone = true; }); }",
+        VIEW_ID,
+    )
     rail.click(position={"x": 0.25 * box["width"], "y": 0.5 * box["height"]})
     page.wait_for_function(SHOWS_ACTIVE_STEP, arg=[VIEW_ID, ROBOT_TRACE, later])
+    page.wait_for_function("() => window.sliderDone")
     clicked = page.evaluate(ACTIVE_STEP)
     assert 0 < clicked < later
     np.testing.assert_allclose(
         np.array(page.evaluate(ROBOT_XYZ, ROBOT_TRACE)).T, expected[clicked], atol=1e-5
     )
 
-    # play runs the animation on from there; pause stops it
+    # play runs the animation on from there (the robot leaves the clicked frame's pose
+    # for a later frame's); pause stops it
     page.locator(f"#{VIEW_ID} .updatemenu-button").filter(has_text="play").click()
-    page.wait_for_function(
-        f"() => document.getElementById('{VIEW_ID}').layout.sliders[0].active > {clicked}"
-    )
+    page.wait_for_function(SHOWS_A_LATER_FRAME, arg=[VIEW_ID, ROBOT_TRACE, clicked])
     page.locator(f"#{VIEW_ID} .updatemenu-button").filter(has_text="pause").click()
 
     screenshot = tmp_path / "report-view.png"
