@@ -194,3 +194,13 @@ def test_plots_without_a_trajectory(tmp_path, corner, unreachable_result):
     assert not _by_gid(path.axes[0], "robot")
     written = write_plots(unreachable_result, corner, tmp_path)
     assert [p.name for p in written] == ["joints.png", "path.png", "speed.png"]
+
+
+def test_joints_use_symlog_when_violations_dwarf_the_limits(corner, corner_result):
+    wild = dataclasses.replace(corner_result.trajectory, qddd=1000 * corner_result.trajectory.qddd)
+    figure = joints_figure(dataclasses.replace(corner_result, trajectory=wild), corner)
+    grid = np.array(figure.axes).reshape(len(LIMIT_KINDS), corner.robot.n_dof)
+    jerk = LIMIT_KINDS.index("jerk")
+    assert {ax.get_yscale() for ax in grid[jerk]} == {"symlog"}
+    assert {ax.get_yscale() for ax in grid[:jerk].ravel()} == {"linear"}
+    assert all(len(_by_gid(ax, "limit")) == 2 for ax in grid[jerk])

@@ -44,6 +44,7 @@ AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")  # frame axes x, y, z
 BEFORE_COLOR = "tab:purple"
 AFTER_COLOR = "tab:orange"
 VIOLATION_COLOR = "red"
+SYMLOG_RATIO = 20.0  # data spanning more than this many limit ranges get a symlog axis
 _SYMBOLS = {
     "position": "$q$",
     "velocity": r"$\dot{q}$",
@@ -88,7 +89,8 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
     shared panel. Limits are dashed lines (``gid="limit"``): ±limit, and q_min/q_max for
     positions. Samples beyond a limit are red markers (``gid="violation"``) and every
     violation window the checker reported is a red band (``gid="violation-window"``).
-    Each panel states its margin (unused fraction of the limit).
+    Each panel states its margin (unused fraction of the limit). A panel whose data exceed
+    the limits by more than 20 times gets a symmetric-log axis (linear within ±limit).
 
     Parameters
     ----------
@@ -128,15 +130,22 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
                         v.t_first - half,
                         v.t_last + half,
                         color=VIOLATION_COLOR,
-                        alpha=0.18,
+                        alpha=0.12,
                         lw=0,
                         label="violation window",
                         gid="violation-window",
                     )
             low = float(np.min(series, initial=lower[j]))
             high = float(np.max(series, initial=upper[j]))
-            pad = 0.08 * (high - low)
-            ax.set_ylim(low - pad, high + pad)
+            limit = max(abs(lower[j]), abs(upper[j]))
+            if high - low > SYMLOG_RATIO * 2 * limit:
+                # linear inside ±limit, logarithmic beyond: the limits stay visible next
+                # to violations that exceed them by orders of magnitude
+                ax.set_yscale("symlog", linthresh=limit)
+                ax.set_ylim(1.5 * low, 1.5 * high)
+            else:
+                pad = 0.08 * (high - low)
+                ax.set_ylim(low - pad, high + pad)
             if margins is not None and np.isfinite(margins[j]):
                 ax.text(
                     0.98,
