@@ -2,14 +2,16 @@
 
 The planner is not needed to test the report: this module plans the paper's corner case
 (Case 3: (0, 0, 0) → (0.5, 0, 0) → (0.3, 0, 0.5), placement X of the paper) with a small
-independent pipeline: a quintic-Bézier corner blend that stays within ρ, a speed law
-made of quintic smoothstep ramps and plateaus, Newton IK sample by sample, and the
-backward differences of design.md. One jerk violation is planted on joint 6 (it turns the
-tool about its own axis, so the tool point and the tracking error are unaffected).
+pipeline of its own: a quintic-Bézier corner blend that stays within ρ, a speed law made
+of quintic smoothstep ramps and plateaus, and Newton IK sample by sample; derivatives and
+joint limits come from the project's backward differences and checker. One jerk violation
+is planted on joint 6 (it turns the tool about its own axis, so the tool point and the
+tracking error are unaffected).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -18,6 +20,8 @@ import pytest
 
 from trackplan.case import Case, Objective, OptimizerSettings, PlacementBounds, Task
 from trackplan.paths.specs import LineSpec
+from trackplan.planning.checker import check_trajectory
+from trackplan.planning.derivatives import backward_derivatives
 from trackplan.planning.placement import placement_transform, pose_matrix, rpy_matrix
 from trackplan.planning.result import (
     LIMIT_KINDS,
@@ -26,7 +30,6 @@ from trackplan.planning.result import (
     PlanStatus,
     SlowDown,
     Trajectory,
-    Violation,
 )
 from trackplan.robots.builtin import puma560
 from trackplan.robots.kinematics import forward_kinematics, jacobian
@@ -156,59 +159,6 @@ def _solve_ik(robot: Robot, T_base_tool: np.ndarray, q_start: np.ndarray) -> np.
     return q
 
 
-def backward_differences(x: np.ndarray, sample_time: float) -> np.ndarray:
-    """Backward difference along axis 0 with the signal at rest before the first sample."""
-    return np.diff(np.concatenate([x[:1], x]), axis=0) / sample_time
-
-
-def joint_check(robot: Robot, trajectory: Trajectory) -> tuple[dict, dict, list[Violation]]:
-    """Joint margins, binding points and violations of every joint limit kind."""
-    margins: dict[str, np.ndarray] = {}
-    binding: dict[str, tuple[int, float]] = {}
-    violations: list[Violation] = []
-    units = {"position": "rad", "velocity": "rad/s", "acceleration": "rad/s²", "jerk": "rad/s³"}
-    series = {
-        "position": trajectory.q,
-        "velocity": trajectory.qd,
-        "acceleration": trajectory.qdd,
-        "jerk": trajectory.qddd,
-    }
-    for kind in LIMIT_KINDS:
-        x = series[kind]
-        if kind == "position":
-            half = 0.5 * (robot.q_max - robot.q_min)
-            mid = 0.5 * (robot.q_max + robot.q_min)
-            used, bound = np.abs(x - mid) / half, np.where(x >= mid, robot.q_max, robot.q_min)
-        else:
-            used, bound = (
-                np.abs(x) / robot.limits(kind),
-                np.broadcast_to(robot.limits(kind), x.shape),
-            )
-        margins[kind] = 1.0 - used.max(axis=0)
-        j_bind = int(np.argmin(margins[kind]))
-        binding[kind] = (j_bind + 1, float(trajectory.t[np.argmax(used[:, j_bind])]))
-        for j in np.flatnonzero(margins[kind] < 0):
-            bad = np.flatnonzero(used[:, j] > 1.0)
-            worst = bad[np.argmax(used[bad, j])]
-            t_worst = trajectory.t[worst]
-            message = (
-                f"joint {j + 1} {kind} {x[worst, j]:.3g} {units[kind]} exceeds "
-                f"{abs(bound[worst, j]):.3g} at t = {t_worst:.3f} s"
-            )
-            violations.append(
-                Violation(
-                    limit=kind,
-                    joint=int(j + 1),
-                    t_first=float(trajectory.t[bad[0]]),
-                    t_last=float(trajectory.t[bad[-1]]),
-                    worst=float(x[worst, j]),
-                    bound=float(bound[worst, j]),
-                    message=message,
-                )
-            )
-    return margins, binding, violations
-
-
 def corner_case(robot: Robot) -> Case:
     """The paper's corner case (Section 4, Case 3) as a Case."""
     reach = (math.sqrt(0.0226), math.sqrt(0.7289))
@@ -263,40 +213,31 @@ def plan_corner(case: Case) -> PlanResult:
     T_base_tool = T_base_part @ pose_matrix(_polyline_at(planned, s), rpy_matrix(TOOL_RPY))
     q = _solve_ik(robot, T_base_tool, IK_START)
     bump = np.exp(-0.5 * ((t - PLANTED_TIME) / 0.02) ** 2)
-    bump_jerk = backward_differences(
-        backward_differences(backward_differences(bump, SAMPLE_TIME), SAMPLE_TIME), SAMPLE_TIME
-    )
-    base_jerk = backward_differences(
-        backward_differences(backward_differences(q, SAMPLE_TIME), SAMPLE_TIME), SAMPLE_TIME
-    )[:, PLANTED_JOINT - 1]
+    bump_jerk = backward_derivatives(bump, SAMPLE_TIME)[2]
+    base_jerk = backward_derivatives(q, SAMPLE_TIME)[2][:, PLANTED_JOINT - 1]
     k_peak = np.argmax(np.abs(bump_jerk))
     q[:, PLANTED_JOINT - 1] += bump * (PLANTED_JERK - base_jerk[k_peak]) / bump_jerk[k_peak]
 
-    qd = backward_differences(q, SAMPLE_TIME)
-    qdd = backward_differences(qd, SAMPLE_TIME)
-    qddd = backward_differences(qdd, SAMPLE_TIME)
+    qd, qdd, qddd = backward_derivatives(q, SAMPLE_TIME)
     tool_position = forward_kinematics(robot, q)[:, :3, 3]
-    speed = np.linalg.norm(backward_differences(tool_position, SAMPLE_TIME), axis=1)
+    speed = np.linalg.norm(backward_derivatives(tool_position, SAMPLE_TIME)[0], axis=1)
     trajectory = Trajectory(SAMPLE_TIME, t, s, q, qd, qdd, qddd, tool_position, speed)
 
-    margins, binding, violations = joint_check(robot, trajectory)
     T_part_base = np.linalg.inv(T_base_part)
     points_part = tool_position @ T_part_base[:3, :3].T + T_part_base[:3, 3]
     tracking_error = float(np.max(distance_to_legs(points_part, CORNER)))
-    check = CheckReport(
-        ok=not violations,
-        joint_margins=margins,
+    check = dataclasses.replace(
+        check_trajectory(robot, q, SAMPLE_TIME),  # the joint limits; the task is known here
         task_margins={
             "tracking": 1.0 - tracking_error / TOLERANCE,
             "speed": round(1.0 - float(speed.max()) / RATED_SPEED, 9),  # the plateaus hold v_r
             "orientation": 0.95,
             "coverage": 1.0,
         },
-        violations=tuple(violations),
         max_tracking_error=tracking_error,
         max_orientation_error=1e-4,
-        binding=binding,
     )
+    violations = check.violations
     straight = leg_1 + leg_2 - 2 * d
     below_rated = (
         (slow_end - slow_start) + 2 * law.ramp_distance(SLOW_SPEED) + 2 * RATED_SPEED * RAMP_TIME
