@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
@@ -56,10 +57,26 @@ def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeomet
 
 
 @pytest.mark.parametrize("method", ["cmaes", "de", "random"])
-def test_other_methods(case: Case, geometry: PathGeometry, method: str) -> None:
-    result = optimize_placement(case, method=method, seed=3, budget=150, geometry=geometry)
-    assert result.method == method and result.evaluations == 150
-    assert result.success and result.final.check.ok
+def test_other_methods_are_reproducible(case: Case, geometry: PathGeometry, method: str) -> None:
+    first, second = (
+        optimize_placement(case, method=method, seed=3, budget=150, geometry=geometry)
+        for _ in range(2)
+    )
+    assert first.method == method and first.evaluations == 150
+    assert first.success and first.final.check.ok
+    assert np.array_equal(first.history.best, second.history.best)
+    assert np.array_equal(first.X, second.X)
+
+
+def test_time_weight_with_an_executor(case: Case, geometry: PathGeometry) -> None:
+    """Timing candidates in threads gives the same search as timing them in turn."""
+    timed = replace(case, objective=replace(case.objective, time_weight=0.1))
+    serial = optimize_placement(timed, budget=58, geometry=geometry)
+    with ThreadPoolExecutor(2) as executor:
+        threaded = optimize_placement(timed, budget=58, geometry=geometry, executor=executor)
+    assert np.array_equal(serial.history.best, threaded.history.best)
+    assert serial.success and np.array_equal(serial.X, threaded.X)
+    assert serial.fitness == pytest.approx(serial.objective + 0.1 * serial.final.duration, rel=1e-3)
 
 
 def test_ctrl_c_keeps_the_best_placement(case: Case, geometry: PathGeometry) -> None:

@@ -286,6 +286,8 @@ def _run(
     try:
         while True:
             infills = algorithm.ask()
+            if infills is None or len(infills) == 0:  # the algorithm has nothing left to try
+                return records, "converged"
             remaining = None if budget is None else budget - problem.n_evaluations
             truncated = remaining is not None and len(infills) > remaining
             if truncated:
