@@ -457,6 +457,14 @@ def optimize(
         int | None,
         typer.Option("--budget", help="Largest number of placement evaluations."),
     ] = None,
+    restarts: Annotated[
+        int | None,
+        typer.Option(
+            "--restarts",
+            help="Independent runs, the best kept (default: optimizer.restarts; 1 = the "
+            "paper's single GA run).",
+        ),
+    ] = None,
     timing: TimingOption = None,
     report: Annotated[bool, typer.Option(help="Write plots and report.html.")] = True,
 ) -> ExitCode:
@@ -467,7 +475,9 @@ def optimize(
     stops the search and still writes everything for the best placement found.
     """
     loaded = load_case(case)
-    result = _search(loaded, method=method, seed=seed, budget=budget, timing=_timing(timing))
+    result = _search(
+        loaded, method=method, seed=seed, budget=budget, restarts=restarts, timing=_timing(timing)
+    )
     _write_search(out, result, loaded, report=report)
     _print_search(result, out)
     return ExitCode.OK if result.success else ExitCode.INFEASIBLE
@@ -539,8 +549,8 @@ def _print_search(result, out: Path) -> None:  # type: ignore[no-untyped-def]
     )
     console.print(
         f"{escape(result.method)} (seed {result.seed}): {result.evaluations} evaluations in "
-        f"{result.generations} generations, {result.wall_time_s:.2f} s, stopped: "
-        f"{escape(result.stop_reason)}"
+        f"{result.generations} generations over {result.runs} runs, {result.wall_time_s:.2f} s, "
+        f"last run stopped: {escape(result.stop_reason)}"
     )
     console.print(f"  before (centre of the bounds, X = {_vector(initial.placement)}): {before}")
     console.print(f"  after  (X = {_vector(result.X)}): {escape(result.message)}")

@@ -33,7 +33,7 @@ def write_run(
     extra
         More keys for ``result.json`` (optimizer figures, the initial plan).
     report
-        Also write the plots and the HTML report.
+        Also write the plots and the HTML report (which embeds them).
 
     Returns
     -------
@@ -43,8 +43,7 @@ def write_run(
     out_dir = Path(out_dir)
     summary = write_plan_files(result, case.robot.joint_names, out_dir, extra)
     if report:
-        from trackplan.report import write_plots, write_report
+        from trackplan.report import write_report
 
-        write_plots(result, case, out_dir, history=history)
         write_report(result, case, out_dir, history=history, optimizer_info=extra)
     return summary

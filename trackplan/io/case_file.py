@@ -166,12 +166,13 @@ class ObjectiveModel(StrictModel):
 
 
 class OptimizerModel(StrictModel):
-    """``optimizer``: method, population, seed and evaluation budget."""
+    """``optimizer``: method, population, seed, evaluation budget and independent runs."""
 
     method: Literal["ga", "cmaes", "de", "random"] = "ga"
     population: Annotated[int, Field(ge=2)] = 30
     seed: Annotated[int, Field(ge=0)] = 0
     budget: Annotated[int, Field(ge=1)] | None = None
+    restarts: Annotated[int, Field(ge=1)] = 6
 
 
 class CaseModel(StrictModel):
@@ -300,6 +301,7 @@ def _case(
             population=optimizer.population,
             seed=optimizer.seed,
             budget=optimizer.budget,
+            restarts=optimizer.restarts,
         ),
         source=file,
     )

@@ -86,6 +86,7 @@ def optimizer_summary(result: OptimizeResult, joint_names: tuple[str, ...]) -> d
             "evaluations": int(result.evaluations),
             "generations": int(result.generations),
             "stop_reason": result.stop_reason,
+            "runs": int(result.runs),
             "wall_time_s": float(result.wall_time_s),
             "status": result.status.value,
             "message": result.message,

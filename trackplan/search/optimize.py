@@ -143,8 +143,11 @@ class OptimizeResult:
     generations
         Generations run (the initial population is generation 1).
     stop_reason
-        ``stall``, ``max_generations``, ``budget``, ``converged`` (CMA-ES) or
-        ``interrupted`` (Ctrl-C).
+        Why the last run stopped: ``stall``, ``max_generations``, ``budget``,
+        ``converged`` (CMA-ES) or ``interrupted`` (Ctrl-C).
+    runs
+        Independent runs made (``optimizer.restarts``, fewer when the budget or Ctrl-C
+        stopped the search).
     wall_time_s
         Wall time of the whole call, s.
     method
@@ -171,6 +174,7 @@ class OptimizeResult:
     wall_time_s: float
     method: str
     seed: int
+    runs: int = 1
     rejected: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
 
 
@@ -188,6 +192,7 @@ def optimize_placement(
     geometry: PathGeometry | None = None,
     timing: str | None = None,
     executor: Executor | None = None,
+    restarts: int | None = None,
 ) -> OptimizeResult:
     """Search the placement X of the workpiece with the least joint travel (Eq. 8, 30).
 
@@ -217,6 +222,10 @@ def optimize_placement(
     executor
         Plans several candidates concurrently when the time law runs during the search
         (paper timing, or ``objective.time_weight > 0``); None: one after the other.
+    restarts
+        Independent runs of the method, each from a fresh initial population, the best of
+        all kept; default the case's ``optimizer.restarts``. The first run uses ``seed``
+        itself, so ``restarts=1`` is one run exactly as configured (the paper's GA).
 
     Returns
     -------
@@ -232,6 +241,7 @@ def optimize_placement(
     method = method or case.optimizer.method
     seed = case.optimizer.seed if seed is None else int(seed)
     budget = case.optimizer.budget if budget is None else int(budget)
+    restarts = case.optimizer.restarts if restarts is None else int(restarts)
     timing = timing or case.task.timing
     if method not in METHODS:
         raise CaseError(f"method must be one of {', '.join(METHODS)}, got {method!r}", key="method")
@@ -239,14 +249,23 @@ def optimize_placement(
         raise CaseError(f"timing must be smooth or paper, got {timing!r}", key="timing")
     if budget is not None and budget < 1:
         raise CaseError(f"budget must be ≥ 1 evaluation, got {budget}", key="budget")
+    if restarts < 1:
+        raise CaseError(f"restarts must be ≥ 1, got {restarts}", key="restarts")
     space = SearchSpace.from_case(case)
     geometry = geometry or PathGeometry.from_case(case, timing)
     fitness = PlacementFitness(case, space, geometry, timing, executor=executor)
     problem = PlacementProblem(space, fitness)
-    algorithm = make_algorithm(method, space, case.optimizer.population)
-    termination, parts = make_termination()
-    algorithm.setup(problem, termination=termination, seed=seed)
-    records, stop_reason = _run(algorithm, problem, parts, budget, progress, start)
+    records: list[GenerationRecord] = []
+    stop_reason = ""
+    runs = 0
+    for run_seed in run_seeds(seed, restarts):
+        algorithm = make_algorithm(method, space, case.optimizer.population)
+        termination, parts = make_termination()
+        algorithm.setup(problem, termination=termination, seed=run_seed)
+        stop_reason = _run(algorithm, problem, parts, budget, progress, start, records)
+        runs += 1
+        if stop_reason in ("budget", "interrupted"):
+            break
     initial = plan_placement(case, space.anchor, timing=timing, geometry=geometry)
     final, rejected = _final_plan(case, problem, timing, geometry)
     archive = problem.archive
@@ -269,8 +288,15 @@ def optimize_placement(
         wall_time_s=time.perf_counter() - start,
         method=method,
         seed=seed,
+        runs=runs,
         rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),
     )
+
+
+def run_seeds(seed: int, restarts: int) -> list[int]:
+    """Seeds of the independent runs: ``seed`` itself, then children of it."""
+    children = np.random.SeedSequence(seed).spawn(restarts - 1)
+    return [seed] + [int(child.generate_state(1)[0]) for child in children]
 
 
 def _run(
@@ -280,14 +306,15 @@ def _run(
     budget: int | None,
     progress: ProgressCallback | None,
     start: float,
-) -> tuple[list[GenerationRecord], str]:
-    """Ask, evaluate, tell until a stopping rule fires; the records and the reason."""
-    records: list[GenerationRecord] = []
+    records: list[GenerationRecord],
+) -> str:
+    """Ask, evaluate, tell until a stopping rule fires, appending one record per generation
+    to ``records`` (numbered on from earlier runs); the stop reason."""
     try:
         while True:
             infills = algorithm.ask()
             if infills is None or len(infills) == 0:  # the algorithm has nothing left to try
-                return records, "converged"
+                return "converged"
             remaining = None if budget is None else budget - problem.n_evaluations
             truncated = remaining is not None and len(infills) > remaining
             if truncated:
@@ -299,12 +326,12 @@ def _run(
             if progress is not None:
                 progress(records[-1])
             if budget is not None and problem.n_evaluations >= budget:
-                return records, "budget"
+                return "budget"
             if getattr(algorithm, "converged", None):
-                return records, "converged"
+                return "converged"
             if algorithm.termination.has_terminated():
                 fired = [name for name, part in parts.items() if part.has_terminated()]
-                return records, fired[0] if fired else "stall"
+                return fired[0] if fired else "stall"
     except KeyboardInterrupt:
         if problem.n_evaluations == 0:
             raise
@@ -312,7 +339,7 @@ def _run(
             not records or records[-1].evaluations < problem.n_evaluations
         ):
             records.append(_record(len(records) + 1, problem, problem.last.fitness, start))
-        return records, "interrupted"
+        return "interrupted"
 
 
 def _record(
