@@ -439,6 +439,36 @@ def _print_summary(result, out: Path) -> None:
     console.print(f"  results in {escape(str(out))}/")
 
 
+@app.command()
+def export(
+    run: Annotated[Path, typer.Argument(help="Run folder (or its trajectory.csv).")],
+    format: Annotated[
+        str, typer.Option("--format", help="csv, json or ros (ROS 2 JointTrajectory YAML).")
+    ] = "ros",
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", help="File to write (default: next to trajectory.csv)."),
+    ] = None,
+    joint_names: Annotated[
+        str | None,
+        typer.Option(
+            "--joint-names",
+            help="Comma-separated joint names for the export (default: result.json's).",
+        ),
+    ] = None,
+    frame_id: Annotated[
+        str, typer.Option("--frame-id", help="header.frame_id of the ROS message.")
+    ] = "",
+) -> ExitCode:
+    """Export a run's trajectory as CSV, JSON or a ROS 2 trajectory_msgs/JointTrajectory."""
+    from trackplan.io.export import export_trajectory
+
+    names = [name.strip() for name in joint_names.split(",")] if joint_names else None
+    written = export_trajectory(run, format, output, joint_names=names, frame_id=frame_id)
+    typer.echo(f"wrote {written}")
+    return ExitCode.OK
+
+
 # --------------------------------------------------------------------------- placement search
 
 
