@@ -462,8 +462,8 @@ class _ZonePlanner:
                     mid = 0.5 * (low + high)
                     low, high = (mid, high) if needed(z, mid) <= lengths[z] else (low, mid)
                 plateau[z] = low
-                if "speed changes" not in reasons[z]:
-                    reasons[z] += "; too short for its speed changes under the joint limits"
+                if "too short" not in reasons[z]:
+                    reasons[z] = _too_short(reasons[z])
                 changed = True
             if not changed:
                 break
@@ -550,6 +550,13 @@ class _ZonePlanner:
                     new_change[z + 1] = min(new_change[z + 1], 0.95 / ratio)
         self.cap_scale *= new_cap
         self.change_scale *= new_change
+
+
+def _too_short(reason: str) -> str:
+    """The reason of a plateau lowered because its zone cannot fit its speed changes."""
+    if reason in ("rated speed", "corner speed"):
+        return f"too short to reach the {reason} under the joint acceleration and jerk limits"
+    return f"{reason}; too short for its speed changes under the joint limits"
 
 
 def _jerk_for_duration(delta: float, accel: float, jerk: float, duration: float) -> float:
