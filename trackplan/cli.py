@@ -406,8 +406,8 @@ def check(
     for kind, margin in report.joint_margins.items():
         cells = "  ".join(f"{m:+.3f}" for m in margin)
         console.print(f"  {kind:<13} margin per joint: {cells}")
-    for kind, margin in report.task_margins.items():
-        console.print(f"  {kind:<13} margin: {margin:+.3f}")
+    for kind, task_margin in report.task_margins.items():
+        console.print(f"  {kind:<13} margin: {task_margin:+.3f}")
     console.print(f"  max tracking error {report.max_tracking_error * 1e3:.4f} mm")
     for violation in report.violations:
         console.print(f"  VIOLATION {escape(violation.message)}")

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trackplan.paths import NominalPath
 from trackplan.planning.derivatives import backward_derivatives
 from trackplan.planning.result import CheckReport, Violation
 from trackplan.planning.tracking import jump_allowance, locate_on_nominal
@@ -55,7 +56,7 @@ class TrackingReference:
         Largest tool orientation error, rad.
     """
 
-    nominal: object
+    nominal: NominalPath
     T_base_part: np.ndarray
     R_part_tool: np.ndarray
     tolerance: float
@@ -104,24 +105,23 @@ def check_trajectory(
     half_range = 0.5 * (robot.q_max - robot.q_min)
     centre = 0.5 * (robot.q_max + robot.q_min)
     position_use = np.abs(q - centre) / half_range
+    bounds = {"velocity": robot.v_max, "acceleration": robot.a_max, "jerk": robot.j_max}
     signals = {
-        "position": (q, position_use, None),
-        "velocity": (qd, np.abs(qd) / robot.v_max, robot.v_max),
-        "acceleration": (qdd, np.abs(qdd) / robot.a_max, robot.a_max),
-        "jerk": (qddd, np.abs(qddd) / robot.j_max, robot.j_max),
+        "position": (q, position_use),
+        "velocity": (qd, np.abs(qd) / robot.v_max),
+        "acceleration": (qdd, np.abs(qdd) / robot.a_max),
+        "jerk": (qddd, np.abs(qddd) / robot.j_max),
     }
-    for kind, (values, use, bound) in signals.items():
+    for kind, (values, use) in signals.items():
         margins[kind] = 1.0 - use.max(axis=0)
         worst_joint = int(np.argmax(use.max(axis=0)))
         binding[kind] = (worst_joint + 1, float(t[int(np.argmax(use[:, worst_joint]))]))
         for j in np.flatnonzero(use.max(axis=0) > 1.0 + RELATIVE_SLACK):
-            limit = (
-                robot.q_max[j]
-                if kind == "position" and values[np.argmax(use[:, j]), j] > centre[j]
-                else robot.q_min[j]
-                if kind == "position"
-                else bound[j]
-            )
+            if kind == "position":
+                above = values[np.argmax(use[:, j]), j] > centre[j]
+                limit = robot.q_max[j] if above else robot.q_min[j]
+            else:
+                limit = bounds[kind][j]
             violations.append(
                 _violation(kind, int(j) + 1, t, values[:, j], use[:, j], float(limit))
             )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -54,7 +55,7 @@ class PathGeometry:
     def from_case(cls, case: Case, timing: str | None = None) -> PathGeometry:
         """Build the nominal and planned paths of a case (``paper`` timing: tangent arcs)."""
         nominal = NominalPath.from_specs(case.start, case.segments)
-        mode = "paper" if (timing or case.task.timing) == "paper" else "g2"
+        mode: Literal["g2", "paper"] = "paper" if (timing or case.task.timing) == "paper" else "g2"
         return cls(nominal, build_path(nominal, case.task.tolerance, mode=mode))
 
     def zones(self) -> list[tuple[float, float, str]]:
@@ -220,7 +221,7 @@ def _finish(
     """Check the sampled trajectory and assemble the result."""
     robot = case.robot
     Ts = case.task.sample_time
-    if q is None or len(q) == 0:  # nothing planned (paper mode returns empty arrays)
+    if q is None or s is None or len(q) == 0:  # nothing planned (paper mode returns empty arrays)
         check = CheckReport(False, {}, {}, (), float("nan"), float("nan"))
         trajectory = empty_trajectory(robot.n_dof, Ts)
         return PlanResult(
