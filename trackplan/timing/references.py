@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
+from trackplan.errors import CaseError
 from trackplan.robots.model import Robot
 
 JointSamples = np.ndarray | Callable[[np.ndarray], np.ndarray]
@@ -379,6 +380,14 @@ def reference_durations(case, X: np.ndarray, result) -> dict[str, float]:  # typ
         ``toppra_duration`` and ``topp3_duration``, s (nan when a reference failed or the
         path has no joint path on that branch).
     """
+    for package, module in (("toppra", "toppra"), ("copp-py", "copp_py")):
+        try:
+            __import__(module)
+        except ImportError:
+            raise CaseError(
+                f"--reference needs the {package} package: pip install -e '.[reference]'",
+                key="--reference",
+            ) from None
     s_grid, q_grid, caps, ok = reference_inputs(case, X, result.planned_path, result.branch)
     if not ok:
         return {"toppra_duration": float("nan"), "topp3_duration": float("nan")}
