@@ -153,3 +153,12 @@ def test_cli_plan_negative_placement_values(tmp_path):
     summary = json.loads((tmp_path / "result.json").read_text())
     assert summary["placement"]["x"] == pytest.approx(-0.1322)
     assert summary["status"] == "unreachable"
+
+
+def test_cli_plan_reference_durations(tmp_path):
+    case = str(CASES / "paper-line.yaml")
+    assert main(["plan", case, "--reference", "--out", str(tmp_path), "--no-report"]) == 0
+    summary = json.loads((tmp_path / "result.json").read_text())
+    # toppra (no jerk limit) ≤ TOPP3 (jerk-limited optimum) ≤ trackplan's duration ≤ 1.05 TOPP3
+    assert summary["toppra_duration"] <= summary["topp3_duration"] <= summary["duration"]
+    assert summary["duration"] <= 1.05 * summary["topp3_duration"]
