@@ -2,16 +2,12 @@
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 import pytest
 
-from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec
 from trackplan.planning.placement import placement_transform
 from trackplan.report.scene import (
     chain_points,
-    distance_to_polyline,
     equal_limits,
     frame_indices,
     nominal_polyline,
@@ -24,43 +20,12 @@ from trackplan.report.scene import (
 from trackplan.robots.kinematics import forward_kinematics
 
 
-def test_full_circle_stays_on_the_circle_within_the_chord_error():
-    # the paper's Case 2: start (0, 0, 0), radius 0.2, centre (0, 0, -0.2), in the x-z plane
-    center = np.array([0.0, 0.0, -0.2])
-    arc = ArcSpec(center=center, normal=np.array([0.0, 1.0, 0.0]), angle=2 * np.pi)
-    points = nominal_polyline(np.zeros(3), [arc], chord_error=1e-6)
-    radius = np.linalg.norm(points - center, axis=1)
-    np.testing.assert_allclose(radius, 0.2, atol=1e-12)
-    np.testing.assert_allclose(points[-1], points[0], atol=1e-12)
-    np.testing.assert_allclose(points[:, 1], 0.0, atol=1e-12)
-    midpoints = 0.5 * (points[1:] + points[:-1])
-    assert np.max(0.2 - np.linalg.norm(midpoints - center, axis=1)) <= 1e-6
-    # right-hand rotation about +y takes (0, 0, 0) - c = +z towards +x
-    assert points[1, 0] > 0
-
-
-def test_lines_and_points_are_kept_exactly():
-    start = np.array([0.1, 0.0, 0.0])
-    samples = np.array([[0.3, 0.1, 0.0], [0.4, 0.1, 0.1]])
-    points = nominal_polyline(start, [LineSpec(to=np.array([0.2, 0.0, 0.0])), PointsSpec(samples)])
-    np.testing.assert_array_equal(points, np.vstack([start, [0.2, 0.0, 0.0], samples]))
-
-
-def test_distance_to_polyline_matches_dense_sampling(rng):
-    polyline = rng.normal(size=(7, 3))
-    points = rng.normal(size=(50, 3))
-    u = np.linspace(0.0, 1.0, 4001)[:, None]
-    dense = np.vstack([a + u * (b - a) for a, b in itertools.pairwise(polyline)])
-    brute = np.min(np.linalg.norm(points[:, None, :] - dense[None], axis=-1), axis=1)
-    distance = distance_to_polyline(points, polyline)
-    assert np.all(distance <= brute + 1e-12)
-    np.testing.assert_allclose(distance, brute, atol=1e-3)
-
-
-def test_distance_to_a_single_point():
-    np.testing.assert_allclose(
-        distance_to_polyline(np.array([[3.0, 4.0, 0.0]]), np.zeros((1, 3))), [5.0]
-    )
+def test_nominal_polyline_is_the_user_path_densely_sampled(corner):
+    points = nominal_polyline(corner)
+    assert np.max(np.linalg.norm(np.diff(points, axis=0), axis=1)) <= 1e-3 + 1e-12
+    # the sharp corner is kept: the corner vertex is one of the points
+    assert np.min(np.linalg.norm(points - np.array([0.5, 0.0, 0.0]), axis=1)) < 1e-12
+    np.testing.assert_allclose(points[0], corner.start)
 
 
 def test_path_points_are_the_tool_points_in_both_frames(corner, corner_result):
@@ -81,7 +46,7 @@ def test_tracking_error_agrees_with_the_check_and_stays_within_tolerance(corner,
 
 def test_path_points_fall_back_to_the_nominal_path(corner, unreachable_result):
     points_part, points_base = path_points(unreachable_result, corner)
-    np.testing.assert_allclose(points_part, nominal_polyline(corner.start, corner.segments))
+    np.testing.assert_allclose(points_part, nominal_polyline(corner))
     T_base_part = placement_transform(unreachable_result.placement)
     np.testing.assert_allclose(points_base, transform_points(T_base_part, points_part))
     assert tracking_error(unreachable_result, corner).size == 0

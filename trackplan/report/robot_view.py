@@ -94,7 +94,7 @@ def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go
     tool = trajectory.tool_position[idx]
     _, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
-    nominal = transform_points(T_base_part, nominal_polyline(case.start, case.segments))
+    nominal = transform_points(T_base_part, nominal_polyline(case))
     reach = case.bounds.reach[1]
     shell = sphere_wireframe(reach, n_meridians=8, n_parallels=5)
     axis_length = 0.15 * reach

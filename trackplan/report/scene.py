@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
+from trackplan.paths import NominalPath
 from trackplan.planning.placement import placement_transform
 from trackplan.planning.result import PlanResult, Trajectory, Violation
 from trackplan.robots.kinematics import joint_frames
@@ -83,87 +83,19 @@ def transform_points(T: np.ndarray, points: np.ndarray) -> np.ndarray:
     return points @ T[:3, :3].T + T[:3, 3]
 
 
-def _rotate(vectors: np.ndarray, axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rodrigues rotation of one vector (3,) about a unit axis (3,) by angles (M,)."""
-    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
-    return vectors * c + np.cross(axis, vectors) * s + axis * (axis @ vectors) * (1.0 - c)
+DRAWING_STEP = 1e-3
+"""Largest distance between drawn points of the nominal path, m."""
 
 
-def nominal_polyline(
-    start: np.ndarray, segments: Sequence[SegmentSpec], chord_error: float = 1e-6
-) -> np.ndarray:
-    """The path as the user gave it (sharp corners kept), as a dense polyline.
-
-    Lines and sampled curves are exact; arcs are sampled so that no chord leaves the
-    arc by more than ``chord_error``.
-
-    Parameters
-    ----------
-    start
-        First point, shape (3,), m, definition frame.
-    segments
-        Line, arc and points segments in order.
-    chord_error
-        Largest distance of a chord from its arc, m.
+def nominal_polyline(case: Case) -> np.ndarray:
+    """The path as the user gave it (sharp corners kept), points at most 1 mm apart.
 
     Returns
     -------
     numpy.ndarray
-        Vertices, shape (K, 3), m, definition frame.
+        Shape (K, 3), m, definition frame.
     """
-    pieces = [np.asarray(start, dtype=float)[None, :]]
-    current = pieces[0][0]
-    for segment in segments:
-        if isinstance(segment, LineSpec):
-            piece = np.asarray(segment.to, dtype=float)[None, :]
-        elif isinstance(segment, ArcSpec):
-            axis = np.asarray(segment.normal, dtype=float)
-            axis = axis / np.linalg.norm(axis)
-            offset = current - np.asarray(segment.center, dtype=float)
-            radius = float(np.linalg.norm(offset - axis * (axis @ offset)))
-            ratio = min(chord_error / radius, 1.0) if radius > 0 else 1.0
-            step = 2.0 * np.arccos(1.0 - ratio)
-            n_pieces = max(1, int(np.ceil(abs(segment.angle) / step)))
-            angles = np.linspace(0.0, segment.angle, n_pieces + 1)[1:]
-            piece = segment.center + _rotate(offset, axis, angles)
-        elif isinstance(segment, PointsSpec):
-            piece = np.asarray(segment.points, dtype=float).reshape(-1, 3)
-        else:
-            raise TypeError(f"unknown segment type {type(segment).__name__}")
-        pieces.append(piece)
-        current = piece[-1]
-    return np.vstack(pieces)
-
-
-def distance_to_polyline(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
-    """Distance of each point from a polyline.
-
-    Parameters
-    ----------
-    points
-        Shape (N, 3), m.
-    polyline
-        Vertices, shape (K, 3), m, same frame as ``points``.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (N,), m.
-    """
-    points = np.asarray(points, dtype=float).reshape(-1, 3)
-    if len(polyline) == 1:
-        return np.linalg.norm(points - polyline[0], axis=1)
-    a = polyline[:-1]
-    ab = np.diff(polyline, axis=0)
-    ab_sq = np.maximum(np.einsum("kj,kj->k", ab, ab), np.finfo(float).tiny)
-    distance = np.empty(len(points))
-    chunk = max(1, 2**20 // len(ab))  # bounds the (chunk, K, 3) scratch arrays
-    for lo in range(0, len(points), chunk):
-        rel = points[lo : lo + chunk, None, :] - a
-        u = np.clip(np.einsum("mkj,kj->mk", rel, ab) / ab_sq, 0.0, 1.0)
-        gap = rel - u[..., None] * ab
-        distance[lo : lo + chunk] = np.sqrt(np.min(np.einsum("mkj,mkj->mk", gap, gap), axis=1))
-    return distance
+    return NominalPath.from_specs(case.start, case.segments).polyline(DRAWING_STEP)
 
 
 def path_points(result: PlanResult, case: Case) -> tuple[np.ndarray, np.ndarray]:
@@ -181,7 +113,7 @@ def path_points(result: PlanResult, case: Case) -> tuple[np.ndarray, np.ndarray]
     T_base_part = placement_transform(result.placement)
     points_base = result.trajectory.tool_position
     if len(points_base) == 0:
-        points_part = nominal_polyline(case.start, case.segments)
+        points_part = nominal_polyline(case)
         return points_part, transform_points(T_base_part, points_part)
     return transform_points(np.linalg.inv(T_base_part), points_base), points_base
 
@@ -197,7 +129,7 @@ def tracking_error(result: PlanResult, case: Case) -> np.ndarray:
     if result.trajectory.n_samples == 0:
         return np.zeros(0)
     points_part, _ = path_points(result, case)
-    return distance_to_polyline(points_part, nominal_polyline(case.start, case.segments))
+    return NominalPath.from_specs(case.start, case.segments).project(points_part)[1]
 
 
 def frame_indices(n_samples: int, n_frames: int) -> np.ndarray:
