@@ -558,3 +558,31 @@ def start_jet(curve: Curve) -> CurveJet:
 def end_jet(curve: Curve) -> CurveJet:
     """Position and derivatives of ``curve`` at its end, each of shape (1, 3)."""
     return curve.evaluate(np.array([curve.length]))
+
+
+def unwrap_closed_arc(sigma: np.ndarray, period: float, length: float) -> np.ndarray:
+    """Arc lengths on a closed (≥ 2π) arc made continuous along a sequence of samples.
+
+    A projection reports the first turn, so where the samples pass the arc's start again
+    their arc length wraps from ``period`` back to 0; unwrapping restores it, and the
+    sequence begins on the first turn (the start and the end of a full circle are one point).
+
+    Parameters
+    ----------
+    sigma
+        Arc lengths of samples in time order, shape (M,), m.
+    period
+        2π · radius, m.
+    length
+        The arc's length, m (the result is clipped to [0, length]).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (M,), m.
+    """
+    if len(sigma) == 0:
+        return sigma
+    values = np.unwrap(sigma, period=period)
+    values -= period * np.round(values.min() / period)
+    return np.clip(values, 0.0, length)

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from trackplan.paths.geometry import unwrap_closed_arc
+
 DIRECTION_SLACK = 0.2
 """A piece agrees with the motion when tangent · velocity ≥ −slack · |velocity|."""
 
@@ -57,9 +59,10 @@ def locate_on_nominal(
     rows = np.arange(n)
     local = sigma[rows, assigned]
     for p, piece in enumerate(pieces):
-        if piece.kind == "arc" and piece.curve.angle >= 2 * np.pi - 1e-9:
-            local = _unwrap_periodic(
-                local, assigned == p, 2 * np.pi * piece.curve.radius, piece.length
+        on_piece = assigned == p
+        if piece.kind == "arc" and piece.curve.angle >= 2 * np.pi - 1e-9 and on_piece.any():
+            local[on_piece] = unwrap_closed_arc(
+                local[on_piece], 2 * np.pi * piece.curve.radius, piece.length
             )
     s_start = np.array([piece.s_start for piece in pieces])
     return s_start[assigned] + local, nearest, assigned
@@ -93,21 +96,6 @@ def _monotone_assignment(candidates: np.ndarray) -> np.ndarray:
             ahead = options[options > piece]
             piece = int(ahead[0]) if ahead.size else int(options[0])
     return assigned
-
-
-def _unwrap_periodic(
-    local: np.ndarray, mask: np.ndarray, period: float, length: float
-) -> np.ndarray:
-    """Undo the wrap of a closed arc's arc length within the samples on it."""
-    idx = np.flatnonzero(mask)
-    if idx.size == 0:
-        return local
-    values = np.unwrap(local[idx], period=period)
-    # the start and the end of a closed arc are one point: begin on the first turn
-    values -= period * np.round(values.min() / period)
-    out = local.copy()
-    out[idx] = np.clip(values, 0.0, length)
-    return out
 
 
 def jump_allowance(nominal, tolerance: float) -> np.ndarray:

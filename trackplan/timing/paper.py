@@ -48,6 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.paths.geometry import unwrap_closed_arc
 from trackplan.planning.placement import placement_transform
 from trackplan.planning.poses import tool_poses
 from trackplan.planning.result import PlanStatus
@@ -383,21 +384,13 @@ class _PaperPlanner:
         for k in np.unique(owner):
             mask = owner == k
             piece = self.pieces[k]
-            s[mask] = piece.s_start + self._project(piece, p_part[mask], mask)
+            s[mask] = piece.s_start + self._project(piece, p_part[mask])
         return np.clip(s, 0.0, self.path.length)
 
-    def _project(self, piece, points: np.ndarray, mask: np.ndarray) -> np.ndarray:  # type: ignore[no-untyped-def]
+    def _project(self, piece, points: np.ndarray) -> np.ndarray:  # type: ignore[no-untyped-def]
         """Arc length along one piece of ``points`` (M, 3), m, in [0, piece length]."""
         curve = piece.curve
-        if piece.kind == "line":
-            sigma = (points - curve.start) @ curve.direction
-        elif piece.kind == "arc":
-            rel = points - curve.center
-            phi = np.arctan2(rel @ curve.e2, rel @ curve.e1)
-            # unwrap along the samples (an arc may turn 2π or more)
-            phi = np.unwrap(np.concatenate([[0.0], phi]))[1:]
-            phi = phi - 2 * np.pi * np.floor(phi[0] / (2 * np.pi) + 0.5)
-            sigma = phi * curve.radius
-        else:
-            sigma, _ = curve.project(points)
+        sigma, _ = curve.project(points)
+        if piece.kind == "arc" and curve.angle >= 2 * np.pi - 1e-9:  # samples in time order
+            sigma = unwrap_closed_arc(sigma, 2 * np.pi * curve.radius, piece.length)
         return np.clip(sigma, 0.0, piece.length)
