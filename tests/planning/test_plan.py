@@ -162,3 +162,29 @@ def test_cli_plan_reference_durations(tmp_path):
     # toppra (no jerk limit) ≤ TOPP3 (jerk-limited optimum) ≤ trackplan's duration ≤ 1.05 TOPP3
     assert summary["toppra_duration"] <= summary["topp3_duration"] <= summary["duration"]
     assert summary["duration"] <= 1.05 * summary["topp3_duration"]
+
+
+def test_full_reversal_is_a_stop_and_go(tmp_path):
+    text = (CASES / "paper-corner.yaml").read_text()
+    text = text.replace(
+        "    - line: {to: [0.3, 0, 0.5]}",
+        "    - line: {to: [0.2, 0, 0]}\n    - line: {to: [0.2, 0, 0.3]}",
+    )
+    file = tmp_path / "reversal.yaml"
+    file.write_text(text)
+    case = load_case(file)
+    result = plan_placement(case, case.bounds.example)
+    assert result.feasible, result.message  # the checker follows the path back along itself
+    traj = result.trajectory
+    at_turn = np.argmin(np.abs(traj.s - 0.5))
+    assert np.diff(traj.s)[at_turn - 1 : at_turn + 1].max() / traj.sample_time < 1e-3
+
+
+def test_a_time_law_too_long_to_sample_says_where(corner_case, corner_geometry, monkeypatch):
+    import trackplan.timing.smooth as smooth
+
+    monkeypatch.setattr(smooth, "MAX_SAMPLES", 1000)
+    result = plan_placement(corner_case, corner_case.bounds.example, geometry=corner_geometry)
+    assert result.status is PlanStatus.LIMITS_VIOLATED and not result.feasible
+    assert "would need" in result.message and "m/s at s =" in result.message
+    assert result.trajectory.n_samples == 0

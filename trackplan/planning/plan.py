@@ -63,10 +63,15 @@ class PathGeometry:
         zones: list[tuple[float, float, str]] = []
         stops = sorted(float(s) for s in self.planned.stops)
         for s0, s1, kind in self.planned.zones:
-            while stops and stops[0] <= s0 + 1e-12:
-                zones.append((s0, s0, "stop"))
-                stops.pop(0)
-            zones.append((float(s0), float(s1), kind))
+            start = float(s0)
+            for stop in (s for s in stops if s0 - 1e-12 <= s <= s1 + 1e-12):
+                if stop > start + 1e-12:
+                    zones.append((start, stop, kind))
+                if not zones or zones[-1][2] != "stop":
+                    zones.append((stop, stop, "stop"))
+                start = stop
+            if s1 > start + 1e-12:
+                zones.append((start, float(s1), kind))
         return zones
 
     def corner_intervals(self) -> np.ndarray:
@@ -203,6 +208,19 @@ def plan_placement(
         case.task.corner_speed,
         case.task.sample_time,
     )
+    if not law.s.size:
+        return _finish(
+            case,
+            geometry,
+            X,
+            timing,
+            chosen,
+            None,
+            None,
+            law,
+            PlanStatus.LIMITS_VIOLATED,
+            law.message,
+        )
     return _finish(case, geometry, X, timing, chosen, law.q, law.s, law, None, "")
 
 

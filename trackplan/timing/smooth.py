@@ -45,6 +45,10 @@ STRAIGHT_GRID_STEP = 2e-3
 CURVED_GRID_POINTS = 80
 """Grid points on each curved zone (arcs are split so a step stays below STRAIGHT_GRID_STEP)."""
 MAX_ITERATIONS = 12
+MAX_SAMPLES = 2_000_000
+"""Longest trajectory built, in samples (33 min at 1 ms): beyond it a joint limit has forced
+the speed to almost nothing somewhere (a path through a singularity), and the time law
+says where instead of sampling it."""
 
 
 @dataclass(frozen=True)
@@ -95,7 +99,10 @@ class TimeLaw:
     iterations
         Rebuilds needed until the sampled trajectory met every rate limit.
     converged
-        False when MAX_ITERATIONS rebuilds still left a rate-limit violation.
+        False when MAX_ITERATIONS rebuilds still left a rate-limit violation, or when no
+        trajectory was sampled (see ``message``).
+    message
+        Why no trajectory was sampled (empty ``s`` and ``q``), else "".
     """
 
     profile: SpeedProfile
@@ -106,6 +113,7 @@ class TimeLaw:
     q: np.ndarray
     iterations: int
     converged: bool
+    message: str = ""
 
     @property
     def duration(self) -> float:
@@ -182,6 +190,25 @@ def plan_smooth_time_law(
         plans = planner.plan()
         profile = planner.profile(plans, length, sample_time)
         n_steps = max(1, int(np.ceil(profile.duration / sample_time - 1e-9)))
+        if n_steps > MAX_SAMPLES:
+            slowest = min((p for p in plans if p.kind != "stop"), key=lambda p: p.plateau)
+            message = (
+                f"the time law would need {profile.duration:.4g} s: {slowest.reason} holds the "
+                f"speed to {slowest.plateau:.3g} m/s at s = {slowest.s_start:.4f}.."
+                f"{slowest.s_end:.4f} m (a singularity near the path?)"
+            )
+            empty = np.zeros(0)
+            return TimeLaw(
+                profile,
+                1.0,
+                tuple(plans),
+                sample_time,
+                empty,
+                np.zeros((0, robot.n_dof)),
+                iteration,
+                False,
+                message,
+            )
         time_scale = max(1.0, n_steps * sample_time / profile.duration)
         t = np.arange(n_steps + 1) * sample_time
         s = profile.evaluate(t / time_scale)[0]
