@@ -63,3 +63,23 @@ def test_rated_speed_held_exactly_elsewhere(tmp_path):
     traj = result.trajectory
     path_speed = np.diff(traj.s) / traj.sample_time
     assert path_speed.max() == pytest.approx(case.task.rated_speed, rel=1e-12)
+
+
+def test_rebuilds_until_the_sampled_trajectory_meets_every_limit(monkeypatch):
+    """Aiming above the limits, the law must still end within them by tightening zones."""
+    import trackplan.planning.plan as plan_module
+    import trackplan.timing.smooth as smooth
+
+    monkeypatch.setattr(smooth, "LIMIT_SHARE", 1.1)
+    laws = []
+    original = smooth.plan_smooth_time_law
+
+    def spy(*args, **kwargs):
+        laws.append(original(*args, **kwargs))
+        return laws[-1]
+
+    monkeypatch.setattr(plan_module, "plan_smooth_time_law", spy)
+    case = load_case(CASES / "paper-corner.yaml")
+    result = plan_placement(case, case.bounds.example)
+    assert laws[-1].iterations > 1 and laws[-1].converged
+    assert result.feasible, result.message

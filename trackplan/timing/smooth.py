@@ -215,7 +215,7 @@ def plan_smooth_time_law(
         s[-1] = length
         q = joint_path(s)
         worst = _worst_rate_violations(robot, q, sample_time)
-        if not worst:
+        if not worst[0].size:
             return TimeLaw(profile, time_scale, tuple(plans), sample_time, s, q, iteration, True)
         planner.tighten(worst, s, t / time_scale, profile)
     return TimeLaw(profile, time_scale, tuple(plans), sample_time, s, q, MAX_ITERATIONS, False)
@@ -555,26 +555,35 @@ class _ZonePlanner:
 
     def tighten(
         self,
-        worst: list[tuple[int, str, float]],
+        worst: tuple[np.ndarray, np.ndarray, np.ndarray],
         s: np.ndarray,
         t_profile: np.ndarray,
         profile: SpeedProfile,
     ) -> None:
-        """Lower the plateau or the speed-change bounds of every zone that broke a limit."""
+        """Lower the plateau or the speed-change bounds of every zone that broke a limit.
+
+        A violation whose backward-difference window (4 samples) lies in a cruise lowers
+        the zone's plateau by ratio^(-1/order); one that touches a speed change lowers the
+        change bounds of its zone and of the next (a change at a zone edge feels both).
+        """
+        sample, order, ratio = worst
+        n_zones = len(self.zones)
         starts = np.array([z[0] for z in self.zones])
-        power = {"velocity": 1.0, "acceleration": 2.0, "jerk": 3.0}
+        zone = np.clip(np.searchsorted(starts, s[sample], side="right") - 1, 0, n_zones - 1)
         phase = profile.phase_index(t_profile)
         cruising = (profile.jerk[phase] == 0.0) & (np.abs(profile.a0[phase]) < 1e-12)
-        new_cap = np.ones(len(self.zones))
-        new_change = np.ones(len(self.zones))
-        for k, kind, ratio in worst:
-            z = int(np.clip(np.searchsorted(starts, s[k], side="right") - 1, 0, len(starts) - 1))
-            if np.all(cruising[max(0, k - 3) : k + 1]):
-                new_cap[z] = min(new_cap[z], 0.98 * ratio ** (-1.0 / power[kind]))
-            else:
-                new_change[z] = min(new_change[z], 0.95 / ratio)
-                if z + 1 < len(starts):  # a change at a zone edge also feels the neighbour
-                    new_change[z + 1] = min(new_change[z + 1], 0.95 / ratio)
+        window = np.convolve(cruising.astype(int), np.ones(4, dtype=int))[: len(cruising)]
+        in_cruise = window[sample] == np.minimum(sample + 1, 4)
+        new_cap = np.ones(n_zones)
+        np.minimum.at(
+            new_cap, zone[in_cruise], 0.98 * ratio[in_cruise] ** (-1.0 / order[in_cruise])
+        )
+        new_change = np.ones(n_zones)
+        changing = ~in_cruise
+        for shift in (0, 1):
+            np.minimum.at(
+                new_change, np.minimum(zone[changing] + shift, n_zones - 1), 0.95 / ratio[changing]
+            )
         self.cap_scale *= new_cap
         self.change_scale *= new_change
 
@@ -600,24 +609,26 @@ def _jerk_for_duration(delta: float, accel: float, jerk: float, duration: float)
 
 def _worst_rate_violations(
     robot: Robot, q: np.ndarray, sample_time: float
-) -> list[tuple[int, str, float]]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Samples where a velocity, acceleration or jerk limit is exceeded.
 
     Returns
     -------
-    list of (sample index, kind, ratio to the limit)
-        The worst sample of each violated (kind, joint); indices past the end are clipped.
+    tuple of numpy.ndarray
+        ``(sample, order, ratio)``, each shape (V,): the sample index (past-the-end samples
+        clipped to the last), the derivative order (1 velocity, 2 acceleration, 3 jerk) and
+        the worst joint's value over its limit (> 1).
     """
     qd, qdd, qddd = backward_derivatives(q, sample_time, pad_end=True)
-    found = []
-    for kind, values, bound in (
-        ("velocity", qd, robot.v_max),
-        ("acceleration", qdd, robot.a_max),
-        ("jerk", qddd, robot.j_max),
+    samples, orders, ratios = [], [], []
+    for order, values, bound in (
+        (1, qd, robot.v_max),
+        (2, qdd, robot.a_max),
+        (3, qddd, robot.j_max),
     ):
-        ratio = np.abs(values) / bound
-        for j in np.flatnonzero(ratio.max(axis=0) > 1.0):
-            bad = np.flatnonzero(ratio[:, j] > 1.0)
-            for k in bad:
-                found.append((min(int(k), len(q) - 1), kind, float(ratio[k, j])))
-    return found
+        ratio = (np.abs(values) / bound).max(axis=1)
+        bad = np.flatnonzero(ratio > 1.0)
+        samples.append(np.minimum(bad, len(q) - 1))
+        orders.append(np.full(bad.size, order))
+        ratios.append(ratio[bad])
+    return np.concatenate(samples), np.concatenate(orders), np.concatenate(ratios)
