@@ -11,6 +11,7 @@ from trackplan.cli import main
 from trackplan.io.case_file import load_case
 from trackplan.io.results import read_trajectory_csv, write_trajectory_csv
 from trackplan.planning.checker import check_trajectory
+from trackplan.planning.placement import placement_transform
 from trackplan.planning.plan import PathGeometry, plan_placement, tracking_reference
 from trackplan.planning.result import PlanStatus
 
@@ -31,7 +32,10 @@ def test_paper_cases_plan_feasibly_in_smooth_mode(name):
         tracking_reference(case, geometry, result.placement),
     )
     assert report.ok, [v.message for v in report.violations]
-    assert result.trajectory.q[0] == pytest.approx(result.trajectory.q[0])
+    # the tool starts at the path's start, placed by X (Eq. 4)
+    T = placement_transform(result.placement)
+    start = T[:3, :3] @ case.start + T[:3, 3]
+    np.testing.assert_allclose(result.trajectory.tool_position[0], start, atol=1e-9)
     lower_bound = result.path_length / case.task.rated_speed
     assert lower_bound < result.duration < 1.15 * lower_bound
 
