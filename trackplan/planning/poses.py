@@ -27,10 +27,11 @@ def tool_poses(X: np.ndarray, positions: np.ndarray, tool_rpy: np.ndarray) -> np
     X = np.asarray(X, dtype=float)
     single = X.ndim == 1
     T_base_part = placement_transform(np.atleast_2d(X))  # (B, 4, 4)
-    R_part_tool = rpy_matrix(np.asarray(tool_rpy, dtype=float))
     R = T_base_part[:, :3, :3]
-    poses = np.zeros((len(X) if not single else 1, len(positions), 4, 4))
-    poses[..., :3, :3] = (R @ R_part_tool)[:, None]
-    poses[..., :3, 3] = np.einsum("bij,mj->bmi", R, positions) + T_base_part[:, None, :3, 3]
+    poses = np.empty((len(R), len(positions), 4, 4))
+    poses[..., :3, :3] = (R @ rpy_matrix(np.asarray(tool_rpy, dtype=float)))[:, None]
+    poses[..., :3, 3] = np.asarray(positions, dtype=float) @ R.transpose(0, 2, 1)
+    poses[..., :3, 3] += T_base_part[:, None, :3, 3]
+    poses[..., 3, :3] = 0.0
     poses[..., 3, 3] = 1.0
     return poses[0] if single else poses
