@@ -30,6 +30,8 @@ and lets :func:`main` report it; it prints results with :func:`_console` or
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import enum
 import os
 import sys
@@ -88,6 +90,27 @@ def _options(
     # main() reads --debug from the arguments itself: it must know before parsing succeeds.
 
 
+MALLOC_MMAP_THRESHOLD = 64 * 2**20
+"""Bytes: glibc serves smaller allocations from its heap instead of fresh mmaps."""
+
+
+def _keep_freed_memory() -> None:
+    """Let glibc reuse freed memory for the batched arrays instead of mapping them anew.
+
+    By default glibc maps every allocation above 128 KiB (raised only gradually) and
+    unmaps it on free, so each generation of the placement search page-faults its (B, M, …)
+    arrays in again: measured 1.1 s of a 4 s search. The CLI owns its process, so it sets
+    a fixed 64 MiB threshold; elsewhere (not glibc) this does nothing.
+    """
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        m_trim_threshold, m_mmap_threshold = -1, -3  # mallopt parameters, <malloc.h>
+        libc.mallopt(m_mmap_threshold, MALLOC_MMAP_THRESHOLD)
+        libc.mallopt(m_trim_threshold, 2 * MALLOC_MMAP_THRESHOLD)
+    except (OSError, AttributeError):
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line and return its exit code; never raises.
 
@@ -102,6 +125,7 @@ def main(argv: list[str] | None = None) -> int:
         An :class:`ExitCode` value (130 on Ctrl-C).
     """
     args = sys.argv[1:] if argv is None else list(argv)
+    _keep_freed_memory()
     debug = "--debug" in args or os.environ.get(DEBUG_ENV, "") not in ("", "0")
     try:
         command = typer.main.get_command(app)
