@@ -81,7 +81,7 @@ def paper_corner_radius(beta: float, tolerance: float) -> float:
     tolerance
         ρ, m.
     """
-    return 2.0 * tolerance / (1.0 - np.sin(0.5 * beta))
+    return 2.0 * corrected_corner_radius(beta, tolerance)
 
 
 def corrected_corner_radius(beta: float, tolerance: float) -> float:

@@ -74,6 +74,14 @@ class PathGeometry:
                 zones.append((start, float(s1), kind))
         return zones
 
+    def on_curved_zone(self, s: np.ndarray) -> np.ndarray:
+        """Whether arc lengths ``s`` (M,) lie on an arc or blend (corner speed), shape (M,)."""
+        curved = np.zeros(np.shape(s), dtype=bool)
+        for s0, s1, kind in self.planned.zones:
+            if kind == "curved":
+                curved |= (s >= s0) & (s <= s1)
+        return curved
+
     def corner_intervals(self) -> np.ndarray:
         """Nominal arc-length intervals where the corner speed applies, shape (K, 2)."""
         curved = [(s0, s1) for s0, s1, kind in self.planned.zones if kind == "curved"]
@@ -305,11 +313,7 @@ def _speed_summary(
     path_speed = ds / trajectory.sample_time
     at_rated = np.abs(path_speed - rated) <= 1e-4 * rated  # paper mode: projection noise
     fraction = float(ds[at_rated].sum() / geometry.planned.length)
-    curved = np.zeros(len(ds), dtype=bool)
-    midpoints = 0.5 * (trajectory.s[1:] + trajectory.s[:-1])
-    for s0, s1, kind in geometry.planned.zones:
-        if kind == "curved":
-            curved |= (midpoints >= s0) & (midpoints <= s1)
+    curved = geometry.on_curved_zone(0.5 * (trajectory.s[1:] + trajectory.s[:-1]))
     corner = float(path_speed[curved].min()) if curved.any() else rated
     slowdowns: tuple[SlowDown, ...] = ()
     if law is not None:

@@ -179,11 +179,7 @@ class PlacementFitness:
         self.flat = case.objective.penalty == "flat"
         self.penalty = float(case.objective.flat_penalty)
         self.time_weight = float(case.objective.time_weight)
-        middle = 0.5 * (self.s_grid[1:] + self.s_grid[:-1])
-        curved = np.zeros(len(middle), dtype=bool)
-        for s0, s1, kind in geometry.planned.zones:
-            if kind == "curved":
-                curved |= (middle >= s0) & (middle <= s1)
+        curved = geometry.on_curved_zone(0.5 * (self.s_grid[1:] + self.s_grid[:-1]))
         cap = np.where(curved, case.task.corner_speed, case.task.rated_speed)
         self.tool_time = np.diff(self.s_grid) / cap  # (M - 1,), s
         self._map: Callable[[Callable, Iterable], Iterable] = (
