@@ -40,9 +40,11 @@ test: $(VENV)/.installed-test browser
 bench: $(VENV)/.installed-test
 	$(PY) -m benchmarks
 
+## lint: ruff (lint and format) and mypy, as CI runs them
 lint: $(VENV)/.installed-test
 	$(VENV)/bin/ruff check trackplan tests benchmarks
 	$(VENV)/bin/ruff format --check trackplan tests benchmarks
+	$(VENV)/bin/mypy trackplan
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .hypothesis

@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from trackplan.planning.placement import pose_matrix, rpy_matrix
+from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.robots.builtin import puma560, ur5
 from trackplan.robots.ik_closed_form import solve_ik_closed_form
 from trackplan.robots.ik_numeric import solve_ik_numeric

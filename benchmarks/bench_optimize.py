@@ -24,11 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
+from trackplan.choices import Method
+from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import PathGeometry, plan_placement
-from trackplan.planning.poses import tool_poses
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.plan import plan_placement
 from trackplan.search import optimize_placement
-from trackplan.search.algorithms import METHODS
 from trackplan.search.fitness import screening_grid
 from trackplan.search.optimize import run_seeds
 
@@ -163,7 +164,7 @@ def main() -> None:
                 screen_errors.append(abs(result.fitness / result.objective - 1.0))
         mean_evaluations = np.mean([r.evaluations for n, _, r in rows if n == name])
         budget = int(REFERENCE_FACTOR * mean_evaluations)
-        references[name] = [_reference(case, geometry, m, budget) for m in METHODS]
+        references[name] = [_reference(case, geometry, m, budget) for m in Method]
 
     corner = load_case(CASES / "paper-corner.yaml")
     print("Corner case (Case 3): the paper's published optimum planned by trackplan")
@@ -175,7 +176,7 @@ def main() -> None:
     for _, seed, result in (r for r in rows if r[0] == "paper-corner"):
         print(
             f"  ga seed {seed}: J = {result.objective:.4f} (final plan at Ts, "
-            f"{'passes' if result.final.check.ok else 'FAILS'} the checker)"
+            f"{'passes' if result.final.check.success else 'FAILS'} the checker)"
         )
 
     print(

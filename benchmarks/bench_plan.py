@@ -25,8 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from trackplan.io.case_file import load_case
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import PathGeometry, plan_placement
+from trackplan.planning.plan import plan_placement
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.timing.references import reference_inputs, topp3_reference, toppra_reference
 

@@ -15,14 +15,15 @@ from pathlib import Path
 import numpy as np
 
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import PathGeometry, plan_placement
-from trackplan.planning.result import PlanStatus
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.plan import plan_placement
+from trackplan.status import Status
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 CASE_NAMES = ("paper-line", "paper-circle", "paper-corner", "ur5-bead", "bracket-weld")
 PLACEMENTS = 150
 SEED = 11
-GEOMETRIC = (PlanStatus.UNREACHABLE, PlanStatus.POSITION_LIMITS, PlanStatus.BRANCH_SWITCH)
+GEOMETRIC = (Status.UNREACHABLE, Status.POSITION_LIMITS, Status.BRANCH_SWITCH)
 
 
 def main() -> None:

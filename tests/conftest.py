@@ -2,10 +2,23 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from trackplan.robots.builtin import puma560, ur5
+
+REPO = Path(__file__).resolve().parents[1]
+"""The repository root."""
+CASES = REPO / "cases"
+"""The shipped case files."""
+
+
+@pytest.fixture(scope="session")
+def cases_dir() -> Path:
+    """The shipped case files' folder."""
+    return CASES
 
 
 @pytest.fixture(scope="session")

@@ -10,13 +10,11 @@ from pathlib import Path
 import pytest
 
 import trackplan
+from tests.conftest import CASES, REPO
 from trackplan import cli
 from trackplan.cli import ExitCode, main
 from trackplan.io.robot_file import load_robot_text
 from trackplan.robots.builtin import ur5
-
-REPO = Path(__file__).resolve().parents[1]
-CASES = REPO / "cases"
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:

@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import yaml
 
+from tests.conftest import CASES
 from trackplan.cli import main
-
-CASES = Path(__file__).resolve().parents[1] / "cases"
 
 
 def test_export_ros_csv_json_and_bad_format(tmp_path, capsys):

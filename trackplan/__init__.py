@@ -4,8 +4,8 @@ Given a path (weld seam, glue bead, deburring edge), a speed and a tolerance, tr
 plans the joint trajectory under the robot's position, velocity, acceleration and jerk
 limits, and searches where to place the workpiece so the motion is feasible and cheap.
 
-Public API
-----------
+Public API (``docs/api.md``)
+----------------------------
 load_case(file) -> Case
     Read and validate a case file (see ``docs/files.md``).
 load_robot(file) -> Robot
@@ -18,8 +18,31 @@ forward_kinematics(robot, q) -> T_base_tool
     Tool poses, q of shape (..., n) in rad, result (..., 4, 4).
 jacobian(robot, q) -> J
     Geometric Jacobian at the tool point in the base frame, shape (..., 6, n).
+plan_placement(case, X, *, timing, branch) -> PlanResult
+    Plan and check the case with the workpiece at placement X (shape (6,), m and rad).
+optimize_placement(case, *, method, seed, budget, restarts, ...) -> OptimizeResult
+    Search the placement; ``method`` may also be a pymoo Algorithm.
+check_trajectory(robot, q, sample_time, reference) -> CheckReport
+    The checker: every sample against every limit (and the path, given a reference).
+check_case_trajectory(case, X, q, sample_time) -> CheckReport
+    The checker in one call for a case at a placement (``trackplan check``).
+JointPath
+    Poses and IK of a placed path on its planning grid, computed once per plan.
+TIME_LAWS, time_law(name)
+    The time laws by name (``smooth``, ``paper``).
+Status, Timing, Method, Penalty
+    The outcome vocabulary and the named choices.
+PlanResult, OptimizeResult, CheckReport, Trajectory, TimeLaw
+    The results.
 CaseError, TrackplanError
     Bad input (with the file and key path), and the root of trackplan's exceptions.
+
+A notebook needs five lines::
+
+    import trackplan
+    case = trackplan.load_case("cases/paper-corner.yaml")
+    result = trackplan.plan_placement(case, case.bounds.example)
+    print(result.status, result.duration)
 
 Names are imported on first use, so ``import trackplan`` stays cheap and the
 computational subpackages can be imported without the file-format dependencies.
@@ -33,12 +56,20 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from trackplan.case import Case
+    from trackplan.choices import Method, Penalty, Timing
     from trackplan.errors import CaseError, TrackplanError
     from trackplan.io.case_file import load_case
     from trackplan.io.robot_file import load_robot
+    from trackplan.jointpath import JointPath
+    from trackplan.planning.checker import check_trajectory
+    from trackplan.planning.plan import check_case_trajectory, plan_placement
+    from trackplan.planning.result import CheckReport, PlanResult, Trajectory
     from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot
     from trackplan.robots.kinematics import forward_kinematics, jacobian
     from trackplan.robots.model import Robot
+    from trackplan.search import OptimizeResult, optimize_placement
+    from trackplan.status import Status
+    from trackplan.timing import TIME_LAWS, TimeLaw, time_law
 
 try:
     __version__ = version("trackplan")
@@ -47,29 +78,61 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 _EXPORTS = {
     "BUILTIN_ROBOTS": "trackplan.robots.builtin",
+    "TIME_LAWS": "trackplan.timing",
     "Case": "trackplan.case",
     "CaseError": "trackplan.errors",
+    "CheckReport": "trackplan.planning.result",
+    "JointPath": "trackplan.jointpath",
+    "Method": "trackplan.choices",
+    "OptimizeResult": "trackplan.search",
+    "Penalty": "trackplan.choices",
+    "PlanResult": "trackplan.planning.result",
     "Robot": "trackplan.robots.model",
+    "Status": "trackplan.status",
+    "TimeLaw": "trackplan.timing",
+    "Timing": "trackplan.choices",
     "TrackplanError": "trackplan.errors",
+    "Trajectory": "trackplan.planning.result",
     "builtin_robot": "trackplan.robots.builtin",
+    "check_case_trajectory": "trackplan.planning.plan",
+    "check_trajectory": "trackplan.planning.checker",
     "forward_kinematics": "trackplan.robots.kinematics",
     "jacobian": "trackplan.robots.kinematics",
     "load_case": "trackplan.io.case_file",
     "load_robot": "trackplan.io.robot_file",
+    "optimize_placement": "trackplan.search",
+    "plan_placement": "trackplan.planning.plan",
+    "time_law": "trackplan.timing",
 }
 
 __all__ = [
     "BUILTIN_ROBOTS",
+    "TIME_LAWS",
     "Case",
     "CaseError",
+    "CheckReport",
+    "JointPath",
+    "Method",
+    "OptimizeResult",
+    "Penalty",
+    "PlanResult",
     "Robot",
+    "Status",
+    "TimeLaw",
+    "Timing",
     "TrackplanError",
+    "Trajectory",
     "__version__",
     "builtin_robot",
+    "check_case_trajectory",
+    "check_trajectory",
     "forward_kinematics",
     "jacobian",
     "load_case",
     "load_robot",
+    "optimize_placement",
+    "plan_placement",
+    "time_law",
 ]
 
 

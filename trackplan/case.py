@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from trackplan.choices import Method, Penalty, Timing, choose
 from trackplan.paths.specs import SegmentSpec
 from trackplan.robots.model import Robot
 
@@ -33,7 +34,8 @@ class Task:
     tool_rpy
         Tool orientation in the definition frame (roll, pitch, yaw), shape (3,), rad.
     timing
-        ``"smooth"`` (jerk-limited, G2 blends) or ``"paper"`` (Section 3.1 as written).
+        The time law: ``smooth`` (jerk-limited, G2 blends) or ``paper`` (Section 3.1 as
+        written).
     """
 
     rated_speed: float
@@ -41,7 +43,10 @@ class Task:
     tolerance: float
     sample_time: float
     tool_rpy: np.ndarray
-    timing: str = "smooth"
+    timing: Timing = Timing.SMOOTH
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "timing", choose(Timing, self.timing, "task.timing"))
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,8 +93,11 @@ class Objective:
 
     weights: np.ndarray
     time_weight: float = 0.0
-    penalty: str = "graded"
+    penalty: Penalty = Penalty.GRADED
     flat_penalty: float = 1.0e6
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "penalty", choose(Penalty, self.penalty, "objective.penalty"))
 
 
 @dataclass(frozen=True)
@@ -112,11 +120,14 @@ class OptimizerSettings:
         within 2 % of the best known J on every paper case and seed 0-4 (README).
     """
 
-    method: str = "ga"
+    method: Method = Method.GA
     population: int = 30
     seed: int = 0
     budget: int | None = None
     restarts: int = 6
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "method", choose(Method, self.method, "optimizer.method"))
 
 
 @dataclass(frozen=True, eq=False)

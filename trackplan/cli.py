@@ -47,6 +47,7 @@ from rich.table import Table
 
 import trackplan
 from trackplan.case import Case
+from trackplan.choices import Timing, choose
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import robot_to_yaml
@@ -360,11 +361,9 @@ def _placement(case: Case, values: tuple[float, ...] | None) -> np.ndarray:
     return np.asarray(case.bounds.example, dtype=float)
 
 
-def _timing(value: str | None) -> str | None:
+def _timing(value: str | None) -> Timing | None:
     """Validate the --timing value."""
-    if value is not None and value not in ("smooth", "paper"):
-        raise CaseError(f"--timing must be smooth or paper, got {value!r}", key="--timing")
-    return value
+    return None if value is None else choose(Timing, value, "--timing")
 
 
 @app.command()
@@ -391,7 +390,8 @@ def plan(
     if reference and result.trajectory.n_samples:
         from trackplan.timing.references import reference_durations
 
-        result = _with_references(result, reference_durations(loaded, X, result))
+        references = reference_durations(result.joint_path, loaded.task)
+        result = _with_references(result, references)
     write_run(out, result, loaded, report=report)
     _print_summary(result, out)
     return ExitCode.OK if result.feasible else ExitCode.INFEASIBLE
@@ -413,8 +413,7 @@ def check(
 ) -> ExitCode:
     """Re-check any trajectory.csv, whoever wrote it, against the case's limits and path."""
     from trackplan.io.results import read_trajectory_csv
-    from trackplan.planning.checker import check_trajectory
-    from trackplan.planning.plan import PathGeometry, tracking_reference
+    from trackplan.planning.plan import check_case_trajectory
 
     loaded = load_case(case)
     X = _placement(loaded, placement)
@@ -423,8 +422,7 @@ def check(
     sample_time = float(np.median(np.diff(t)))
     if not np.allclose(np.diff(t), sample_time, rtol=1e-6, atol=1e-9):
         raise CaseError("samples are not evenly spaced in t", file=str(csv), key="t")
-    geometry = PathGeometry.from_case(loaded, _timing(timing))
-    report = check_trajectory(loaded.robot, q, sample_time, tracking_reference(loaded, geometry, X))
+    report = check_case_trajectory(loaded, X, q, sample_time, timing=_timing(timing))
     console = _console()
     console.print(f"{escape(str(csv))}: {len(t)} samples at Ts = {sample_time:g} s")
     for kind, margin in report.joint_margins.items():
@@ -435,8 +433,9 @@ def check(
     console.print(f"  max tracking error {report.max_tracking_error * 1e3:.4f} mm")
     for violation in report.violations:
         console.print(f"  VIOLATION {escape(violation.message)}")
-    console.print("feasible" if report.ok else f"infeasible: {len(report.violations)} violations")
-    return ExitCode.OK if report.ok else ExitCode.INFEASIBLE
+    verdict = "feasible" if report.success else f"infeasible: {len(report.violations)} violations"
+    console.print(verdict)
+    return ExitCode.OK if report.success else ExitCode.INFEASIBLE
 
 
 def _print_summary(result, out: Path) -> None:

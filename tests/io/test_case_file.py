@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
+from tests.conftest import CASES
 from trackplan.case import Case
 from trackplan.cli import main
 from trackplan.errors import CaseError
@@ -18,8 +19,6 @@ from trackplan.io.case_file import PAPER_WEIGHTS, load_case, load_case_text, loa
 from trackplan.io.robot_file import robot_to_yaml
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec
 from trackplan.robots.builtin import puma560
-
-CASES = Path(__file__).resolve().parents[2] / "cases"
 
 BASE: dict[str, Any] = {
     "name": "test-case",

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from trackplan.errors import CaseError
+from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_file import (
     is_robot_file,
     load_robot,
@@ -15,7 +16,6 @@ from trackplan.io.robot_file import (
     load_robot_text,
     robot_to_yaml,
 )
-from trackplan.planning.placement import pose_matrix, rpy_matrix
 from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot, puma560
 from trackplan.robots.model import Robot
 

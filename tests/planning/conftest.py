@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import PathGeometry, plan_placement
-
-CASES = Path(__file__).resolve().parents[2] / "cases"
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.plan import plan_placement
 
 
 @pytest.fixture(scope="session")

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from trackplan.frames import placement_transform, tool_poses
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.placement import placement_transform
-from trackplan.planning.plan import PathGeometry, plan_placement, tracking_reference
-from trackplan.planning.poses import tool_poses
+from trackplan.planning.plan import plan_placement, tracking_reference
 from trackplan.robots.path_ik import solve_path_ik
 
 
@@ -24,7 +24,7 @@ def _kinds(report):
 
 def test_feasible_plan_passes_every_check(corner_case, corner_geometry, corner_plan):
     report = _check(corner_case, corner_geometry, corner_plan.trajectory.q, corner_plan.placement)
-    assert report.ok, [v.message for v in report.violations]
+    assert report.success, [v.message for v in report.violations]
     assert report.max_tracking_error <= corner_case.task.tolerance
     for kind, margins in report.joint_margins.items():
         assert np.all(margins >= 0), kind
@@ -107,4 +107,4 @@ def test_orientation_error_is_caught(corner_case, corner_geometry, corner_plan):
 
 def test_joint_limits_only_without_reference(corner_case, corner_plan):
     report = check_trajectory(corner_case.robot, corner_plan.trajectory.q, 1e-3)
-    assert report.ok and report.task_margins == {}
+    assert report.success and report.task_margins == {}

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from trackplan.planning.derivatives import backward_derivatives
+from trackplan.derivatives import backward_derivatives
 from trackplan.planning.objective import joint_travel
 
 

@@ -8,12 +8,13 @@ import numpy as np
 import pytest
 
 from trackplan.cli import main
+from trackplan.frames import placement_transform
 from trackplan.io.case_file import load_case
 from trackplan.io.results import read_trajectory_csv, write_trajectory_csv
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.placement import placement_transform
-from trackplan.planning.plan import PathGeometry, plan_placement, tracking_reference
-from trackplan.planning.result import PlanStatus
+from trackplan.planning.plan import plan_placement, tracking_reference
+from trackplan.status import Status
 
 from .conftest import CASES
 
@@ -31,7 +32,7 @@ def test_paper_cases_plan_feasibly_in_smooth_mode(name):
         case.task.sample_time,
         tracking_reference(case, geometry, result.placement),
     )
-    assert report.ok, [v.message for v in report.violations]
+    assert report.success, [v.message for v in report.violations]
     # the tool starts at the path's start, placed by X (Eq. 4)
     T = placement_transform(result.placement)
     start = T[:3, :3] @ case.start + T[:3, 3]
@@ -79,7 +80,7 @@ def test_random_reachable_placements_always_meet_rate_limits(corner_case, corner
         if not reach_min <= np.linalg.norm(X[:3]) <= reach_max:
             continue
         result = plan_placement(corner_case, X, geometry=corner_geometry)
-        if result.status in (PlanStatus.UNREACHABLE, PlanStatus.POSITION_LIMITS):
+        if result.status in (Status.UNREACHABLE, Status.POSITION_LIMITS):
             continue
         planned += 1
         assert result.feasible, (X, result.message)
@@ -88,7 +89,7 @@ def test_random_reachable_placements_always_meet_rate_limits(corner_case, corner
 def test_unreachable_placement_reports_why(corner_case, corner_geometry):
     result = plan_placement(corner_case, np.array([2.0, 0, 0, 0, 0, 0]), geometry=corner_geometry)
     assert not result.feasible
-    assert result.status is PlanStatus.UNREACHABLE
+    assert result.status is Status.UNREACHABLE
     assert "out of reach" in result.message
     assert result.trajectory.n_samples == 0
 
@@ -189,6 +190,6 @@ def test_a_time_law_too_long_to_sample_says_where(corner_case, corner_geometry, 
 
     monkeypatch.setattr(smooth, "MAX_SAMPLES", 1000)
     result = plan_placement(corner_case, corner_case.bounds.example, geometry=corner_geometry)
-    assert result.status is PlanStatus.LIMITS_VIOLATED and not result.feasible
+    assert result.status is Status.LIMITS_VIOLATED and not result.feasible
     assert "would need" in result.message and "m/s at s =" in result.message
     assert result.trajectory.n_samples == 0

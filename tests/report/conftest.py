@@ -14,25 +14,16 @@ import numpy as np
 import pytest
 
 from trackplan.case import Case, Objective, OptimizerSettings, PlacementBounds, Task
+from trackplan.derivatives import backward_derivatives
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.derivatives import backward_derivatives
-from trackplan.planning.plan import (
-    PathGeometry,
-    make_trajectory,
-    plan_placement,
-    tracking_reference,
-)
-from trackplan.planning.result import (
-    LIMIT_KINDS,
-    CheckReport,
-    PlanResult,
-    PlanStatus,
-    SlowDown,
-    Trajectory,
-)
+from trackplan.planning.plan import make_trajectory, plan_placement, tracking_reference
+from trackplan.planning.result import LIMIT_KINDS, CheckReport, PlanResult, Trajectory
 from trackplan.robots.builtin import puma560
 from trackplan.robots.model import Robot
+from trackplan.status import Status
+from trackplan.timing import SlowDown
 
 SAMPLE_TIME = 0.005  # s
 TOLERANCE = 0.001  # ρ, m
@@ -43,6 +34,7 @@ PAPER_PLACEMENT = np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522])
 PAPER_WEIGHTS = np.array([0.3, 0.2, 0.2, 0.1, 0.1, 0.1])
 TOOL_RPY = np.array([-np.pi / 2, 0.0, 0.0])
 CORNER = np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [0.3, 0.0, 0.5]])  # m
+UNREACHABLE_PLACEMENT = np.array([0.8, 0.0, 0.4, 0.0, 0.0, 0.0])  # beyond the PUMA's reach
 PLANTED_JOINT = 6
 PLANTED_TIME = 2.0  # s
 PLANTED_JERK = 31.2  # rad/s³, against the limit of 20
@@ -95,8 +87,8 @@ def plan_corner(case: Case) -> PlanResult:
         planned,
         trajectory=trajectory,
         check=check,
-        feasible=check.ok,
-        status=PlanStatus.FEASIBLE if check.ok else PlanStatus.LIMITS_VIOLATED,
+        success=check.success,
+        status=Status.FEASIBLE if check.success else Status.LIMITS_VIOLATED,
         message=check.violations[0].message if check.violations else "feasible",
         objective=float(np.sum(PAPER_WEIGHTS * np.abs(np.diff(q, axis=0)))),
         slowdowns=(
@@ -114,18 +106,18 @@ def empty_result(case: Case) -> PlanResult:
     n = case.robot.n_dof
     empty = np.zeros((0, n))
     trajectory = Trajectory(
-        SAMPLE_TIME,
-        np.zeros(0),
-        np.zeros(0),
-        empty,
-        empty,
-        empty,
-        empty,
-        np.zeros((0, 3)),
-        np.zeros(0),
+        sample_time=SAMPLE_TIME,
+        t=np.zeros(0),
+        s=np.zeros(0),
+        q=empty,
+        qd=empty,
+        qdd=empty,
+        qddd=empty,
+        tool_position=np.zeros((0, 3)),
+        speed=np.zeros(0),
     )
     check = CheckReport(
-        ok=False,
+        success=False,
         joint_margins={kind: np.full(n, np.nan) for kind in LIMIT_KINDS},
         task_margins={"coverage": -1.0},
         violations=(),
@@ -134,9 +126,9 @@ def empty_result(case: Case) -> PlanResult:
     )
     return PlanResult(
         case_name=case.name,
-        placement=np.array([0.8, 0.0, 0.4, 0.0, 0.0, 0.0]),
-        feasible=False,
-        status=PlanStatus.UNREACHABLE,
+        placement=UNREACHABLE_PLACEMENT,
+        success=False,
+        status=Status.UNREACHABLE,
         message="path pose 12 at s = 0.061 m is out of reach",
         timing="smooth",
         branch=-1,
@@ -149,8 +141,7 @@ def empty_result(case: Case) -> PlanResult:
         min_corner_speed=0.0,
         slowdowns=(),
         references={},
-        planned_path=None,
-        nominal_path=None,
+        joint_path=plan_placement(case, UNREACHABLE_PLACEMENT).joint_path,
     )
 
 

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from trackplan.planning.placement import placement_transform
+from trackplan.frames import placement_transform
 from trackplan.planning.result import LIMIT_KINDS, Violation
 from trackplan.report import (
     convergence_figure,
@@ -148,7 +148,15 @@ def test_speed_figure_bounds_and_series(corner, corner_result):
 def test_speed_figure_marks_a_reported_speed_violation(corner, corner_result):
     t = corner_result.trajectory.t
     k = int(np.argmax(corner_result.trajectory.speed))
-    overspeed = Violation("speed", None, float(t[k - 2]), float(t[k + 2]), 0.16, 0.15, "speed")
+    overspeed = Violation(
+        limit="speed",
+        joint=None,
+        t_first=float(t[k - 2]),
+        t_last=float(t[k + 2]),
+        worst=0.16,
+        bound=0.15,
+        message="speed",
+    )
     check = dataclasses.replace(corner_result.check, violations=(overspeed,))
     figure = speed_figure(dataclasses.replace(corner_result, check=check), corner)
     (marker,) = _by_gid(figure.axes[0], "violation")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from trackplan.planning.placement import placement_transform
+from trackplan.frames import placement_transform
 from trackplan.report.scene import (
     chain_points,
     equal_limits,

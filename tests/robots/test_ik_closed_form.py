@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from trackplan.errors import CaseError
-from trackplan.planning.placement import pose_matrix, rpy_matrix
+from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.robots.ik_closed_form import (
     branch_bits,
     describe_branch,

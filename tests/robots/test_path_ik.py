@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from trackplan.errors import CaseError
-from trackplan.planning.placement import placement_transform, pose_matrix, rpy_matrix
+from trackplan.frames import placement_transform, pose_matrix, rpy_matrix
 from trackplan.robots.ik_closed_form import solve_ik_closed_form
 from trackplan.robots.kinematics import forward_kinematics
-from trackplan.robots.path_ik import PathIKStatus, numeric_seeds, solve_path_ik
+from trackplan.robots.path_ik import numeric_seeds, solve_path_ik
+from trackplan.status import Status
 
 # A 1 m line with constant tool orientation that the PUMA follows within its limits.
 LINE_CENTRE = np.array([0.403, -0.159, 0.081])
@@ -45,7 +46,7 @@ def test_line_at_process_speed_is_continuous(puma):
     n_poses = round(1.0 / (SPEED * SAMPLE_TIME)) + 1  # poses 0.15 mm apart
     T = feasible_line(n_poses)[None]
     result = solve_path_ik(puma, T)
-    assert result.ok[0] and result.status[0] is PathIKStatus.OK
+    assert result.success[0] and result.status[0] is Status.FEASIBLE
     assert result.first_problem[0] == -1 and not result.switch.any()
     assert_follows(puma, result, T)
     steps = np.abs(np.diff(result.q[0], axis=0))
@@ -60,8 +61,8 @@ def test_default_branch_is_the_ok_one_with_the_largest_margin(puma):
     T = feasible_line(200)[None]
     chosen = solve_path_ik(puma, T)
     forced = [solve_path_ik(puma, T, branch=b) for b in range(8)]
-    ok = [f.ok[0] for f in forced]
-    margins = [f.margin[0] if f.ok[0] else -np.inf for f in forced]
+    ok = [f.success[0] for f in forced]
+    margins = [f.margin[0] if f.success[0] else -np.inf for f in forced]
     assert any(ok)
     assert chosen.branch[0] == int(np.argmax(margins))
     assert chosen.margin[0] == max(margins)
@@ -92,7 +93,7 @@ def test_batched_equals_loop_of_single_candidates(puma, rng):
     assert len(set(batched.status)) > 1  # the batch mixes outcomes
     for c in range(len(X)):
         single = solve_path_ik(puma, T[c : c + 1])
-        for field in ("q", "branch", "reachable", "switch", "ok", "margin", "first_problem"):
+        for field in ("q", "branch", "reachable", "switch", "success", "margin", "first_problem"):
             np.testing.assert_array_equal(getattr(batched, field)[c], getattr(single, field)[0])
         assert batched.status[c] == single.status[0]
         assert batched.message[c] == single.message[0]
@@ -114,7 +115,7 @@ def test_wrist_singularity_crossing_is_a_branch_switch(puma):
     T, branch = wrist_singular_line(puma, n_poses)
     for b in (branch, branch ^ 1):  # both wrist labels of the singular arm
         result = solve_path_ik(puma, T[None], branch=b)
-        assert result.status[0] is PathIKStatus.BRANCH_SWITCH and not result.ok[0]
+        assert result.status[0] is Status.BRANCH_SWITCH and not result.success[0]
         flagged = np.flatnonzero(result.switch[0])
         assert flagged.min() >= 99 and flagged.max() <= 101
         assert result.first_problem[0] <= flagged.min()  # the flipped wrist: limits first
@@ -141,7 +142,7 @@ def test_elbow_and_shoulder_singularities_are_branch_switches(puma):
     )  # touches r = 0
     for T, words in ((stretched, "elbow singularity"), (tangent, "shoulder singularity")):
         result = solve_path_ik(puma, T[None])
-        assert result.status[0] is PathIKStatus.BRANCH_SWITCH
+        assert result.status[0] is Status.BRANCH_SWITCH
         assert words in result.message[0]
         assert 49 <= result.first_problem[0] <= 51
 
@@ -154,7 +155,7 @@ def test_unreachable_pose_is_reported(puma):
     first_out = int(np.argmin(reachable))
     assert 0 < first_out < 100
     result = solve_path_ik(puma, T[None])
-    assert result.status[0] is PathIKStatus.UNREACHABLE
+    assert result.status[0] is Status.UNREACHABLE
     np.testing.assert_array_equal(result.reachable[0], reachable)
     assert result.first_problem[0] == first_out
     assert (
@@ -171,19 +172,17 @@ def test_unreachable_pose_is_reported(puma):
 def test_position_limits_and_jumps_are_reported(puma):
     T = feasible_line(200)[None]
     limited = [
-        b
-        for b in range(8)
-        if solve_path_ik(puma, T, branch=b).status[0] is PathIKStatus.POSITION_LIMITS
+        b for b in range(8) if solve_path_ik(puma, T, branch=b).status[0] is Status.POSITION_LIMITS
     ]
     assert limited
     result = solve_path_ik(puma, T, branch=limited[0])
-    assert result.margin[0] < 0 and not result.ok[0]
+    assert result.margin[0] < 0 and not result.success[0]
     assert "leaves [" in result.message[0]
     k = result.first_problem[0]
     outside = (result.q[0, k] < puma.q_min) | (result.q[0, k] > puma.q_max)
     assert outside.any()
     jumpy = solve_path_ik(puma, T, max_step=1e-4)
-    assert jumpy.status[0] is PathIKStatus.BRANCH_SWITCH and "jumps" in jumpy.message[0]
+    assert jumpy.status[0] is Status.BRANCH_SWITCH and "jumps" in jumpy.message[0]
     assert jumpy.first_problem[0] == 1
 
 
@@ -208,7 +207,7 @@ def test_ur5_numeric_path_is_continuous_on_a_line(ur):
     T = line(T_mid[:3, 3], np.array([0.3, 1.0, -0.2]), T_mid[:3, :3], 0.4, 400)[None]
     result = solve_path_ik(ur, T)
     assert result.method == "numeric"
-    assert result.ok[0], result.message[0]
+    assert result.success[0], result.message[0]
     assert_follows(ur, result, T, tol=1e-9)
     assert np.abs(np.diff(result.q[0], axis=0)).max() < 0.02
     forced = solve_path_ik(ur, T, branch=int(result.branch[0]))
@@ -220,7 +219,7 @@ def test_numeric_mode_agrees_with_closed_form(puma):
     T = feasible_line(300)[None]
     closed = solve_path_ik(puma, T, method="closed_form")
     numeric = solve_path_ik(puma, T, method="numeric")
-    assert numeric.ok[0]
+    assert numeric.success[0]
     assert_follows(puma, numeric, T)
     # The numeric branch is one of the closed-form branches along the whole path.
     branches = solve_ik_closed_form(puma, T[0]).q
@@ -234,4 +233,4 @@ def test_numeric_mode_flags_a_singularity_crossing(puma):
     statuses = {
         solve_path_ik(puma, T[None], branch=b, method="numeric").status[0] for b in range(8)
     }
-    assert PathIKStatus.BRANCH_SWITCH in statuses
+    assert Status.BRANCH_SWITCH in statuses

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from trackplan.errors import CaseError
-from trackplan.planning.placement import pose_matrix
+from trackplan.frames import pose_matrix
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.path_ik import solve_path_ik
 from trackplan.robots.resolved_rate import solve_path_resolved_rate
@@ -26,7 +26,7 @@ def puma_line(puma):
         puma, np.array([0.2, -0.6, 0.4, 0.3, 0.8, 0.1]), np.array([0, 1.0, 0.3]), 0.4, 2001
     )
     reference = solve_path_ik(puma, T[None])
-    assert reference.ok[0]
+    assert reference.success[0]
     return T, reference.q[0]
 
 

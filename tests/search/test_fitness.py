@@ -3,16 +3,17 @@
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from trackplan.case import Case
+from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.objective import joint_travel
-from trackplan.planning.plan import PathGeometry, plan_placement
-from trackplan.planning.poses import tool_poses
+from trackplan.planning.plan import plan_placement
 from trackplan.robots.path_ik import solve_path_ik, solve_path_ik_branches
 from trackplan.search.fitness import (
     CURVED_POSES,
@@ -22,7 +23,6 @@ from trackplan.search.fitness import (
 )
 from trackplan.search.space import SearchSpace
 
-CASES = Path(__file__).resolve().parents[2] / "cases"
 PAPER_X = np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522])
 """The paper's Case 3 optimum (Section 4)."""
 GOOD_X = np.array([-0.0896, -0.1998, -0.0157, 0.0, 0.3835, -1.2381])
@@ -63,7 +63,7 @@ def test_every_branch_matches_the_single_branch_solver(case: Case, geometry: Pat
     assert branches.q.shape == (12, 8, poses.shape[1], 6)
     for k in range(8):
         single = solve_path_ik(case.robot, poses, branch=k)
-        assert np.array_equal(single.ok, branches.ok[:, k])
+        assert np.array_equal(single.success, branches.success[:, k])
         assert np.array_equal(single.reachable, branches.reachable[:, k])
         assert np.allclose(single.q, branches.q[:, k], equal_nan=True)
         assert np.array_equal(single.margin, branches.margin[:, k])
@@ -78,7 +78,7 @@ def test_branch_with_the_least_travel_is_chosen(case: Case, geometry: PathGeomet
         travels = []
         for k in range(8):
             single = solve_path_ik(case.robot, poses[i : i + 1], branch=k)
-            if single.ok[0]:
+            if single.success[0]:
                 travels.append((joint_travel(single.q[0], case.objective.weights), k))
         assert (result.objective[i], result.branch[i]) == pytest.approx(min(travels))
     assert result.fitness == pytest.approx(result.objective)

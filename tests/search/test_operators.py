@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 
+from tests.conftest import CASES
 from trackplan.case import PlacementBounds
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
@@ -25,8 +24,6 @@ from trackplan.search.operators import (
     stochastic_uniform,
 )
 from trackplan.search.space import SearchSpace, box_distance_range
-
-CASES = Path(__file__).resolve().parents[2] / "cases"
 
 
 @pytest.fixture(scope="module")

@@ -4,21 +4,21 @@ from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from trackplan.case import Case, PlacementBounds
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
-from trackplan.planning.plan import PathGeometry, plan_placement
-from trackplan.search import GenerationRecord, OptimizeStatus, optimize_placement
+from trackplan.planning.plan import plan_placement
+from trackplan.search import GenerationRecord, optimize_placement
 from trackplan.search.fitness import Finding, PlacementFitness
 from trackplan.search.space import SearchSpace
-
-CASES = Path(__file__).resolve().parents[2] / "cases"
+from trackplan.status import Status
 
 
 @pytest.fixture(scope="module")
@@ -48,8 +48,8 @@ def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeomet
     assert result.evaluations == 100 and result.stop_reason == "budget"
     assert result.history.evaluations.tolist() == [30, 58, 86, 100]
     assert result.generations == 4 and result.method == "ga" and result.seed == 0
-    assert result.success and result.status is OptimizeStatus.FEASIBLE
-    assert result.final.feasible and result.final.check.ok
+    assert result.success and result.status is Status.FEASIBLE
+    assert result.final.feasible and result.final.check.success
     assert np.array_equal(result.final.placement, result.X)
     assert result.objective == pytest.approx(result.fitness, rel=5e-3)
     assert np.all(np.diff(result.history.best) <= 0)
@@ -63,7 +63,7 @@ def test_other_methods_are_reproducible(case: Case, geometry: PathGeometry, meth
         for _ in range(2)
     )
     assert first.method == method and first.evaluations == 150
-    assert first.success and first.final.check.ok
+    assert first.success and first.final.check.success
     assert np.array_equal(first.history.best, second.history.best)
     assert np.array_equal(first.X, second.X)
 
@@ -121,7 +121,7 @@ def test_final_recheck_catches_a_wrong_screening(
     monkeypatch.setattr(SearchSpace, "sample", planting)
     result = optimize_placement(case, budget=60, geometry=geometry)
     assert result.rejected.shape == (1, 6) and np.allclose(result.rejected[0], planted)
-    assert result.success and result.final.check.ok
+    assert result.success and result.final.check.success
     assert not np.allclose(result.X, planted)
     assert "failed the final check" in result.message
 
@@ -141,14 +141,14 @@ def test_no_candidate_passing_the_check_gives_infeasible(
 
     monkeypatch.setattr(PlacementFitness, "_screen", everything_feasible)
     result = optimize_placement(case, budget=30, seed=1, geometry=geometry)
-    assert not result.success and result.status is OptimizeStatus.INFEASIBLE
+    assert not result.success and result.status is not Status.FEASIBLE
     assert not result.final.feasible and len(result.rejected) >= 1
 
 
 def test_impossible_case_explains_the_closest_candidate(case: Case) -> None:
     long_line = replace(case, segments=(LineSpec(np.array([3.0, 0.0, 0.0])),))
     result = optimize_placement(long_line, budget=120)
-    assert not result.success and result.status is OptimizeStatus.INFEASIBLE
+    assert not result.success and result.status is not Status.FEASIBLE
     assert result.final.status.value == "unreachable"
     assert "no feasible placement in 120 evaluations" in result.message
     assert "out of reach" in result.message

@@ -2,19 +2,16 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from trackplan.cli import main
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import PathGeometry
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.search import optimize_placement
 from trackplan.search.optimize import run_seeds
-
-CASES = Path(__file__).resolve().parents[2] / "cases"
 
 
 @pytest.fixture(scope="module")

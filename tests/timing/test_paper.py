@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import PathGeometry, plan_placement
-from trackplan.planning.result import PlanStatus
+from trackplan.jointpath import JointPath
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.plan import plan_placement
+from trackplan.status import Status
 from trackplan.timing import paper
 
-CASES = Path(__file__).resolve().parents[2] / "cases"
 LINE_PUBLISHED = np.array([-0.1322, 0.0610, 0.1829, 0.0312, -0.4124, 0.5020])
 LINE_MOVED_OUT = np.array([-0.2230, 0.1029, 0.1829, 0.0312, -0.4124, 0.5020])
 """Case 1's placement with (x, y) moved 0.1 m away from joint 1's axis (reachable)."""
@@ -48,14 +48,14 @@ def test_published_line_placement_is_out_of_reach(line_case):
     # The start (x, y) is 0.146 m from joint 1's axis, inside the 0.15 m shoulder offset d3.
     assert np.hypot(*LINE_PUBLISHED[:2]) < line_case.robot.d[2]
     result = plan_placement(line_case, LINE_PUBLISHED, timing="paper")
-    assert result.status is PlanStatus.UNREACHABLE
+    assert result.status is Status.UNREACHABLE
     assert result.trajectory.n_samples == 0
     assert "out of reach" in result.message
 
 
 def test_line_produces_a_checked_trajectory(line_result, line_case):
     assert line_result.trajectory.n_samples > 0
-    assert line_result.status is PlanStatus.LIMITS_VIOLATED
+    assert line_result.status is Status.LIMITS_VIOLATED
     # the paper's Fig. 5b finding: acceleration and jerk limits broken, velocities within
     assert {"acceleration", "jerk"} <= kinds(line_result)
     assert "velocity" not in kinds(line_result)
@@ -93,7 +93,9 @@ def test_corner_tracking_error_is_two_rho(corner_result, corner_case):
 
 def test_corner_arc_is_a_whole_number_of_periods(corner_case):
     geometry = PathGeometry.from_case(corner_case, "paper")
-    planner = paper._PaperPlanner(corner_case, geometry.planned, CORNER_PUBLISHED, 3)
+    planner = paper._PaperPlanner(
+        corner_case.robot, corner_case.task, geometry.planned, CORNER_PUBLISHED, 3
+    )
     arc = next(k for k, piece in enumerate(geometry.planned.pieces) if not piece.straight)
     steps = planner._arc_steps(arc)
     speed = planner._arc_speed(arc)
@@ -116,24 +118,25 @@ def test_arc_started_at_constant_speed_steps_the_velocity():
 
 def test_forced_branch_is_used_or_refused(corner_case):
     geometry = PathGeometry.from_case(corner_case, "paper")
-    q, s, branch, status, message = paper.plan_paper_trajectory(
-        corner_case, geometry, CORNER_PUBLISHED, 3
+    joint_path = JointPath.solve(
+        corner_case.robot, geometry, CORNER_PUBLISHED, corner_case.task.tool_rpy, branch=3
     )
-    assert branch == 3 and status is None and message == ""
-    assert q.shape == (len(s), 6)
-    assert np.all(np.diff(s) >= -1e-6)
-    q, s, branch, status, message = paper.plan_paper_trajectory(
-        corner_case, geometry, CORNER_PUBLISHED, 0
-    )
-    assert branch == 0 and status is PlanStatus.POSITION_LIMITS
-    assert q.shape == (0, 6) and message
+    law = paper.plan_paper_trajectory(joint_path, corner_case.task)
+    assert joint_path.branch == 3 and law.success and law.message == ""
+    assert law.q.shape == (len(law.s), 6)
+    assert np.all(np.diff(law.s) >= -1e-6)
+    refused = plan_placement(corner_case, CORNER_PUBLISHED, timing="paper", branch=0)
+    assert refused.branch == 0 and refused.status is Status.POSITION_LIMITS
+    assert refused.trajectory.q.shape == (0, 6) and refused.message
 
 
 def test_via_spacing_keeps_the_ramp_from_stalling(line_case):
     # With 1 mm vias at Ts = 1 ms, rounding each interval up to whole periods cancels the
     # acceleration: the forward piece stalls at 1 mm / (m Ts) below v_r.
     geometry = PathGeometry.from_case(line_case, "paper")
-    planner = paper._PaperPlanner(line_case, geometry.planned, LINE_MOVED_OUT, 2)
+    planner = paper._PaperPlanner(
+        line_case.robot, line_case.task, geometry.planned, LINE_MOVED_OUT, 2
+    )
     piece = geometry.planned.pieces[0]
     q_start = plan_placement(line_case, LINE_MOVED_OUT, timing="paper").trajectory.q[0]
     rated = line_case.task.rated_speed

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from trackplan.planning.derivatives import backward_derivatives
+from trackplan.derivatives import backward_derivatives
 from trackplan.timing.profile import (
     SpeedProfile,
     speed_change_distance,

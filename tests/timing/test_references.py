@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.planning.checker import check_trajectory
 from trackplan.planning.plan import plan_placement
@@ -21,7 +20,6 @@ from trackplan.timing.references import (
 pytest.importorskip("toppra")
 pytest.importorskip("copp_py")
 
-CASES = Path(__file__).resolve().parents[2] / "cases"
 LINE = np.array([-0.2230, 0.1029, 0.1829, 0.0312, -0.4124, 0.5020])
 
 
@@ -29,8 +27,8 @@ LINE = np.array([-0.2230, 0.1029, 0.1829, 0.0312, -0.4124, 0.5020])
 def line():
     case = load_case(CASES / "paper-line.yaml")
     result = plan_placement(case, LINE, timing="smooth")
-    s_grid, q_grid, caps, ok = reference_inputs(case, LINE, result.planned_path, result.branch)
-    assert ok
+    assert result.joint_path.success
+    s_grid, q_grid, caps = reference_inputs(result.joint_path, case.task)
     return case, result, s_grid, q_grid, caps
 
 
@@ -98,7 +96,7 @@ def test_reference_durations_keys(line, monkeypatch):
         )
 
     monkeypatch.setattr(references, "topp3_reference", fake_topp3)
-    durations = reference_durations(case, LINE, result)
+    durations = reference_durations(result.joint_path, case.task)
     assert set(durations) == {"toppra_duration", "topp3_duration"}
     assert durations["topp3_duration"] == 9.0
     assert durations["toppra_duration"] <= result.duration

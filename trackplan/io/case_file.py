@@ -24,6 +24,7 @@ from trackplan.case import (
     PlacementBounds,
     Task,
 )
+from trackplan.choices import Method, Penalty, Timing
 from trackplan.errors import CaseError
 from trackplan.io.robot_file import load_robot_spec
 from trackplan.io.yaml_input import (
@@ -282,7 +283,7 @@ def _case(
             tolerance=task.tolerance,
             sample_time=task.sample_time,
             tool_rpy=_array(task.tool_rpy),
-            timing=task.timing,
+            timing=Timing(task.timing),
         ),
         bounds=PlacementBounds(
             lower=_array(ranges[:, 0]),
@@ -293,11 +294,11 @@ def _case(
         objective=Objective(
             weights=_array(weights),
             time_weight=objective.time_weight,
-            penalty=objective.penalty,
+            penalty=Penalty(objective.penalty),
             flat_penalty=objective.flat_penalty,
         ),
         optimizer=OptimizerSettings(
-            method=optimizer.method,
+            method=Method(optimizer.method),
             population=optimizer.population,
             seed=optimizer.seed,
             budget=optimizer.budget,

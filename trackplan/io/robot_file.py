@@ -24,6 +24,7 @@ import yaml
 from pydantic import Field
 
 from trackplan.errors import CaseError
+from trackplan.frames import pose_matrix, rpy_from_matrix, rpy_matrix
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     Positive,
@@ -38,7 +39,6 @@ from trackplan.io.yaml_input import (
     show,
     validate_model,
 )
-from trackplan.planning.placement import pose_matrix, rpy_from_matrix, rpy_matrix
 from trackplan.robots.builtin import builtin_robot
 from trackplan.robots.model import Robot
 

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trackplan.derivatives import backward_derivatives
 from trackplan.paths import NominalPath
-from trackplan.planning.derivatives import backward_derivatives
 from trackplan.planning.result import CheckReport, Violation
 from trackplan.planning.tracking import jump_allowance, locate_on_nominal
 from trackplan.robots.kinematics import forward_kinematics
@@ -135,7 +135,7 @@ def check_trajectory(
         violations.extend(task_violations)
 
     return CheckReport(
-        ok=not violations,
+        success=not violations,
         joint_margins=margins,
         task_margins=task_margins,
         violations=tuple(violations),
@@ -157,7 +157,15 @@ def _violation(
         f"{who} {abs(value):.4g} {UNITS[kind]} exceeds {abs(bound):.4g} at t = {t[worst]:.3f} s"
         f" ({len(bad)} samples from t = {t[bad[0]]:.3f} to {t[bad[-1]]:.3f} s)"
     )
-    return Violation(kind, joint, float(t[bad[0]]), float(t[bad[-1]]), value, bound, message)
+    return Violation(
+        limit=kind,
+        joint=joint,
+        t_first=float(t[bad[0]]),
+        t_last=float(t[bad[-1]]),
+        worst=value,
+        bound=bound,
+        message=message,
+    )
 
 
 def _check_task(
@@ -227,7 +235,17 @@ def _coverage_violations(
     found: list[Violation] = []
 
     def add(k: int, value: float, bound: float, text: str) -> None:
-        found.append(Violation("coverage", None, float(t[k]), float(t[k]), value, bound, text))
+        found.append(
+            Violation(
+                limit="coverage",
+                joint=None,
+                t_first=float(t[k]),
+                t_last=float(t[k]),
+                worst=value,
+                bound=bound,
+                message=text,
+            )
+        )
 
     if s[0] > tol:
         add(

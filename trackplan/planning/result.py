@@ -2,27 +2,20 @@
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from trackplan.jointpath import JointPath
+from trackplan.paths import NominalPath, Path
 from trackplan.robots.model import LIMIT_KINDS
+from trackplan.status import Status
+from trackplan.timing.protocol import SlowDown
 
 TASK_KINDS = ("tracking", "orientation", "speed", "coverage")
 
 
-class PlanStatus(enum.Enum):
-    """Outcome of planning one placement."""
-
-    FEASIBLE = "feasible"
-    LIMITS_VIOLATED = "limits_violated"  # a trajectory exists but breaks a limit
-    UNREACHABLE = "unreachable"  # some path pose has no IK solution
-    BRANCH_SWITCH = "branch_switch"  # the path crosses a singularity
-    POSITION_LIMITS = "position_limits"  # every branch leaves the joint range
-
-
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class Trajectory:
     """Joint trajectory sampled at the controller period, from rest to rest.
 
@@ -66,7 +59,7 @@ class Trajectory:
         return float(self.t[-1])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Violation:
     """One limit broken over a time window.
 
@@ -96,13 +89,13 @@ class Violation:
     message: str
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class CheckReport:
     """What the checker found, sample by sample.
 
     Attributes
     ----------
-    ok
+    success
         True when nothing is violated.
     joint_margins
         Per joint limit kind, shape (n,): the smallest unused fraction of the limit
@@ -121,7 +114,7 @@ class CheckReport:
         For each joint limit kind, the (joint, time) at which it is closest to binding.
     """
 
-    ok: bool
+    success: bool
     joint_margins: dict[str, np.ndarray]
     task_margins: dict[str, float]
     violations: tuple[Violation, ...]
@@ -136,30 +129,7 @@ class CheckReport:
         return min(values)
 
 
-@dataclass(frozen=True)
-class SlowDown:
-    """A stretch of a straight piece run below the rated speed.
-
-    Attributes
-    ----------
-    s_start, s_end
-        Arc length on the planned path, m.
-    speed
-        Plateau speed held there, m/s.
-    rated_speed
-        The rated speed, m/s.
-    limit
-        What forced it (e.g. ``"joint 4 velocity"``).
-    """
-
-    s_start: float
-    s_end: float
-    speed: float
-    rated_speed: float
-    limit: str
-
-
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class PlanResult:
     """One placement planned end to end.
 
@@ -169,14 +139,14 @@ class PlanResult:
         Name of the case.
     placement
         X = (x, y, z, roll, pitch, yaw), shape (6,).
-    feasible
-        True when the checker found no violation.
+    success
+        True when the checker found no violation (``status`` is ``FEASIBLE``).
     status
-        See :class:`PlanStatus`.
+        See :class:`trackplan.status.Status`.
     message
         One line saying what happened (the first violation when infeasible).
     timing
-        ``smooth`` or ``paper``.
+        The time law (``smooth`` or ``paper``).
     branch
         IK branch used (closed form: 0-7; numeric: the seed index).
     trajectory
@@ -197,16 +167,15 @@ class PlanResult:
         Where straight pieces run below the rated speed.
     references
         Reference durations when computed: ``toppra_duration``, ``topp3_duration`` (s).
-    planned_path
-        The planned (blended) path, :class:`trackplan.paths.Path`.
-    nominal_path
-        The path as the user gave it, :class:`trackplan.paths.NominalPath`.
+    joint_path
+        The placed path's poses and IK on the planning grid
+        (:class:`trackplan.jointpath.JointPath`).
     """
 
     case_name: str
     placement: np.ndarray
-    feasible: bool
-    status: PlanStatus
+    success: bool
+    status: Status
     message: str
     timing: str
     branch: int
@@ -219,8 +188,22 @@ class PlanResult:
     min_corner_speed: float
     slowdowns: tuple[SlowDown, ...]
     references: dict[str, float]
-    planned_path: object
-    nominal_path: object
+    joint_path: JointPath
+
+    @property
+    def planned_path(self) -> Path:
+        """The planned (blended) path."""
+        return self.joint_path.geometry.planned
+
+    @property
+    def nominal_path(self) -> NominalPath:
+        """The path as the user gave it."""
+        return self.joint_path.geometry.nominal
+
+    @property
+    def feasible(self) -> bool:
+        """Alias of :attr:`success`: the plan passed every check."""
+        return self.success
 
 
 __all__ = [
@@ -228,8 +211,6 @@ __all__ = [
     "TASK_KINDS",
     "CheckReport",
     "PlanResult",
-    "PlanStatus",
-    "SlowDown",
     "Trajectory",
     "Violation",
 ]

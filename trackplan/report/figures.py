@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.frames import placement_transform
 from trackplan.planning.checker import RELATIVE_SLACK
-from trackplan.planning.placement import placement_transform
 from trackplan.planning.result import LIMIT_KINDS, PlanResult
 from trackplan.report.scene import (
     JOINT_QUANTITIES,

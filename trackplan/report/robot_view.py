@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.planning.placement import placement_transform
+from trackplan.frames import placement_transform
 from trackplan.planning.result import PlanResult
 from trackplan.report.scene import (
     chain_points,

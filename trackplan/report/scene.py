@@ -12,8 +12,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.frames import placement_transform
 from trackplan.paths import NominalPath
-from trackplan.planning.placement import placement_transform
 from trackplan.planning.result import PlanResult, Trajectory, Violation
 from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.model import Robot

@@ -3,7 +3,7 @@
 For each candidate (a placement of the path) and each branch, the IK solutions of the M
 poses form a joint path. The path is unwrapped continuously along M and then shifted by
 a multiple of 2π per joint so that it sits inside ``[q_min, q_max]`` with the largest
-margin. A branch is usable (``ok``) when every pose is reachable, the branch never
+margin. A branch is usable (``success``) when every pose is reachable, the branch never
 switches (a switch is a singularity crossing: the joint path would need infinite speed
 or a jump) and the shifted path stays inside the position limits.
 
@@ -32,7 +32,6 @@ consecutive poses (default :data:`DEFAULT_MAX_STEP`).
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass
 
@@ -49,6 +48,7 @@ from trackplan.robots.ik_numeric import (
     work_size_kernel,
 )
 from trackplan.robots.model import Robot
+from trackplan.status import Status
 
 DEFAULT_MAX_STEP = np.pi / 4
 """Joint step between consecutive poses that counts as a jump when ``max_step`` is None,
@@ -77,15 +77,6 @@ _MARCH_MAX_ITER = 100  # first pose from a seed, and the coarse march
 _FINE_MAX_ITER = 30  # every pose, seeded within a coarse step of its solution
 
 
-class PathIKStatus(enum.Enum):
-    """Outcome of the chosen branch of one candidate (the first that applies)."""
-
-    OK = "ok"
-    UNREACHABLE = "unreachable"  # some pose has no IK solution
-    BRANCH_SWITCH = "branch_switch"  # the path crosses a singularity or jumps
-    POSITION_LIMITS = "position_limits"  # the path does not fit the joint range
-
-
 @dataclass(frozen=True, eq=False)
 class PathIK:
     """Joint paths of B candidates along M poses each, one branch per candidate.
@@ -103,16 +94,16 @@ class PathIK:
     switch
         Shape (B, M), bool: going from pose k − 1 to pose k needs a branch change
         (singularity crossing) or a joint step larger than ``max_step``.
-    ok
+    success
         Shape (B,), bool: reachable everywhere, no switch, inside the position limits.
     margin
         Smallest distance of the path to a joint position limit, shape (B,), rad;
         negative when outside, −inf when no pose is reachable.
     first_problem
         First pose with a problem (unreachable, switch, outside the limits), shape (B,),
-        int; −1 when ``ok``.
+        int; −1 when ``success``.
     status
-        One :class:`PathIKStatus` per candidate.
+        One :class:`trackplan.status.Status` per candidate (``FEASIBLE`` when ``success``).
     message
         One line per candidate saying what is wrong, or which branch is used and its margin.
     method
@@ -123,10 +114,10 @@ class PathIK:
     branch: np.ndarray
     reachable: np.ndarray
     switch: np.ndarray
-    ok: np.ndarray
+    success: np.ndarray
     margin: np.ndarray
     first_problem: np.ndarray
-    status: tuple[PathIKStatus, ...]
+    status: tuple[Status, ...]
     message: tuple[str, ...]
     method: str
 
@@ -151,13 +142,13 @@ class PathIKBranches:
         Shape (B, K, M), bool: the branch has an IK solution at the pose.
     switch
         Shape (B, K, M), bool: a singularity crossing or jump between poses k − 1 and k.
-    ok
+    success
         Shape (B, K), bool: reachable everywhere, no switch, inside the position limits.
     margin
         Smallest distance of the path to a joint position limit, shape (B, K), rad; negative
         when outside, −inf when no pose is reachable.
     first_problem
-        First pose with a problem, shape (B, K), int; −1 when ``ok``.
+        First pose with a problem, shape (B, K), int; −1 when ``success``.
     reachable_fraction
         Share of the M poses the branch reaches, shape (B, K), in [0, 1].
     n_switches
@@ -170,7 +161,7 @@ class PathIKBranches:
     branches: np.ndarray
     reachable: np.ndarray
     switch: np.ndarray
-    ok: np.ndarray
+    success: np.ndarray
     margin: np.ndarray
     first_problem: np.ndarray
     reachable_fraction: np.ndarray
@@ -263,7 +254,7 @@ def solve_path_ik(
         branch=branches,
         reachable=reach[rows, chosen],
         switch=switch[rows, chosen],
-        ok=ok[rows, chosen],
+        success=ok[rows, chosen],
         margin=values[:, _F_MARGIN],
         first_problem=report[:, _I_FIRST],
         status=statuses,
@@ -309,7 +300,7 @@ def solve_path_ik_branches(
         branches=np.arange(N_BRANCHES),
         reachable=reach,
         switch=switch,
-        ok=ok,
+        success=ok,
         margin=values[..., _F_MARGIN],
         first_problem=report[..., _I_FIRST],
         reachable_fraction=1.0 - report[..., _I_N_UNREACH] / reach.shape[2],
@@ -423,22 +414,22 @@ def _choose(ok: np.ndarray, first_problem: np.ndarray, margin: np.ndarray) -> np
     return order[:, 0]
 
 
-def _status(report: np.ndarray, values: np.ndarray) -> PathIKStatus:
+def _status(report: np.ndarray, values: np.ndarray) -> Status:
     """The status of one branch's report."""
     if report[_I_N_UNREACH] > 0:
-        return PathIKStatus.UNREACHABLE
+        return Status.UNREACHABLE
     if report[_I_N_SWITCH] > 0:
-        return PathIKStatus.BRANCH_SWITCH
+        return Status.BRANCH_SWITCH
     if values[_F_MARGIN] < 0.0:
-        return PathIKStatus.POSITION_LIMITS
-    return PathIKStatus.OK
+        return Status.POSITION_LIMITS
+    return Status.FEASIBLE
 
 
 def _message(
     robot: Robot,
     method: str,
     branch: int,
-    status: PathIKStatus,
+    status: Status,
     report: np.ndarray,
     values: np.ndarray,
     n_poses: int,
@@ -446,7 +437,7 @@ def _message(
 ) -> str:
     """One line about one candidate's branch."""
     name = describe_branch(branch) if method == "closed_form" else f"seed {branch}"
-    if status is PathIKStatus.OK:
+    if status is Status.FEASIBLE:
         margin = values[_F_MARGIN]
         return f"branch {branch} ({name}) follows all {n_poses} poses, margin {margin:.3f} rad"
     parts = []

@@ -10,7 +10,6 @@ from trackplan.search.optimize import (
     HISTORY_KEYS,
     GenerationRecord,
     OptimizeResult,
-    OptimizeStatus,
     SearchHistory,
     optimize_placement,
 )
@@ -19,7 +18,6 @@ __all__ = [
     "HISTORY_KEYS",
     "GenerationRecord",
     "OptimizeResult",
-    "OptimizeStatus",
     "SearchHistory",
     "optimize_placement",
 ]

@@ -25,6 +25,7 @@ from pymoo.algorithms.soo.nonconvex.random_search import RandomSearch
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.population import Population
 from pymoo.core.termination import TerminateIfAny, Termination
+from pymoo.termination import get_termination
 from pymoo.termination.max_gen import MaximumGenerationTermination
 
 from trackplan.errors import CaseError
@@ -41,7 +42,6 @@ from trackplan.search.operators import (
 )
 from trackplan.search.space import N_VAR, SearchSpace
 
-METHODS = ("ga", "cmaes", "de", "random")
 """Placement search methods."""
 CROSSOVER_FRACTION = 0.8
 """MATLAB's CrossoverFraction as the paper sets it."""
@@ -65,7 +65,7 @@ def make_algorithm(method: str, space: SearchSpace, population: int) -> Algorith
     Parameters
     ----------
     method
-        One of :data:`METHODS`.
+        A :class:`trackplan.choices.Method`.
     space
         The admissible placements.
     population
@@ -108,11 +108,19 @@ def make_algorithm(method: str, space: SearchSpace, population: int) -> Algorith
         return CMAESearch(space, population)
     if method == "random":
         return RandomSearch(n_points_per_iteration=population, sampling=sampling)
-    raise CaseError(f"method must be one of {', '.join(METHODS)}, got {method!r}", key="method")
+    raise CaseError(f"unknown method {method!r}", key="method")
 
 
-def make_termination() -> tuple[Termination, dict[str, Termination]]:
+def make_termination(
+    termination: Termination | tuple | None = None,
+) -> tuple[Termination, dict[str, Termination]]:
     """The stopping rules every method shares (the budget is the driver's).
+
+    Parameters
+    ----------
+    termination
+        A pymoo ``Termination`` or a ``get_termination`` tuple (``("n_gen", 50)``) to use
+        instead of the default stall and generation rules; it is reported as ``custom``.
 
     Returns
     -------
@@ -120,6 +128,10 @@ def make_termination() -> tuple[Termination, dict[str, Termination]]:
         The combined termination, and its parts by stop reason (``stall``,
         ``max_generations``) to tell which one fired.
     """
+    if termination is not None:
+        if isinstance(termination, tuple):
+            termination = get_termination(*termination)
+        return termination, {"custom": termination}
     parts: dict[str, Termination] = {
         "stall": StallTermination(STALL_GENERATIONS, FUNCTION_TOLERANCE),
         "max_generations": MaximumGenerationTermination(MAX_GENERATIONS),

@@ -48,12 +48,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.choices import Penalty
+from trackplan.frames import tool_poses
+from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.objective import joint_travel
-from trackplan.planning.plan import PathGeometry, plan_placement
-from trackplan.planning.poses import tool_poses
+from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.search.space import SearchSpace
+from trackplan.timing import time_law
 
 SCREEN_POSES = 150
 """Target number of poses of the screening grid along the planned path."""
@@ -151,7 +154,7 @@ class PlacementFitness:
     geometry
         The case's paths for the timing used.
     timing
-        ``smooth`` or ``paper``.
+        The time law (:data:`trackplan.timing.TIME_LAWS`).
     n_poses
         Target size of the screening grid.
     executor
@@ -173,10 +176,11 @@ class PlacementFitness:
         self.space = space
         self.geometry = geometry
         self.timing = timing
+        self.law = time_law(timing)
         self.s_grid = screening_grid(geometry, n_poses)
         self.points = geometry.planned.sample(self.s_grid).position
         self.weights = np.asarray(case.objective.weights, dtype=float)
-        self.flat = case.objective.penalty == "flat"
+        self.flat = case.objective.penalty == Penalty.FLAT
         self.penalty = float(case.objective.flat_penalty)
         self.time_weight = float(case.objective.time_weight)
         curved = geometry.on_curved_zone(0.5 * (self.s_grid[1:] + self.s_grid[:-1]))
@@ -221,7 +225,7 @@ class PlacementFitness:
         feasible = finding == Finding.FEASIBLE
         violation[feasible] = 0.0
         fitness[feasible] = objective[feasible] + self.time_weight * bound[feasible]
-        if self.timing == "paper" or self.time_weight > 0.0:
+        if not self.law.follows_joint_path or self.time_weight > 0.0:
             self._time(X, incumbent, fitness, objective, duration, branch, violation, finding)
             feasible = finding == Finding.FEASIBLE
         infeasible = ~feasible
@@ -242,12 +246,12 @@ class PlacementFitness:
         n_poses = len(self.s_grid)
         with np.errstate(invalid="ignore"):
             J = joint_travel(paths.q, self.weights)  # (B, K)
-        J = np.where(paths.ok, J, np.inf)
+        J = np.where(paths.success, J, np.inf)
         unreachable = 1.0 - paths.reachable_fraction
         switches = paths.n_switches / n_poses
         limits = np.minimum(1.0, np.maximum(0.0, -paths.margin) / np.pi)
         graded = GEOMETRY_LEVEL + unreachable + switches + limits  # (B, K)
-        any_ok = paths.ok.any(axis=1)
+        any_ok = paths.success.any(axis=1)
         choice = np.where(any_ok, np.argmin(J, axis=1), np.argmin(graded, axis=1))
         rows = np.arange(len(X))
         objective = np.where(any_ok, J[rows, choice], np.nan)
@@ -280,7 +284,7 @@ class PlacementFitness:
     ) -> None:
         """Plan and check the candidates whose time matters; update the arrays in place."""
         candidates = finding == Finding.FEASIBLE
-        if self.timing != "paper":
+        if self.law.follows_joint_path:
             candidates &= fitness < incumbent
         index = np.flatnonzero(candidates)
         if not len(index):
@@ -288,8 +292,9 @@ class PlacementFitness:
         jobs = [(self.case, X[i], self.timing, int(branch[i]), self.geometry) for i in index]
         for i, plan in zip(index, self._map(plan_candidate, jobs), strict=True):
             duration[i] = plan.duration
-            if plan.feasible:
-                objective[i] = plan.objective if self.timing == "paper" else objective[i]
+            if plan.success:
+                if not self.law.follows_joint_path:
+                    objective[i] = plan.objective
                 fitness[i] = objective[i] + self.time_weight * plan.duration
             else:
                 finding[i] = int(Finding.CHECK)

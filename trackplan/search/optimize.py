@@ -11,7 +11,7 @@ the archive is planned instead.
 
 from __future__ import annotations
 
-import enum
+import copy
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor
@@ -20,27 +20,23 @@ from dataclasses import dataclass, field
 import numpy as np
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.population import Population
+from pymoo.core.termination import Termination
 
 from trackplan.case import Case
+from trackplan.choices import Method, choose
 from trackplan.errors import CaseError
-from trackplan.planning.plan import PathGeometry, plan_placement
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
-from trackplan.search.algorithms import METHODS, make_algorithm, make_termination
+from trackplan.search.algorithms import make_algorithm, make_termination
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.problem import PlacementProblem
 from trackplan.search.space import SearchSpace
+from trackplan.status import Status
+from trackplan.timing import time_law
 
-TIMINGS = ("smooth", "paper")
-"""Time laws a search can plan with."""
 HISTORY_KEYS = ("generation", "evaluations", "best", "mean", "feasible_share", "wall_time")
 """Columns of the search history (``history.csv`` and the report's convergence plot)."""
-
-
-class OptimizeStatus(enum.Enum):
-    """Outcome of a placement search."""
-
-    FEASIBLE = "feasible"  # the final plan passed the checker
-    INFEASIBLE = "infeasible"  # no candidate passed: the result is the closest one
 
 
 @dataclass(frozen=True)
@@ -120,7 +116,9 @@ class OptimizeResult:
     success
         True when the final plan is feasible.
     status
-        :class:`OptimizeStatus`.
+        :class:`trackplan.status.Status`: ``FEASIBLE``, ``INTERRUPTED`` when a signal
+        stopped the search (the best placement found is still planned and checked), else
+        the final plan's status.
     message
         One line: what was found, or why nothing feasible was.
     X
@@ -151,7 +149,7 @@ class OptimizeResult:
     wall_time_s
         Wall time of the whole call, s.
     method
-        The search method.
+        The search method (the class name of a pymoo ``Algorithm`` passed in).
     seed
         The seed.
     rejected
@@ -159,7 +157,7 @@ class OptimizeResult:
     """
 
     success: bool
-    status: OptimizeStatus
+    status: Status
     message: str
     X: np.ndarray
     branch: int
@@ -185,7 +183,8 @@ ProgressCallback = Callable[[GenerationRecord], None]
 def optimize_placement(
     case: Case,
     *,
-    method: str | None = None,
+    method: str | Method | Algorithm | None = None,
+    termination: Termination | tuple | None = None,
     seed: int | None = None,
     budget: int | None = None,
     progress: ProgressCallback | None = None,
@@ -201,8 +200,14 @@ def optimize_placement(
     case
         The case: robot, path, task, bounds (Eq. 28, 29), objective and optimizer settings.
     method
-        ``ga`` (the paper's configuration), ``cmaes``, ``de`` or ``random``; default the
-        case's ``optimizer.method``.
+        A :class:`trackplan.choices.Method` (``ga``: the paper's configuration,
+        ``cmaes``, ``de``, ``random``), or any single-objective pymoo ``Algorithm``
+        instance, as pymoo's ``minimize`` takes it (each restart runs a fresh copy);
+        default the case's ``optimizer.method``.
+    termination
+        A pymoo ``Termination`` (or a tuple such as ``("n_gen", 50)``, as ``minimize``
+        takes it) replacing the default stall and generation rules; the budget still
+        applies.
     seed
         Fixes every random choice; default the case's ``optimizer.seed``. The same seed
         gives the same history and result.
@@ -238,30 +243,34 @@ def optimize_placement(
         inside the reach interval.
     """
     start = time.perf_counter()
-    method = method or case.optimizer.method
+    if not isinstance(method, Algorithm):
+        method = choose(Method, method or case.optimizer.method, "method")
     seed = case.optimizer.seed if seed is None else int(seed)
     budget = case.optimizer.budget if budget is None else int(budget)
     restarts = case.optimizer.restarts if restarts is None else int(restarts)
-    timing = timing or case.task.timing
-    if method not in METHODS:
-        raise CaseError(f"method must be one of {', '.join(METHODS)}, got {method!r}", key="method")
-    if timing not in TIMINGS:
-        raise CaseError(f"timing must be smooth or paper, got {timing!r}", key="timing")
+    law = time_law(timing or case.task.timing)
+    if seed < 0:
+        raise CaseError(f"seed must be ≥ 0, got {seed}", key="seed")
     if budget is not None and budget < 1:
         raise CaseError(f"budget must be ≥ 1 evaluation, got {budget}", key="budget")
     if restarts < 1:
         raise CaseError(f"restarts must be ≥ 1, got {restarts}", key="restarts")
     space = SearchSpace.from_case(case)
-    geometry = geometry or PathGeometry.from_case(case, timing)
+    if geometry is None or geometry.mode != law.path_mode:
+        geometry = PathGeometry.from_case(case, law.path_mode)
+    timing = law.timing
     fitness = PlacementFitness(case, space, geometry, timing, executor=executor)
     problem = PlacementProblem(space, fitness)
     records: list[GenerationRecord] = []
     stop_reason = ""
     runs = 0
     for run_seed in run_seeds(seed, restarts):
-        algorithm = make_algorithm(method, space, case.optimizer.population)
-        termination, parts = make_termination()
-        algorithm.setup(problem, termination=termination, seed=run_seed)
+        if isinstance(method, Algorithm):
+            algorithm = copy.deepcopy(method)
+        else:
+            algorithm = make_algorithm(method, space, case.optimizer.population)
+        rules, parts = make_termination(termination)
+        algorithm.setup(problem, termination=rules, seed=run_seed)
         stop_reason = _run(algorithm, problem, parts, budget, progress, start, records)
         runs += 1
         if stop_reason in ("budget", "interrupted"):
@@ -270,10 +279,13 @@ def optimize_placement(
     final, rejected = _final_plan(case, problem, timing, geometry)
     archive = problem.archive
     chosen = int(np.flatnonzero(np.all(archive.X == final.placement, axis=1))[0])
-    success = bool(final.feasible)
+    if stop_reason == "interrupted":
+        status = Status.INTERRUPTED
+    else:
+        status = final.status
     return OptimizeResult(
-        success=success,
-        status=OptimizeStatus.FEASIBLE if success else OptimizeStatus.INFEASIBLE,
+        success=status is Status.FEASIBLE,
+        status=status,
         message=_message(final, problem, rejected, space),
         X=final.placement,
         branch=int(final.branch),
@@ -286,7 +298,7 @@ def optimize_placement(
         generations=len(records),
         stop_reason=stop_reason,
         wall_time_s=time.perf_counter() - start,
-        method=method,
+        method=method if isinstance(method, Method) else type(method).__name__,
         seed=seed,
         runs=runs,
         rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),

@@ -47,15 +47,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Case
+from trackplan.case import Task
+from trackplan.choices import Timing
+from trackplan.frames import placement_transform, tool_poses
+from trackplan.jointpath import JointPath
 from trackplan.paths.geometry import unwrap_closed_arc
-from trackplan.planning.placement import placement_transform
-from trackplan.planning.poses import tool_poses
-from trackplan.planning.result import PlanStatus
 from trackplan.robots.kinematics import forward_kinematics, jacobian
 from trackplan.robots.model import Robot
-from trackplan.robots.path_ik import PathIKStatus, solve_path_ik
+from trackplan.robots.path_ik import solve_path_ik
 from trackplan.robots.resolved_rate import solve_path_resolved_rate
+from trackplan.status import Status
+from trackplan.timing.protocol import TimeLaw, TimeLawSpec, unsampled
 
 MIN_VIA_SPACING = 1e-3
 """Smallest distance between the via points of a line, m."""
@@ -65,17 +67,11 @@ docstring: a finer spacing stalls the forward piece below v_r)."""
 SPEED_REACHED = 1e-6
 """Relative shortfall of v_r at which the forward piece counts as having reached it."""
 
-_STATUS = {
-    PathIKStatus.UNREACHABLE: PlanStatus.UNREACHABLE,
-    PathIKStatus.BRANCH_SWITCH: PlanStatus.BRANCH_SWITCH,
-    PathIKStatus.POSITION_LIMITS: PlanStatus.POSITION_LIMITS,
-}
-
 
 class _PlanStop(Exception):
     """A piece could not be mapped to the joints (carries the status and message)."""
 
-    def __init__(self, status: PlanStatus, message: str) -> None:
+    def __init__(self, status: Status, message: str) -> None:
         super().__init__(message)
         self.status = status
         self.message = message
@@ -103,67 +99,52 @@ class _Ramp:
     reached: int | None
 
 
-def plan_paper_trajectory(
-    case: Case,
-    geometry,  # type: ignore[no-untyped-def]  # trackplan.planning.plan.PathGeometry
-    X: np.ndarray,
-    branch: int | None = None,
-) -> tuple[np.ndarray, np.ndarray, int, PlanStatus | None, str]:
-    """Sample the paper's trajectory (Section 3.1) for the workpiece at placement X.
+def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimeLaw:
+    """Sample the paper's trajectory (Section 3.1) along a placed path.
 
     Parameters
     ----------
-    case
-        The case (robot, task speeds, tolerance, Ts, tool orientation).
-    geometry
-        :class:`trackplan.planning.plan.PathGeometry` whose planned path was built with
-        ``mode="paper"`` (lines and Eq. 10 tangent arcs).
-    X
-        Placement (x, y, z, roll, pitch, yaw), shape (6,), metres and radians.
-    branch
-        IK branch to start on; default: the one path IK chooses on the planned path.
+    joint_path
+        The placed path's joint path on the chosen branch; its geometry must be built
+        with ``mode="paper"`` (lines and Eq. 10 tangent arcs).
+    task
+        Speeds (m/s), Ts (s) and the tool orientation.
 
     Returns
     -------
-    q : numpy.ndarray
-        Joint positions at Ts, shape (N, n), rad (shape (0, n) when nothing was planned).
-    s : numpy.ndarray
-        Arc length on the planned path of each sample's tool point, shape (N,), m.
-    branch_used : int
-        The IK branch.
-    status : PlanStatus or None
-        None when a trajectory was produced (the checker decides feasibility), else why not.
-    message : str
-        Empty when a trajectory was produced, else one line.
+    TimeLaw
+        The samples, or none with the reason (resolved-rate divergence, a via point
+        off the branch).
     """
-    robot = case.robot
-    X = np.asarray(X, dtype=float)
-    path = geometry.planned
-    s_grid = geometry.grid()
-    poses = tool_poses(X, path.sample(s_grid).position, case.task.tool_rpy)
-    path_ik = solve_path_ik(robot, poses[None], branch=branch)
-    chosen = int(path_ik.branch[0])
-    empty = (np.zeros((0, robot.n_dof)), np.zeros(0))
-    if not path_ik.ok[0]:
-        return (*empty, chosen, _STATUS[path_ik.status[0]], str(path_ik.message[0]))
-    planner = _PaperPlanner(case, path, X, chosen)
+    robot = joint_path.robot
+    planner = _PaperPlanner(
+        robot, task, joint_path.geometry.planned, joint_path.placement, joint_path.branch
+    )
     try:
-        q, s = planner.run(path_ik.q[0, 0])
+        q, s = planner.run(joint_path.q[0])
     except _PlanStop as stop:
-        return (*empty, chosen, stop.status, stop.message)
-    return q, s, chosen, None, ""
+        return unsampled(Timing.PAPER, stop.status, stop.message, task.sample_time, robot.n_dof)
+    return TimeLaw(
+        timing=Timing.PAPER,
+        success=True,
+        status=Status.FEASIBLE,
+        message="",
+        sample_time=task.sample_time,
+        s=s,
+        q=q,
+    )
 
 
 class _PaperPlanner:
     """Walks the pieces of the planned path and appends their samples."""
 
-    def __init__(self, case: Case, path, X: np.ndarray, branch: int) -> None:  # type: ignore[no-untyped-def]
-        self.robot: Robot = case.robot
-        self.task = case.task
+    def __init__(self, robot: Robot, task: Task, path, X: np.ndarray, branch: int) -> None:  # type: ignore[no-untyped-def]
+        self.robot = robot
+        self.task = task
         self.path = path
         self.X = X
         self.branch = branch
-        self.Ts = case.task.sample_time
+        self.Ts = task.sample_time
         self.T_base_part = placement_transform(X)
         self.pieces = tuple(path.pieces)
         stops = np.asarray(list(path.stops), dtype=float)
@@ -209,7 +190,7 @@ class _PaperPlanner:
             owner.append(np.full(len(samples[-1]), k))
         q = np.concatenate(samples)
         if not np.all(np.isfinite(q)):
-            raise _PlanStop(PlanStatus.UNREACHABLE, "resolved-rate IK diverged (singularity)")
+            raise _PlanStop(Status.UNREACHABLE, "resolved-rate IK diverged (singularity)")
         return q, self._arc_lengths(q, np.concatenate(owner))
 
     def _poses(self, positions: np.ndarray) -> np.ndarray:
@@ -301,8 +282,8 @@ class _PaperPlanner:
     def _via_ik(self, positions: np.ndarray, q_near: np.ndarray) -> np.ndarray:
         """Closed-form IK of the via poses on the branch, continuous with ``q_near``."""
         result = solve_path_ik(self.robot, self._poses(positions)[None], branch=self.branch)
-        if not result.ok[0]:
-            raise _PlanStop(_STATUS[result.status[0]], str(result.message[0]))
+        if not result.success[0]:
+            raise _PlanStop(result.status[0], str(result.message[0]))
         q = result.q[0]
         return q - 2 * np.pi * np.round((q[0] - q_near) / (2 * np.pi))
 
@@ -394,3 +375,7 @@ class _PaperPlanner:
         if piece.kind == "arc" and curve.angle >= 2 * np.pi - 1e-9:  # samples in time order
             sigma = unwrap_closed_arc(sigma, 2 * np.pi * curve.radius, piece.length)
         return np.clip(sigma, 0.0, piece.length)
+
+
+SPEC = TimeLawSpec(Timing.PAPER, "paper", plan_paper_trajectory, follows_joint_path=False)
+"""The paper's law, as :data:`trackplan.timing.TIME_LAWS` lists it."""

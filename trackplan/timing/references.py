@@ -31,7 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
+from trackplan.case import Task
 from trackplan.errors import CaseError
+from trackplan.jointpath import JointPath
 from trackplan.robots.model import Robot
 
 JointSamples = np.ndarray | Callable[[np.ndarray], np.ndarray]
@@ -43,8 +45,6 @@ TOPP3_MAX_ROUNDS = 6
 """Largest number of TOPP3 solves (first linearisation around TOPP2-RA, then re-linearised)."""
 TOPP3_SETTLED = 1.0e-4
 """Relative duration change below which the TOPP3 re-linearisation stops."""
-CURVED_GRID_POINTS = 40
-"""Fewest grid intervals on each curved zone of :func:`reference_inputs`."""
 A_FLOOR = 1.0e-8
 """Smallest ṡ² (m²/s²) of the TOPP3 linearisation profile (the rest ends are 0)."""
 
@@ -312,67 +312,45 @@ def speed_caps(
     return caps
 
 
-def reference_inputs(case, X: np.ndarray, planned_path, branch: int):  # type: ignore[no-untyped-def]
-    """Grid, joint samples and speed caps of a placement's planned path on one IK branch.
+def reference_inputs(
+    joint_path: JointPath, task: Task
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Grid, joint samples and speed caps of a joint path, for the reference laws.
 
     Parameters
     ----------
-    case
-        The :class:`trackplan.case.Case`.
-    X
-        Placement, shape (6,), metres and radians.
-    planned_path
-        The planned :class:`trackplan.paths.Path`.
-    branch
-        IK branch to follow.
+    joint_path
+        The placed path's joint path (its planning grid, each boundary once).
+    task
+        Rated and corner speeds, m/s.
 
     Returns
     -------
     s_grid : numpy.ndarray
-        Shape (M,), m.
+        Shape (M,), m, increasing.
     q_grid : numpy.ndarray
         Shape (M, n), rad.
     caps : numpy.ndarray
         Shape (M,), m/s.
-    ok : bool
-        False when path IK failed on that branch.
     """
-    from trackplan.planning.plan import GEOMETRIC_STEP
-    from trackplan.planning.poses import tool_poses
-    from trackplan.robots.path_ik import solve_path_ik
-
-    zones = [(float(a), float(b), str(k)) for a, b, k in planned_path.zones]
-    parts = []
-    for a, b, kind in zones:
-        if b <= a:
-            continue
-        n = int(np.ceil((b - a) / GEOMETRIC_STEP))
-        if kind != "straight":  # blends and short arcs: the derivatives change fast there
-            n = max(n, CURVED_GRID_POINTS)
-        parts.append(np.linspace(a, b, n + 1)[:-1])
-    s_grid = np.concatenate([*parts, [float(planned_path.length)]])
-    poses = tool_poses(
-        np.asarray(X, dtype=float), planned_path.sample(s_grid).position, case.task.tool_rpy
-    )
-    path_ik = solve_path_ik(case.robot, poses[None], branch=branch)
-    caps = speed_caps(zones, s_grid, case.task.rated_speed, case.task.corner_speed)
-    return s_grid, path_ik.q[0], caps, bool(path_ik.ok[0])
+    s_grid, first = np.unique(joint_path.s, return_index=True)
+    zones = [(float(a), float(b), str(k)) for a, b, k in joint_path.geometry.planned.zones]
+    caps = speed_caps(zones, s_grid, task.rated_speed, task.corner_speed)
+    return s_grid, joint_path.q[first], caps
 
 
-def reference_durations(case, X: np.ndarray, result) -> dict[str, float]:  # type: ignore[no-untyped-def]
-    """toppra and TOPP3 durations on the joint path of a planned placement.
+def reference_durations(joint_path: JointPath, task: Task) -> dict[str, float]:
+    """toppra and TOPP3 durations on a joint path.
 
-    The references follow the result's planned path on the result's IK branch with the
-    case's limits and speed caps, from rest to rest.
+    The references follow the same planned path on the same IK branch with the same
+    limits and speed caps as the plan, from rest to rest.
 
     Parameters
     ----------
-    case
-        The :class:`trackplan.case.Case`.
-    X
-        Placement, shape (6,), metres and radians.
-    result
-        The :class:`trackplan.planning.result.PlanResult` of that placement.
+    joint_path
+        The placed path's joint path (``PlanResult.joint_path``).
+    task
+        Speeds (m/s) and Ts (s).
 
     Returns
     -------
@@ -388,10 +366,10 @@ def reference_durations(case, X: np.ndarray, result) -> dict[str, float]:  # typ
                 f"--reference needs the {package} package: pip install -e '.[reference]'",
                 key="--reference",
             ) from None
-    s_grid, q_grid, caps, ok = reference_inputs(case, X, result.planned_path, result.branch)
-    if not ok:
+    if not joint_path.success:
         return {"toppra_duration": float("nan"), "topp3_duration": float("nan")}
-    Ts = case.task.sample_time
-    second = toppra_reference(case.robot, s_grid, q_grid, caps, Ts)
-    third = topp3_reference(case.robot, s_grid, q_grid, caps, Ts)
+    s_grid, q_grid, caps = reference_inputs(joint_path, task)
+    Ts = task.sample_time
+    second = toppra_reference(joint_path.robot, s_grid, q_grid, caps, Ts)
+    third = topp3_reference(joint_path.robot, s_grid, q_grid, caps, Ts)
     return {"toppra_duration": second.duration, "topp3_duration": third.duration}

@@ -21,29 +21,26 @@ Straight zones therefore run at exactly the rated speed wherever the limits allo
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.planning.derivatives import backward_derivatives
+from trackplan.case import Task
+from trackplan.choices import Timing
+from trackplan.derivatives import backward_derivatives
+from trackplan.jointpath import JointPath
 from trackplan.robots.model import Robot
+from trackplan.status import Status
 from trackplan.timing.profile import (
     SpeedProfile,
     speed_change_distance,
     speed_change_phases,
     speed_change_time,
 )
-
-JointPath = Callable[[np.ndarray], np.ndarray]
-"""Maps path arc lengths s (M,) in increasing order to joint positions (M, n) on one branch."""
+from trackplan.timing.protocol import SlowDown, TimeLaw, TimeLawSpec, unsampled
 
 LIMIT_SHARE = 0.97
 """Share of each joint limit the planner aims at; the rest absorbs sampling effects."""
-STRAIGHT_GRID_STEP = 2e-3
-"""Grid step on straight zones for the joint-path derivatives, m."""
-CURVED_GRID_POINTS = 80
-"""Grid points on each curved zone (arcs are split so a step stays below STRAIGHT_GRID_STEP)."""
 MAX_ITERATIONS = 12
 MAX_SAMPLES = 2_000_000
 """Longest trajectory built, in samples (33 min at 1 ms): beyond it a joint limit has forced
@@ -78,50 +75,6 @@ class ZonePlan:
 
 
 @dataclass(frozen=True, eq=False)
-class TimeLaw:
-    """A sampled time law and its joint trajectory.
-
-    Attributes
-    ----------
-    profile
-        The continuous s(t) (before the final time stretch to a whole number of periods).
-    time_scale
-        Factor ≥ 1 by which the profile's time is stretched so the last sample lands on
-        the end of the path exactly.
-    zones
-        Zones and their plateaus.
-    sample_time
-        Ts, s.
-    s
-        Arc length at each sample, shape (N,), m.
-    q
-        Joint positions at each sample, shape (N, n), rad.
-    iterations
-        Rebuilds needed until the sampled trajectory met every rate limit.
-    converged
-        False when MAX_ITERATIONS rebuilds still left a rate-limit violation, or when no
-        trajectory was sampled (see ``message``).
-    message
-        Why no trajectory was sampled (empty ``s`` and ``q``), else "".
-    """
-
-    profile: SpeedProfile
-    time_scale: float
-    zones: tuple[ZonePlan, ...]
-    sample_time: float
-    s: np.ndarray
-    q: np.ndarray
-    iterations: int
-    converged: bool
-    message: str = ""
-
-    @property
-    def duration(self) -> float:
-        """Time of the last sample, s."""
-        return (len(self.s) - 1) * self.sample_time
-
-
-@dataclass(frozen=True, eq=False)
 class _ZoneDemand:
     """|dq/ds|, |d²q/ds²|, |d³q/ds³| on a zone's grid.
 
@@ -153,38 +106,27 @@ class _ZoneDemand:
         )
 
 
-def plan_smooth_time_law(
-    robot: Robot,
-    zones: list[tuple[float, float, str]],
-    joint_path: JointPath,
-    rated_speed: float,
-    corner_speed: float,
-    sample_time: float,
-) -> TimeLaw:
+def plan_smooth_time_law(joint_path: JointPath, task: Task) -> TimeLaw:
     """Shortest jerk-limited time law of the smooth mode (see the module docstring).
 
     Parameters
     ----------
-    robot
-        Joint limits.
-    zones
-        ``(s_start, s_end, kind)`` covering the planned path in order; kind is
-        ``straight``, ``curved`` or ``stop`` (zero length, speed zero).
     joint_path
-        q(s) on the chosen IK branch.
-    rated_speed, corner_speed
-        Task speed caps, m/s.
-    sample_time
-        Ts, s.
+        q(s) on the chosen IK branch, with its derivatives on the planning grid.
+    task
+        Rated and corner speeds (m/s) and the sample time Ts (s).
 
     Returns
     -------
     TimeLaw
         Sampled at Ts from rest to rest; the last sample is the end of the path.
     """
-    demands = _zone_demands(zones, joint_path)
-    zones, demands = _slow_down_windows(robot, zones, demands, rated_speed, corner_speed)
-    planner = _ZonePlanner(robot, zones, demands, rated_speed, corner_speed)
+    robot = joint_path.robot
+    sample_time = task.sample_time
+    zones = joint_path.geometry.zones()
+    demands = _zone_demands(joint_path)
+    zones, demands = _slow_down_windows(robot, zones, demands, task.rated_speed, task.corner_speed)
+    planner = _ZonePlanner(robot, zones, demands, task.rated_speed, task.corner_speed)
     length = zones[-1][1]
     for iteration in range(1, MAX_ITERATIONS + 1):
         plans = planner.plan()
@@ -197,92 +139,65 @@ def plan_smooth_time_law(
                 f"speed to {slowest.plateau:.3g} m/s at s = {slowest.s_start:.4f}.."
                 f"{slowest.s_end:.4f} m (a singularity near the path?)"
             )
-            empty = np.zeros(0)
-            return TimeLaw(
-                profile,
-                1.0,
-                tuple(plans),
-                sample_time,
-                empty,
-                np.zeros((0, robot.n_dof)),
-                iteration,
-                False,
-                message,
+            return unsampled(
+                Timing.SMOOTH, Status.LIMITS_VIOLATED, message, sample_time, robot.n_dof
             )
         time_scale = max(1.0, n_steps * sample_time / profile.duration)
         t = np.arange(n_steps + 1) * sample_time
         s = profile.evaluate(t / time_scale)[0]
         s[-1] = length
-        q = joint_path(s)
+        q = joint_path.joints(s)
         worst = _worst_rate_violations(robot, q, sample_time)
         if not worst[0].size:
-            return TimeLaw(profile, time_scale, tuple(plans), sample_time, s, q, iteration, True)
+            return _sampled(plans, task, s, q, iteration, converged=True)
         planner.tighten(worst, s, t / time_scale, profile)
-    return TimeLaw(profile, time_scale, tuple(plans), sample_time, s, q, MAX_ITERATIONS, False)
+    return _sampled(plans, task, s, q, MAX_ITERATIONS, converged=False)
 
 
-STENCIL_POINTS = 5
-"""Points of the local stencil that differentiates q(s) at each grid point."""
+def _sampled(
+    plans: list[ZonePlan],
+    task: Task,
+    s: np.ndarray,
+    q: np.ndarray,
+    iterations: int,
+    converged: bool,
+) -> TimeLaw:
+    """The law's result: samples, slow-downs and corner speed from the zone plans."""
+    rated = task.rated_speed
+    plateaus = [z.plateau for z in plans if z.kind == "curved"]
+    slowdowns = tuple(
+        SlowDown(z.s_start, z.s_end, z.plateau, rated, z.reason)
+        for z in plans
+        if z.kind == "straight" and z.plateau < rated * (1 - 1e-9)
+    )
+    message = "" if converged else f"rate limits still exceeded after {iterations} rebuilds"
+    return TimeLaw(
+        timing=Timing.SMOOTH,
+        success=converged,
+        status=Status.FEASIBLE if converged else Status.NOT_CONVERGED,
+        message=message,
+        sample_time=task.sample_time,
+        s=s,
+        q=q,
+        slowdowns=slowdowns,
+        corner_speed=min(plateaus) if plateaus else rated,
+        iterations=iterations,
+    )
 
 
-def _stencil_weights(offset: int, spacing: float) -> np.ndarray:
-    """Weights of the 1st, 2nd and 3rd derivative at stencil point ``offset`` (0…4).
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (3, STENCIL_POINTS); exact for polynomials of degree 4.
-    """
-    x = (np.arange(STENCIL_POINTS) - offset) * spacing
-    powers = np.vander(x, STENCIL_POINTS, increasing=True).T  # row k: x**k
-    weights = np.empty((3, STENCIL_POINTS))
-    for order, factorial in ((1, 1.0), (2, 2.0), (3, 6.0)):
-        rhs = np.zeros(STENCIL_POINTS)
-        rhs[order] = factorial
-        weights[order - 1] = np.linalg.solve(powers, rhs)
-    return weights
-
-
-def _zone_demands(
-    zones: list[tuple[float, float, str]], joint_path: JointPath
-) -> list[_ZoneDemand]:
-    """Differentiate q(s) at grid points of each zone with small local stencils.
-
-    Each grid point gets a 5-point stencil of spacing ``h`` (a tenth of the grid step)
-    kept inside its zone: one-sided at the zone ends, where a G2 blend has its largest
-    |q'''| and a wide centred difference would smear the jump of q''' at the junction.
-    One batched IK call serves every zone.
-    """
-    grids, stencils, spacings = [], [], []
-    for s0, s1, kind in zones:
-        span = s1 - s0
-        if kind == "straight":
-            n = int(np.clip(np.ceil(span / STRAIGHT_GRID_STEP), 8, 2000)) + 1
-        else:
-            n = max(CURVED_GRID_POINTS, int(np.ceil(span / STRAIGHT_GRID_STEP))) + 1
-        grid = np.linspace(s0, s1, n) if span > 0 else np.array([s0])
-        h = span / (n - 1) / 10.0 if span > 0 else 0.0
-        first = np.clip(grid - 2 * h, s0, s1 - (STENCIL_POINTS - 1) * h)
-        stencils.append(first[:, None] + h * np.arange(STENCIL_POINTS))
-        grids.append(grid)
-        spacings.append(h)
-    q_all = joint_path(np.concatenate([st.ravel() for st in stencils]))
+def _zone_demands(joint_path: JointPath) -> list[_ZoneDemand]:
+    """|dq/ds|, |d²q/ds²|, |d³q/ds³| of each zone, from the joint path's planning grid."""
     demands = []
-    start = 0
-    for grid, stencil, h in zip(grids, stencils, spacings, strict=True):
-        q = q_all[start : start + stencil.size].reshape(*stencil.shape, -1)  # (G, 5, n)
-        start += stencil.size
-        if h == 0.0:
-            zero = np.zeros((1, q.shape[-1]))
-            demands.append(_ZoneDemand(grid, zero, zero, zero))
-            continue
-        offsets = np.rint((grid - stencil[:, 0]) / h).astype(int)
-        derivatives = np.empty((3, len(grid), q.shape[-1]))
-        for offset in np.unique(offsets):
-            rows = offsets == offset
-            derivatives[:, rows] = np.einsum("dk,gkn->dgn", _stencil_weights(offset, h), q[rows])
-        q1, q2, q3 = np.abs(derivatives)
-        demands.append(_ZoneDemand(grid, q1, q2, q3))
+    for z in range(len(joint_path.geometry.zones())):
+        rows = joint_path.zone == z
+        demands.append(
+            _ZoneDemand(
+                joint_path.s[rows],
+                np.abs(joint_path.dq[rows]),
+                np.abs(joint_path.ddq[rows]),
+                np.abs(joint_path.dddq[rows]),
+            )
+        )
     return demands
 
 
@@ -632,3 +547,7 @@ def _worst_rate_violations(
         orders.append(np.full(bad.size, order))
         ratios.append(ratio[bad])
     return np.concatenate(samples), np.concatenate(orders), np.concatenate(ratios)
+
+
+SPEC = TimeLawSpec(Timing.SMOOTH, "g2", plan_smooth_time_law)
+"""The smooth law, as :data:`trackplan.timing.TIME_LAWS` lists it."""

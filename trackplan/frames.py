@@ -1,12 +1,18 @@
-"""Placement of the path's definition frame in the robot base frame (Eq. 4).
+"""Frames: RPY rotations, the placement transform (Eq. 4) and tool poses (Eq. 3).
 
-Conventions (design.md): ``R = Rz(yaw) · Ry(pitch) · Rx(roll)`` (fixed axes) and
-``T_X = Trans(x, y, z) · RPY(roll, pitch, yaw)``.
+Conventions (``docs/conventions.md``): ``R = Rz(yaw) · Ry(pitch) · Rx(roll)`` (fixed axes),
+``T_X = Trans(x, y, z) · RPY(roll, pitch, yaw)`` places the path's definition frame in the
+robot base frame, and the tool pose at path point p is ``T_X · [R_tool p; 0 1]``.
+
+This module sits below ``paths/``, ``timing/`` and ``planning/``: everything that turns
+placements into poses imports it, and it imports nothing of trackplan's.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from trackplan.errors import CaseError
 
 
 def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
@@ -103,3 +109,63 @@ def pose_matrix(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     T[..., :3, 3] = position
     T[..., 3, 3] = 1.0
     return T
+
+
+def tool_poses(X: np.ndarray, positions: np.ndarray, tool_rpy: np.ndarray) -> np.ndarray:
+    """``T_base_tool = T_X · [R_tool  p; 0 1]`` for every placement and path point.
+
+    Parameters
+    ----------
+    X
+        Placements, shape (B, 6) (or (6,)), metres and radians.
+    positions
+        Path points in the definition frame, shape (M, 3), m.
+    tool_rpy
+        Tool orientation in the definition frame, shape (3,), rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (B, M, 4, 4) (or (M, 4, 4) for a single placement).
+    """
+    X = np.asarray(X, dtype=float)
+    single = X.ndim == 1
+    T_base_part = placement_transform(np.atleast_2d(X))  # (B, 4, 4)
+    R = T_base_part[:, :3, :3]
+    poses = np.empty((len(R), len(positions), 4, 4))
+    poses[..., :3, :3] = (R @ rpy_matrix(np.asarray(tool_rpy, dtype=float)))[:, None]
+    poses[..., :3, 3] = np.asarray(positions, dtype=float) @ R.transpose(0, 2, 1)
+    poses[..., :3, 3] += T_base_part[:, None, :3, 3]
+    poses[..., 3, :3] = 0.0
+    poses[..., 3, 3] = 1.0
+    return poses[0] if single else poses
+
+
+def as_placement(X: object, key: str = "placement") -> np.ndarray:
+    """X as a float array of shape (6,), checked.
+
+    Parameters
+    ----------
+    X
+        (x, y, z, roll, pitch, yaw), metres and radians.
+    key
+        Where X came from, for the error.
+
+    Raises
+    ------
+    CaseError
+        When X is not six finite numbers.
+    """
+    try:
+        values = np.asarray(X, dtype=float)
+    except (TypeError, ValueError):
+        raise CaseError(
+            f"must be 6 numbers (x, y, z, roll, pitch, yaw), got {X!r}", key=key
+        ) from None
+    if values.shape != (6,):
+        raise CaseError(
+            f"must be 6 numbers (x, y, z, roll, pitch, yaw), got shape {values.shape}", key=key
+        )
+    if not np.all(np.isfinite(values)):
+        raise CaseError(f"must be finite, got {values.tolist()}", key=key)
+    return values

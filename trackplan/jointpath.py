@@ -1,0 +1,207 @@
+"""The joint path of one placed path: poses and IK on the planning grid, computed once.
+
+A plan turns the placed path into joints once: :meth:`JointPath.solve` evaluates the tool
+poses at every point of the planning grid (and of the small stencils around them that give
+the derivatives in s), solves the path IK on one continuous branch in one batched call, and
+keeps q(s), dq/ds, d²q/ds² and d³q/ds³ there. Every time law, the reference laws and the
+search's final plan read it; only the trajectory samples themselves need the IK again
+(:meth:`JointPath.q`), so that the written joints are exact IK solutions of the path.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.frames import placement_transform, rpy_matrix, tool_poses
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.robots.model import Robot
+from trackplan.robots.path_ik import PathIK, solve_path_ik
+from trackplan.status import Status
+from trackplan.stencils import stencil_derivatives, stencil_points
+
+STENCIL_FRACTION = 0.1
+"""Stencil spacing as a share of the grid step: small against the scale on which the
+derivatives change, large against the IK's round-off."""
+
+
+@dataclass(frozen=True, eq=False)
+class JointPath:
+    """IK of a placed path on its planning grid, one branch, continuous.
+
+    Attributes
+    ----------
+    robot
+        The robot.
+    geometry
+        The case's paths and zones.
+    placement
+        X = (x, y, z, roll, pitch, yaw), shape (6,), metres and radians.
+    tool_rpy
+        Tool orientation in the path's definition frame, shape (3,), rad.
+    s
+        Planning grid, shape (G,), m, non-decreasing; a zone boundary appears once per
+        zone it bounds (the derivatives there are one-sided, from inside each zone).
+    zone
+        Index of each grid point's zone in ``geometry.zones()``, shape (G,), int.
+    q
+        Joint positions at the grid, shape (G, n), rad: continuous, inside the limits.
+    dq, ddq, dddq
+        dq/ds, d²q/ds², d³q/ds³ at the grid, shape (G, n), rad/m, rad/m², rad/m³.
+    ik
+        The path IK over the grid and its stencils (branch, status, message, margin).
+    """
+
+    robot: Robot
+    geometry: PathGeometry
+    placement: np.ndarray
+    tool_rpy: np.ndarray
+    s: np.ndarray
+    zone: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+    dddq: np.ndarray
+    ik: PathIK
+
+    @classmethod
+    def solve(
+        cls,
+        robot: Robot,
+        geometry: PathGeometry,
+        placement: np.ndarray,
+        tool_rpy: np.ndarray,
+        branch: int | None = None,
+    ) -> JointPath:
+        """Poses and path IK of the planning grid, in one pose pass and one IK pass.
+
+        Parameters
+        ----------
+        robot
+            The robot.
+        geometry
+            The case's paths (:meth:`PathGeometry.zone_grids` gives the grid).
+        placement
+            X, shape (6,), metres and radians.
+        tool_rpy
+            Tool orientation in the definition frame, shape (3,), rad.
+        branch
+            Force an IK branch; default: the usable one with the largest margin.
+
+        Returns
+        -------
+        JointPath
+            Check :attr:`success` before using the joints: an unreachable pose, a branch
+            switch or a joint range left shows in :attr:`status` and :attr:`message`.
+        """
+        placement = np.asarray(placement, dtype=float)
+        tool_rpy = np.asarray(tool_rpy, dtype=float)
+        grids = geometry.zone_grids()
+        zones = geometry.zones()
+        s = np.concatenate(grids)
+        zone = np.repeat(np.arange(len(grids)), [len(g) for g in grids])
+        lo = np.array([z[0] for z in zones])[zone]
+        hi = np.array([z[1] for z in zones])[zone]
+        steps = np.array([(g[-1] - g[0]) / max(len(g) - 1, 1) for g in grids])
+        h = STENCIL_FRACTION * steps[zone]
+        points, offset = stencil_points(s, lo, hi, h)
+        poses = tool_poses(placement, geometry.planned.sample(points.ravel()).position, tool_rpy)
+        ik = solve_path_ik(robot, poses[None], branch=branch)
+        q_points = ik.q[0].reshape(*points.shape, robot.n_dof)
+        dq, ddq, dddq = stencil_derivatives(q_points, offset, h)
+        q = q_points[np.arange(len(s)), offset]
+        return cls(robot, geometry, placement, tool_rpy, s, zone, q, dq, ddq, dddq, ik)
+
+    @property
+    def success(self) -> bool:
+        """True when every grid pose is reached on one branch, inside the joint range."""
+        return bool(self.ik.success[0])
+
+    @property
+    def status(self) -> Status:
+        """:attr:`Status.FEASIBLE`, or why the path has no joint path."""
+        return self.ik.status[0]
+
+    @property
+    def message(self) -> str:
+        """One line: the branch and its margin, or what is wrong and where."""
+        return self.ik.message[0]
+
+    @property
+    def branch(self) -> int:
+        """The IK branch (closed form 0-7, or the numeric seed index)."""
+        return int(self.ik.branch[0])
+
+    @property
+    def length(self) -> float:
+        """Length of the planned path, m."""
+        return float(self.geometry.planned.length)
+
+    @property
+    def T_base_part(self) -> np.ndarray:
+        """The placement transform T_X, shape (4, 4)."""
+        return placement_transform(self.placement)
+
+    @property
+    def R_part_tool(self) -> np.ndarray:
+        """Tool orientation in the path's definition frame, shape (3, 3)."""
+        return rpy_matrix(self.tool_rpy)
+
+    def poses(self, s: np.ndarray) -> np.ndarray:
+        """Tool poses in the base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
+        positions = self.geometry.planned.sample(np.asarray(s, dtype=float)).position
+        return tool_poses(self.placement, positions, self.tool_rpy)
+
+    def joints(self, s: np.ndarray) -> np.ndarray:
+        """Joint positions at arc lengths ``s`` by IK on this path's branch.
+
+        Each joint is put on the winding of the grid solution nearest in s, so the result
+        continues :attr:`q` whatever the order of ``s``.
+
+        Parameters
+        ----------
+        s
+            Arc lengths on the planned path, shape (M,), m.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (M, n), rad.
+        """
+        s = np.asarray(s, dtype=float)
+        q = solve_path_ik(self.robot, self.poses(s)[None], branch=self.branch).q[0]
+        reference = self.interpolate(s)
+        return q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
+
+    def interpolate(self, s: np.ndarray) -> np.ndarray:
+        """q at ``s`` (M,) by linear interpolation of the grid, shape (M, n), rad."""
+        grid, first = np.unique(self.s, return_index=True)
+        s = np.asarray(s, dtype=float)
+        return np.stack(
+            [np.interp(s, grid, self.q[first, j]) for j in range(self.robot.n_dof)], axis=-1
+        )
+
+    def derivatives(
+        self, s: np.ndarray, lo: np.ndarray, hi: np.ndarray, h: np.ndarray | float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """dq/ds, d²q/ds², d³q/ds³ at any arc lengths, by IK on stencils kept in [lo, hi].
+
+        Parameters
+        ----------
+        s
+            Arc lengths, shape (M,), m.
+        lo, hi
+            Interval each stencil stays in (a zone), shape (M,) or scalars, m.
+        h
+            Stencil spacing, m (``hi - lo ≥ 4 h``).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            Each shape (M, n), rad/m, rad/m², rad/m³.
+        """
+        spacing = np.asarray(h, dtype=float)
+        points, offset = stencil_points(np.asarray(s, dtype=float), lo, hi, spacing)
+        q = self.joints(points.ravel()).reshape(*points.shape, self.robot.n_dof)
+        return stencil_derivatives(q, offset, spacing)

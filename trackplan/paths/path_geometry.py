@@ -1,0 +1,132 @@
+"""The case's path, built once: the nominal path, the planned path and its zones.
+
+Every placement of a case shares one :class:`PathGeometry`; a time law states which planned
+path it needs (G2 blends, or the paper's tangent arcs).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from trackplan.paths.nominal import NominalPath
+from trackplan.paths.planned import Path, build_path
+
+if TYPE_CHECKING:
+    from trackplan.case import Case
+
+GEOMETRIC_STEP = 2e-3
+"""Arc-length step of the planning grid on straight zones, m."""
+CURVED_GRID_POINTS = 80
+"""Grid intervals on each curved zone at least (blends change their derivatives fast)."""
+MAX_ZONE_POINTS = 2000
+"""Grid intervals on one straight zone at most (a long line needs no finer grid)."""
+
+PathMode = Literal["g2", "paper"]
+"""``g2``: curvature-continuous blends; ``paper``: the paper's tangent arcs (Eq. 10)."""
+
+
+@dataclass(frozen=True, eq=False)
+class PathGeometry:
+    """The case's path, built once and shared by every placement.
+
+    Attributes
+    ----------
+    nominal
+        The path as the user gave it.
+    planned
+        The path the tool follows (blended corners).
+    """
+
+    nominal: NominalPath
+    planned: Path
+
+    mode: PathMode = "g2"
+
+    @classmethod
+    def from_case(cls, case: Case, mode: PathMode = "g2") -> PathGeometry:
+        """Build the nominal and planned paths of a case.
+
+        Parameters
+        ----------
+        case
+            The case (path segments and tolerance).
+        mode
+            How corners are rounded; a time law names the mode it needs
+            (:attr:`trackplan.timing.TimeLawSpec.path_mode`).
+        """
+        nominal = NominalPath.from_specs(case.start, case.segments)
+        return cls(nominal, build_path(nominal, case.task.tolerance, mode=mode), mode)
+
+    def zones(self) -> list[tuple[float, float, str]]:
+        """Zones of the planned path with stops inserted as zero-length zones."""
+        zones: list[tuple[float, float, str]] = []
+        stops = sorted(float(s) for s in self.planned.stops)
+        for s0, s1, kind in self.planned.zones:
+            start = float(s0)
+            for stop in (s for s in stops if s0 - 1e-12 <= s <= s1 + 1e-12):
+                if stop > start + 1e-12:
+                    zones.append((start, stop, kind))
+                if not zones or zones[-1][2] != "stop":
+                    zones.append((stop, stop, "stop"))
+                start = stop
+            if s1 > start + 1e-12:
+                zones.append((start, float(s1), kind))
+        return zones
+
+    def on_curved_zone(self, s: np.ndarray) -> np.ndarray:
+        """Whether arc lengths ``s`` (M,) lie on an arc or blend (corner speed), shape (M,)."""
+        curved = np.zeros(np.shape(s), dtype=bool)
+        for s0, s1, kind in self.planned.zones:
+            if kind == "curved":
+                curved |= (s >= s0) & (s <= s1)
+        return curved
+
+    def corner_intervals(self) -> np.ndarray:
+        """Nominal arc-length intervals where the corner speed applies, shape (K, 2)."""
+        curved = [(s0, s1) for s0, s1, kind in self.planned.zones if kind == "curved"]
+        if not curved:
+            return np.zeros((0, 2))
+        ends = self.planned.sample(np.asarray(curved).ravel()).position
+        s_nominal, _ = self.nominal.project(ends)
+        return np.sort(s_nominal.reshape(-1, 2), axis=1)
+
+    def zone_grids(self) -> list[np.ndarray]:
+        """The planning grid of each zone of :meth:`zones`, in order.
+
+        Straight zones get a step of about :data:`GEOMETRIC_STEP` (at most
+        :data:`MAX_ZONE_POINTS` intervals), curved ones at least :data:`CURVED_GRID_POINTS`
+        intervals; each grid holds both ends of its zone, so a boundary appears in the
+        grids of both zones it separates. A stop is one point.
+
+        Returns
+        -------
+        list of numpy.ndarray
+            One array of arc lengths per zone, shape (G_z,), m.
+        """
+        grids = []
+        for s0, s1, kind in self.zones():
+            span = s1 - s0
+            if span <= 0.0:
+                grids.append(np.array([s0]))
+                continue
+            n = int(np.ceil(span / GEOMETRIC_STEP))
+            if kind == "straight":
+                n = int(np.clip(n, 8, MAX_ZONE_POINTS))
+            else:
+                n = max(n, CURVED_GRID_POINTS)
+            grids.append(np.linspace(s0, s1, n + 1))
+        return grids
+
+    def grid(self, step: float = GEOMETRIC_STEP) -> np.ndarray:
+        """Arc lengths covering the planned path with every zone boundary, shape (M,)."""
+        edges = np.array([z[0] for z in self.planned.zones] + [self.planned.length])
+        parts = [
+            np.linspace(a, b, max(2, int(np.ceil((b - a) / step)) + 1), endpoint=False)
+            for a, b in itertools.pairwise(edges)
+            if b > a
+        ]
+        return np.concatenate([*parts, [self.planned.length]])

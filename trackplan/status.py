@@ -1,0 +1,43 @@
+"""One outcome vocabulary for IK, time laws, plans, searches and jobs.
+
+Every result of trackplan carries a :class:`Status` and a boolean ``success`` that is true
+exactly when the status is :attr:`Status.FEASIBLE`. "It worked" is spelled ``success``
+everywhere; ``feasible`` is a read-only alias on plan results.
+"""
+
+from __future__ import annotations
+
+import enum
+
+
+class Status(enum.Enum):
+    """Outcome of one computation (the first problem that applies).
+
+    The values are the words written to result files and summaries.
+    """
+
+    FEASIBLE = "feasible"
+    """Everything asked for was met (IK: every pose solved on one branch inside the limits;
+    plan: the checker found no violation; search: the final plan is feasible)."""
+    LIMITS_VIOLATED = "limits_violated"
+    """A trajectory exists but breaks a limit (the checker says which, where)."""
+    UNREACHABLE = "unreachable"
+    """Some path pose has no IK solution."""
+    BRANCH_SWITCH = "branch_switch"
+    """The path crosses a singularity (or the joints jump between poses)."""
+    POSITION_LIMITS = "position_limits"
+    """Every IK branch leaves the joint range."""
+    NOT_CONVERGED = "not_converged"
+    """An iterative method stopped before meeting its own tolerance."""
+    INTERRUPTED = "interrupted"
+    """Stopped by a signal; the result is the best found until then."""
+    FAILED = "failed"
+    """The computation raised; the message says why."""
+
+    @property
+    def success(self) -> bool:
+        """True for :attr:`FEASIBLE` only."""
+        return self is Status.FEASIBLE
+
+
+__all__ = ["Status"]
