@@ -1,7 +1,7 @@
 """The ``trackplan`` command line.
 
-Commands: ``validate`` (check case files and their robots), ``robots`` (built-in robots
-and their limits), ``cases`` (the cases shipped in the repository's ``cases/`` folder).
+Commands: ``validate``, ``robots``, ``cases``, ``plan``, ``check``, ``optimize``, ``export``
+and ``demo`` (the README has the command table).
 
 Exit codes: 0 ok, 1 internal error, 2 bad input, 3 infeasible (:class:`ExitCode`).
 :func:`main` never raises: a :class:`~trackplan.errors.CaseError` becomes one line on
@@ -19,12 +19,12 @@ and lets :func:`main` report it; it prints results with :func:`_console` or
     @app.command()
     def plan(
         case: Annotated[Path, typer.Argument(help="Case file.")],
-        out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
+        out: Annotated[Path, typer.Option(help="Output folder.")] = Path("runs/plan"),
     ) -> ExitCode:
         \"\"\"Plan the trajectory of one placement.\"\"\"
         loaded = load_case(case)
         result = plan_placement(loaded, loaded.bounds.example)
-        save_plan(result, out)
+        write_run(out, result, loaded)
         return ExitCode.OK if result.success else ExitCode.INFEASIBLE
 """
 
@@ -37,7 +37,7 @@ import os
 import sys
 import traceback
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 import typer
@@ -54,6 +54,11 @@ from trackplan.io.robot_file import robot_to_yaml
 from trackplan.paths import NominalPath
 from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot
 from trackplan.robots.model import Robot
+from trackplan.run_files import TRAJECTORY_FILE
+from trackplan.status import Status
+
+if TYPE_CHECKING:
+    from trackplan.search import OptimizeResult
 
 
 class ExitCode(enum.IntEnum):
@@ -63,6 +68,15 @@ class ExitCode(enum.IntEnum):
     INTERNAL_ERROR = 1
     BAD_INPUT = 2
     INFEASIBLE = 3
+    INTERRUPTED = 130
+    """Ctrl-C stopped a search; the best placement found was still planned and written."""
+
+
+def search_exit_code(result: OptimizeResult) -> ExitCode:
+    """The exit code of a finished or interrupted search."""
+    if result.status is Status.INTERRUPTED:
+        return ExitCode.INTERRUPTED
+    return ExitCode.OK if result.success else ExitCode.INFEASIBLE
 
 
 PIPE_WIDTH = 160
@@ -417,7 +431,7 @@ def check(
 
     loaded = load_case(case)
     X = _placement(loaded, placement)
-    csv = run / "trajectory.csv" if run.is_dir() else run
+    csv = run / TRAJECTORY_FILE if run.is_dir() else run
     t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
     sample_time = float(np.median(np.diff(t)))
     if not np.allclose(np.diff(t), sample_time, rtol=1e-6, atol=1e-9):
@@ -533,7 +547,7 @@ def optimize(
     )
     _write_search(out, result, loaded, report=report)
     _print_search(result, out)
-    return ExitCode.OK if result.success else ExitCode.INFEASIBLE
+    return search_exit_code(result)
 
 
 @app.command()
@@ -549,7 +563,7 @@ def demo(
     _write_search(out, result, loaded, report=True)
     _print_search(result, out)
     typer.echo(f"report: {(out / 'report.html').resolve()}")
-    return ExitCode.OK if result.success else ExitCode.INFEASIBLE
+    return search_exit_code(result)
 
 
 def _search(case: Case, **options):  # type: ignore[no-untyped-def]

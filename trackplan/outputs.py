@@ -43,7 +43,8 @@ def write_run(
     out_dir = Path(out_dir)
     summary = write_plan_files(result, case.robot.joint_names, out_dir, extra)
     if report:
-        from trackplan.report import write_report
+        from trackplan.report import write_plots, write_report
 
-        write_report(result, case, out_dir, history=history, optimizer_info=extra)
+        plots = write_plots(result, case, out_dir, history)
+        write_report(result, case, out_dir, plots, history=history, optimizer_info=extra)
     return summary

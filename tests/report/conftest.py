@@ -192,9 +192,12 @@ REPORT_FRAMES = 60  # animation frames of the 3D view in the report tests
 @pytest.fixture(scope="session")
 def report_file(tmp_path_factory, corner: Case, corner_result: PlanResult):
     """report.html of the corner result with an optimizer history (written once)."""
-    from trackplan.report import write_report
+    from trackplan.report import write_plots, write_report
 
     history = optimizer_history(np.random.default_rng(7))
     info = {"method": "ga", "evaluations": 750, "wall_time": 37.5, "best_X": PAPER_PLACEMENT}
     out_dir = tmp_path_factory.mktemp("report")
-    return write_report(corner_result, corner, out_dir, history, info, n_frames=REPORT_FRAMES)
+    plots = write_plots(corner_result, corner, out_dir, history)
+    return write_report(
+        corner_result, corner, out_dir, plots, history, info, n_frames=REPORT_FRAMES
+    )

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tests.report.conftest import REPORT_FRAMES
-from trackplan.report import VIEW_ID, robot_view_figure, write_report
+from trackplan.report import VIEW_ID, robot_view_figure, write_plots, write_report
 from trackplan.report.robot_view import ROBOT_TRACE, TRAIL_TRACE, frame_name
 from trackplan.report.scene import chain_points, frame_indices
 
@@ -93,7 +93,8 @@ def test_robot_view_animates_the_dh_chain(corner, corner_result):
 
 
 def test_report_without_a_trajectory(tmp_path, corner, unreachable_result):
-    page = write_report(unreachable_result, corner, tmp_path).read_text(encoding="utf-8")
+    plots = write_plots(unreachable_result, corner, tmp_path)
+    page = write_report(unreachable_result, corner, tmp_path, plots).read_text(encoding="utf-8")
     assert "No trajectory to show" in page
     assert unreachable_result.message in page
     assert len(EMBEDDED_PNG.findall(page)) == 3

@@ -12,7 +12,8 @@ from tests.conftest import CASES
 from trackplan import cli
 from trackplan.cli import ExitCode, main
 from trackplan.errors import CaseError
-from trackplan.io.history import HISTORY_FILE, read_history_csv, write_history_csv
+from trackplan.io.history import read_history_csv, write_history_csv
+from trackplan.run_files import HISTORY_FILE
 from trackplan.search import SearchHistory
 
 
@@ -85,7 +86,7 @@ def test_ctrl_c_during_the_progress_bar_still_writes_everything(
     code, stdout, _ = run(
         capsys, "optimize", str(CASES / "paper-corner.yaml"), "--out", str(out), "--no-report"
     )
-    assert code == ExitCode.OK
+    assert code == ExitCode.INTERRUPTED
     assert descriptions[0].startswith("generation 1  30 evaluations  best J")
     assert "feasible" in descriptions[0] and "%" in descriptions[0]
     summary = json.loads((out / "result.json").read_text())

@@ -25,6 +25,7 @@ import yaml
 from trackplan.errors import CaseError
 from trackplan.io.results import trajectory_header
 from trackplan.planning.result import Trajectory
+from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
 EXPORT_FORMATS = ("csv", "json", "ros")
 EXPORT_FILES = {
@@ -32,8 +33,6 @@ EXPORT_FILES = {
     "json": "trajectory.json",
     "ros": "trajectory.ros.yaml",
 }
-TRAJECTORY_FILE = "trajectory.csv"
-RESULT_FILE = "result.json"
 UNITS = {
     "t": "s",
     "positions": "rad",

@@ -8,9 +8,9 @@ import numpy as np
 
 from trackplan.errors import CaseError
 from trackplan.io.results import result_summary
-from trackplan.search.optimize import HISTORY_KEYS, OptimizeResult, SearchHistory
+from trackplan.run_files import HISTORY_FILE, HISTORY_KEYS
+from trackplan.search.optimize import OptimizeResult, SearchHistory
 
-HISTORY_FILE = "history.csv"
 """File name of the search history in a run folder."""
 
 

@@ -10,6 +10,7 @@ import numpy as np
 from trackplan.case import PLACEMENT_KEYS
 from trackplan.errors import CaseError
 from trackplan.planning.result import PlanResult, Trajectory
+from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
 
 def trajectory_header(n_dof: int) -> list[str]:
@@ -168,7 +169,7 @@ def write_plan_files(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_trajectory_csv(result.trajectory, out_dir / "trajectory.csv")
+    write_trajectory_csv(result.trajectory, out_dir / TRAJECTORY_FILE)
     summary = {**result_summary(result, joint_names), **(extra or {})}
-    write_result_json(summary, out_dir / "result.json")
+    write_result_json(summary, out_dir / RESULT_FILE)
     return summary

@@ -13,11 +13,10 @@ from trackplan.report.figures import (
     speed_figure,
     write_plots,
 )
-from trackplan.report.html import REPORT_FILE, write_report
+from trackplan.report.html import write_report
 from trackplan.report.robot_view import VIEW_ID, robot_view_figure
 
 __all__ = [
-    "REPORT_FILE",
     "VIEW_ID",
     "convergence_figure",
     "joints_figure",

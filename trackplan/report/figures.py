@@ -32,13 +32,13 @@ from trackplan.report.scene import (
     violation_samples,
 )
 from trackplan.robots.kinematics import forward_kinematics
+from trackplan.run_files import HISTORY_KEYS
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d import Axes3D
 
-HISTORY_KEYS = ("generation", "evaluations", "best", "mean", "feasible_share", "wall_time")
 DPI = 100
 AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")  # frame axes x, y, z
 BEFORE_COLOR = "tab:purple"

@@ -18,11 +18,10 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.result import LIMIT_KINDS, PlanResult
-from trackplan.report.figures import history_columns, write_plots
+from trackplan.report.figures import history_columns
 from trackplan.report.robot_view import VIEW_ID, robot_view_figure
 from trackplan.report.scene import JOINT_QUANTITIES
-
-REPORT_FILE = "report.html"
+from trackplan.run_files import REPORT_FILE
 
 Cell = str | tuple[str, str]
 """A table cell: escaped HTML, or (escaped HTML, css class)."""
@@ -464,15 +463,16 @@ def write_report(
     result: PlanResult,
     case: Case,
     out_dir: Path,
+    plots: Sequence[Path],
     history: Mapping[str, Mapping[str, np.ndarray]] | None = None,
     optimizer_info: Mapping[str, object] | None = None,
     n_frames: int = 150,
 ) -> Path:
     """Write ``report.html``, one self-contained page that works offline.
 
-    The plots are written first with :func:`write_plots` (``joints.png``, ``path.png``,
-    ``speed.png`` and, with a history, ``convergence.png``) and embedded as data URIs;
-    plotly.js is embedded once for the interactive 3D view (div id ``robot-view``).
+    The PNG plots (written by :func:`trackplan.report.figures.write_plots`) are embedded
+    as data URIs; plotly.js is embedded once for the interactive 3D view (div id
+    ``robot-view``).
 
     Parameters
     ----------
@@ -482,6 +482,8 @@ def write_report(
         The case it was planned for.
     out_dir
         Directory to write into (created when missing).
+    plots
+        The PNG files to embed, in report order.
     history
         Optimizer history ``{method: {"generation", "evaluations", "best", "mean",
         "feasible_share", "wall_time"}}`` with arrays of shape (G,), for ``optimize`` runs.
@@ -496,7 +498,7 @@ def write_report(
         The report file.
     """
     out_dir = Path(out_dir)
-    plots = write_plots(result, case, out_dir, history)
+    out_dir.mkdir(parents=True, exist_ok=True)
     verdict = "feasible" if result.feasible else "infeasible"
     body = "".join(
         [

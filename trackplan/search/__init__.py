@@ -7,7 +7,6 @@ re-planned at the full sample time and re-checked.
 """
 
 from trackplan.search.optimize import (
-    HISTORY_KEYS,
     GenerationRecord,
     OptimizeResult,
     SearchHistory,
@@ -15,7 +14,6 @@ from trackplan.search.optimize import (
 )
 
 __all__ = [
-    "HISTORY_KEYS",
     "GenerationRecord",
     "OptimizeResult",
     "SearchHistory",

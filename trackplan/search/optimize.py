@@ -28,15 +28,13 @@ from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
+from trackplan.run_files import HISTORY_KEYS
 from trackplan.search.algorithms import make_algorithm, make_termination
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.problem import PlacementProblem
 from trackplan.search.space import SearchSpace
 from trackplan.status import Status
 from trackplan.timing import time_law
-
-HISTORY_KEYS = ("generation", "evaluations", "best", "mean", "feasible_share", "wall_time")
-"""Columns of the search history (``history.csv`` and the report's convergence plot)."""
 
 
 @dataclass(frozen=True)
