@@ -438,7 +438,7 @@ def check(
         raise CaseError("samples are not evenly spaced in t", file=str(csv), key="t")
     report = check_case_trajectory(loaded, X, q, sample_time, timing=_timing(timing))
     console = _console()
-    console.print(f"{escape(str(csv))}: {len(t)} samples at Ts = {sample_time:g} s")
+    console.print(f"{escape(str(csv))}: {_count(t, 'sample')} at Ts = {sample_time:g} s")
     for kind, margin in report.joint_margins.items():
         cells = "  ".join(f"{m:+.3f}" for m in margin)
         console.print(f"  {kind:<13} margin per joint: {cells}")
@@ -447,7 +447,7 @@ def check(
     console.print(f"  max tracking error {report.max_tracking_error * 1e3:.4f} mm")
     for violation in report.violations:
         console.print(f"  VIOLATION {escape(violation.message)}")
-    verdict = "feasible" if report.success else f"infeasible: {len(report.violations)} violations"
+    verdict = "feasible" if report.success else f"infeasible: {_count(report.violations, 'violation')}"
     console.print(verdict)
     return ExitCode.OK if report.success else ExitCode.INFEASIBLE
 
@@ -455,8 +455,19 @@ def check(
 def _print_summary(result, out: Path) -> None:
     """A few lines on what a plan achieved and where its files are."""
     console = _console()
-    state = "" if result.feasible else f"INFEASIBLE ({result.status.value}): "
-    console.print(f"{escape(result.case_name)}: {state}{escape(result.message)}")
+    violations = result.check.violations
+    if result.feasible:
+        console.print(f"{escape(result.case_name)}: {escape(result.message)}")
+    elif violations:  # the list below says it all; the message would repeat its first line
+        console.print(
+            f"{escape(result.case_name)}: INFEASIBLE ({result.status.value}): "
+            f"{_count(violations, 'violation')}"
+        )
+    else:
+        console.print(
+            f"{escape(result.case_name)}: INFEASIBLE ({result.status.value}): "
+            f"{escape(result.message)}"
+        )
     if result.trajectory.n_samples:
         console.print(
             f"  J = {result.objective:.4f}  duration = {result.duration:.3f} s  "
@@ -473,6 +484,10 @@ def _print_summary(result, out: Path) -> None:
             )
         for key, value in result.references.items():
             console.print(f"  {key} = {value:.4f} s")
+    for violation in violations[:8]:
+        console.print(f"  VIOLATION {escape(violation.message)}")
+    if len(violations) > 8:
+        console.print(f"  ... and {len(violations) - 8} more in result.json")
     console.print(f"  results in {escape(str(out))}/")
 
 
@@ -616,15 +631,25 @@ def _print_search(result, out: Path) -> None:  # type: ignore[no-untyped-def]
     )
     console.print(
         f"{escape(result.method)} (seed {result.seed}): {result.evaluations} evaluations in "
-        f"{result.generations} generations over {result.runs} runs, {result.wall_time_s:.2f} s, "
+        f"{_count(result.generations, 'generation')} over {_count(result.runs, 'run')}, "
+        f"{result.wall_time_s:.2f} s, "
         f"last run stopped: {escape(result.stop_reason)}"
     )
     console.print(f"  before (centre of the bounds, X = {_vector(initial.placement)}): {before}")
-    console.print(f"  after  (X = {_vector(result.X)}): {escape(result.message)}")
-    if not result.success:
-        for violation in result.final.check.violations[:8]:
-            console.print(f"  VIOLATION {escape(violation.message)}")
+    after = (
+        escape(result.message)
+        if result.success
+        else f"no feasible placement in {_count(result.evaluations, 'evaluation')}; "
+        "the closest one is planned below"
+    )
+    console.print(f"  after  (X = {_vector(result.X)}): {after}")
     _print_summary(result.final, out)
+
+
+def _count(items: object, noun: str) -> str:
+    """``1 run``, ``6 runs``: a count (or a sized collection) with its noun."""
+    n = len(items) if hasattr(items, "__len__") else int(items)  # type: ignore[arg-type]
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 def _vector(values: np.ndarray) -> str:

@@ -1,6 +1,6 @@
 """The nominal path: the path exactly as the user gave it, sharp corners included.
 
-The tracking error of a trajectory is its distance from this path (design.md).
+The tracking error of a trajectory is its distance from this path (docs/conventions.md).
 """
 
 from __future__ import annotations

@@ -30,6 +30,8 @@ UNITS = {
 }
 RELATIVE_SLACK = 1e-9
 """Values within this relative amount of a limit count as meeting it (float round-off)."""
+SPEED_SLACK = 1e-6
+"""The same for the Cartesian speed caps (the speed is a difference of FK positions)."""
 ORIENTATION_TOLERANCE = 1e-3
 """Largest tool orientation error accepted, rad."""
 
@@ -75,7 +77,7 @@ def check_trajectory(
     """Check a sampled joint trajectory against the robot's limits and the task.
 
     Derivatives are backward differences at Ts with the robot at rest before the first and
-    after the last sample (design.md), exactly what a controller consuming the samples sees.
+    after the last sample (docs/conventions.md), exactly what a controller consuming the samples sees.
 
     Parameters
     ----------
@@ -113,7 +115,7 @@ def check_trajectory(
         "jerk": (qddd, np.abs(qddd) / robot.j_max),
     }
     for kind, (values, use) in signals.items():
-        margins[kind] = 1.0 - use.max(axis=0)
+        margins[kind] = _met(1.0 - use.max(axis=0), RELATIVE_SLACK)
         worst_joint = int(np.argmax(use.max(axis=0)))
         binding[kind] = (worst_joint + 1, float(t[int(np.argmax(use[:, worst_joint]))]))
         for j in np.flatnonzero(use.max(axis=0) > 1.0 + RELATIVE_SLACK):
@@ -145,6 +147,16 @@ def check_trajectory(
     )
 
 
+def _count(n: int, noun: str) -> str:
+    """``1 sample``, ``2 samples``."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
+
+def _met(margin: float | np.ndarray, slack: float) -> float | np.ndarray:
+    """A margin within the round-off slack of a limit counts as met: reported as 0, not < 0."""
+    return np.where((margin < 0) & (margin >= -slack), 0.0, margin)
+
+
 def _violation(
     kind: str, joint: int | None, t: np.ndarray, values: np.ndarray, use: np.ndarray, bound: float
 ) -> Violation:
@@ -155,7 +167,7 @@ def _violation(
     who = f"joint {joint} {kind}" if joint is not None else kind
     message = (
         f"{who} {abs(value):.4g} {UNITS[kind]} exceeds {abs(bound):.4g} at t = {t[worst]:.3f} s"
-        f" ({len(bad)} samples from t = {t[bad[0]]:.3f} to {t[bad[-1]]:.3f} s)"
+        f" ({_count(len(bad), 'sample')} from t = {t[bad[0]]:.3f} to {t[bad[-1]]:.3f} s)"
     )
     return Violation(
         limit=kind,
@@ -184,8 +196,10 @@ def _check_task(
     R_err = np.einsum("ji,njk->nik", R_expected, T_base_tool[:, :3, :3])
     cos_angle = np.clip((np.trace(R_err, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
     orientation_error = np.arccos(cos_angle)
-    margins["orientation"] = float(1.0 - orientation_error.max() / ref.orientation_tolerance)
-    if margins["orientation"] < -RELATIVE_SLACK:
+    margins["orientation"] = float(
+        _met(1.0 - orientation_error.max() / ref.orientation_tolerance, RELATIVE_SLACK)
+    )
+    if margins["orientation"] < 0:
         use = orientation_error / ref.orientation_tolerance
         violations.append(
             _violation("orientation", None, t, orientation_error, use, ref.orientation_tolerance)
@@ -194,8 +208,8 @@ def _check_task(
     # tracking error and the position along the nominal path, in order of travel
     velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
     s_nominal, distance, piece = locate_on_nominal(ref.nominal, p_part, velocity, ref.tolerance)
-    margins["tracking"] = float(1.0 - distance.max() / ref.tolerance)
-    if margins["tracking"] < -RELATIVE_SLACK:
+    margins["tracking"] = float(_met(1.0 - distance.max() / ref.tolerance, RELATIVE_SLACK))
+    if margins["tracking"] < 0:
         violations.append(
             _violation("tracking", None, t, distance, distance / ref.tolerance, ref.tolerance)
         )
@@ -209,8 +223,9 @@ def _check_task(
     # a backward difference is the mean speed over the last period: where that period
     # straddles the end of a corner, the mean may reach the higher of the two caps
     cap[1:] = np.maximum(cap[1:], cap[:-1])
-    margins["speed"] = float(1.0 - (speed / cap).max())
-    if margins["speed"] < -1e-6:  # speed is a task bound: allow ppm-level round-off
+    # speed is a task bound: ppm-level round-off counts as meeting it
+    margins["speed"] = float(_met(1.0 - (speed / cap).max(), SPEED_SLACK))
+    if margins["speed"] < 0:
         violations.append(
             _violation("speed", None, t, speed, speed / cap * (1 - 1e-6), float(cap.min()))
         )
@@ -269,7 +284,7 @@ def _coverage_violations(
             k,
             float(step[k - 1]),
             0.0,
-            f"coverage: the path is run backwards at t = {t[k]:.3f} s ({backwards.size} steps)",
+            f"coverage: the path is run backwards at t = {t[k]:.3f} s ({_count(backwards.size, 'step')})",
         )
     allowance = jump_allowance(nominal, ref.tolerance)  # (P,) extra jump allowed after piece p
     # one sample may advance up to a few times the task speed (a speed excess is reported

@@ -31,7 +31,7 @@ class Trajectory:
         Joint positions, shape (N, n), rad.
     qd, qdd, qddd
         Backward differences of ``q`` at Ts with the robot at rest before the first
-        sample (design.md), shape (N, n), rad/s, rad/s², rad/s³.
+        sample (docs/conventions.md), shape (N, n), rad/s, rad/s², rad/s³.
     tool_position
         Tool point by FK in the base frame, shape (N, 3), m.
     speed

@@ -1,6 +1,6 @@
 """Closed-form inverse kinematics of 6R arms with a spherical wrist (PUMA560 family).
 
-Supported DH structure (:func:`has_closed_form`), standard DH as in design.md::
+Supported DH structure (:func:`has_closed_form`), standard DH as in docs/conventions.md::
 
     joint  alpha    a    d
     1      +π/2     0    d1

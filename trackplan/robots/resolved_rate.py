@@ -9,7 +9,7 @@ where Δ (Eq. 23–27) is the increment from the pose actually reached by q(k) (
 kinematics, step ii: the "compensation" of the linearisation error) to the next target
 pose: ``Δ = (t(k+1) − t_a(k), vex(R(k+1) R_a(k)ᵀ − I))`` with vex taking the upper
 triangle (Eq. 26–27). The result still drifts by a second-order error per step and at
-singularities J⁻¹ amplifies it: design.md, point 4.
+singularities J⁻¹ amplifies it: docs/paper.md, departure 4.
 
 Modes of :func:`solve_path_resolved_rate`:
 

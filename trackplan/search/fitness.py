@@ -1,4 +1,4 @@
-"""Batched fitness of placements (Eq. 30) with geometric screening (design.md items 5–7).
+"""Batched fitness of placements (Eq. 30) with geometric screening (docs/search.md, "Screening").
 
 Joint travel J (Eq. 8) and reachability depend only on the geometric path, not on the
 time law: J sums |Δq| along the joint path whatever the speed. So a whole population is

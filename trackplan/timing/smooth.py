@@ -1,6 +1,6 @@
 """The smooth time law: steady process speed, jerk-limited speed changes, every joint limit.
 
-Method (design.md, "Where the paper is weak", items 3 and 6):
+Method (docs/paper.md, departures 3 and 6; docs/timing.md):
 
 1. The planned path is cut into zones: straight pieces (capped at the rated speed), curved
    pieces and G2 blends (capped at the corner speed), and stops (full reversals).
