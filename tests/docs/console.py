@@ -1,0 +1,97 @@
+"""Run the ``console`` blocks of the documentation and compare what they print.
+
+A ``console`` block holds commands (lines starting with ``$ ``) each followed by the output
+it prints. A command may end with a shell comment ``# exit N`` giving its exit code
+(default 0). Each shown output line must equal a line of the real output (trailing spaces
+aside), in the same order; a shown line ending in ``...`` must be the beginning of one; a
+line ``...`` stands for output that is left out. Numbers are compared as printed, so they
+match within the precision the documentation states.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+BLOCK = re.compile(r"^```console\n(.*?)^```", re.M | re.S)
+EXIT = re.compile(r"#\s*exit\s+(\d+)\s*$")
+
+
+@dataclass(frozen=True)
+class Command:
+    """One documented command, its exit code and the output lines shown for it."""
+
+    line: str
+    argv: tuple[str, ...]
+    exit_code: int
+    shown: tuple[str, ...]
+
+
+def commands(text: str) -> list[Command]:
+    """The commands of every ``console`` block of a Markdown text, in order."""
+    found: list[Command] = []
+    for block in BLOCK.findall(text):
+        current: tuple[str, list[str]] | None = None
+        for raw in block.splitlines():
+            if raw.startswith("$ "):
+                if current is not None:
+                    found.append(_command(*current))
+                current = (raw[2:], [])
+            elif current is not None:
+                current[1].append(raw.rstrip())
+        if current is not None:
+            found.append(_command(*current))
+    return found
+
+
+def _command(line: str, shown: list[str]) -> Command:
+    match = EXIT.search(line)
+    argv = tuple(shlex.split(line, comments=True))
+    return Command(line, argv, int(match.group(1)) if match else 0, tuple(shown))
+
+
+def run(command: Command, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """Run a documented ``trackplan …`` command with this interpreter, in ``cwd``."""
+    assert command.argv[0] == "trackplan", f"not a trackplan command: {command.line}"
+    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "160"}
+    return subprocess.run(
+        [sys.executable, "-m", "trackplan", *command.argv[1:]],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+
+
+def mismatch(shown: tuple[str, ...], output: str) -> str | None:
+    """Why ``output`` does not show ``shown`` in order, or None when it does."""
+    lines = [line.rstrip() for line in output.splitlines()]
+    at = 0
+    for expected in shown:
+        if expected in ("...", ""):
+            continue
+        prefix = expected.endswith("...")
+        want = expected[:-3] if prefix else expected
+        while at < len(lines) and not (
+            lines[at].startswith(want) if prefix else lines[at] == want
+        ):
+            at += 1
+        if at == len(lines):
+            return f"line not printed (in this order): {expected!r}"
+        at += 1
+    return None
+
+
+def workspace(tmp: Path) -> Path:
+    """A folder where the documented relative paths (cases/, robots/) resolve."""
+    for name in ("cases", "robots"):
+        (tmp / name).symlink_to(REPO / name, target_is_directory=True)
+    return tmp
