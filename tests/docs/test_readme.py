@@ -51,6 +51,14 @@ def test_walkthrough_runs_as_written(tmp_path: Path):
     assert (cwd / "runs" / "bracket" / "report.html").is_file()
     ros = yaml.safe_load((cwd / "runs" / "bracket" / "trajectory.ros.yaml").read_text())
     assert len(ros["points"]) == 9676  # one point per sample, as `check` counted them
+    # docs/results.md shows the first two points of this file, to 4 significant digits
+    page = (console.REPO / "docs" / "results.md").read_text(encoding="utf-8")
+    shown = yaml.safe_load(re.search(r"### The ROS message.*?```yaml\n(.*?)```", page, re.S)[1])
+    for want, got in zip(shown["points"][:2], ros["points"][:2], strict=True):
+        np.testing.assert_allclose(got["positions"], want["positions"], rtol=0, atol=5e-5)
+        for key in ("velocities", "accelerations"):  # 4 significant digits
+            np.testing.assert_allclose(got[key], want[key], rtol=5e-4, atol=0, err_msg=key)
+        assert got["time_from_start"] == want["time_from_start"]
 
 
 def test_walkthrough_explains_the_planned_pieces():
