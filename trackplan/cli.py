@@ -438,7 +438,7 @@ def check(
         raise CaseError("samples are not evenly spaced in t", file=str(csv), key="t")
     report = check_case_trajectory(loaded, X, q, sample_time, timing=_timing(timing))
     console = _console()
-    console.print(f"{escape(str(csv))}: {_count(t, 'sample')} at Ts = {sample_time:g} s")
+    console.print(f"{escape(str(csv))}: {_count(len(t), 'sample')} at Ts = {sample_time:g} s")
     for kind, margin in report.joint_margins.items():
         cells = "  ".join(f"{m:+.3f}" for m in margin)
         console.print(f"  {kind:<13} margin per joint: {cells}")
@@ -447,8 +447,8 @@ def check(
     console.print(f"  max tracking error {report.max_tracking_error * 1e3:.4f} mm")
     for violation in report.violations:
         console.print(f"  VIOLATION {escape(violation.message)}")
-    verdict = "feasible" if report.success else f"infeasible: {_count(report.violations, 'violation')}"
-    console.print(verdict)
+    count = _count(len(report.violations), "violation")
+    console.print("feasible" if report.success else f"infeasible: {count}")
     return ExitCode.OK if report.success else ExitCode.INFEASIBLE
 
 
@@ -461,7 +461,7 @@ def _print_summary(result, out: Path) -> None:
     elif violations:  # the list below says it all; the message would repeat its first line
         console.print(
             f"{escape(result.case_name)}: INFEASIBLE ({result.status.value}): "
-            f"{_count(violations, 'violation')}"
+            f"{_count(len(violations), 'violation')}"
         )
     else:
         console.print(
@@ -644,12 +644,6 @@ def _print_search(result, out: Path) -> None:  # type: ignore[no-untyped-def]
     )
     console.print(f"  after  (X = {_vector(result.X)}): {after}")
     _print_summary(result.final, out)
-
-
-def _count(items: object, noun: str) -> str:
-    """``1 run``, ``6 runs``: a count (or a sized collection) with its noun."""
-    n = len(items) if hasattr(items, "__len__") else int(items)  # type: ignore[arg-type]
-    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 def _vector(values: np.ndarray) -> str:

@@ -1,4 +1,4 @@
-"""Joint derivatives exactly as a controller consuming the samples sees them (docs/conventions.md)."""
+"""Joint derivatives as a controller consuming the samples sees them (docs/conventions.md)."""
 
 from __future__ import annotations
 

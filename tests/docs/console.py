@@ -80,9 +80,7 @@ def mismatch(shown: tuple[str, ...], output: str) -> str | None:
             continue
         prefix = expected.endswith("...")
         want = expected[:-3] if prefix else expected
-        while at < len(lines) and not (
-            lines[at].startswith(want) if prefix else lines[at] == want
-        ):
+        while at < len(lines) and not (lines[at].startswith(want) if prefix else lines[at] == want):
             at += 1
         if at == len(lines):
             return f"line not printed (in this order): {expected!r}"

@@ -18,14 +18,20 @@ def test_api_page_runs(tmp_path, monkeypatch):
     monkeypatch.chdir(console.workspace(tmp_path))
     namespace: dict[str, object] = {}
     for block in blocks:
-        exec(compile(block, str(PAGE), "exec"), namespace)  # noqa: S102 - the documented code
+        exec(compile(block, str(PAGE), "exec"), namespace)  # the documented code, as pasted
     assert (tmp_path / "runs" / "notebook" / "trajectory.ros.yaml").is_file()
 
 
 def test_front_door_names_import_from_the_top_level():
     import trackplan
 
-    for name in ("load_case", "load_robot", "plan_placement", "optimize_placement",
-                 "check_trajectory", "CaseError"):
+    for name in (
+        "load_case",
+        "load_robot",
+        "plan_placement",
+        "optimize_placement",
+        "check_trajectory",
+        "CaseError",
+    ):
         assert callable(getattr(trackplan, name)), name
         assert name in trackplan.__all__

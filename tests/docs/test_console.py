@@ -8,9 +8,11 @@ import pytest
 
 from tests.docs import console
 
-PAGES = [page for page in sorted((console.REPO / "docs").glob("*.md")) if console.commands(
-    page.read_text(encoding="utf-8")
-)]
+PAGES = [
+    page
+    for page in sorted((console.REPO / "docs").glob("*.md"))
+    if console.commands(page.read_text(encoding="utf-8"))
+]
 
 
 def test_pages_with_commands_are_found():

@@ -47,9 +47,7 @@ def _schema(model: type[BaseModel], prefix: str = "") -> dict[str, object]:
             is_list = origin is list or "list[" in str(field.annotation)
             keys.update(_schema(inner, f"{key}[i]." if is_list else f"{key}."))
         else:
-            keys[key] = (
-                ... if field.is_required() else field.get_default(call_default_factory=True)
-            )
+            keys[key] = ... if field.is_required() else field.get_default(call_default_factory=True)
     return keys
 
 
@@ -98,7 +96,7 @@ def test_segment_kinds_and_their_keys_are_documented():
     rows = {
         line.split("|")[1].strip(): line
         for line in table.splitlines()
-        if line.startswith("| `line`") or line.startswith("| `arc`") or line.startswith("| `points`")
+        if line.startswith(("| `line`", "| `arc`", "| `points`"))
     }
     assert {"`line`", "`arc`", "`points`"} <= set(rows)
     for kind, model in (("line", LineModel), ("arc", ArcModel)):

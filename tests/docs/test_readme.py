@@ -64,10 +64,10 @@ def test_walkthrough_runs_as_written(tmp_path: Path):
 def test_walkthrough_explains_the_planned_pieces():
     """The lengths the README gives for where the speed dips are those of the planned path."""
     from trackplan import load_case
-    from trackplan.planning.plan import PathGeometry
+    from trackplan.paths.path_geometry import PathGeometry
 
     text = " ".join(_walkthrough().split())
-    pieces = PathGeometry.from_case(load_case(CASE), None).planned.pieces
+    pieces = PathGeometry.from_case(load_case(CASE)).planned.pieces
     kinds = [piece.kind for piece in pieces]
     starts = np.array([piece.s_start for piece in pieces])
     lengths = np.array([piece.length for piece in pieces])

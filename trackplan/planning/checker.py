@@ -77,7 +77,8 @@ def check_trajectory(
     """Check a sampled joint trajectory against the robot's limits and the task.
 
     Derivatives are backward differences at Ts with the robot at rest before the first and
-    after the last sample (docs/conventions.md), exactly what a controller consuming the samples sees.
+    after the last sample (docs/conventions.md), exactly what a controller consuming the
+    samples sees.
 
     Parameters
     ----------
@@ -152,8 +153,9 @@ def _count(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
-def _met(margin: float | np.ndarray, slack: float) -> float | np.ndarray:
+def _met(margin: np.ndarray | float, slack: float) -> np.ndarray:
     """A margin within the round-off slack of a limit counts as met: reported as 0, not < 0."""
+    margin = np.asarray(margin, dtype=float)
     return np.where((margin < 0) & (margin >= -slack), 0.0, margin)
 
 
@@ -284,7 +286,8 @@ def _coverage_violations(
             k,
             float(step[k - 1]),
             0.0,
-            f"coverage: the path is run backwards at t = {t[k]:.3f} s ({_count(backwards.size, 'step')})",
+            f"coverage: the path is run backwards at t = {t[k]:.3f} s "
+            f"({_count(backwards.size, 'step')})",
         )
     allowance = jump_allowance(nominal, ref.tolerance)  # (P,) extra jump allowed after piece p
     # one sample may advance up to a few times the task speed (a speed excess is reported

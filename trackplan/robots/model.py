@@ -19,7 +19,8 @@ LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk")
 class Robot:
     """A serial robot described by standard DH parameters.
 
-    Link transform (docs/conventions.md): ``A_i = Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i)``.
+    Link transform (docs/conventions.md):
+    ``A_i = Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i)``.
     The world frame is the DH base frame; the end effector is DH frame n followed by
     ``T_flange_tool``.
 
