@@ -107,24 +107,27 @@ class OptimizerSettings:
     Attributes
     ----------
     method
-        ``ga``, ``cmaes``, ``de`` or ``random``.
+        The search method (:class:`trackplan.choices.Method`): ``multistart`` (default),
+        ``ga`` (the paper's), ``cmaes``, ``de`` or ``random``.
     population
-        Population size (candidates evaluated per batch).
+        Population size (candidates evaluated per batch; ``multistart`` sets its own
+        batches).
     seed
         Fixes every random choice.
     budget
         Largest number of placement evaluations, or None for the method's own stop rule.
     restarts
         Independent runs of the method (fresh initial populations), the best kept; 1 is a
-        single run as the paper made it. The default, 6, is what it takes for the GA to land
-        within 2 % of the best known J on every paper case and seed 0-4 (README).
+        single run as the paper made it. None: the method's own default (``ga``: 6, what
+        it takes to land within 2 % of the best known J on every paper case and seed 0-4;
+        ``multistart``: 1, see ``docs/search.md``).
     """
 
-    method: Method = Method.GA
+    method: Method = Method.MULTISTART
     population: int = 30
     seed: int = 0
     budget: int | None = None
-    restarts: int = 6
+    restarts: int | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "method", choose(Method, self.method, "optimizer.method"))

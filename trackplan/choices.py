@@ -25,7 +25,10 @@ class Timing(enum.StrEnum):
 class Method(enum.StrEnum):
     """Placement search methods (see ``docs/search.md``)."""
 
+    MULTISTART = "multistart"
+    """Uniform samples, then local CMA-ES runs from the best distinct ones (default)."""
     GA = "ga"
+    """The reference paper's MATLAB GA configuration."""
     CMAES = "cmaes"
     DE = "de"
     RANDOM = "random"

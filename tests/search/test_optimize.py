@@ -44,7 +44,7 @@ def test_same_seed_same_history_and_result(case: Case, geometry: PathGeometry) -
 
 
 def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeometry) -> None:
-    result = optimize_placement(case, budget=100, geometry=geometry)
+    result = optimize_placement(case, method="ga", budget=100, geometry=geometry)
     assert result.evaluations == 100 and result.stop_reason == "budget"
     assert result.history.evaluations.tolist() == [30, 58, 86, 100]
     assert result.generations == 4 and result.method == "ga" and result.seed == 0
@@ -56,13 +56,14 @@ def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeomet
     assert result.initial.placement == pytest.approx([case.bounds.reach[0], 0, 0, 0, 0, 0])
 
 
-@pytest.mark.parametrize("method", ["cmaes", "de", "random"])
+@pytest.mark.parametrize("method", ["cmaes", "de", "random", "multistart"])
 def test_other_methods_are_reproducible(case: Case, geometry: PathGeometry, method: str) -> None:
+    budget = 2150 if method == "multistart" else 150  # multistart: into its first local run
     first, second = (
-        optimize_placement(case, method=method, seed=3, budget=150, geometry=geometry)
+        optimize_placement(case, method=method, seed=3, budget=budget, geometry=geometry)
         for _ in range(2)
     )
-    assert first.method == method and first.evaluations == 150
+    assert first.method == method and first.evaluations == budget
     assert first.success and first.final.check.success
     assert np.array_equal(first.history.best, second.history.best)
     assert np.array_equal(first.X, second.X)
@@ -87,7 +88,7 @@ def test_ctrl_c_keeps_the_best_placement(case: Case, geometry: PathGeometry) -> 
         if record.generation == 3:
             raise KeyboardInterrupt
 
-    result = optimize_placement(case, progress=progress, geometry=geometry)
+    result = optimize_placement(case, method="ga", progress=progress, geometry=geometry)
     assert result.stop_reason == "interrupted"
     assert [r.generation for r in seen] == [1, 2, 3] and result.generations == 3
     assert result.evaluations == seen[-1].evaluations == 86
@@ -169,7 +170,7 @@ def test_empty_reach_is_bad_input(case: Case) -> None:
 
 @pytest.mark.parametrize(
     ("options", "match"),
-    [({"method": "pso"}, "method must be one of"), ({"timing": "fast"}, "timing must be")],
+    [({"method": "pso"}, "method must be one of"), ({"timing": "fast"}, "timing must be one")],
 )
 def test_bad_options(case: Case, options: dict, match: str) -> None:
     with pytest.raises(CaseError, match=match):
@@ -183,6 +184,33 @@ def test_corner_beats_the_papers_optimum(case: Case, geometry: PathGeometry) -> 
         case, np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522]), geometry=geometry
     )
     result = optimize_placement(case, geometry=geometry)
-    assert result.success and result.stop_reason == "stall"
+    assert result.success and result.stop_reason == "converged"
     assert result.objective < paper.objective
     assert result.objective == pytest.approx(result.fitness, rel=5e-3)
+
+
+def test_multistart_descends_from_its_best_distinct_samples(
+    case: Case, geometry: PathGeometry
+) -> None:
+    """Local runs start from mutually distant good samples and improve on the sampling."""
+    from trackplan.search import algorithms
+
+    result = optimize_placement(case, method="multistart", seed=2, geometry=geometry)
+    sampled = result.history.evaluations <= algorithms.MULTISTART_SAMPLES
+    assert result.success and result.stop_reason == "converged"
+    assert result.history.best[~sampled].min() < result.history.best[sampled].min()
+    assert result.evaluations <= algorithms.MULTISTART_SAMPLES + algorithms.MULTISTART_STARTS * (
+        algorithms.LOCAL_EVALUATIONS + algorithms.LOCAL_POPULATION
+    )
+
+
+def test_a_pymoo_algorithm_and_termination_can_be_passed_in(
+    case: Case, geometry: PathGeometry
+) -> None:
+    from pymoo.algorithms.soo.nonconvex.ga import GA
+
+    result = optimize_placement(
+        case, method=GA(pop_size=20), termination=("n_gen", 4), seed=1, geometry=geometry
+    )
+    assert result.method == "GA" and result.runs == 1 and result.stop_reason == "custom"
+    assert result.evaluations == 80 and result.generations == 4

@@ -169,11 +169,11 @@ class ObjectiveModel(StrictModel):
 class OptimizerModel(StrictModel):
     """``optimizer``: method, population, seed, evaluation budget and independent runs."""
 
-    method: Literal["ga", "cmaes", "de", "random"] = "ga"
+    method: Literal["multistart", "ga", "cmaes", "de", "random"] = "multistart"
     population: Annotated[int, Field(ge=2)] = 30
     seed: Annotated[int, Field(ge=0)] = 0
     budget: Annotated[int, Field(ge=1)] | None = None
-    restarts: Annotated[int, Field(ge=1)] = 6
+    restarts: Annotated[int, Field(ge=1)] | None = None
 
 
 class CaseModel(StrictModel):

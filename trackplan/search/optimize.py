@@ -29,7 +29,7 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
 from trackplan.run_files import HISTORY_KEYS
-from trackplan.search.algorithms import make_algorithm, make_termination
+from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm, make_termination
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.problem import PlacementProblem
 from trackplan.search.space import SearchSpace
@@ -227,8 +227,10 @@ def optimize_placement(
         (paper timing, or ``objective.time_weight > 0``); None: one after the other.
     restarts
         Independent runs of the method, each from a fresh initial population, the best of
-        all kept; default the case's ``optimizer.restarts``. The first run uses ``seed``
-        itself, so ``restarts=1`` is one run exactly as configured (the paper's GA).
+        all kept; default the case's ``optimizer.restarts``, else the method's own
+        (:data:`trackplan.search.algorithms.DEFAULT_RESTARTS`; 1 for a pymoo Algorithm).
+        The first run uses ``seed`` itself, so ``restarts=1`` is one run exactly as
+        configured (the paper's GA).
 
     Returns
     -------
@@ -245,7 +247,11 @@ def optimize_placement(
         method = choose(Method, method or case.optimizer.method, "method")
     seed = case.optimizer.seed if seed is None else int(seed)
     budget = case.optimizer.budget if budget is None else int(budget)
-    restarts = case.optimizer.restarts if restarts is None else int(restarts)
+    if restarts is None:
+        restarts = case.optimizer.restarts
+    if restarts is None:
+        restarts = DEFAULT_RESTARTS[method] if isinstance(method, Method) else 1
+    restarts = int(restarts)
     law = time_law(timing or case.task.timing)
     if seed < 0:
         raise CaseError(f"seed must be ≥ 0, got {seed}", key="seed")
@@ -267,7 +273,7 @@ def optimize_placement(
             algorithm = copy.deepcopy(method)
         else:
             algorithm = make_algorithm(method, space, case.optimizer.population)
-        rules, parts = make_termination(termination)
+        rules, parts = make_termination(termination, method if isinstance(method, Method) else None)
         algorithm.setup(problem, termination=rules, seed=run_seed)
         stop_reason = _run(algorithm, problem, parts, budget, progress, start, records)
         runs += 1
