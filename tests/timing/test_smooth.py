@@ -18,7 +18,7 @@ def test_level_runs_merge_short_runs_into_slower_ones():
     level = np.zeros(101, dtype=int)
     level[40:42] = 3  # a 1 mm dip: too short for a window of its own
     level[60:90] = 1
-    runs = _level_runs(s, level)
+    runs = _level_runs(s, level, WINDOW_MIN_LENGTH)
     for first, last in runs:
         assert s[last] - s[first] >= WINDOW_MIN_LENGTH or len(runs) == 1
     # the dip survives (merged into a slower neighbourhood, never sped up)
