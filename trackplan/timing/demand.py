@@ -240,11 +240,11 @@ def speed_change(
     return best
 
 
-BOUND_FACTORS = np.geomspace(1.0, 8.0, 10)
+BOUND_FACTORS = np.geomspace(1.0, 8.0, 8)
 """Multiples of the zone-wide bounds tried first for a speed change (each axis)."""
-FINE_FACTORS = np.geomspace(0.85, 1.2, 5)
+FINE_FACTORS = np.geomspace(0.87, 1.15, 4)
 """Multiples of the best first-round bounds tried second (each axis)."""
-PHASE_POINTS = 9
+PHASE_POINTS = 6
 """Check points in each of a change's constant-jerk phases (both ends included)."""
 
 
