@@ -184,6 +184,7 @@ def speed_change(
     v_to: float,
     at_start: bool,
     share: float,
+    start: SpeedChange | None = None,
 ) -> SpeedChange:
     """Fastest jerk-limited speed change inside a zone, bounded by the joints along its stretch.
 
@@ -213,6 +214,9 @@ def speed_change(
         True when the change starts at the zone start, False when it ends at the zone end.
     share
         Share of each limit planned against.
+    start
+        A change known to meet the limits (bounds valid over its own stretch): the
+        search starts from it when it is shorter than the zone-wide one.
 
     Returns
     -------
@@ -221,9 +225,13 @@ def speed_change(
     """
     top = max(v_from, v_to)
     accel, jerk = uniform_change_bounds(robot, demand.peaks(), top, share)
-    if accel <= 0.0 or jerk <= 0.0:
-        return SpeedChange(np.inf, accel, jerk)
-    best = SpeedChange(speed_change_distance(v_from, v_to, accel, jerk), accel, jerk)
+    best = SpeedChange(np.inf, accel, jerk)
+    if accel > 0.0 and jerk > 0.0:
+        best = SpeedChange(speed_change_distance(v_from, v_to, accel, jerk), accel, jerk)
+    if start is not None and start.distance < best.distance:
+        best = start
+    if not np.isfinite(best.distance):
+        return best
     if v_from == v_to or len(demand.s) < 2:
         return best
     for factors in (BOUND_FACTORS, FINE_FACTORS):

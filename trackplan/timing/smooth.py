@@ -274,18 +274,28 @@ class _ZonePlanner:
         self.change_scale = np.ones(len(zones))
         self._changes: dict[tuple[int, float, float], SpeedChange] = {}
 
-    def quick_change(self, z: int, v_from: float, v_to: float) -> float:
-        """Distance of a speed change in zone z under the zone-wide bounds, m.
+    def quick_change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
+        """A speed change in zone z under bounds valid over the stretch it covers.
 
-        Never shorter than :meth:`change`'s, so a zone that fits its quick changes fits the
-        refined ones: the plateau search uses this cheaper bound.
+        First the bounds over the whole zone at the top speed, then those over the shorter
+        stretch that needs (valid: it lies inside). Never shorter than :meth:`change`'s,
+        so a zone that fits its quick changes fits the refined ones: the plateau search
+        uses this cheaper one.
         """
+        s0, s1, _ = self.zones[z]
         share = LIMIT_SHARE * self.change_scale[z]
-        peaks = self.demands[z].peaks()
-        accel, jerk = uniform_change_bounds(self.robot, peaks, max(v_from, v_to), share)
+        demand = self.demands[z]
+        top = max(v_from, v_to)
+        accel, jerk = uniform_change_bounds(self.robot, demand.peaks(), top, share)
         if accel <= 0.0 or jerk <= 0.0:
-            return np.inf
-        return speed_change_distance(v_from, v_to, accel, jerk)
+            return SpeedChange(np.inf, accel, jerk)
+        distance = speed_change_distance(v_from, v_to, accel, jerk)
+        if distance < s1 - s0:
+            stretch = (s0, s0 + distance) if v_to > v_from else (s1 - distance, s1)
+            local = uniform_change_bounds(self.robot, demand.peaks(*stretch), top, share)
+            accel, jerk = max(accel, local[0]), max(jerk, local[1])
+            distance = speed_change_distance(v_from, v_to, accel, jerk)
+        return SpeedChange(distance, accel, jerk)
 
     def change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
         """The speed change inside zone z: a rise starts at its start, a fall ends at its end.
@@ -305,6 +315,7 @@ class _ZonePlanner:
                 v_to,
                 at_start=v_to > v_from,
                 share=LIMIT_SHARE * self.change_scale[z],
+                start=self.quick_change(z, v_from, v_to),
             )
         return self._changes[key]
 
@@ -332,8 +343,8 @@ class _ZonePlanner:
         def needed(z: int, v: float) -> float:
             before = plateau[z - 1] if z > 0 else 0.0
             after = plateau[z + 1] if z < n - 1 else 0.0
-            total = self.quick_change(z, before, v) if before < v else 0.0
-            return total + (self.quick_change(z, v, after) if after < v else 0.0)
+            total = self.quick_change(z, before, v).distance if before < v else 0.0
+            return total + (self.quick_change(z, v, after).distance if after < v else 0.0)
 
         for _ in range(10 * n + 10):  # look-ahead passes until every zone fits
             changed = False
