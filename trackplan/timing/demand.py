@@ -54,11 +54,13 @@ class ZoneDemand:
     d3: np.ndarray
     _abs: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
     _peaks: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
+    _maxima: list[np.ndarray | None] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         absolute = (np.abs(self.d1), np.abs(self.d2), np.abs(self.d3))
         object.__setattr__(self, "_abs", absolute)
         object.__setattr__(self, "_peaks", tuple(d.max(axis=0) for d in absolute))
+        object.__setattr__(self, "_maxima", [None, None])
 
     @property
     def absolute(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -81,9 +83,37 @@ class ZoneDemand:
         """
         if s_from is None or s_to is None or len(self.s) < 2:
             return self._peaks
-        q1, q2, q3 = self._abs
         rows = self._rows(s_from, s_to)
+        if rows.start == 0:  # a stretch from the zone start: running maxima
+            return self._running(0)[rows.stop - 1]
+        if rows.stop == len(self.s):  # a stretch to the zone end
+            return self._running(1)[rows.start]
+        q1, q2, q3 = self._abs
         return q1[rows].max(axis=0), q2[rows].max(axis=0), q3[rows].max(axis=0)
+
+    def stretch_peaks(self, distance: np.ndarray, at_start: bool) -> np.ndarray:
+        """Largest |q'|, |q''|, |q'''| over stretches of the zone's grid, shape (V, 3, n).
+
+        Each stretch starts at the grid's first point (``at_start``) or ends at its last,
+        and is ``distance`` (V,) metres long (widened by one grid point, as :meth:`peaks`).
+        """
+        if at_start:
+            stop = np.searchsorted(self.s, self.s[0] + distance, side="left") + 2
+            return self._running(0)[np.clip(stop, 1, len(self.s)) - 1]
+        first = np.searchsorted(self.s, self.s[-1] - distance, side="right") - 2
+        return self._running(1)[np.clip(first, 0, len(self.s) - 1)]
+
+    def _running(self, backward: int) -> np.ndarray:
+        """Running maxima of |q'|, |q''|, |q'''| from the zone start (0) or from its end (1),
+        shape (G, 3, n): row k covers rows 0 … k, or k … G - 1."""
+        if self._maxima[backward] is None:
+            stacked = np.stack(self._abs, axis=1)  # (G, 3, n)
+            if backward:
+                running = np.maximum.accumulate(stacked[::-1], axis=0)[::-1]
+            else:
+                running = np.maximum.accumulate(stacked, axis=0)
+            self._maxima[backward] = running
+        return self._maxima[backward]  # type: ignore[return-value]
 
     def _rows(self, s_from: float, s_to: float) -> slice:
         """Grid rows covering [s_from, s_to] plus one neighbour on each side."""
@@ -146,16 +176,54 @@ def uniform_change_bounds(
     tuple of float
         ``(accel, jerk)``, m/s² and m/s³ (≤ 0 when the top speed leaves no room).
     """
-    q1, q2, q3 = peaks
-    accel_room = share * robot.a_max - q2 * top_speed**2
-    jerk_room = share * robot.j_max - q3 * top_speed**3
-    coupling = 3.0 * q2 * top_speed
-    accel = min(
-        float(np.min(safe_ratio(accel_room, q1))),
-        float(np.min(safe_ratio(0.5 * jerk_room, coupling))),
+    accel, jerk = uniform_change_bounds_many(robot, peaks, np.array([top_speed]), share)
+    return float(accel[0]), float(jerk[0])
+
+
+def uniform_change_bounds_many(
+    robot: Robot, peaks: tuple | np.ndarray, top_speed: np.ndarray, share: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`uniform_change_bounds` for many top speeds at once.
+
+    Parameters
+    ----------
+    peaks
+        Largest |q'|, |q''|, |q'''| per joint: three arrays of shape (n,) or (V, n)
+        (a tuple or an array (3, n)), or one array of shape (V, 3, n).
+    top_speed
+        Shape (V,), m/s.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(accel, jerk)``, each shape (V,).
+    """
+    if isinstance(peaks, np.ndarray) and peaks.ndim == 3:
+        peaks = peaks.swapaxes(0, 1)  # (3, V, n)
+    q1, q2, q3 = (np.asarray(p) for p in peaks)
+    top = np.asarray(top_speed, dtype=float)[:, None]
+    accel_room = share * robot.a_max - q2 * top**2
+    jerk_room = share * robot.j_max - q3 * top**3
+    coupling = 3.0 * q2 * top
+    accel = np.minimum(
+        safe_ratio(accel_room, q1).min(axis=-1), safe_ratio(0.5 * jerk_room, coupling).min(axis=-1)
     )
-    jerk = float(np.min(safe_ratio(jerk_room - coupling * accel, q1)))
-    return min(accel, MAX_PATH_ACCELERATION), min(jerk, MAX_PATH_JERK)
+    jerk = safe_ratio(jerk_room - coupling * accel[:, None], q1).min(axis=-1)
+    return np.minimum(accel, MAX_PATH_ACCELERATION), np.minimum(jerk, MAX_PATH_JERK)
+
+
+def change_distances(
+    v_from: np.ndarray, v_to: np.ndarray, accel: np.ndarray, jerk: np.ndarray
+) -> np.ndarray:
+    """:func:`~trackplan.timing.profile.speed_change_distance` for arrays, m (inf where a
+    bound is not positive, 0 where the speeds are equal)."""
+    delta = np.abs(v_to - v_from)
+    ok = (accel > 0.0) & (jerk > 0.0)
+    a = np.where(ok, accel, 1.0)
+    j = np.where(ok, jerk, 1.0)
+    time = np.where(delta * j >= a * a, delta / a + a / j, 2.0 * np.sqrt(delta / j))
+    distance = np.where(ok, 0.5 * (v_from + v_to) * time, np.inf)
+    return np.where(delta == 0.0, 0.0, distance)
 
 
 @dataclass(frozen=True)
@@ -248,9 +316,9 @@ def speed_change(
     return best
 
 
-BOUND_FACTORS = np.geomspace(1.0, 8.0, 8)
+BOUND_FACTORS = np.geomspace(1.0, 8.0, 6)
 """Multiples of the zone-wide bounds tried first for a speed change (each axis)."""
-FINE_FACTORS = np.geomspace(0.87, 1.15, 4)
+FINE_FACTORS = np.geomspace(0.85, 1.15, 3)
 """Multiples of the best first-round bounds tried second (each axis)."""
 PHASE_POINTS = 6
 """Check points in each of a change's constant-jerk phases (both ends included)."""

@@ -33,9 +33,11 @@ from trackplan.status import Status
 from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
+    change_distances,
     cruise_cap,
     speed_change,
     uniform_change_bounds,
+    uniform_change_bounds_many,
 )
 from trackplan.timing.profile import (
     SpeedProfile,
@@ -49,8 +51,10 @@ from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, SampleCheck
 LIMIT_SHARE = 0.97
 """Share of each joint limit the planner aims at; the rest absorbs sampling effects."""
 MAX_ITERATIONS = 12
-PLATEAU_TOLERANCE = 1e-4
-"""Relative precision of a plateau lowered to fit its zone's speed changes."""
+PLATEAU_GRID = 48
+PLATEAU_ROUNDS = 2
+"""A plateau lowered to fit its zone's speed changes is searched on a grid of PLATEAU_GRID
+speeds, PLATEAU_ROUNDS times finer each round (precision 1/48² ≈ 4e-4 of the cap)."""
 MAX_SAMPLES = 2_000_000
 """Longest trajectory built, in samples (33 min at 1 ms): beyond it a joint limit has forced
 the speed to almost nothing somewhere (a path through a singularity), and the time law
@@ -274,14 +278,41 @@ class _ZonePlanner:
         self.change_scale = np.ones(len(zones))
         self._changes: dict[tuple[int, float, float], SpeedChange] = {}
 
-    def quick_change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
-        """A speed change in zone z under bounds valid over the stretch it covers.
+    def quick_distances(self, z: int, v_from: np.ndarray, v_to: np.ndarray) -> np.ndarray:
+        """Distances of speed changes in zone z under bounds valid over their stretch, m.
 
         First the bounds over the whole zone at the top speed, then those over the shorter
         stretch that needs (valid: it lies inside). Never shorter than :meth:`change`'s,
         so a zone that fits its quick changes fits the refined ones: the plateau search
-        uses this cheaper one.
+        uses these cheaper ones, for many speeds at once.
+
+        Parameters
+        ----------
+        v_from, v_to
+            Speeds before and after, shape (V,), m/s; all rises or all falls.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (V,), m (inf where the joints leave no room).
         """
+        s0, s1, _ = self.zones[z]
+        share = LIMIT_SHARE * self.change_scale[z]
+        demand = self.demands[z]
+        top = np.maximum(v_from, v_to)
+        accel, jerk = uniform_change_bounds_many(self.robot, demand.peaks(), top, share)
+        distance = change_distances(v_from, v_to, accel, jerk)
+        rise = bool(np.all(v_to >= v_from))
+        stretch = np.minimum(distance, s1 - s0)
+        local = demand.stretch_peaks(np.where(np.isfinite(stretch), stretch, 0.0), rise)
+        local_accel, local_jerk = uniform_change_bounds_many(self.robot, local, top, share)
+        refined = change_distances(
+            v_from, v_to, np.maximum(accel, local_accel), np.maximum(jerk, local_jerk)
+        )
+        return np.where(np.isfinite(distance) & (distance < s1 - s0), refined, distance)
+
+    def quick_change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
+        """One change of :meth:`quick_distances`, with its bounds."""
         s0, s1, _ = self.zones[z]
         share = LIMIT_SHARE * self.change_scale[z]
         demand = self.demands[z]
@@ -340,21 +371,36 @@ class _ZonePlanner:
         lengths = np.array([s1 - s0 for s0, s1, _ in zones])
         plateau = caps.copy()
 
-        def needed(z: int, v: float) -> float:
+        def needed(z: int, v: np.ndarray) -> np.ndarray:
             before = plateau[z - 1] if z > 0 else 0.0
             after = plateau[z + 1] if z < n - 1 else 0.0
-            total = self.quick_change(z, before, v).distance if before < v else 0.0
-            return total + (self.quick_change(z, v, after).distance if after < v else 0.0)
+            rise = self.quick_distances(z, np.full_like(v, before), np.maximum(v, before))
+            fall = self.quick_distances(z, np.maximum(v, after), np.full_like(v, after))
+            return np.where(before < v, rise, 0.0) + np.where(after < v, fall, 0.0)
 
+        fitting: set[tuple[int, float, float, float]] = set()
         for _ in range(10 * n + 10):  # look-ahead passes until every zone fits
             changed = False
             for z in range(n):
-                if plateau[z] == 0.0 or needed(z, plateau[z]) <= lengths[z]:
+                top = plateau[z]
+                key = (
+                    z,
+                    plateau[z - 1] if z > 0 else 0.0,
+                    top,
+                    plateau[z + 1] if z < n - 1 else 0.0,
+                )
+                if top == 0.0 or key in fitting:
                     continue
-                low, high = 0.0, plateau[z]
-                while high - low > PLATEAU_TOLERANCE * high:
-                    mid = 0.5 * (low + high)
-                    low, high = (mid, high) if needed(z, mid) <= lengths[z] else (low, mid)
+                if needed(z, np.array([top]))[0] <= lengths[z]:
+                    fitting.add(key)
+                    continue
+                low, high = 0.0, top
+                for _ in range(PLATEAU_ROUNDS):  # a grid of speeds, then a finer one
+                    trial = np.linspace(low, high, PLATEAU_GRID + 1)[1:]
+                    fits = needed(z, trial) <= lengths[z]
+                    k = int(np.argmin(fits)) if not fits.all() else len(trial)
+                    low = float(trial[k - 1]) if k > 0 else low
+                    high = float(trial[k]) if k < len(trial) else high
                 plateau[z] = low
                 if "too short" not in reasons[z]:
                     reasons[z] = _too_short(reasons[z])
