@@ -1,22 +1,28 @@
 """The smooth time law: steady process speed, jerk-limited speed changes, every joint limit.
 
-Method (docs/paper.md, departures 3 and 6; docs/timing.md):
+Method (``docs/paper.md``, departures 3 and 6; ``docs/timing.md``):
 
 1. The planned path is cut into zones: straight pieces (capped at the rated speed), curved
-   pieces and G2 blends (capped at the corner speed), and stops (full reversals).
-2. On a fine grid of each zone the joint path q(s) is differentiated in s. At constant
-   path speed v the joint velocity, acceleration and jerk are ``q' v``, ``q'' v²`` and
-   ``q''' v³``, which caps the speed each zone may hold.
-3. Each zone holds one plateau speed. Speed changes are jerk-limited (trapezoidal
-   acceleration pulses) whose path acceleration and jerk bounds come from the joint limits:
-   ``|q'| s̈ + |q''| v² ≤ q̈max`` and ``|q'| s⃛ + 3 |q''| v s̈ + |q'''| v³ ≤ q⃛max``. A change
-   happens inside the faster of the two zones, so the speed never exceeds a cap. A zone
-   too short for its changes gets a lower plateau (look-ahead over all zones).
-4. The profile is sampled at Ts, mapped to joints, and checked with backward differences
-   exactly as the checker does. Where a sample still breaks a limit (the grid missed a peak),
-   that zone's plateau or speed-change bounds are lowered and the law is rebuilt.
+   pieces and G2 blends (capped at the corner speed, planned :data:`LIMIT_MARGIN` under it),
+   and stops (full reversals). The joint path gives the signed q', q'', q''' on each zone's
+   grid; at constant path speed v the joint velocity, acceleration and jerk are ``q' v``,
+   ``q'' v²`` and ``q''' v³``, which caps the speed each grid point allows.
+2. Zones are split into windows where the joint limits lower that cap on part of them
+   (levels 0.9^k of the task cap on straights, 0.95^k on arcs and blends): a straight slows
+   down only where it must, and the speed through a blend follows its joint demand.
+3. Each window holds one plateau. Speed changes are jerk-limited (trapezoidal acceleration
+   pulses) inside the faster of two neighbouring windows, so the speed never exceeds a cap.
+   Their acceleration and jerk bounds are sized from the joint demand along the stretch they
+   actually cover, at the speed, acceleration and jerk they have there
+   (:func:`~trackplan.timing.demand.speed_change`). A window too short for its changes gets a
+   lower plateau (look-ahead over all windows).
+4. The profile is sampled at Ts, mapped to joints by IK, and run through the sample checks
+   (:mod:`trackplan.timing.sample_checks`: the joint rate limits by backward differences,
+   exactly as the checker, :data:`LIMIT_MARGIN` under each limit; more checks may be handed
+   in). Where a sample still fails (the grid missed a peak), that window's plateau or
+   speed-change bounds are lowered and the law is rebuilt.
 
-Straight zones therefore run at exactly the rated speed wherever the limits allow.
+Straight windows therefore run at exactly the rated speed wherever the limits allow.
 """
 
 from __future__ import annotations
