@@ -32,7 +32,8 @@ MAX_PATH_JERK = 5000.0
 def safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
     """numerator / denominator with +inf where the denominator is zero."""
     out = np.full(np.broadcast(numerator, denominator).shape, np.inf)
-    np.divide(numerator, denominator, out=out, where=denominator > 0)
+    with np.errstate(over="ignore"):  # a tiny demand: no bound (inf)
+        np.divide(numerator, denominator, out=out, where=denominator > 0)
     return out
 
 
@@ -208,8 +209,9 @@ def uniform_change_bounds_many(
     accel = np.minimum(
         safe_ratio(accel_room, q1).min(axis=-1), safe_ratio(0.5 * jerk_room, coupling).min(axis=-1)
     )
+    accel = np.minimum(accel, MAX_PATH_ACCELERATION)
     jerk = safe_ratio(jerk_room - coupling * accel[:, None], q1).min(axis=-1)
-    return np.minimum(accel, MAX_PATH_ACCELERATION), np.minimum(jerk, MAX_PATH_JERK)
+    return accel, np.minimum(jerk, MAX_PATH_JERK)
 
 
 def change_distances(
