@@ -230,6 +230,12 @@ def _random_table() -> None:
         f"duration / toppra (lower bound): median {np.median(to_toppra):.4f},"
         f" worst {np.max(to_toppra):.4f}"
     )
+    below = ratios[ratios >= 1.0]
+    if below.size:
+        print(
+            f"  over the {below.size} placements where TOPP3 is below the smooth law:"
+            f" median {np.median(below):.4f}, worst {below.max():.4f}"
+        )
     print(
         f"TOPP3 above the smooth law (TOPP3 short of its optimum): {unconverged} placements;"
         f" outputs failing the re-check: {rechecked_bad}"
