@@ -31,10 +31,9 @@ MAX_PATH_JERK = 5000.0
 
 def safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
     """numerator / denominator with +inf where the denominator is zero."""
-    out = np.full(np.broadcast(numerator, denominator).shape, np.inf)
-    with np.errstate(over="ignore"):  # a tiny demand: no bound (inf)
-        np.divide(numerator, denominator, out=out, where=denominator > 0)
-    return out
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        out = np.asarray(numerator / denominator, dtype=float)
+    return np.where(denominator > 0, out, np.inf)
 
 
 @dataclass(frozen=True, eq=False)

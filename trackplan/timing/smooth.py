@@ -57,10 +57,10 @@ from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, SampleCheck
 LIMIT_SHARE = 0.97
 """Share of each joint limit the planner aims at; the rest absorbs sampling effects."""
 MAX_ITERATIONS = 12
-PLATEAU_GRID = 48
+PLATEAU_GRID = 24
 PLATEAU_ROUNDS = 2
 """A plateau lowered to fit its zone's speed changes is searched on a grid of PLATEAU_GRID
-speeds, PLATEAU_ROUNDS times finer each round (precision 1/48² ≈ 4e-4 of the cap)."""
+speeds, PLATEAU_ROUNDS times finer each round (precision 1/24² ≈ 2e-3 of the cap)."""
 MAX_SAMPLES = 2_000_000
 """Longest trajectory built, in samples (33 min at 1 ms): beyond it a joint limit has forced
 the speed to almost nothing somewhere (a path through a singularity), and the time law
