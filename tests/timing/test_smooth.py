@@ -9,8 +9,13 @@ import pytest
 
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import plan_placement
-from trackplan.timing.smooth import WINDOW_MIN_LENGTH, _level_runs
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.plan import check_case_trajectory, plan_placement
+from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, run_checks
+from trackplan.timing.smooth import WINDOW_MIN_LENGTH, _level_runs, plan_smooth_time_law
+
+SHIPPED_CASES = sorted(file.stem for file in CASES.glob("*.yaml"))
+PLACEMENTS_PER_CASE = 3
 
 
 def test_level_runs_merge_short_runs_into_slower_ones():
@@ -18,7 +23,7 @@ def test_level_runs_merge_short_runs_into_slower_ones():
     level = np.zeros(101, dtype=int)
     level[40:42] = 3  # a 1 mm dip: too short for a window of its own
     level[60:90] = 1
-    runs = _level_runs(s, level)
+    runs = _level_runs(s, level, WINDOW_MIN_LENGTH)
     for first, last in runs:
         assert s[last] - s[first] >= WINDOW_MIN_LENGTH or len(runs) == 1
     # the dip survives (merged into a slower neighbourhood, never sped up)
@@ -71,3 +76,80 @@ def test_rebuilds_until_the_sampled_trajectory_meets_every_limit(monkeypatch):
     result = plan_placement(case, case.bounds.example)
     assert laws[-1].iterations > 1 and laws[-1].success
     assert result.feasible, result.message
+
+
+@pytest.mark.parametrize("name", SHIPPED_CASES)
+def test_random_placements_of_every_case_pass_the_checker(name):
+    """Wherever the path has a joint path, the smooth law's samples pass every check."""
+    case = load_case(CASES / f"{name}.yaml")
+    geometry = PathGeometry.from_case(case)
+    rng = np.random.default_rng(sum(map(ord, name)))
+    lower, upper = case.bounds.lower, case.bounds.upper
+    reach_min, reach_max = case.bounds.reach
+    planned = 0
+    for _ in range(2000):
+        X = rng.uniform(lower, upper)
+        if not reach_min <= np.linalg.norm(X[:3]) <= reach_max:
+            continue
+        result = plan_placement(case, X, geometry=geometry)
+        if not result.joint_path.success:
+            continue
+        planned += 1
+        assert result.success, (X, result.message)
+        report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
+        assert report.success, (X, report.violations)
+        if planned == PLACEMENTS_PER_CASE:
+            break
+    assert planned == PLACEMENTS_PER_CASE
+
+
+def test_planned_speed_stays_under_the_corner_cap_by_the_margin():
+    """ur5-bead at Ts = 1 ms once exceeded its corner speed by 9e-8 m/s: the law plans
+    arcs and blends at (1 - LIMIT_MARGIN) of the corner speed, straights at the rated one."""
+    case = load_case(CASES / "ur5-bead.yaml")
+    fine = replace(case, task=replace(case.task, sample_time=1e-3))
+    geometry = PathGeometry.from_case(fine)
+    rng = np.random.default_rng(8)
+    for _ in range(2000):
+        X = rng.uniform(case.bounds.lower, case.bounds.upper)
+        result = plan_placement(fine, X, geometry=geometry)
+        if result.joint_path.success:
+            break
+    traj = result.trajectory
+    speed = np.diff(traj.s) / traj.sample_time
+    curved = geometry.on_curved_zone(traj.s[1:]) & geometry.on_curved_zone(traj.s[:-1])
+    corner = case.task.corner_speed
+    assert speed[curved].max() <= corner * (1 - LIMIT_MARGIN) * (1 + 1e-9)
+    assert speed[curved].max() > 0.99 * corner  # the arcs do run at the corner speed
+    assert speed.max() == pytest.approx(case.task.rated_speed, rel=1e-12)
+
+
+def test_a_sample_check_handed_to_the_law_is_met():
+    """Another limit joins the rebuild loop as one more check, without touching the law."""
+    case = load_case(CASES / "paper-corner.yaml")
+    free = plan_placement(case, case.bounds.example)
+    cap = 0.5 * np.abs(free.trajectory.qd[:, 0]).max()
+
+    def joint_1_speed(q, sample_time):
+        qd = np.abs(np.diff(q[:, 0], prepend=q[0, 0])) / sample_time
+        bad = np.flatnonzero(qd > cap)
+        return bad, np.ones(bad.size, dtype=int), qd[bad] / cap
+
+    law = plan_smooth_time_law(
+        free.joint_path, case.task, sample_checks=(RateLimits(case.robot), joint_1_speed)
+    )
+    assert law.success and law.iterations > 1
+    assert joint_1_speed(law.q, case.task.sample_time)[0].size == 0
+    assert law.duration > free.duration
+    assert not run_checks((RateLimits(case.robot),), law.q, case.task.sample_time)[0].size
+
+
+def test_rate_limits_keep_a_relative_margin(puma):
+    """A sample 5e-7 under a limit counts as a violation: the law keeps 1e-6 clear of it."""
+    Ts = 1e-3
+    q = np.zeros((10, 6))
+    q[5:, 0] = (1 - 5e-7) * puma.v_max[0] * Ts * np.arange(1, 6)
+    sample, order, ratio = RateLimits(puma)(q, Ts)
+    assert 1 in order[sample >= 5]
+    assert np.all(ratio > 1.0)
+    assert not RateLimits(puma, margin=0.0)(q[:, :1].repeat(6, axis=1) * 0, Ts)[0].size

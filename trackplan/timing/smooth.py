@@ -1,22 +1,28 @@
 """The smooth time law: steady process speed, jerk-limited speed changes, every joint limit.
 
-Method (docs/paper.md, departures 3 and 6; docs/timing.md):
+Method (``docs/paper.md``, departures 3 and 6; ``docs/timing.md``):
 
 1. The planned path is cut into zones: straight pieces (capped at the rated speed), curved
-   pieces and G2 blends (capped at the corner speed), and stops (full reversals).
-2. On a fine grid of each zone the joint path q(s) is differentiated in s. At constant
-   path speed v the joint velocity, acceleration and jerk are ``q' v``, ``q'' v²`` and
-   ``q''' v³``, which caps the speed each zone may hold.
-3. Each zone holds one plateau speed. Speed changes are jerk-limited (trapezoidal
-   acceleration pulses) whose path acceleration and jerk bounds come from the joint limits:
-   ``|q'| s̈ + |q''| v² ≤ q̈max`` and ``|q'| s⃛ + 3 |q''| v s̈ + |q'''| v³ ≤ q⃛max``. A change
-   happens inside the faster of the two zones, so the speed never exceeds a cap. A zone
-   too short for its changes gets a lower plateau (look-ahead over all zones).
-4. The profile is sampled at Ts, mapped to joints, and checked with backward differences
-   exactly as the checker does. Where a sample still breaks a limit (the grid missed a peak),
-   that zone's plateau or speed-change bounds are lowered and the law is rebuilt.
+   pieces and G2 blends (capped at the corner speed, planned :data:`LIMIT_MARGIN` under it),
+   and stops (full reversals). The joint path gives the signed q', q'', q''' on each zone's
+   grid; at constant path speed v the joint velocity, acceleration and jerk are ``q' v``,
+   ``q'' v²`` and ``q''' v³``, which caps the speed each grid point allows.
+2. Zones are split into windows where the joint limits lower that cap on part of them
+   (levels 0.9^k of the task cap on straights, 0.95^k on arcs and blends): a straight slows
+   down only where it must, and the speed through a blend follows its joint demand.
+3. Each window holds one plateau. Speed changes are jerk-limited (trapezoidal acceleration
+   pulses) inside the faster of two neighbouring windows, so the speed never exceeds a cap.
+   Their acceleration and jerk bounds are sized from the joint demand along the stretch they
+   actually cover, at the speed, acceleration and jerk they have there
+   (:func:`~trackplan.timing.demand.speed_change`). A window too short for its changes gets a
+   lower plateau (look-ahead over all windows).
+4. The profile is sampled at Ts, mapped to joints by IK, and run through the sample checks
+   (:mod:`trackplan.timing.sample_checks`: the joint rate limits by backward differences,
+   exactly as the checker, :data:`LIMIT_MARGIN` under each limit; more checks may be handed
+   in). Where a sample still fails (the grid missed a peak), that window's plateau or
+   speed-change bounds are lowered and the law is rebuilt.
 
-Straight zones therefore run at exactly the rated speed wherever the limits allow.
+Straight windows therefore run at exactly the rated speed wherever the limits allow.
 """
 
 from __future__ import annotations
@@ -27,10 +33,18 @@ import numpy as np
 
 from trackplan.case import Task
 from trackplan.choices import Timing
-from trackplan.derivatives import backward_derivatives
 from trackplan.jointpath import JointPath
 from trackplan.robots.model import Robot
 from trackplan.status import Status
+from trackplan.timing.demand import (
+    SpeedChange,
+    ZoneDemand,
+    change_distances,
+    cruise_cap,
+    speed_change,
+    uniform_change_bounds,
+    uniform_change_bounds_many,
+)
 from trackplan.timing.profile import (
     SpeedProfile,
     speed_change_distance,
@@ -38,10 +52,15 @@ from trackplan.timing.profile import (
     speed_change_time,
 )
 from trackplan.timing.protocol import SlowDown, TimeLaw, TimeLawSpec, unsampled
+from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, SampleCheck, run_checks
 
 LIMIT_SHARE = 0.97
 """Share of each joint limit the planner aims at; the rest absorbs sampling effects."""
 MAX_ITERATIONS = 12
+PLATEAU_GRID = 24
+PLATEAU_ROUNDS = 2
+"""A plateau lowered to fit its zone's speed changes is searched on a grid of PLATEAU_GRID
+speeds, PLATEAU_ROUNDS times finer each round (precision 1/24² ≈ 2e-3 of the cap)."""
 MAX_SAMPLES = 2_000_000
 """Longest trajectory built, in samples (33 min at 1 ms): beyond it a joint limit has forced
 the speed to almost nothing somewhere (a path through a singularity), and the time law
@@ -74,39 +93,9 @@ class ZonePlan:
     reason: str
 
 
-@dataclass(frozen=True, eq=False)
-class _ZoneDemand:
-    """|dq/ds|, |d²q/ds²|, |d³q/ds³| on a zone's grid.
-
-    Attributes
-    ----------
-    s
-        Grid, shape (G,), m.
-    q1, q2, q3
-        Absolute derivatives at the grid points, shape (G, n).
-    """
-
-    s: np.ndarray
-    q1: np.ndarray
-    q2: np.ndarray
-    q3: np.ndarray
-
-    def peaks(
-        self, s_from: float | None = None, s_to: float | None = None
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Largest |q'|, |q''|, |q'''| per joint over the zone, or over [s_from, s_to]."""
-        if s_from is None or s_to is None or len(self.s) < 2:
-            return self.q1.max(axis=0), self.q2.max(axis=0), self.q3.max(axis=0)
-        step = self.s[1] - self.s[0]
-        inside = (self.s >= s_from - step) & (self.s <= s_to + step)
-        return (
-            self.q1[inside].max(axis=0),
-            self.q2[inside].max(axis=0),
-            self.q3[inside].max(axis=0),
-        )
-
-
-def plan_smooth_time_law(joint_path: JointPath, task: Task) -> TimeLaw:
+def plan_smooth_time_law(
+    joint_path: JointPath, task: Task, sample_checks: tuple[SampleCheck, ...] | None = None
+) -> TimeLaw:
     """Shortest jerk-limited time law of the smooth mode (see the module docstring).
 
     Parameters
@@ -115,6 +104,9 @@ def plan_smooth_time_law(joint_path: JointPath, task: Task) -> TimeLaw:
         q(s) on the chosen IK branch, with its derivatives on the planning grid.
     task
         Rated and corner speeds (m/s) and the sample time Ts (s).
+    sample_checks
+        What the sampled joints must pass before the law returns
+        (:mod:`trackplan.timing.sample_checks`); default: the joint rate limits.
 
     Returns
     -------
@@ -123,6 +115,7 @@ def plan_smooth_time_law(joint_path: JointPath, task: Task) -> TimeLaw:
     """
     robot = joint_path.robot
     sample_time = task.sample_time
+    checks = sample_checks if sample_checks is not None else (RateLimits(robot),)
     zones = joint_path.geometry.zones()
     demands = _zone_demands(joint_path)
     zones, demands = _slow_down_windows(robot, zones, demands, task.rated_speed, task.corner_speed)
@@ -147,7 +140,7 @@ def plan_smooth_time_law(joint_path: JointPath, task: Task) -> TimeLaw:
         s = profile.evaluate(t / time_scale)[0]
         s[-1] = length
         q = joint_path.joints(s)
-        worst = _worst_rate_violations(robot, q, sample_time)
+        worst = run_checks(checks, q, sample_time)
         if not worst[0].size:
             return _sampled(plans, task, s, q, iteration, converged=True)
         planner.tighten(worst, s, t / time_scale, profile)
@@ -185,86 +178,80 @@ def _sampled(
     )
 
 
-def _zone_demands(joint_path: JointPath) -> list[_ZoneDemand]:
-    """|dq/ds|, |d²q/ds²|, |d³q/ds³| of each zone, from the joint path's planning grid."""
-    demands = []
-    for z in range(len(joint_path.geometry.zones())):
-        rows = joint_path.zone == z
-        demands.append(
-            _ZoneDemand(
-                joint_path.s[rows],
-                np.abs(joint_path.dq[rows]),
-                np.abs(joint_path.ddq[rows]),
-                np.abs(joint_path.dddq[rows]),
-            )
+def _zone_demands(joint_path: JointPath) -> list[ZoneDemand]:
+    """Signed dq/ds, d²q/ds², d³q/ds³ of each zone, from the joint path's planning grid."""
+    return [
+        ZoneDemand(
+            joint_path.s[rows], joint_path.dq[rows], joint_path.ddq[rows], joint_path.dddq[rows]
         )
-    return demands
+        for rows in (joint_path.zone == z for z in range(len(joint_path.geometry.zones())))
+    ]
 
 
 WINDOW_LEVEL = 0.9
-"""Ratio between successive speed levels of slow-down windows."""
+"""Ratio between successive speed levels of slow-down windows on straight zones."""
+CURVED_WINDOW_LEVEL = 0.95
+"""Ratio between successive speed levels on arcs and blends, where the speed follows the
+joint limits more closely (a blend's joint jerk peaks near its ends)."""
 WINDOW_MIN_LENGTH = 5e-3
-"""Shortest slow-down window, m: shorter runs join their slower neighbour."""
-
-
-def _local_caps(robot: Robot, demand: _ZoneDemand) -> np.ndarray:
-    """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s."""
-    share = LIMIT_SHARE
-    caps = np.minimum(
-        _safe_ratio(share * robot.v_max, demand.q1).min(axis=1),
-        np.sqrt(_safe_ratio(share * robot.a_max, demand.q2)).min(axis=1),
-    )
-    return np.minimum(caps, np.cbrt(_safe_ratio(share * robot.j_max, demand.q3)).min(axis=1))
+"""Shortest slow-down window on a straight zone, m: shorter runs join their slower neighbour."""
+CURVED_WINDOW_SHARE = 0.125
+"""Shortest window on an arc or blend, as a share of the zone's length (when below
+WINDOW_MIN_LENGTH: a blend a few millimetres long gets several windows)."""
 
 
 def _slow_down_windows(
     robot: Robot,
     zones: list[tuple[float, float, str]],
-    demands: list[_ZoneDemand],
+    demands: list[ZoneDemand],
     rated_speed: float,
     corner_speed: float,
-) -> tuple[list[tuple[float, float, str]], list[_ZoneDemand]]:
+) -> tuple[list[tuple[float, float, str]], list[ZoneDemand]]:
     """Split zones where the joint limits force a lower speed on only part of them.
 
     Along a zone the local cap (the speed the joints allow at each grid point) is rounded
-    down to levels ``task cap · 0.9^k``; runs of one level become windows of their own, so a
-    straight piece slows down only where it must and runs at the rated speed elsewhere.
-    Windows shorter than WINDOW_MIN_LENGTH join the slower neighbour (never raising a cap).
+    down to levels ``task cap · r^k`` (r = :data:`WINDOW_LEVEL` on straight zones,
+    :data:`CURVED_WINDOW_LEVEL` on curved ones); runs of one level become windows of their
+    own, so a straight piece slows down only where it must and runs at the rated speed
+    elsewhere, and the speed through a blend follows its joint demand. Short windows join
+    the slower neighbour (never raising a cap).
     """
     out_zones: list[tuple[float, float, str]] = []
-    out_demands: list[_ZoneDemand] = []
+    out_demands: list[ZoneDemand] = []
     for (s0, s1, kind), demand in zip(zones, demands, strict=True):
         task_cap = rated_speed if kind == "straight" else corner_speed
-        local = _local_caps(robot, demand) if kind != "stop" and len(demand.s) > 2 else None
+        usable = kind != "stop" and len(demand.s) > 2
+        local = demand.local_caps(robot, LIMIT_SHARE) if usable else None
         if local is None or local.min() >= task_cap:
             out_zones.append((s0, s1, kind))
             out_demands.append(demand)
             continue
+        straight = kind == "straight"
         ratio = np.minimum(local, task_cap) / task_cap
-        level = np.ceil(np.log(np.maximum(ratio, 1e-12)) / np.log(WINDOW_LEVEL) - 1e-9)
+        step = np.log(WINDOW_LEVEL if straight else CURVED_WINDOW_LEVEL)
+        level = np.ceil(np.log(np.maximum(ratio, 1e-12)) / step - 1e-9)
         level = np.maximum(level, 0).astype(int)
-        runs = _level_runs(demand.s, level)
-        for first, last in runs:
-            lo = max(first - 1, 0)
-            hi = min(last + 2, len(demand.s))
+        shortest = WINDOW_MIN_LENGTH
+        if not straight:
+            shortest = min(shortest, CURVED_WINDOW_SHARE * (s1 - s0))
+        for first, last in _level_runs(demand.s, level, shortest):
             a = s0 if first == 0 else 0.5 * (demand.s[first - 1] + demand.s[first])
             b = s1 if last == len(demand.s) - 1 else 0.5 * (demand.s[last] + demand.s[last + 1])
             out_zones.append((float(a), float(b), kind))
-            out_demands.append(
-                _ZoneDemand(demand.s[lo:hi], demand.q1[lo:hi], demand.q2[lo:hi], demand.q3[lo:hi])
-            )
+            out_demands.append(demand.part(max(first - 1, 0), min(last + 2, len(demand.s))))
     return out_zones, out_demands
 
 
-def _level_runs(s: np.ndarray, level: np.ndarray) -> list[tuple[int, int]]:
-    """Runs (first, last grid index) of equal level, short runs merged into slower ones."""
+def _level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> list[tuple[int, int]]:
+    """Runs (first, last grid index) of equal level, runs under ``shortest`` (m) merged
+    into slower ones."""
     level = level.copy()
     while True:
         edges = np.flatnonzero(np.diff(level)) + 1
         starts = np.concatenate([[0], edges])
         ends = np.concatenate([edges - 1, [len(level) - 1]])
         lengths = s[ends] - s[starts]
-        short = np.flatnonzero(lengths < WINDOW_MIN_LENGTH)
+        short = np.flatnonzero(lengths < shortest)
         if short.size == 0 or len(starts) == 1:
             return list(zip(starts.tolist(), ends.tolist(), strict=True))
         k = int(short[np.argmin(lengths[short])])
@@ -277,55 +264,6 @@ def _level_runs(s: np.ndarray, level: np.ndarray) -> list[tuple[int, int]]:
             level[starts[slower] : ends[slower] + 1] = own
 
 
-def _safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
-    """numerator / denominator with +inf where the denominator is zero."""
-    out = np.full(np.broadcast(numerator, denominator).shape, np.inf)
-    np.divide(numerator, denominator, out=out, where=denominator > 0)
-    return out
-
-
-def _cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
-    """Highest constant path speed the joint limits allow on a zone, and what binds."""
-    q1, q2, q3 = peaks
-    candidates = [
-        (_safe_ratio(share * robot.v_max, q1), "velocity"),
-        (np.sqrt(_safe_ratio(share * robot.a_max, q2)), "acceleration"),
-        (np.cbrt(_safe_ratio(share * robot.j_max, q3)), "jerk"),
-    ]
-    best, reason = np.inf, ""
-    for values, kind in candidates:
-        j = int(np.argmin(values))
-        if values[j] < best:
-            best, reason = float(values[j]), f"joint {j + 1} {kind}"
-    return best, reason
-
-
-MAX_PATH_ACCELERATION = 50.0
-"""Upper bound on |s̈|, m/s², where no joint bounds it (a joint path that does not move)."""
-MAX_PATH_JERK = 5000.0
-"""Upper bound on |s⃛|, m/s³, likewise."""
-
-
-def _change_bounds(
-    robot: Robot, peaks: tuple, top_speed: float, share: float
-) -> tuple[float, float]:
-    """Path acceleration and jerk bounds for a speed change up to ``top_speed``.
-
-    From ``|q'| s̈ + |q''| v² ≤ q̈max`` and ``|q'| s⃛ + 3 |q''| v s̈ + |q'''| v³ ≤ q⃛max``,
-    with the acceleration bound lowered where needed to leave half the jerk room to ``s⃛``.
-    """
-    q1, q2, q3 = peaks
-    accel_room = share * robot.a_max - q2 * top_speed**2
-    jerk_room = share * robot.j_max - q3 * top_speed**3
-    coupling = 3.0 * q2 * top_speed
-    accel = min(
-        float(np.min(_safe_ratio(accel_room, q1))),
-        float(np.min(_safe_ratio(0.5 * jerk_room, coupling))),
-    )
-    jerk = float(np.min(_safe_ratio(jerk_room - coupling * accel, q1)))
-    return min(accel, MAX_PATH_ACCELERATION), min(jerk, MAX_PATH_JERK)
-
-
 class _ZonePlanner:
     """Plateaus and speed changes over the zones, with per-zone safety scales."""
 
@@ -333,7 +271,7 @@ class _ZonePlanner:
         self,
         robot: Robot,
         zones: list[tuple[float, float, str]],
-        demands: list[_ZoneDemand],
+        demands: list[ZoneDemand],
         rated_speed: float,
         corner_speed: float,
     ) -> None:
@@ -344,28 +282,79 @@ class _ZonePlanner:
         self.corner_speed = corner_speed
         self.cap_scale = np.ones(len(zones))
         self.change_scale = np.ones(len(zones))
+        self._changes: dict[tuple[int, float, float], SpeedChange] = {}
 
-    def change(self, z: int, v_from: float, v_to: float) -> tuple[float, float, float]:
-        """Distance, acceleration and jerk bounds of a speed change inside zone z.
+    def quick_distances(self, z: int, v_from: np.ndarray, v_to: np.ndarray) -> np.ndarray:
+        """Distances of speed changes in zone z under bounds valid over their stretch, m.
 
-        A rise starts at the zone's start, a fall ends at its end. The bounds come from the
-        joint demand over the stretch the change covers: first over the whole zone, then
-        over the shorter stretch that needs, which stays valid because it lies inside.
+        First the bounds over the whole zone at the top speed, then those over the shorter
+        stretch that needs (valid: it lies inside). Never shorter than :meth:`change`'s,
+        so a zone that fits its quick changes fits the refined ones: the plateau search
+        uses these cheaper ones, for many speeds at once.
+
+        Parameters
+        ----------
+        v_from, v_to
+            Speeds before and after, shape (V,), m/s; all rises or all falls.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (V,), m (inf where the joints leave no room).
         """
         s0, s1, _ = self.zones[z]
-        top = max(v_from, v_to)
         share = LIMIT_SHARE * self.change_scale[z]
         demand = self.demands[z]
-        accel, jerk = _change_bounds(self.robot, demand.peaks(), top, share)
+        top = np.maximum(v_from, v_to)
+        accel, jerk = uniform_change_bounds_many(self.robot, demand.peaks(), top, share)
+        distance = change_distances(v_from, v_to, accel, jerk)
+        rise = bool(np.all(v_to >= v_from))
+        stretch = np.minimum(distance, s1 - s0)
+        local = demand.stretch_peaks(np.where(np.isfinite(stretch), stretch, 0.0), rise)
+        local_accel, local_jerk = uniform_change_bounds_many(self.robot, local, top, share)
+        refined = change_distances(
+            v_from, v_to, np.maximum(accel, local_accel), np.maximum(jerk, local_jerk)
+        )
+        return np.where(np.isfinite(distance) & (distance < s1 - s0), refined, distance)
+
+    def quick_change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
+        """One change of :meth:`quick_distances`, with its bounds."""
+        s0, s1, _ = self.zones[z]
+        share = LIMIT_SHARE * self.change_scale[z]
+        demand = self.demands[z]
+        top = max(v_from, v_to)
+        accel, jerk = uniform_change_bounds(self.robot, demand.peaks(), top, share)
         if accel <= 0.0 or jerk <= 0.0:
-            return np.inf, accel, jerk
+            return SpeedChange(np.inf, accel, jerk)
         distance = speed_change_distance(v_from, v_to, accel, jerk)
         if distance < s1 - s0:
             stretch = (s0, s0 + distance) if v_to > v_from else (s1 - distance, s1)
-            local = _change_bounds(self.robot, demand.peaks(*stretch), top, share)
+            local = uniform_change_bounds(self.robot, demand.peaks(*stretch), top, share)
             accel, jerk = max(accel, local[0]), max(jerk, local[1])
             distance = speed_change_distance(v_from, v_to, accel, jerk)
-        return distance, accel, jerk
+        return SpeedChange(distance, accel, jerk)
+
+    def change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
+        """The speed change inside zone z: a rise starts at its start, a fall ends at its end.
+
+        Its bounds come from the joint demand along the stretch it covers, at the speed it
+        has there (:func:`~trackplan.timing.demand.speed_change`).
+        """
+        key = (z, v_from, v_to)
+        if key not in self._changes:
+            s0, s1, _ = self.zones[z]
+            self._changes[key] = speed_change(
+                self.robot,
+                self.demands[z],
+                s0,
+                s1,
+                v_from,
+                v_to,
+                at_start=v_to > v_from,
+                share=LIMIT_SHARE * self.change_scale[z],
+                start=self.quick_change(z, v_from, v_to),
+            )
+        return self._changes[key]
 
     def plan(self) -> list[ZonePlan]:
         """Caps per zone, then plateaus lowered until every zone fits its speed changes."""
@@ -377,9 +366,9 @@ class _ZonePlanner:
             if kind == "stop":
                 caps[z], reasons[z] = 0.0, "stop"
                 continue
-            task_cap = self.rated_speed if kind == "straight" else self.corner_speed
+            task_cap = _task_cap(kind, self.rated_speed, self.corner_speed)
             share = LIMIT_SHARE * self.cap_scale[z]
-            joint_cap, joint_reason = _cruise_cap(self.robot, self.demands[z].peaks(), share)
+            joint_cap, joint_reason = cruise_cap(self.robot, self.demands[z].peaks(), share)
             if joint_cap < task_cap:
                 caps[z], reasons[z] = joint_cap, joint_reason
             else:
@@ -388,21 +377,36 @@ class _ZonePlanner:
         lengths = np.array([s1 - s0 for s0, s1, _ in zones])
         plateau = caps.copy()
 
-        def needed(z: int, v: float) -> float:
+        def needed(z: int, v: np.ndarray) -> np.ndarray:
             before = plateau[z - 1] if z > 0 else 0.0
             after = plateau[z + 1] if z < n - 1 else 0.0
-            total = self.change(z, before, v)[0] if before < v else 0.0
-            return total + (self.change(z, v, after)[0] if after < v else 0.0)
+            rise = self.quick_distances(z, np.full_like(v, before), np.maximum(v, before))
+            fall = self.quick_distances(z, np.maximum(v, after), np.full_like(v, after))
+            return np.where(before < v, rise, 0.0) + np.where(after < v, fall, 0.0)
 
+        fitting: set[tuple[int, float, float, float]] = set()
         for _ in range(10 * n + 10):  # look-ahead passes until every zone fits
             changed = False
             for z in range(n):
-                if plateau[z] == 0.0 or needed(z, plateau[z]) <= lengths[z]:
+                top = plateau[z]
+                key = (
+                    z,
+                    plateau[z - 1] if z > 0 else 0.0,
+                    top,
+                    plateau[z + 1] if z < n - 1 else 0.0,
+                )
+                if top == 0.0 or key in fitting:
                     continue
-                low, high = 0.0, plateau[z]
-                for _ in range(50):
-                    mid = 0.5 * (low + high)
-                    low, high = (mid, high) if needed(z, mid) <= lengths[z] else (low, mid)
+                if needed(z, np.array([top]))[0] <= lengths[z]:
+                    fitting.add(key)
+                    continue
+                low, high = 0.0, top
+                for _ in range(PLATEAU_ROUNDS):  # a grid of speeds, then a finer one
+                    trial = np.linspace(low, high, PLATEAU_GRID + 1)[1:]
+                    fits = needed(z, trial) <= lengths[z]
+                    k = int(np.argmin(fits)) if not fits.all() else len(trial)
+                    low = float(trial[k - 1]) if k > 0 else low
+                    high = float(trial[k]) if k < len(trial) else high
                 plateau[z] = low
                 if "too short" not in reasons[z]:
                     reasons[z] = _too_short(reasons[z])
@@ -446,11 +450,12 @@ class _ZonePlanner:
             change_in: list[tuple[float, float]] = []
             change_out: list[tuple[float, float]] = []
             if before < v:
-                distance, accel, jerk = self.change(z, before, v)
-                change_in = speed_change_phases(before, v, accel, jerk)
-                cruise -= distance
+                rise = self.change(z, before, v)
+                change_in = speed_change_phases(before, v, rise.accel, rise.jerk)
+                cruise -= rise.distance
             if after < v:
-                distance, accel, jerk = self.change(z, v, after)
+                fall = self.change(z, v, after)
+                distance, accel, jerk = fall.distance, fall.accel, fall.jerk
                 if z == last and stretch > 0.0:
                     # a stop lasting δ longer covers v·δ/2 more: the cruise gives it, and the
                     # whole motion then lasts δ/2 longer: stretch the stop by 2·stretch.
@@ -501,6 +506,15 @@ class _ZonePlanner:
             )
         self.cap_scale *= new_cap
         self.change_scale *= new_change
+        self._changes.clear()
+
+
+def _task_cap(kind: str, rated_speed: float, corner_speed: float) -> float:
+    """The task's speed cap on a zone of this kind, m/s: the rated speed on straight zones
+    (exactly), the corner speed less :data:`LIMIT_MARGIN` on curved ones."""
+    if kind == "straight":
+        return rated_speed
+    return min(rated_speed, corner_speed * (1.0 - LIMIT_MARGIN))
 
 
 def _too_short(reason: str) -> str:
@@ -520,33 +534,6 @@ def _jerk_for_duration(delta: float, accel: float, jerk: float, duration: float)
         else:
             high = mid
     return high
-
-
-def _worst_rate_violations(
-    robot: Robot, q: np.ndarray, sample_time: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Samples where a velocity, acceleration or jerk limit is exceeded.
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        ``(sample, order, ratio)``, each shape (V,): the sample index (past-the-end samples
-        clipped to the last), the derivative order (1 velocity, 2 acceleration, 3 jerk) and
-        the worst joint's value over its limit (> 1).
-    """
-    qd, qdd, qddd = backward_derivatives(q, sample_time, pad_end=True)
-    samples, orders, ratios = [], [], []
-    for order, values, bound in (
-        (1, qd, robot.v_max),
-        (2, qdd, robot.a_max),
-        (3, qddd, robot.j_max),
-    ):
-        ratio = (np.abs(values) / bound).max(axis=1)
-        bad = np.flatnonzero(ratio > 1.0)
-        samples.append(np.minimum(bad, len(q) - 1))
-        orders.append(np.full(bad.size, order))
-        ratios.append(ratio[bad])
-    return np.concatenate(samples), np.concatenate(orders), np.concatenate(ratios)
 
 
 SPEC = TimeLawSpec(Timing.SMOOTH, "g2", plan_smooth_time_law)

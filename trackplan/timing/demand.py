@@ -1,0 +1,397 @@
+"""What the joint path asks of the joints at a path speed: speed caps and speed-change bounds.
+
+Along the path the joints move as ``q(s)``; at path speed ``v = ṡ``, acceleration ``a = s̈``
+and jerk ``j = s⃛`` the joint velocity, acceleration and jerk are
+
+    q̇ = q' v,    q̈ = q' a + q'' v²,    q⃛ = q' j + 3 q'' v a + q''' v³
+
+(``'`` is d/ds). A :class:`ZoneDemand` holds the signed q', q'', q''' on a zone's grid and
+turns them into
+
+- the highest constant speed each grid point allows (:meth:`ZoneDemand.local_caps`), and
+- the acceleration and jerk bounds of one jerk-limited speed change across the stretch it
+  covers (:func:`speed_change`), with the speed the change actually has at each grid point,
+  not its top speed everywhere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from trackplan.robots.model import Robot
+from trackplan.timing.profile import speed_change_distance
+
+MAX_PATH_ACCELERATION = 50.0
+"""Upper bound on |s̈|, m/s², where no joint bounds it (a joint path that does not move)."""
+MAX_PATH_JERK = 5000.0
+"""Upper bound on |s⃛|, m/s³, likewise."""
+
+
+def safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
+    """numerator / denominator with +inf where the denominator is zero."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        out = np.asarray(numerator / denominator, dtype=float)
+    return np.where(denominator > 0, out, np.inf)
+
+
+@dataclass(frozen=True, eq=False)
+class ZoneDemand:
+    """Signed joint-path derivatives on one zone's grid.
+
+    Attributes
+    ----------
+    s
+        Grid, shape (G,), m, increasing.
+    d1, d2, d3
+        dq/ds, d²q/ds², d³q/ds³ at the grid, shape (G, n), rad/m, rad/m², rad/m³.
+    """
+
+    s: np.ndarray
+    d1: np.ndarray
+    d2: np.ndarray
+    d3: np.ndarray
+    _abs: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
+    _peaks: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
+    _maxima: list[np.ndarray | None] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        absolute = (np.abs(self.d1), np.abs(self.d2), np.abs(self.d3))
+        object.__setattr__(self, "_abs", absolute)
+        object.__setattr__(self, "_peaks", tuple(d.max(axis=0) for d in absolute))
+        object.__setattr__(self, "_maxima", [None, None])
+
+    @property
+    def absolute(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """|q'|, |q''|, |q'''| at the grid, each shape (G, n)."""
+        return self._abs
+
+    def part(self, first: int, stop: int) -> ZoneDemand:
+        """The grid points ``first … stop - 1``."""
+        return ZoneDemand(
+            self.s[first:stop], self.d1[first:stop], self.d2[first:stop], self.d3[first:stop]
+        )
+
+    def peaks(
+        self, s_from: float | None = None, s_to: float | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Largest |q'|, |q''|, |q'''| per joint over the zone, or over [s_from, s_to].
+
+        The stretch is widened by one grid point on each side (a peak between two grid
+        points shows at the nearer one).
+        """
+        if s_from is None or s_to is None or len(self.s) < 2:
+            return self._peaks
+        rows = self._rows(s_from, s_to)
+        if rows.start == 0:  # a stretch from the zone start: running maxima
+            return self._running(0)[rows.stop - 1]
+        if rows.stop == len(self.s):  # a stretch to the zone end
+            return self._running(1)[rows.start]
+        q1, q2, q3 = self._abs
+        return q1[rows].max(axis=0), q2[rows].max(axis=0), q3[rows].max(axis=0)
+
+    def stretch_peaks(self, distance: np.ndarray, at_start: bool) -> np.ndarray:
+        """Largest |q'|, |q''|, |q'''| over stretches of the zone's grid, shape (V, 3, n).
+
+        Each stretch starts at the grid's first point (``at_start``) or ends at its last,
+        and is ``distance`` (V,) metres long (widened by one grid point, as :meth:`peaks`).
+        """
+        if at_start:
+            stop = np.searchsorted(self.s, self.s[0] + distance, side="left") + 2
+            return self._running(0)[np.clip(stop, 1, len(self.s)) - 1]
+        first = np.searchsorted(self.s, self.s[-1] - distance, side="right") - 2
+        return self._running(1)[np.clip(first, 0, len(self.s) - 1)]
+
+    def _running(self, backward: int) -> np.ndarray:
+        """Running maxima of |q'|, |q''|, |q'''| from the zone start (0) or from its end (1),
+        shape (G, 3, n): row k covers rows 0 … k, or k … G - 1."""
+        if self._maxima[backward] is None:
+            stacked = np.stack(self._abs, axis=1)  # (G, 3, n)
+            if backward:
+                running = np.maximum.accumulate(stacked[::-1], axis=0)[::-1]
+            else:
+                running = np.maximum.accumulate(stacked, axis=0)
+            self._maxima[backward] = running
+        return self._maxima[backward]  # type: ignore[return-value]
+
+    def _rows(self, s_from: float, s_to: float) -> slice:
+        """Grid rows covering [s_from, s_to] plus one neighbour on each side."""
+        first = max(int(np.searchsorted(self.s, s_from, side="right")) - 2, 0)
+        stop = min(int(np.searchsorted(self.s, s_to, side="left")) + 2, len(self.s))
+        return slice(first, max(stop, first + 1))
+
+    def local_caps(self, robot: Robot, share: float) -> np.ndarray:
+        """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s."""
+        q1, q2, q3 = self._abs
+        caps = np.minimum(
+            safe_ratio(share * robot.v_max, q1).min(axis=1),
+            np.sqrt(safe_ratio(share * robot.a_max, q2)).min(axis=1),
+        )
+        return np.minimum(caps, np.cbrt(safe_ratio(share * robot.j_max, q3)).min(axis=1))
+
+
+def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
+    """Highest constant path speed the joint limits allow given peak demands, and what binds.
+
+    Parameters
+    ----------
+    robot
+        Joint limits, each shape (n,).
+    peaks
+        Largest |q'|, |q''|, |q'''| per joint, each shape (n,).
+    share
+        Share of each limit planned against.
+
+    Returns
+    -------
+    tuple of (float, str)
+        The speed, m/s, and e.g. ``"joint 3 jerk"``.
+    """
+    q1, q2, q3 = peaks
+    candidates = [
+        (safe_ratio(share * robot.v_max, q1), "velocity"),
+        (np.sqrt(safe_ratio(share * robot.a_max, q2)), "acceleration"),
+        (np.cbrt(safe_ratio(share * robot.j_max, q3)), "jerk"),
+    ]
+    best, reason = np.inf, ""
+    for values, kind in candidates:
+        j = int(np.argmin(values))
+        if values[j] < best:
+            best, reason = float(values[j]), f"joint {j + 1} {kind}"
+    return best, reason
+
+
+def uniform_change_bounds(
+    robot: Robot, peaks: tuple, top_speed: float, share: float
+) -> tuple[float, float]:
+    """Path acceleration and jerk bounds valid wherever the demand stays below ``peaks``.
+
+    From ``|q'| |s̈| + |q''| v² ≤ q̈max`` and ``|q'| |s⃛| + 3 |q''| v |s̈| + |q'''| v³ ≤ q⃛max``
+    at the top speed, with the acceleration lowered where needed to leave half the jerk
+    room to ``s⃛``. Conservative: the zone-wide fallback of :func:`speed_change`.
+
+    Returns
+    -------
+    tuple of float
+        ``(accel, jerk)``, m/s² and m/s³ (≤ 0 when the top speed leaves no room).
+    """
+    accel, jerk = uniform_change_bounds_many(robot, peaks, np.array([top_speed]), share)
+    return float(accel[0]), float(jerk[0])
+
+
+def uniform_change_bounds_many(
+    robot: Robot, peaks: tuple | np.ndarray, top_speed: np.ndarray, share: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`uniform_change_bounds` for many top speeds at once.
+
+    Parameters
+    ----------
+    peaks
+        Largest |q'|, |q''|, |q'''| per joint: three arrays of shape (n,) or (V, n)
+        (a tuple or an array (3, n)), or one array of shape (V, 3, n).
+    top_speed
+        Shape (V,), m/s.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(accel, jerk)``, each shape (V,).
+    """
+    if isinstance(peaks, np.ndarray) and peaks.ndim == 3:
+        peaks = peaks.swapaxes(0, 1)  # (3, V, n)
+    q1, q2, q3 = (np.asarray(p) for p in peaks)
+    top = np.asarray(top_speed, dtype=float)[:, None]
+    accel_room = share * robot.a_max - q2 * top**2
+    jerk_room = share * robot.j_max - q3 * top**3
+    coupling = 3.0 * q2 * top
+    accel = np.minimum(
+        safe_ratio(accel_room, q1).min(axis=-1), safe_ratio(0.5 * jerk_room, coupling).min(axis=-1)
+    )
+    accel = np.minimum(accel, MAX_PATH_ACCELERATION)
+    jerk = safe_ratio(jerk_room - coupling * accel[:, None], q1).min(axis=-1)
+    return accel, np.minimum(jerk, MAX_PATH_JERK)
+
+
+def change_distances(
+    v_from: np.ndarray, v_to: np.ndarray, accel: np.ndarray, jerk: np.ndarray
+) -> np.ndarray:
+    """:func:`~trackplan.timing.profile.speed_change_distance` for arrays, m (inf where a
+    bound is not positive, 0 where the speeds are equal)."""
+    delta = np.abs(v_to - v_from)
+    ok = (accel > 0.0) & (jerk > 0.0)
+    a = np.where(ok, accel, 1.0)
+    j = np.where(ok, jerk, 1.0)
+    time = np.where(delta * j >= a * a, delta / a + a / j, 2.0 * np.sqrt(delta / j))
+    distance = np.where(ok, 0.5 * (v_from + v_to) * time, np.inf)
+    return np.where(delta == 0.0, 0.0, distance)
+
+
+@dataclass(frozen=True)
+class SpeedChange:
+    """A jerk-limited speed change and the bounds it runs at.
+
+    Attributes
+    ----------
+    distance
+        Path length it covers, m (inf when the joint limits leave no room for it).
+    accel, jerk
+        Bounds on |s̈| (m/s²) and |s⃛| (m/s³) of its trapezoidal acceleration pulse.
+    """
+
+    distance: float
+    accel: float
+    jerk: float
+
+
+def speed_change(
+    robot: Robot,
+    demand: ZoneDemand,
+    s_start: float,
+    s_end: float,
+    v_from: float,
+    v_to: float,
+    at_start: bool,
+    share: float,
+    start: SpeedChange | None = None,
+) -> SpeedChange:
+    """Fastest jerk-limited speed change inside a zone, bounded by the joints along its stretch.
+
+    The change starts at ``s_start`` (``at_start``) or ends at ``s_end``. It is a
+    trapezoidal acceleration pulse (:func:`~trackplan.timing.profile.speed_change_phases`)
+    with bounds ``accel`` and ``jerk``. The bounds valid over the whole zone at the top
+    speed (:func:`uniform_change_bounds`) are always safe; larger ones are tried on a
+    grid of multiples (:data:`BOUND_FACTORS` on each axis), each checked where it actually
+    runs: at points along its own stretch, with its own speed, acceleration and jerk there,
+
+        |q' a + q'' v²| ≤ q̈max,    |q' j + 3 q'' v a + q''' v³| ≤ q⃛max,
+
+    using the signed joint-path derivatives interpolated from the zone's grid. The
+    shortest change that passes wins; a second, finer grid around it refines it.
+
+    Parameters
+    ----------
+    robot
+        Joint limits, each shape (n,).
+    demand
+        The zone's joint-path derivatives (its grid may reach one point beyond the zone).
+    s_start, s_end
+        The zone, m.
+    v_from, v_to
+        Speeds before and after, m/s.
+    at_start
+        True when the change starts at the zone start, False when it ends at the zone end.
+    share
+        Share of each limit planned against.
+    start
+        A change known to meet the limits (bounds valid over its own stretch): the
+        search starts from it when it is shorter than the zone-wide one.
+
+    Returns
+    -------
+    SpeedChange
+        Its distance and bounds.
+    """
+    top = max(v_from, v_to)
+    accel, jerk = uniform_change_bounds(robot, demand.peaks(), top, share)
+    best = SpeedChange(np.inf, accel, jerk)
+    if accel > 0.0 and jerk > 0.0:
+        best = SpeedChange(speed_change_distance(v_from, v_to, accel, jerk), accel, jerk)
+    if start is not None and start.distance < best.distance:
+        best = start
+    if not np.isfinite(best.distance):
+        return best
+    if v_from == v_to or len(demand.s) < 2:
+        return best
+    for factors in (BOUND_FACTORS, FINE_FACTORS):
+        a_trial = np.minimum(best.accel * factors, MAX_PATH_ACCELERATION)
+        j_trial = np.minimum(best.jerk * factors, MAX_PATH_JERK)
+        a_grid, j_grid = (g.ravel() for g in np.meshgrid(a_trial, j_trial, indexing="ij"))
+        ok, distance = _changes_within_limits(
+            robot, demand, s_start, s_end, v_from, v_to, at_start, share, a_grid, j_grid
+        )
+        if ok.any():
+            k = int(np.flatnonzero(ok)[np.argmin(distance[ok])])
+            if distance[k] < best.distance:
+                best = SpeedChange(float(distance[k]), float(a_grid[k]), float(j_grid[k]))
+    return best
+
+
+BOUND_FACTORS = np.geomspace(1.0, 8.0, 6)
+"""Multiples of the zone-wide bounds tried first for a speed change (each axis)."""
+FINE_FACTORS = np.geomspace(0.85, 1.15, 3)
+"""Multiples of the best first-round bounds tried second (each axis)."""
+PHASE_POINTS = 6
+"""Check points in each of a change's constant-jerk phases (both ends included)."""
+
+
+def _changes_within_limits(
+    robot: Robot,
+    demand: ZoneDemand,
+    s_start: float,
+    s_end: float,
+    v_from: float,
+    v_to: float,
+    at_start: bool,
+    share: float,
+    accel: np.ndarray,
+    jerk: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Which candidate speed changes meet the joint limits along their own stretch.
+
+    Parameters
+    ----------
+    accel, jerk
+        Candidate bounds, shape (K,), m/s² and m/s³.
+
+    Returns
+    -------
+    ok : numpy.ndarray
+        Shape (K,), bool.
+    distance : numpy.ndarray
+        Path length of each change, shape (K,), m.
+    """
+    delta = abs(v_to - v_from)
+    sign = 1.0 if v_to > v_from else -1.0
+    # trapezoid (hold phase) or triangle (accel not reached) per candidate
+    full = delta * jerk >= accel * accel
+    peak = np.where(full, accel, np.sqrt(delta * jerk))
+    t_jerk = peak / jerk
+    t_hold = np.where(full, delta / np.where(full, accel, 1.0) - t_jerk, 0.0)
+    distance = 0.5 * (v_from + v_to) * (2 * t_jerk + t_hold)
+    # check points: PHASE_POINTS per phase, phase-local time tau (K, 3, P)
+    u = np.linspace(0.0, 1.0, PHASE_POINTS)
+    durations = np.stack([t_jerk, t_hold, t_jerk], axis=1)  # (K, 3)
+    tau = durations[:, :, None] * u  # (K, 3, P)
+    j_phase = sign * jerk[:, None] * np.array([1.0, 0.0, -1.0])  # (K, 3)
+    a0 = np.stack([np.zeros_like(peak), sign * peak, sign * peak], axis=1)
+    v1 = v_from + sign * 0.5 * jerk * t_jerk**2
+    v2 = v1 + sign * peak * t_hold
+    v0 = np.stack([np.full_like(peak, v_from), v1, v2], axis=1)
+    s1 = v_from * t_jerk + sign * jerk * t_jerk**3 / 6.0
+    s2 = s1 + v1 * t_hold + sign * peak * t_hold**2 / 2.0
+    s0 = np.stack([np.zeros_like(peak), s1, s2], axis=1)
+    j = j_phase[:, :, None]
+    a = a0[:, :, None] + j * tau
+    v = v0[:, :, None] + a0[:, :, None] * tau + j * tau**2 / 2.0
+    s = s0[:, :, None] + v0[:, :, None] * tau + a0[:, :, None] * tau**2 / 2 + j * tau**3 / 6
+    origin = np.where(at_start, s_start, s_end - distance)  # (K,)
+    where = np.clip(origin[:, None, None] + s, s_start, s_end).ravel()
+    d1, d2, d3 = _interpolate(demand, where)  # (M, n)
+    j = np.broadcast_to(j, tau.shape)
+    v, a, j = v.ravel()[:, None], a.ravel()[:, None], j.ravel()[:, None]
+    joint_accel = np.abs(d1 * a + d2 * v * v) / (share * robot.a_max)
+    joint_jerk = np.abs(d1 * j + 3.0 * d2 * v * a + d3 * v**3) / (share * robot.j_max)
+    worst = np.maximum(joint_accel, joint_jerk).max(axis=1).reshape(len(accel), -1)
+    return worst.max(axis=1) <= 1.0, distance
+
+
+def _interpolate(demand: ZoneDemand, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Signed q', q'', q''' at ``s`` (M,) by linear interpolation of the grid, each (M, n)."""
+    grid = demand.s
+    k = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
+    span = grid[k + 1] - grid[k]
+    w = np.clip((s - grid[k]) / np.where(span > 0, span, 1.0), 0.0, 1.0)[:, None]
+    return tuple(  # type: ignore[return-value]
+        d[k] + w * (d[k + 1] - d[k]) for d in (demand.d1, demand.d2, demand.d3)
+    )
