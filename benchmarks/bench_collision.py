@@ -29,8 +29,8 @@ import numpy as np
 
 from trackplan.cell.exact import ExactDistance
 from trackplan.cell.screening import CellGeometry
-from trackplan.io.case_file import load_case
 from trackplan.frames import placement_transform
+from trackplan.io.case_file import load_case
 from trackplan.robots.kinematics import joint_frames
 
 ROOT = Path(__file__).resolve().parent.parent

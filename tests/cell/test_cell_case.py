@@ -10,8 +10,8 @@ import pytest
 
 from trackplan.cli import main
 from trackplan.io.case_file import load_case
-from trackplan.status import Status
 from trackplan.search.optimize import optimize_placement
+from trackplan.status import Status
 
 REPO = Path(__file__).resolve().parents[2]
 CELL_CASE = REPO / "cases" / "paper-corner-cell.yaml"

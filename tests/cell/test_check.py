@@ -12,8 +12,8 @@ from trackplan.cell.check import check_cell, pair_distances
 from trackplan.cell.exact import ExactDistance
 from trackplan.cell.model import Body, Capsules, Cell, Shape
 from trackplan.cell.screening import CellGeometry, clip_tool_segment
-from trackplan.io.case_file import load_case
 from trackplan.frames import pose_matrix, rpy_matrix
+from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.robots.builtin import puma560
 from trackplan.robots.kinematics import forward_kinematics, joint_frames

@@ -132,7 +132,16 @@ def check_cell(
     clearance = geometry.cell.clearance
     names = geometry.pair_names()
     if distance.shape[1] == 0:
-        return CellReport(np.inf, ("", ""), 0.0, 0, clearance, 1.0, np.full(len(q), np.inf), ())
+        return CellReport(
+            min_clearance=np.inf,
+            closest=("", ""),
+            t_closest=0.0,
+            point=0,
+            clearance=clearance,
+            margin=1.0,
+            distance=np.full(len(q), np.inf),
+            violations=(),
+        )
     point, pair = np.unravel_index(int(np.argmin(distance)), distance.shape)
     least = float(distance[point, pair])
     violations = []
@@ -155,7 +164,15 @@ def check_cell(
                 f"(least allowed {clearance * 1e3:.1f} mm) at t = {t[worst]:.3f} s ({span})"
             )
         violations.append(
-            Violation(kind, None, float(t[bad[0]]), float(t[bad[-1]]), value, clearance, text)
+            Violation(
+                limit=kind,
+                joint=None,
+                t_first=float(t[bad[0]]),
+                t_last=float(t[bad[-1]]),
+                worst=value,
+                bound=clearance,
+                message=text,
+            )
         )
     violations.sort(key=lambda v: v.t_first)
     margin = min(1.0, (least - clearance) / max(clearance, 1e-3))

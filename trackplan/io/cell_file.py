@@ -34,6 +34,7 @@ from pydantic_core import PydanticCustomError
 
 from trackplan.cell.model import DEFAULT_CLEARANCE, Body, Capsules, Cell, Shape
 from trackplan.errors import CaseError
+from trackplan.frames import placement_transform
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -46,7 +47,6 @@ from trackplan.io.yaml_input import (
     list_default,
     show,
 )
-from trackplan.frames import placement_transform
 
 SHAPES = ("plane", "box", "cylinder", "sphere", "capsule", "mesh")
 

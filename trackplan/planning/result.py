@@ -252,8 +252,8 @@ class PlanResult:
 
 __all__ = [
     "LIMIT_KINDS",
-    "CellReport",
     "TASK_KINDS",
+    "CellReport",
     "CheckReport",
     "PlanResult",
     "Trajectory",
