@@ -476,6 +476,13 @@ def _print_summary(result, out: Path) -> None:
             f"max tracking error = {result.check.max_tracking_error * 1e3:.4f} mm  "
             f"branch {result.branch}"
         )
+        cell = result.check.cell
+        if cell is not None:
+            console.print(
+                f"  min clearance = {1e3 * cell.min_clearance:.1f} mm "
+                f"({escape(cell.closest[0])} – {escape(cell.closest[1])} at "
+                f"t = {cell.t_closest:.3f} s; required {1e3 * cell.clearance:.1f} mm)"
+            )
         for slow in result.slowdowns:
             console.print(
                 f"  slow-down: s = {slow.s_start:.4f}..{slow.s_end:.4f} m at "

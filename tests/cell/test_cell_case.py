@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -42,6 +43,10 @@ def test_plan_at_the_unconstrained_optimum_reports_the_collision(
     link, obstacle, depth, _ = found.groups()
     assert (link, obstacle) == ("link 2", "table")
     assert float(depth) > 10.0
+    closest = json.loads((tmp_path / "result.json").read_text(encoding="utf-8"))["min_clearance"]
+    assert closest["distance"] == pytest.approx(-float(depth) / 1e3, abs=1e-4)
+    assert (closest["robot_body"], closest["other_body"]) == ("link 2", "table")
+    assert "min clearance = " in out
 
 
 @pytest.mark.slow

@@ -15,7 +15,7 @@ from trackplan.cell.screening import CellGeometry, clip_tool_segment
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.robots.builtin import puma560
+from trackplan.robots.builtin import puma560, ur5
 from trackplan.robots.kinematics import forward_kinematics, joint_frames
 from trackplan.search.fitness import Finding, PlacementFitness
 from trackplan.search.space import SearchSpace
@@ -164,3 +164,17 @@ def test_search_grades_colliding_candidates() -> None:
     assert not with_cell.feasible[0]
     assert with_cell.finding[0] == Finding.COLLISION
     assert 0.25 < with_cell.violation[0] < 0.5
+
+
+@pytest.mark.parametrize(
+    ("robot", "home"),
+    [
+        (puma560(), [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        (ur5(), [0.0, -np.pi / 2, 0.0, -np.pi / 2, 0.0, 0.0]),
+    ],
+    ids=["puma560", "ur5"],
+)
+def test_builtin_capsules_keep_the_default_clearance_at_home(robot, home) -> None:
+    geometry = CellGeometry.from_cell(Cell(), robot)
+    _, own = geometry.screen(joint_frames(robot, np.array([home])), np.eye(4))
+    assert own.min() > Cell().clearance
