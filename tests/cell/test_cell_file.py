@@ -107,3 +107,20 @@ def test_bad_cell_is_one_line_exit_2(
     assert code == ExitCode.BAD_INPUT
     assert len(err.splitlines()) == 1
     assert err.startswith(f"{file}: " + message.format(dir=tmp_path))
+
+
+def test_robot_without_capsule_model_needs_links(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    robot = tmp_path / "arm.yaml"
+    main(["robots", "--yaml", "puma560"])
+    robot.write_text(capsys.readouterr().out.replace("name: puma560", "name: arm"), "utf-8")
+    file = tmp_path / "cell.yaml"
+    text = CORNER.replace("robot: puma560", "robot: arm.yaml")
+    file.write_text(text + "cell:\n  clearance: 0.01\n", encoding="utf-8")
+    code, err = validate(capsys, file)
+    assert code == ExitCode.BAD_INPUT
+    assert err.startswith(f"{file}: cell: robot 'arm' has no built-in capsule model")
+    links = "  links:\n    - {link: 2, from: [-0.4, 0, 0], to: [0, 0, 0], radius: 0.07}\n"
+    file.write_text(text + "cell:\n" + links, encoding="utf-8")
+    assert load_case(file).cell.links.name == ("link 2",)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.cell.exact import ExactDistance
-from trackplan.cell.model import Shape
+from trackplan.cell.model import Capsules, Shape
 from trackplan.cell.screening import CellGeometry
 from trackplan.planning.result import CellReport, Violation
 from trackplan.robots.kinematics import joint_frames
@@ -94,7 +94,8 @@ def pair_distances(
     return distance
 
 
-def _world(frames: np.ndarray, capsules, k: int) -> tuple[np.ndarray, np.ndarray]:
+def _world(frames: np.ndarray, capsules: Capsules, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """World end points of capsule k; frames (n + 2, 4, 4) of one sample."""
     T = frames[capsules.frame[k]]
     a, b = capsules.segment[k] @ T[:3, :3].T + T[:3, 3]
     return a, b

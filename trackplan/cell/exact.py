@@ -1,9 +1,9 @@
 """Exact distances through coal (the maintained successor of hpp-fcl).
 
 Signed: positive when apart, negative (the penetration depth) when overlapping. Meshes are
-triangle meshes (a BVH): their distance is to the surface, and a capsule wholly inside a
-closed mesh is not reported as overlapping by this level (the screening, which sees the
-mesh as its bounding box, is conservative there).
+triangle meshes (a BVH) and their distance is to the surface: a capsule wholly inside a
+closed mesh, touching no triangle, is not reported as overlapping (model solid parts
+that can swallow a link as primitives, or as meshes of their outer surfaces).
 """
 
 from __future__ import annotations

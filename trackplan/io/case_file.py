@@ -259,7 +259,7 @@ def load_case_text(text: str, file: str | None = None, base_dir: str | Path | No
     case = _case(model, robot, start, segments, file)
     if model.cell is None:
         return case
-    return dataclasses.replace(case, cell=build_cell(model.cell, base, file))
+    return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
 
 
 def _case(

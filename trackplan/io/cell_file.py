@@ -33,6 +33,7 @@ from pydantic import Field, model_validator
 from pydantic_core import PydanticCustomError
 
 from trackplan.cell.model import DEFAULT_CLEARANCE, Body, Capsules, Cell, Shape
+from trackplan.cell.robot_bodies import builtin_link_capsules
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.io.yaml_input import (
@@ -47,6 +48,7 @@ from trackplan.io.yaml_input import (
     list_default,
     show,
 )
+from trackplan.robots.model import Robot
 
 SHAPES = ("plane", "box", "cylinder", "sphere", "capsule", "mesh")
 
@@ -165,14 +167,20 @@ def cell_problems(model: CellModel, n_dof: int) -> list[Problem]:
     return problems
 
 
-def build_cell(model: CellModel, base_dir: Path, case_file: str | None) -> Cell:
+def build_cell(model: CellModel, base_dir: Path, case_file: str | None, robot: Robot) -> Cell:
     """The :class:`Cell` of a validated ``cell:`` block (meshes read relative to ``base_dir``).
 
     Raises
     ------
     CaseError
-        When a mesh file is missing or cannot be read as a mesh (at its ``file`` key).
+        When a mesh file is missing or cannot be read as a mesh (at its ``file`` key), or
+        the block gives no ``links`` for a robot without a built-in capsule model.
     """
+    if model.links is None:
+        try:
+            builtin_link_capsules(robot)
+        except CaseError as exc:
+            raise CaseError(exc.message, file=case_file, key="cell") from None
     obstacles = tuple(
         _body(body, base_dir, case_file, ("cell", "obstacles", i))
         for i, body in enumerate(model.obstacles)
