@@ -32,11 +32,11 @@ def pair_distances(
 ) -> np.ndarray:
     """Distances of every checked pair at every sample, exact where they decide.
 
-    Every sample is screened; the exact library re-measures each pair at its local minima
-    in time that come within :data:`EXACT_BAND` of the clearance (the screening equals the
-    exact distance for primitives to 1e-6 m), at its overall minimum, wherever the bodies
-    overlap (the exact value is then the penetration depth), and, for meshes (screened as
-    their bounding boxes), at every sample within the band.
+    Every sample is screened; the exact library re-measures each pair at the closest
+    sample of every stretch of time it spends within :data:`EXACT_BAND` of the clearance
+    (the screening equals the exact distance for primitives to 1e-6 m), at its overall
+    minimum, wherever the bodies overlap (the exact value is then the penetration depth),
+    and, for meshes (screened as their bounding boxes), at every sample within the band.
 
     Parameters
     ----------
@@ -58,19 +58,23 @@ def pair_distances(
     distance = np.concatenate([body, own], axis=1)
     if not exact or distance.size == 0:
         return distance
-    near = distance < geometry.cell.clearance + EXACT_BAND
-    # the screening is exact for primitives (tests/cell): re-measure where it decides,
-    # at each pair's local minima in time; mesh pairs (screened as boxes) everywhere near
-    previous = np.vstack([np.full((1, distance.shape[1]), np.inf), distance[:-1]])
-    following = np.vstack([distance[1:], np.full((1, distance.shape[1]), np.inf)])
-    minimum = (distance < previous) & (distance <= following)
-    minimum[np.argmin(distance, axis=0), np.arange(distance.shape[1])] = True
-    mesh_pair = np.zeros(distance.shape[1], dtype=bool)
-    mesh_pair[: len(geometry.pair_body)] = [
-        geometry.bodies[o].shape is Shape.MESH for o in geometry.pair_body
-    ]
-    # overlapping samples all exactly: the kernel's overlap grade is not a penetration depth
-    near &= minimum | mesh_pair | (distance < 0.0)
+    band = distance < geometry.cell.clearance + EXACT_BAND
+    # the screening is exact for primitives (tests/cell): re-measure where it decides, at
+    # the closest sample of each stretch of time a pair spends within the band and at its
+    # overall minimum; all overlapping samples (the kernel's overlap grade is not a
+    # penetration depth); mesh pairs (screened as boxes) at every sample within the band
+    near = distance < 0.0
+    near[np.argmin(distance, axis=0), np.arange(distance.shape[1])] = True
+    mesh = [geometry.bodies[o].shape is Shape.MESH for o in geometry.pair_body]
+    for p in range(distance.shape[1]):
+        inside = np.flatnonzero(band[:, p])
+        if not len(inside):
+            continue
+        if p < len(mesh) and mesh[p]:
+            near[inside, p] = True
+            continue
+        for stretch in np.split(inside, np.flatnonzero(np.diff(inside) > 1) + 1):
+            near[stretch[np.argmin(distance[stretch, p])], p] = True
     oracle = ExactDistance()
     capsules = geometry.capsules
     n_body_pairs = len(geometry.pair_capsule)
