@@ -114,15 +114,26 @@ def screening() -> None:
 
 
 def optimize_process(case: Path) -> tuple[float, float]:
-    """Wall and CPU time of ``python -m trackplan optimize CASE`` in a fresh process, s."""
+    """Wall and CPU time of ``python -m trackplan optimize CASE`` in a fresh process, s.
+
+    Raises
+    ------
+    RuntimeError
+        When the search does not end with a feasible plan (exit code other than 0).
+    """
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as out:
-        subprocess.run(
+        run = subprocess.run(
             [sys.executable, "-m", "trackplan", "optimize", str(case), "--out", out, "--no-report"],
             check=False,
             capture_output=True,
+            text=True,
             env={**os.environ, "PYTHONPATH": str(ROOT)},
+        )
+    if run.returncode != 0:
+        raise RuntimeError(
+            f"optimize {case.name} exited {run.returncode}: {run.stdout}{run.stderr}"
         )
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -34,9 +34,10 @@ def pair_distances(
 
     Every sample is screened; the exact library re-measures each pair at the closest
     sample of every stretch of time it spends within :data:`EXACT_BAND` of the clearance
-    (the screening equals the exact distance for primitives to 1e-6 m), at its overall
-    minimum, wherever the bodies overlap (the exact value is then the penetration depth),
-    and, for meshes (screened as their bounding boxes), at every sample within the band.
+    and of every stretch of overlap (the screening equals the exact distance for
+    primitives to 1e-6 m when apart; overlapping, the exact value is the penetration depth
+    and the screened one a grade), at its overall minimum, and, for meshes (screened as
+    their bounding boxes), at every sample within the band.
 
     Parameters
     ----------
@@ -60,21 +61,22 @@ def pair_distances(
         return distance
     band = distance < geometry.cell.clearance + EXACT_BAND
     # the screening is exact for primitives (tests/cell): re-measure where it decides, at
-    # the closest sample of each stretch of time a pair spends within the band and at its
-    # overall minimum; all overlapping samples (the kernel's overlap grade is not a
-    # penetration depth); mesh pairs (screened as boxes) at every sample within the band
-    near = distance < 0.0
+    # the closest sample of each stretch of time a pair spends within the band (and so of
+    # each overlap) and at its overall minimum; mesh pairs (screened as boxes) at every
+    # sample within the band
+    near = np.zeros_like(band)
     near[np.argmin(distance, axis=0), np.arange(distance.shape[1])] = True
     mesh = [geometry.bodies[o].shape is Shape.MESH for o in geometry.pair_body]
     for p in range(distance.shape[1]):
-        inside = np.flatnonzero(band[:, p])
-        if not len(inside):
-            continue
-        if p < len(mesh) and mesh[p]:
-            near[inside, p] = True
-            continue
-        for stretch in np.split(inside, np.flatnonzero(np.diff(inside) > 1) + 1):
-            near[stretch[np.argmin(distance[stretch, p])], p] = True
+        for stretches in (band[:, p], distance[:, p] < 0.0):
+            inside = np.flatnonzero(stretches)
+            if not len(inside):
+                continue
+            if p < len(mesh) and mesh[p]:
+                near[inside, p] = True
+                continue
+            for stretch in np.split(inside, np.flatnonzero(np.diff(inside) > 1) + 1):
+                near[stretch[np.argmin(distance[stretch, p])], p] = True
     oracle = ExactDistance()
     capsules = geometry.capsules
     n_body_pairs = len(geometry.pair_capsule)

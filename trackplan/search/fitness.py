@@ -77,6 +77,9 @@ CLEARANCE_LEVEL = 0.25
 """Graded violation of a placement whose only problem is the clearance, before its shortfall."""
 CLEARANCE_SCALE = 0.05
 """Clearance shortfall at which the graded violation is halfway to the next level, m."""
+CELL_MARGIN = 0.003
+"""The search asks for this much more than the clearance, m: its optimum lies on the
+clearance boundary, and the final plan, checked at every sample, must not dip below it."""
 CELL_STRIDE = 3
 """The clearance is screened on every third pose of the screening grid (about 2 cm apart on
 the paper's corner path): the search's cost of the cell stays within 2× (``python -m
@@ -323,7 +326,7 @@ class PlacementFitness:
         J = J.copy()
         graded = graded.copy()
         T_base_part = placement_transform(X)
-        clearance = self.cell.cell.clearance
+        clearance = self.cell.cell.clearance + CELL_MARGIN
         # every CELL_STRIDE-th pose of the screening grid, and the last
         poses = np.unique(np.r_[np.arange(0, q.shape[2], CELL_STRIDE), q.shape[2] - 1])
         q = q[:, :, poses]
