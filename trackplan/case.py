@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from trackplan.cell.model import Cell
 from trackplan.choices import Method, Penalty, Timing, choose
 from trackplan.paths.specs import SegmentSpec
 from trackplan.robots.model import Robot
@@ -149,6 +150,9 @@ class Case:
         The path segments, in order.
     task, bounds, objective, optimizer
         See the classes.
+    cell
+        The work cell (obstacles, workpiece, tool and link bodies), or None to plan
+        without collision checks.
     source
         The case file, if the case came from one.
     """
@@ -162,3 +166,4 @@ class Case:
     objective: Objective
     optimizer: OptimizerSettings = field(default_factory=OptimizerSettings)
     source: str | None = None
+    cell: Cell | None = None

@@ -476,6 +476,13 @@ def _print_summary(result, out: Path) -> None:
             f"max tracking error = {result.check.max_tracking_error * 1e3:.4f} mm  "
             f"branch {result.branch}"
         )
+        cell = result.check.cell
+        if cell is not None:
+            console.print(
+                f"  min clearance = {1e3 * cell.min_clearance:.1f} mm "
+                f"({escape(cell.closest[0])} – {escape(cell.closest[1])} at "
+                f"t = {cell.t_closest:.3f} s; required {1e3 * cell.clearance:.1f} mm)"
+            )
         for slow in result.slowdowns:
             console.print(
                 f"  slow-down: s = {slow.s_start:.4f}..{slow.s_end:.4f} m at "
@@ -579,6 +586,55 @@ def demo(
     _print_search(result, out)
     typer.echo(f"report: {(out / 'report.html').resolve()}")
     return search_exit_code(result)
+
+
+@app.command("map")
+def map_command(
+    case: Annotated[Path, typer.Argument(help="Case file.", show_default=False)],
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/map"),
+    rpy: Annotated[
+        tuple[float, float, float] | None,
+        typer.Option(
+            "--rpy",
+            help="ROLL PITCH YAW of every placement, rad (default: the search's best).",
+            show_default=False,
+        ),
+    ] = None,
+    z: Annotated[
+        float | None,
+        typer.Option("--z", help="Height of every placement, m (default: the search's best)."),
+    ] = None,
+    points: Annotated[
+        int, typer.Option("--points", min=2, help="Grid points along x and along y.")
+    ] = 41,
+) -> ExitCode:
+    """Map feasibility (reach, joint limit, collision) and J over an x-y grid of placements.
+
+    Writes map.png, map.csv and map.html. Without --rpy and --z the case's placement
+    search runs first and the map keeps its best placement's height and orientation.
+    """
+    from trackplan.io.map_file import write_map_csv
+    from trackplan.report.cell_figures import write_map_report
+    from trackplan.search.placement_map import placement_map
+
+    loaded = load_case(case)
+    reference = np.full(6, np.nan)  # x, y stay unset unless the search ran
+    if rpy is None or z is None:
+        reference = np.asarray(_search(loaded).X, dtype=float)
+    if z is not None:
+        reference[2] = z
+    if rpy is not None:
+        reference[3:] = rpy
+    pmap = placement_map(loaded, reference, n_points=points)
+    write_map_csv(pmap, out)
+    write_map_report(pmap, out)
+    typer.echo(
+        f"{loaded.name}: placement map at z = {pmap.z:.4f} m, rpy = "
+        f"({', '.join(f'{v:.4f}' for v in pmap.rpy)}) rad: feasible on "
+        f"{100 * pmap.feasible_share:.0f} % of {points} x {points} placements"
+    )
+    typer.echo(f"  results in {out}/")
+    return ExitCode.OK
 
 
 def _search(case: Case, **options):  # type: ignore[no-untyped-def]

@@ -27,6 +27,8 @@ class Status(enum.Enum):
     """The path crosses a singularity (or the joints jump between poses)."""
     POSITION_LIMITS = "position_limits"
     """Every IK branch leaves the joint range."""
+    COLLISION = "collision"
+    """Every limit is met, but the robot breaks the work cell's clearance."""
     NOT_CONVERGED = "not_converged"
     """An iterative method stopped before meeting its own tolerance."""
     INTERRUPTED = "interrupted"

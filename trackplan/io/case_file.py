@@ -8,6 +8,7 @@ naming the file, the key path (``path.segments[2].arc.normal``) and what is expe
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -26,6 +27,7 @@ from trackplan.case import (
 )
 from trackplan.choices import Method, Penalty, Timing
 from trackplan.errors import CaseError
+from trackplan.io.cell_file import CellModel, build_cell, cell_problems
 from trackplan.io.robot_file import load_robot_spec
 from trackplan.io.yaml_input import (
     NonEmptyStr,
@@ -186,6 +188,7 @@ class CaseModel(StrictModel):
     placement: PlacementModel = PlacementModel()
     objective: ObjectiveModel = ObjectiveModel()
     optimizer: OptimizerModel = OptimizerModel()
+    cell: CellModel | None = None
 
 
 # --------------------------------------------------------------------------- loading
@@ -250,9 +253,13 @@ def load_case_text(text: str, file: str | None = None, base_dir: str | Path | No
         *_path_problems(start, segments, model, base),
         *_placement_problems(model.placement),
         *_objective_problems(model.objective, robot),
+        *(cell_problems(model.cell, robot.n_dof) if model.cell is not None else []),
     ]
     raise_first(problems, data, file)
-    return _case(model, robot, start, segments, file)
+    case = _case(model, robot, start, segments, file)
+    if model.cell is None:
+        return case
+    return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
 
 
 def _case(

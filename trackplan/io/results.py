@@ -9,7 +9,7 @@ import numpy as np
 
 from trackplan.case import PLACEMENT_KEYS
 from trackplan.errors import CaseError
-from trackplan.planning.result import PlanResult, Trajectory
+from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
 
@@ -96,6 +96,22 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     return data[:, 0], data[:, index]
 
 
+def _cell_summary(check: CheckReport) -> dict:
+    """``min_clearance`` block of ``result.json`` when the case has a cell."""
+    cell = check.cell
+    if cell is None:
+        return {}
+    return {
+        "min_clearance": {
+            "distance": float(cell.min_clearance),
+            "robot_body": cell.closest[0],
+            "other_body": cell.closest[1],
+            "t": float(cell.t_closest),
+            "clearance": float(cell.clearance),
+        }
+    }
+
+
 def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
     """The ``result.json`` content of a plan (plain JSON types)."""
     check = result.check
@@ -120,6 +136,7 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
             **{kind: float(value) for kind, value in check.task_margins.items()},
         },
         "binding": {kind: {"joint": j, "t": t} for kind, (j, t) in check.binding.items()},
+        **_cell_summary(check),
         "violations": [
             {
                 "limit": v.limit,

@@ -311,7 +311,7 @@ def _message(model: type[BaseModel], error: ErrorDetails) -> str:
     return error["msg"] + got
 
 
-CUSTOM_ERRORS = frozenset({"segment_kind", "points_type"})
+CUSTOM_ERRORS = frozenset({"segment_kind", "points_type", "body_shape"})
 """Error types raised by our schemas whose message already says everything."""
 
 

@@ -8,6 +8,7 @@ joint, and every violation with its time window and worst value.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,6 +19,9 @@ from trackplan.planning.tracking import jump_allowance, locate_on_nominal
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 
+if TYPE_CHECKING:
+    from trackplan.cell.screening import CellGeometry
+
 UNITS = {
     "position": "rad",
     "velocity": "rad/s",
@@ -27,6 +31,7 @@ UNITS = {
     "orientation": "rad",
     "speed": "m/s",
     "coverage": "m",
+    "clearance": "m",
 }
 RELATIVE_SLACK = 1e-9
 """Values within this relative amount of a limit count as meeting it (float round-off)."""
@@ -73,6 +78,7 @@ def check_trajectory(
     q: np.ndarray,
     sample_time: float,
     reference: TrackingReference | None = None,
+    cell: CellGeometry | None = None,
 ) -> CheckReport:
     """Check a sampled joint trajectory against the robot's limits and the task.
 
@@ -91,6 +97,10 @@ def check_trajectory(
     reference
         The task to check against (tracking, orientation, Cartesian speed, coverage);
         None checks joint limits only.
+    cell
+        The work cell laid out for the robot (:class:`trackplan.cell.screening.CellGeometry`):
+        adds the clearance margin and collision violations (:mod:`trackplan.cell.check`);
+        its workpiece is placed at ``reference.T_base_part`` (identity without a reference).
 
     Returns
     -------
@@ -137,6 +147,15 @@ def check_trajectory(
         task_margins, task_violations = task
         violations.extend(task_violations)
 
+    cell_report = None
+    if cell is not None:
+        from trackplan.cell.check import check_cell
+
+        T_base_part = reference.T_base_part if reference is not None else np.eye(4)
+        cell_report = check_cell(cell, robot, q, sample_time, T_base_part)
+        task_margins["clearance"] = cell_report.margin
+        violations.extend(cell_report.violations)
+
     return CheckReport(
         success=not violations,
         joint_margins=margins,
@@ -145,6 +164,7 @@ def check_trajectory(
         max_tracking_error=max_tracking,
         max_orientation_error=max_orientation,
         binding=binding,
+        cell=cell_report,
     )
 
 

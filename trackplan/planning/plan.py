@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.cell.screening import CellGeometry
 from trackplan.derivatives import backward_derivatives
 from trackplan.frames import as_placement, placement_transform, rpy_matrix
 from trackplan.jointpath import JointPath
@@ -21,6 +22,9 @@ from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.timing import TimeLaw, time_law
+
+CELL_KINDS = ("collision", "clearance")
+"""Violation kinds of the cell check."""
 
 
 def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> TrackingReference:
@@ -170,9 +174,12 @@ def _checked(case: Case, joint_path: JointPath, timed: TimeLaw) -> PlanResult:
         timed.q,
         timed.sample_time,
         tracking_reference(case, geometry, joint_path.placement),
+        cell_geometry(case),
     )
     if not check.success:
         status = Status.LIMITS_VIOLATED
+        if all(v.limit in CELL_KINDS for v in check.violations):
+            status = Status.COLLISION
         message = check.violations[0].message
     elif not timed.success:
         status, message = timed.status, timed.message
@@ -231,8 +238,8 @@ def check_case_trajectory(
 ) -> CheckReport:
     """Check any joint trajectory against a case with the workpiece at placement X.
 
-    The one call behind ``trackplan check``: the joint limits, and the tracking, speed,
-    orientation and coverage of the case's path placed at X.
+    The one call behind ``trackplan check``: the joint limits, the tracking, speed,
+    orientation and coverage of the case's path placed at X, and the case's cell.
 
     Parameters
     ----------
@@ -254,4 +261,10 @@ def check_case_trajectory(
     law = time_law(timing or case.task.timing)
     geometry = PathGeometry.from_case(case, law.path_mode)
     reference = tracking_reference(case, geometry, as_placement(X))
-    return check_trajectory(case.robot, np.asarray(q, dtype=float), sample_time, reference)
+    q = np.asarray(q, dtype=float)
+    return check_trajectory(case.robot, q, sample_time, reference, cell_geometry(case))
+
+
+def cell_geometry(case: Case) -> CellGeometry | None:
+    """The case's cell laid out for its robot, or None without a cell."""
+    return CellGeometry.from_cell(case.cell, case.robot) if case.cell is not None else None

@@ -90,6 +90,47 @@ class Violation:
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
+class CellReport:
+    """What the cell check (:func:`trackplan.cell.check.check_cell`) found.
+
+    Attributes
+    ----------
+    min_clearance
+        Least signed distance over every checked pair and sample, m (negative: overlap).
+    closest
+        (robot body, other body) names of the pair where it occurs.
+    t_closest
+        Time of the closest approach, s.
+    point
+        Sample index of the closest approach.
+    clearance
+        The required clearance, m.
+    margin
+        ``(min_clearance − clearance) / max(clearance, 1 mm)``, capped at 1: the unused
+        share in the checker's sign convention (negative when violated).
+    distance
+        Least distance over all pairs at each sample, shape (N,), m (clearance vs time).
+    violations
+        One per pair that breaks the clearance (kind ``collision`` when the bodies
+        overlap, ``clearance`` otherwise), in time order.
+    """
+
+    min_clearance: float
+    closest: tuple[str, str]
+    t_closest: float
+    point: int
+    clearance: float
+    margin: float
+    distance: np.ndarray
+    violations: tuple[Violation, ...]
+
+    @property
+    def success(self) -> bool:
+        """True when every pair keeps the clearance at every sample."""
+        return not self.violations
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
 class CheckReport:
     """What the checker found, sample by sample.
 
@@ -112,6 +153,8 @@ class CheckReport:
         Largest tool orientation error, rad.
     binding
         For each joint limit kind, the (joint, time) at which it is closest to binding.
+    cell
+        The cell check, when the case has a cell.
     """
 
     success: bool
@@ -121,6 +164,7 @@ class CheckReport:
     max_tracking_error: float
     max_orientation_error: float
     binding: dict[str, tuple[int, float]] = field(default_factory=dict)
+    cell: CellReport | None = None
 
     def worst_margin(self) -> float:
         """The smallest margin over every limit (negative when infeasible)."""
@@ -209,6 +253,7 @@ class PlanResult:
 __all__ = [
     "LIMIT_KINDS",
     "TASK_KINDS",
+    "CellReport",
     "CheckReport",
     "PlanResult",
     "Trajectory",

@@ -516,6 +516,10 @@ def plot_figures(
         "path.png": lambda: path_figure(result, case),
         "speed.png": lambda: speed_figure(result, case),
     }
+    if result.check.cell is not None and result.trajectory.n_samples:
+        from trackplan.report.cell_figures import clearance_figure
+
+        builders["clearance.png"] = lambda: clearance_figure(result)
     if history:
         builders["convergence.png"] = lambda: convergence_figure(history)
     return builders

@@ -47,6 +47,12 @@ _PLOT_CAPTIONS = {
         "shaded. Bottom: distance of the tool point from the nominal path (sharp corners kept) "
         "against the tolerance ρ.",
     ),
+    "clearance.png": (
+        "Clearance",
+        "Least distance between the robot (link and tool capsules) and the cell (obstacles, "
+        "workpiece, non-adjacent links) at each sample, against the required clearance; the "
+        "closest approach is marked with the pair it occurs between.",
+    ),
     "convergence.png": (
         "Placement search",
         "Best and mean fitness and the share of feasible candidates per generation, placed at "

@@ -3,11 +3,14 @@
 The robot is drawn from its DH chain as links between consecutive frame origins (base,
 DH frames 1..n, tool) with a marker at each joint, on a subsampled trajectory. A time
 slider and play/pause buttons drive plotly animation frames that update only the robot
-and the tool trail. plotly is imported inside the functions.
+and the tool trail. With a work cell, obstacles and the placed workpiece are drawn as
+solids, the robot's link and tool capsules follow the animation, and the closest approach
+is a red segment between the nearest points. plotly is imported inside the functions.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,6 +28,7 @@ from trackplan.report.scene import (
     transform_points,
     triad_lines,
 )
+from trackplan.robots.kinematics import joint_frames
 
 if TYPE_CHECKING:
     import plotly.graph_objects as go
@@ -36,6 +40,8 @@ ROBOT_TRACE = "robot"
 TRAIL_TRACE = "tool trail"
 PATH_TRACE = "planned path"
 NOMINAL_TRACE = "nominal path"
+CAPSULES_TRACE = "link capsules"
+CLOSEST_TRACE = "closest approach"
 DECIMALS = 5  # 10 µm: keeps the page small, far below anything visible
 _AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")
 
@@ -52,6 +58,88 @@ def _xyz(points: np.ndarray) -> dict[str, list[float | None]]:
 def frame_name(k: int) -> str:
     """Name of animation frame k (0-based)."""
     return f"frame-{k:04d}"
+
+
+def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list, Callable]:
+    """Static traces of the cell (obstacles, workpiece, closest approach) and the builder of
+    the animated link-capsule trace."""
+    import plotly.graph_objects as go
+
+    from trackplan.cell.screening import CellGeometry
+    from trackplan.report.cell_scene import (
+        body_mesh,
+        closest_approach,
+        merge,
+        robot_capsules_mesh,
+    )
+
+    assert case.cell is not None
+    geometry = CellGeometry.from_cell(case.cell, case.robot)
+    T_base_part = placement_transform(result.placement)
+    traces: list = []
+    for label, bodies, T, color, opacity in (
+        ("obstacles", case.cell.obstacles, np.eye(4), "#8c8c8c", 0.35),
+        ("workpiece", case.cell.workpiece, T_base_part, "#c49a6c", 0.6),
+    ):
+        if not bodies:
+            continue
+        vertices, faces = merge([body_mesh(body, T) for body in bodies])
+        traces.append(_mesh_trace(go, vertices, faces, label, color, opacity))
+    closest = closest_approach(geometry, case.robot, result)
+    if closest is not None:
+        points, label = closest
+        traces.append(
+            go.Scatter3d(
+                **_xyz(points),
+                mode="lines+markers",
+                name=CLOSEST_TRACE,
+                line={"color": "red", "width": 6},
+                marker={"size": 4, "color": "red"},
+                hovertext=[label, label],
+                hoverinfo="text",
+            )
+        )
+    frames = joint_frames(case.robot, result.trajectory.q[idx])
+
+    def capsules_trace(k: int) -> dict:
+        vertices, faces = robot_capsules_mesh(geometry, frames[k])
+        # the triangles are the same in every frame: only the first carries them
+        triangles = (
+            {"i": faces[:, 0].tolist(), "j": faces[:, 1].tolist(), "k": faces[:, 2].tolist()}
+            if k == 0
+            else {}
+        )
+        return {
+            "type": "mesh3d",
+            "x": np.round(vertices[:, 0], 3).tolist(),
+            "y": np.round(vertices[:, 1], 3).tolist(),
+            "z": np.round(vertices[:, 2], 3).tolist(),
+            **triangles,
+            "name": CAPSULES_TRACE,
+            "showlegend": True,
+            "color": "#4c72b0",
+            "opacity": 0.35,
+            "hoverinfo": "skip",
+        }
+
+    return traces, capsules_trace
+
+
+def _mesh_trace(go, vertices: np.ndarray, faces: np.ndarray, name: str, color: str, opacity: float):  # type: ignore[no-untyped-def]
+    return go.Mesh3d(
+        x=vertices[:, 0],
+        y=vertices[:, 1],
+        z=vertices[:, 2],
+        i=faces[:, 0],
+        j=faces[:, 1],
+        k=faces[:, 2],
+        name=name,
+        showlegend=True,
+        color=color,
+        opacity=opacity,
+        flatshading=True,
+        hoverinfo="name",
+    )
 
 
 def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go.Figure:
@@ -168,12 +256,21 @@ def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go
                     hoverinfo="skip",
                 )
             )
-    animated = [robot_trace(0), trail_trace(0)]
+    builders = [robot_trace, trail_trace]
+    if case.cell is not None:
+        cell_static, capsules_trace = _cell_traces(result, case, idx)
+        static += cell_static
+        builders.append(capsules_trace)
+    animated = [build(0) for build in builders]
     first_animated = len(static)
-    animated_ids = [first_animated, first_animated + 1]
+    animated_ids = [first_animated + i for i in range(len(builders))]
 
     frames = [
-        {"name": frame_name(k), "data": [robot_trace(k), trail_trace(k)], "traces": animated_ids}
+        {
+            "name": frame_name(k),
+            "data": [build(k) for build in builders],
+            "traces": animated_ids,
+        }
         for k in range(len(idx))
     ]
     times = trajectory.t[idx]

@@ -26,6 +26,9 @@ Graded violation v (the smallest over the branches, in the order of the checks)
   of reach, ``s`` the share of poses where the branch switches (a singularity crossing)
   or jumps, ``l = min(1, excess / π)`` with ``excess`` how far (rad) the joint path leaves
   the position limits;
+- ``0.25 + 0.25 e / (e + 0.05 m)`` (in [0.25, 0.5)): geometrically feasible on some branch,
+  but every such branch comes closer to the cell than its clearance (screened by the
+  compiled kernel, :mod:`trackplan.cell.screening`), ``e`` the least shortfall in metres;
 - ``0.5 L / (1 + L)`` with ``L = ln(1 + x)`` (in (0, 0.5)): geometrically feasible but the
   planned trajectory fails the checker, ``x`` being the worst excess over a limit as a
   fraction of the limit (logarithmic: the paper's time law exceeds jerk limits 1000-fold).
@@ -48,12 +51,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.cell.screening import CellGeometry
 from trackplan.choices import Penalty
-from trackplan.frames import tool_poses
+from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.objective import joint_travel
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
+from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.search.space import SearchSpace
 from trackplan.timing import time_law
@@ -68,6 +73,17 @@ REACH_SCALE = 0.1
 """Reach excess that adds 1 to the graded violation, m."""
 GEOMETRY_LEVEL = 0.5
 """Graded violation of a geometrically infeasible placement, before its shares."""
+CLEARANCE_LEVEL = 0.25
+"""Graded violation of a placement whose only problem is the clearance, before its shortfall."""
+CLEARANCE_SCALE = 0.05
+"""Clearance shortfall at which the graded violation is halfway to the next level, m."""
+CELL_MARGIN = 0.003
+"""The search asks for this much more than the clearance, m: its optimum lies on the
+clearance boundary, and the final plan, checked at every sample, must not dip below it."""
+CELL_STRIDE = 3
+"""The clearance is screened on every third pose of the screening grid (about 2 cm apart on
+the paper's corner path): the search's cost of the cell stays within 2× (``python -m
+benchmarks collision``); the final plan is checked exactly at every sample."""
 
 
 class Finding(enum.IntEnum):
@@ -79,6 +95,7 @@ class Finding(enum.IntEnum):
     BRANCH_SWITCH = 3  # every reaching branch crosses a singularity or jumps
     POSITION_LIMITS = 4  # every continuous branch leaves the joint range
     CHECK = 5  # the planned trajectory fails the checker
+    COLLISION = 6  # every geometrically feasible branch breaks the cell clearance
 
 
 @dataclass(frozen=True, eq=False)
@@ -186,6 +203,7 @@ class PlacementFitness:
         curved = geometry.on_curved_zone(0.5 * (self.s_grid[1:] + self.s_grid[:-1]))
         cap = np.where(curved, case.task.corner_speed, case.task.rated_speed)
         self.tool_time = np.diff(self.s_grid) / cap  # (M - 1,), s
+        self.cell = CellGeometry.from_cell(case.cell, case.robot) if case.cell else None
         self._map: Callable[[Callable, Iterable], Iterable] = (
             executor.map if executor is not None else map
         )
@@ -251,18 +269,27 @@ class PlacementFitness:
         switches = paths.n_switches / n_poses
         limits = np.minimum(1.0, np.maximum(0.0, -paths.margin) / np.pi)
         graded = GEOMETRY_LEVEL + unreachable + switches + limits  # (B, K)
-        any_ok = paths.success.any(axis=1)
-        choice = np.where(any_ok, np.argmin(J, axis=1), np.argmin(graded, axis=1))
+        geometric = paths.success.any(axis=1)
         rows = np.arange(len(X))
+        if self.cell is not None:
+            J, graded = self._screen_cell(X, paths.q, J, graded)
+        any_ok = np.isfinite(J).any(axis=1)
+        choice = np.where(any_ok, np.argmin(J, axis=1), np.argmin(graded, axis=1))
         objective = np.where(any_ok, J[rows, choice], np.nan)
         violation = np.where(any_ok, 0.0, graded[rows, choice])
         finding = np.select(
             [
                 any_ok,
+                geometric,
                 unreachable[rows, choice] > 0.0,
                 paths.n_switches[rows, choice] > 0,
             ],
-            [int(Finding.FEASIBLE), int(Finding.UNREACHABLE), int(Finding.BRANCH_SWITCH)],
+            [
+                int(Finding.FEASIBLE),
+                int(Finding.COLLISION),
+                int(Finding.UNREACHABLE),
+                int(Finding.BRANCH_SWITCH),
+            ],
             int(Finding.POSITION_LIMITS),
         )
         steps = np.abs(np.diff(paths.q[rows, choice], axis=1))  # (B, M - 1, n)
@@ -270,6 +297,67 @@ class PlacementFitness:
             joint_time = np.max(steps / self.case.robot.v_max, axis=2)
         bound = np.sum(np.maximum(self.tool_time, joint_time), axis=1)
         return objective, paths.branches[choice], violation, finding, bound
+
+    def _screen_cell(
+        self, X: np.ndarray, q: np.ndarray, J: np.ndarray, graded: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Drop the branches that break the clearance; grade the candidates left with none.
+
+        Branches are screened best J first, so mostly one branch per candidate is screened,
+        on every :data:`CELL_STRIDE`-th pose of the screening grid.
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6).
+        q
+            Joint paths of every branch, shape (B, K, M, n), rad.
+        J, graded
+            Objective (inf where the branch is geometrically infeasible) and graded
+            violation per branch, shape (B, K).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            J with colliding branches set to inf, and the graded violation with colliding
+            branches graded by their clearance shortfall, shape (B, K) each.
+        """
+        assert self.cell is not None
+        J = J.copy()
+        graded = graded.copy()
+        T_base_part = placement_transform(X)
+        clearance = self.cell.cell.clearance + CELL_MARGIN
+        # every CELL_STRIDE-th pose of the screening grid, and the last
+        poses = np.unique(np.r_[np.arange(0, q.shape[2], CELL_STRIDE), q.shape[2] - 1])
+        q = q[:, :, poses]
+        n_poses, n_dof = q.shape[2:]
+        pending = np.isfinite(J)
+        rows = np.arange(len(X))
+        while True:
+            best = np.argmin(np.where(pending, J, np.inf), axis=1)
+            todo = np.flatnonzero(pending[rows, best])
+            if not len(todo):
+                return J, graded
+            q_todo = q[todo, best[todo]].reshape(-1, n_dof)
+            body, own = self.cell.screen(
+                joint_frames(self.case.robot, q_todo),
+                T_base_part[todo],
+                np.repeat(np.arange(len(todo)), n_poses),
+            )
+            least = (
+                np.minimum(body.min(axis=1, initial=np.inf), own.min(axis=1, initial=np.inf))
+                .reshape(len(todo), n_poses)
+                .min(axis=1)
+            )
+            shortfall = np.maximum(0.0, clearance - least)
+            blocked = shortfall > 0.0
+            b, k = todo[blocked], best[todo[blocked]]
+            J[b, k] = np.inf
+            e = shortfall[blocked]
+            graded[b, k] = CLEARANCE_LEVEL + CLEARANCE_LEVEL * e / (e + CLEARANCE_SCALE)
+            pending[todo, best[todo]] = False
+            # a candidate with a clear branch is done
+            pending[todo[~blocked]] = False
 
     def _time(
         self,

@@ -1,0 +1,156 @@
+"""The work cell as pure data: bodies (primitive shapes and meshes) and capsules.
+
+Frames (docs/cell.md): obstacles are fixed in the robot base frame, workpiece bodies in the
+path's definition frame (they move with the placement X), robot link capsules in their link
+frames and tool capsules in the TCP frame.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+import numpy as np
+
+DEFAULT_CLEARANCE = 0.005
+"""Least allowed distance between the robot and the cell when the case gives none, m."""
+
+
+class Shape(enum.IntEnum):
+    """Kinds of bodies (the codes the screening kernel dispatches on)."""
+
+    PLANE = 0  # half-space z <= 0 of the body frame: the normal (z) points to the free side
+    BOX = 1  # centred box, half extents (hx, hy, hz)
+    CYLINDER = 2  # axis z, radius, half length
+    SPHERE = 3  # centre at the origin, radius
+    CAPSULE = 4  # axis z, radius, half length
+    MESH = 5  # triangle mesh; screened as its bounding box
+
+
+@dataclass(frozen=True, eq=False)
+class Body:
+    """One rigid body of the cell.
+
+    Attributes
+    ----------
+    name
+        Name used in reports.
+    shape
+        Its :class:`Shape`.
+    T_frame_body
+        Pose of the body in its frame (base frame for obstacles, definition frame for
+        the workpiece), shape (4, 4).
+    size
+        Shape parameters, shape (3,), m: box half extents; cylinder and capsule
+        (radius, half length, 0); sphere (radius, 0, 0); plane and mesh zeros.
+    vertices, faces
+        Mesh only: vertices in the body frame, shape (V, 3), m, and triangles, shape
+        (F, 3), int; empty otherwise.
+    """
+
+    name: str
+    shape: Shape
+    T_frame_body: np.ndarray
+    size: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    faces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int64))
+
+    def __post_init__(self) -> None:
+        for key, dtype in (
+            ("T_frame_body", float),
+            ("size", float),
+            ("vertices", float),
+            ("faces", np.int64),
+        ):
+            value = np.array(getattr(self, key), dtype=dtype)
+            value.flags.writeable = False
+            object.__setattr__(self, key, value)
+
+    def screening_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """A mesh's axis-aligned bounding box in its body frame, as (T_frame_box, half extents).
+
+        The screening kernel sees a mesh as this box, which encloses it: screened
+        distances to a mesh are never larger than the exact ones.
+        """
+        low, high = self.vertices.min(axis=0), self.vertices.max(axis=0)
+        T_body_box = np.eye(4)
+        T_body_box[:3, 3] = 0.5 * (low + high)
+        return self.T_frame_body @ T_body_box, 0.5 * (high - low)
+
+
+@dataclass(frozen=True, eq=False)
+class Capsules:
+    """Capsules attached to the frames of a chain (robot links, tool).
+
+    Attributes
+    ----------
+    frame
+        Index of the frame each capsule moves with, shape (K,), int: 0 the robot base,
+        i the frame of link i (1..n), n + 1 the TCP (see
+        :func:`trackplan.robots.kinematics.joint_frames`).
+    segment
+        End points of each capsule's axis in its frame, shape (K, 2, 3), m.
+    radius
+        Shape (K,), m.
+    name
+        Name of each capsule for reports (``link 3``, ``tool``), length K.
+    """
+
+    frame: np.ndarray
+    segment: np.ndarray
+    radius: np.ndarray
+    name: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        for key, dtype in (("frame", np.int64), ("segment", float), ("radius", float)):
+            value = np.array(getattr(self, key), dtype=dtype)
+            value.flags.writeable = False
+            object.__setattr__(self, key, value)
+        object.__setattr__(self, "segment", self.segment.reshape(-1, 2, 3))
+
+    @classmethod
+    def empty(cls) -> Capsules:
+        """No capsule."""
+        return cls(np.zeros(0, np.int64), np.zeros((0, 2, 3)), np.zeros(0), ())
+
+    def __len__(self) -> int:
+        return len(self.radius)
+
+    def __add__(self, other: Capsules) -> Capsules:
+        return Capsules(
+            np.concatenate([self.frame, other.frame]),
+            np.concatenate([self.segment, other.segment]),
+            np.concatenate([self.radius, other.radius]),
+            self.name + other.name,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Cell:
+    """The work cell of a case.
+
+    Attributes
+    ----------
+    obstacles
+        Bodies fixed in the robot base frame.
+    workpiece
+        Bodies in the path's definition frame (they move with the placement).
+    tool
+        Tool capsules in the TCP frame (their ``frame`` is ignored: always the TCP).
+    links
+        Robot link capsules, or None for the built-in model of the case's robot
+        (:func:`trackplan.cell.robot_bodies.builtin_link_capsules`).
+    clearance
+        Least allowed distance between the robot (links and tool) and the cell, and
+        between non-adjacent links, m.
+    tool_contact
+        Length of the tool from the TCP back along its axis (−z of the TCP frame) that may
+        touch the workpiece, m.
+    """
+
+    obstacles: tuple[Body, ...] = ()
+    workpiece: tuple[Body, ...] = ()
+    tool: Capsules = field(default_factory=Capsules.empty)
+    links: Capsules | None = None
+    clearance: float = DEFAULT_CLEARANCE
+    tool_contact: float = 0.0

@@ -1,0 +1,142 @@
+"""The placement map: feasibility and J over an x–y grid of placements at one orientation.
+
+A cell designer's view of where the part may go: every grid point is screened by the
+search's batched fitness (:class:`trackplan.search.fitness.PlacementFitness`, geometric
+path, IK on every branch, the cell's clearance) and classified by the first reason it
+fails: ``reach`` (outside the reach interval, or some pose has no IK solution),
+``joint limit`` (every reaching branch leaves the joint range or crosses a singularity),
+``collision`` (every otherwise feasible branch breaks the clearance) or ``feasible`` with
+its joint travel J (Eq. 8).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.case import Case
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search.space import SearchSpace
+
+REASONS = ("feasible", "reach", "joint limit", "collision")
+"""Map classes, by code 0..3."""
+_CODE = {
+    Finding.FEASIBLE: 0,
+    Finding.REACH: 1,
+    Finding.UNREACHABLE: 1,
+    Finding.BRANCH_SWITCH: 2,
+    Finding.POSITION_LIMITS: 2,
+    Finding.CHECK: 2,
+    Finding.COLLISION: 3,
+}
+CHUNK = 256
+"""Placements screened per batch (bounds the IK arrays' memory)."""
+
+
+@dataclass(frozen=True, eq=False)
+class PlacementMap:
+    """Feasibility over an x–y grid of placements.
+
+    Attributes
+    ----------
+    case_name
+        The case.
+    x, y
+        Grid coordinates of the definition frame's origin in the base frame, shapes (nx,)
+        and (ny,), m.
+    z
+        Height of every placement, m.
+    rpy
+        Orientation of every placement (roll, pitch, yaw), shape (3,), rad.
+    reason
+        Class of each grid point, shape (ny, nx), int: index into :data:`REASONS`.
+    objective
+        J of Eq. 8 on the screening grid where feasible, NaN elsewhere, shape (ny, nx).
+    reference
+        The placement the height and orientation came from (the search's best), shape
+        (6,); x and y are NaN when only a height and orientation were given.
+    """
+
+    case_name: str
+    x: np.ndarray
+    y: np.ndarray
+    z: float
+    rpy: np.ndarray
+    reason: np.ndarray
+    objective: np.ndarray
+    reference: np.ndarray
+
+    @property
+    def feasible_share(self) -> float:
+        """Share of the grid that is feasible."""
+        return float(np.mean(self.reason == 0))
+
+    def placements(self) -> np.ndarray:
+        """Every grid placement, shape (ny, nx, 6), row-major like :attr:`reason`."""
+        xx, yy = np.meshgrid(self.x, self.y)
+        X = np.empty((*xx.shape, 6))
+        X[..., 0], X[..., 1], X[..., 2] = xx, yy, self.z
+        X[..., 3:] = self.rpy
+        return X
+
+
+def placement_map(
+    case: Case,
+    reference: np.ndarray,
+    *,
+    n_points: int = 41,
+    geometry: PathGeometry | None = None,
+) -> PlacementMap:
+    """Screen an x–y grid of placements at the height and orientation of ``reference``.
+
+    Parameters
+    ----------
+    case
+        The case (its cell, if any, is checked).
+    reference
+        Placement (x, y, z, roll, pitch, yaw) whose z and orientation the map keeps,
+        shape (6,), metres and radians (for example the search's best).
+    n_points
+        Grid points along x and along y, over the case's placement ranges.
+    geometry
+        The case's paths (smooth timing) when already built.
+
+    Returns
+    -------
+    PlacementMap
+    """
+    reference = np.asarray(reference, dtype=float)
+    geometry = geometry or PathGeometry.from_case(case, "g2")
+    fitness = PlacementFitness(case, SearchSpace.from_bounds(case.bounds), geometry, "smooth")
+    x = np.linspace(case.bounds.lower[0], case.bounds.upper[0], n_points)
+    y = np.linspace(case.bounds.lower[1], case.bounds.upper[1], n_points)
+    partial = PlacementMap(
+        case.name,
+        x,
+        y,
+        float(reference[2]),
+        reference[3:].copy(),
+        np.zeros((n_points, n_points), dtype=int),
+        np.full((n_points, n_points), np.nan),
+        reference,
+    )
+    X = partial.placements().reshape(-1, 6)
+    reason = np.empty(len(X), dtype=int)
+    objective = np.full(len(X), np.nan)
+    for start in range(0, len(X), CHUNK):
+        # an incumbent of -inf: no candidate is timed, the map is about geometry
+        screening = fitness.evaluate(X[start : start + CHUNK], incumbent=-np.inf)
+        reason[start : start + CHUNK] = [_CODE[Finding(f)] for f in screening.finding]
+        objective[start : start + CHUNK] = screening.objective
+    return PlacementMap(
+        case.name,
+        x,
+        y,
+        partial.z,
+        partial.rpy,
+        reason.reshape(n_points, n_points),
+        np.where(reason == 0, objective, np.nan).reshape(n_points, n_points),
+        reference,
+    )
