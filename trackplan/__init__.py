@@ -77,6 +77,10 @@ except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
 
 _EXPORTS = {
+    "placement_map": "trackplan.search.placement_map",
+    "PlacementMap": "trackplan.search.placement_map",
+    "CellReport": "trackplan.planning.result",
+    "Cell": "trackplan.cell",
     "BUILTIN_ROBOTS": "trackplan.robots.builtin",
     "TIME_LAWS": "trackplan.timing",
     "Case": "trackplan.case",

@@ -75,7 +75,11 @@ def test_paper_cases_load_with_the_paper_settings(name: str) -> None:
     np.testing.assert_array_equal(case.bounds.upper, [0.87] * 3 + [1.57] * 3)
     np.testing.assert_allclose(np.square(case.bounds.reach), [0.0226, 0.7289], atol=1e-6)
     np.testing.assert_array_equal(case.objective.weights, PAPER_WEIGHTS)
-    assert (case.optimizer.method, case.optimizer.population, case.optimizer.seed) == ("multistart", 30, 0)
+    assert (case.optimizer.method, case.optimizer.population, case.optimizer.seed) == (
+        "multistart",
+        30,
+        0,
+    )
     assert case.source == str(CASES / f"{name}.yaml")
 
 
