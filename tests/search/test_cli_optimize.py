@@ -53,7 +53,7 @@ def test_optimize_writes_the_plan_files_and_the_search(
     assert sorted(p.name for p in out.iterdir()) == ["history.csv", "result.json", "trajectory.csv"]
     summary = json.loads((out / "result.json").read_text())
     optimizer = summary["optimizer"]
-    assert (optimizer["method"], optimizer["seed"]) == ("ga", 2)
+    assert (optimizer["method"], optimizer["seed"]) == ("multistart", 2)
     assert (optimizer["evaluations"], optimizer["stop_reason"]) == (200, "budget")
     assert optimizer["generations"] == 8 and optimizer["wall_time_s"] > 0
     initial = summary["initial"]
@@ -87,7 +87,7 @@ def test_ctrl_c_during_the_progress_bar_still_writes_everything(
         capsys, "optimize", str(CASES / "paper-corner.yaml"), "--out", str(out), "--no-report"
     )
     assert code == ExitCode.INTERRUPTED
-    assert descriptions[0].startswith("generation 1  30 evaluations  best J")
+    assert descriptions[0].startswith("generation 1  100 evaluations  best J")
     assert "feasible" in descriptions[0] and "%" in descriptions[0]
     summary = json.loads((out / "result.json").read_text())
     assert summary["optimizer"]["stop_reason"] == "interrupted"
@@ -124,7 +124,7 @@ def test_bad_method_exits_2(capsys: pytest.CaptureFixture[str], tmp_path: Path) 
     code, _, err = run(
         capsys, "optimize", str(CASES / "paper-line.yaml"), "--method", "pso", "--out", "x"
     )
-    assert code == ExitCode.BAD_INPUT and "method must be one of ga, cmaes, de, random" in err
+    assert code == ExitCode.BAD_INPUT and "method must be one of multistart, ga, cmaes, de, random" in err
 
 
 def test_history_round_trip(tmp_path: Path) -> None:
@@ -159,4 +159,4 @@ def test_demo_writes_the_report(
     assert report.is_file() and f"report: {report.resolve()}" in stdout
     for name in ("trajectory.csv", "result.json", "history.csv", "convergence.png"):
         assert (out / name).is_file(), name
-    assert json.loads((out / "result.json").read_text())["optimizer"]["stop_reason"] == "stall"
+    assert json.loads((out / "result.json").read_text())["optimizer"]["stop_reason"] == "converged"
