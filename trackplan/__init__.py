@@ -26,6 +26,16 @@ check_trajectory(robot, q, sample_time, reference) -> CheckReport
     The checker: every sample against every limit (and the path, given a reference).
 check_case_trajectory(case, X, q, sample_time) -> CheckReport
     The checker in one call for a case at a placement (``trackplan check``).
+inverse_dynamics(robot, q, qd, qdd) -> tau, gravity_load(robot, q) -> tau
+    Joint torques (N·m, shape (..., n)) of a robot with dynamics (``docs/dynamics.md``).
+RobotDynamics, Payload
+    Masses, inertias, actuators, friction, torque limits; a load at the TCP.
+energy_figures(robot, q, sample_time) -> EnergyFigures
+    Mechanical energy, copper loss and peak torque ratio of a sampled trajectory.
+OBJECTIVES
+    The search objectives by name (``travel``, ``time``, ``energy``, ``copper``).
+pareto_front(case, (A, B), ...) -> ParetoResult
+    NSGA-II front of two objectives over the placement, every point re-planned.
 JointPath
     Poses and IK of a placed path on its planning grid, computed once per plan.
 TIME_LAWS, time_law(name)
@@ -62,12 +72,17 @@ if TYPE_CHECKING:
     from trackplan.io.robot_file import load_robot
     from trackplan.jointpath import JointPath
     from trackplan.planning.checker import check_trajectory
+    from trackplan.planning.energy import EnergyFigures, energy_figures
+    from trackplan.planning.objectives import OBJECTIVES
     from trackplan.planning.plan import check_case_trajectory, plan_placement
     from trackplan.planning.result import CheckReport, PlanResult, Trajectory
     from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot
+    from trackplan.robots.dynamics.parameters import Payload, RobotDynamics
+    from trackplan.robots.dynamics.rne import gravity_load, inverse_dynamics
     from trackplan.robots.kinematics import forward_kinematics, jacobian
     from trackplan.robots.model import Robot
     from trackplan.search import OptimizeResult, optimize_placement
+    from trackplan.search.pareto import ParetoResult, pareto_front
     from trackplan.status import Status
     from trackplan.timing import TIME_LAWS, TimeLaw, time_law
 
@@ -82,16 +97,21 @@ _EXPORTS = {
     "CellReport": "trackplan.planning.result",
     "Cell": "trackplan.cell",
     "BUILTIN_ROBOTS": "trackplan.robots.builtin",
+    "OBJECTIVES": "trackplan.planning.objectives",
     "TIME_LAWS": "trackplan.timing",
     "Case": "trackplan.case",
     "CaseError": "trackplan.errors",
     "CheckReport": "trackplan.planning.result",
+    "EnergyFigures": "trackplan.planning.energy",
     "JointPath": "trackplan.jointpath",
     "Method": "trackplan.choices",
     "OptimizeResult": "trackplan.search",
+    "ParetoResult": "trackplan.search.pareto",
+    "Payload": "trackplan.robots.dynamics.parameters",
     "Penalty": "trackplan.choices",
     "PlanResult": "trackplan.planning.result",
     "Robot": "trackplan.robots.model",
+    "RobotDynamics": "trackplan.robots.dynamics.parameters",
     "Status": "trackplan.status",
     "TimeLaw": "trackplan.timing",
     "Timing": "trackplan.choices",
@@ -100,27 +120,36 @@ _EXPORTS = {
     "builtin_robot": "trackplan.robots.builtin",
     "check_case_trajectory": "trackplan.planning.plan",
     "check_trajectory": "trackplan.planning.checker",
+    "energy_figures": "trackplan.planning.energy",
     "forward_kinematics": "trackplan.robots.kinematics",
+    "gravity_load": "trackplan.robots.dynamics.rne",
+    "inverse_dynamics": "trackplan.robots.dynamics.rne",
     "jacobian": "trackplan.robots.kinematics",
     "load_case": "trackplan.io.case_file",
     "load_robot": "trackplan.io.robot_file",
     "optimize_placement": "trackplan.search",
+    "pareto_front": "trackplan.search.pareto",
     "plan_placement": "trackplan.planning.plan",
     "time_law": "trackplan.timing",
 }
 
 __all__ = [
     "BUILTIN_ROBOTS",
+    "OBJECTIVES",
     "TIME_LAWS",
     "Case",
     "CaseError",
     "CheckReport",
+    "EnergyFigures",
     "JointPath",
     "Method",
     "OptimizeResult",
+    "ParetoResult",
+    "Payload",
     "Penalty",
     "PlanResult",
     "Robot",
+    "RobotDynamics",
     "Status",
     "TimeLaw",
     "Timing",
@@ -130,11 +159,15 @@ __all__ = [
     "builtin_robot",
     "check_case_trajectory",
     "check_trajectory",
+    "energy_figures",
     "forward_kinematics",
+    "gravity_load",
+    "inverse_dynamics",
     "jacobian",
     "load_case",
     "load_robot",
     "optimize_placement",
+    "pareto_front",
     "plan_placement",
     "time_law",
 ]

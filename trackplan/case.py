@@ -90,12 +90,19 @@ class Objective:
         ``"flat"``: the paper's constant M.
     flat_penalty
         The constant M of Eq. 30 for ``penalty="flat"``.
+    kind
+        What the search minimises: ``travel`` (Eq. 8, default), ``energy``, ``copper``,
+        ``time`` or ``weighted`` (see :mod:`trackplan.planning.objectives`).
+    mix
+        For ``weighted``: coefficient of each objective by name.
     """
 
     weights: np.ndarray
     time_weight: float = 0.0
     penalty: Penalty = Penalty.GRADED
     flat_penalty: float = 1.0e6
+    kind: str = "travel"
+    mix: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "penalty", choose(Penalty, self.penalty, "objective.penalty"))

@@ -483,6 +483,14 @@ def _print_summary(result, out: Path) -> None:
                 f"({escape(cell.closest[0])} – {escape(cell.closest[1])} at "
                 f"t = {cell.t_closest:.3f} s; required {1e3 * cell.clearance:.1f} mm)"
             )
+        if result.energy is not None:
+            energy = result.energy
+            console.print(
+                f"  copper loss = {energy.copper_loss:.4g} {escape(energy.copper_loss_unit)}  "
+                f"mechanical energy = {energy.mechanical_energy:.4g} J  peak torque = "
+                f"{100 * energy.peak_torque_ratio:.1f} % of the limit (joint "
+                f"{energy.peak_torque_joint})"
+            )
         for slow in result.slowdowns:
             console.print(
                 f"  slow-down: s = {slow.s_start:.4f}..{slow.s_end:.4f} m at "
@@ -556,6 +564,21 @@ def optimize(
     ] = None,
     timing: TimingOption = None,
     report: Annotated[bool, typer.Option(help="Write plots and report.html.")] = True,
+    objective: Annotated[
+        str | None,
+        typer.Option(
+            "--objective",
+            help="What to minimise: travel, time, energy or copper (default: objective.kind).",
+        ),
+    ] = None,
+    pareto: Annotated[
+        str | None,
+        typer.Option(
+            "--pareto",
+            help="Two objectives A,B (travel, time, energy, copper): an NSGA-II front instead "
+            "of one placement; writes pareto.csv, pareto.png, pareto.html and front/NN/.",
+        ),
+    ] = None,
 ) -> ExitCode:
     """Search where to place the workpiece; write the best plan, history.csv and the report.
 
@@ -564,6 +587,12 @@ def optimize(
     stops the search and still writes everything for the best placement found.
     """
     loaded = load_case(case)
+    if objective is not None:
+        from trackplan.planning.objectives import with_objective
+
+        loaded = with_objective(loaded, objective)
+    if pareto is not None:
+        return _pareto(loaded, pareto, out, seed=seed, timing=_timing(timing), report=report)
     result = _search(
         loaded, method=method, seed=seed, budget=budget, restarts=restarts, timing=_timing(timing)
     )
@@ -635,6 +664,33 @@ def map_command(
     )
     typer.echo(f"  results in {out}/")
     return ExitCode.OK
+
+
+def _pareto(
+    case: Case, pair: str, out: Path, *, seed: int | None, timing: str | None, report: bool
+) -> ExitCode:
+    """``optimize --pareto A,B``: the front, every point re-planned, its files and plots."""
+    from trackplan.io.pareto import write_pareto_csv
+    from trackplan.outputs import write_run
+    from trackplan.search.pareto import pareto_front, parse_objective_pair
+
+    names = parse_objective_pair(pair, case)
+    result = pareto_front(case, names, seed=seed, timing=timing)
+    rows = write_pareto_csv(result, out)
+    for row, plan in zip(rows, result.plans, strict=True):
+        write_run(out / str(row["folder"]), plan, case, report=report)
+    if report:
+        from trackplan.report.pareto import write_pareto_report
+
+        write_pareto_report(result, case.name, rows, out)
+    console = _console()
+    console.print(f"{escape(result.message)}, {result.wall_time_s:.2f} s (seed {result.seed})")
+    a, b = result.objectives
+    for row in rows:
+        state = "feasible" if row["feasible"] else "INFEASIBLE"
+        console.print(f"  {row['point']:>2}  {a} {row[a]:.4g}  {b} {row[b]:.4g}  {state}")
+    console.print(f"  results in {escape(str(out))}/")
+    return ExitCode.OK if result.success else ExitCode.INFEASIBLE
 
 
 def _search(case: Case, **options):  # type: ignore[no-untyped-def]

@@ -81,9 +81,9 @@ def test_robot_names_and_files_in_case_files(tmp_path: Path) -> None:
 
 def test_errors_inside_a_robot_file_name_that_file(tmp_path: Path) -> None:
     file = tmp_path / "arm.yaml"
-    file.write_text(robot_to_yaml(puma560()).replace("jerk: 20.0}", "jerk: 20.0, mass: 3}", 1))
+    file.write_text(robot_to_yaml(puma560()).replace("jerk: 20.0}", "jerk: 20.0, weight: 3}", 1))
     with pytest.raises(CaseError) as error:
         load_robot(file)
     assert error.value.file == str(file)
-    assert error.value.key == "joints[3].mass"
+    assert error.value.key == "joints[3].weight"
     assert "unknown key" in error.value.message

@@ -99,3 +99,12 @@ def test_report_without_a_trajectory(tmp_path, corner, unreachable_result):
     assert unreachable_result.message in page
     assert len(EMBEDDED_PNG.findall(page)) == 3
     assert "Plotly.newPlot" not in page
+
+
+def test_report_shows_torque_margins_and_energy(page, corner_result):
+    """The PUMA560 has dynamics: a torque row in the margins and the energy figures."""
+    energy = corner_result.energy
+    assert energy is not None
+    assert "torque [N·m]" in page
+    assert "copper loss" in page and energy.copper_loss_unit in page
+    assert f"(joint {energy.peak_torque_joint})" in page

@@ -11,6 +11,7 @@ from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import check_case_trajectory, plan_placement
+from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, run_checks
 from trackplan.timing.smooth import WINDOW_MIN_LENGTH, _level_runs, plan_smooth_time_law
 
@@ -80,7 +81,8 @@ def test_rebuilds_until_the_sampled_trajectory_meets_every_limit(monkeypatch):
 
 @pytest.mark.parametrize("name", SHIPPED_CASES)
 def test_random_placements_of_every_case_pass_the_checker(name):
-    """Wherever the path has a joint path, the smooth law's samples pass every check."""
+    """Wherever the path has a joint path the robot can hold against gravity, the smooth
+    law's samples pass every check."""
     case = load_case(CASES / f"{name}.yaml")
     geometry = PathGeometry.from_case(case)
     rng = np.random.default_rng(sum(map(ord, name)))
@@ -94,6 +96,8 @@ def test_random_placements_of_every_case_pass_the_checker(name):
         result = plan_placement(case, X, geometry=geometry)
         if not result.joint_path.success:
             continue
+        if case.robot.dynamics and holding_torque_ratio(case.robot, result.joint_path.q) > 1:
+            continue  # the robot cannot hold the path still: no time law helps
         planned += 1
         assert result.success, (X, result.message)
         report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)

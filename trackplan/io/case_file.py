@@ -28,7 +28,7 @@ from trackplan.case import (
 from trackplan.choices import Method, Penalty, Timing
 from trackplan.errors import CaseError
 from trackplan.io.cell_file import CellModel, build_cell, cell_problems
-from trackplan.io.robot_file import load_robot_spec
+from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -49,6 +49,7 @@ from trackplan.io.yaml_input import (
 )
 from trackplan.paths import check_segments
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
+from trackplan.planning.objectives import OBJECTIVES
 from trackplan.robots.model import Robot
 
 PAPER_WEIGHTS = (0.3, 0.2, 0.2, 0.1, 0.1, 0.1)
@@ -160,8 +161,10 @@ class PlacementModel(StrictModel):
 
 
 class ObjectiveModel(StrictModel):
-    """``objective``: joint weights of Eq. 8, time weight (1/s) and penalty."""
+    """``objective``: kind, joint weights of Eq. 8, time weight (1/s), mix and penalty."""
 
+    kind: Literal["travel", "energy", "copper", "time", "weighted"] = "travel"
+    mix: dict[str, NonNegative] | None = None
     weights: list[NonNegative] | None = None
     time_weight: NonNegative = 0.0
     penalty: Literal["graded", "flat"] = "graded"
@@ -183,6 +186,7 @@ class CaseModel(StrictModel):
 
     name: NonEmptyStr
     robot: NonEmptyStr = "puma560"
+    payload: PayloadModel | None = None
     path: PathModel
     task: TaskModel
     placement: PlacementModel = PlacementModel()
@@ -254,8 +258,13 @@ def load_case_text(text: str, file: str | None = None, base_dir: str | Path | No
         *_placement_problems(model.placement),
         *_objective_problems(model.objective, robot),
         *(cell_problems(model.cell, robot.n_dof) if model.cell is not None else []),
+        *_objective_kind_problems(model.objective, robot),
+        *_payload_problems(model.payload, robot),
     ]
     raise_first(problems, data, file)
+    if model.payload is not None and robot.dynamics is not None:
+        dynamics = dataclasses.replace(robot.dynamics, payload=as_payload(model.payload))
+        robot = dataclasses.replace(robot, dynamics=dynamics)
     case = _case(model, robot, start, segments, file)
     if model.cell is None:
         return case
@@ -303,6 +312,8 @@ def _case(
             time_weight=objective.time_weight,
             penalty=Penalty(objective.penalty),
             flat_penalty=objective.flat_penalty,
+            kind=objective.kind,
+            mix=dict(objective.mix or {}),
         ),
         optimizer=OptimizerSettings(
             method=Method(optimizer.method),
@@ -458,6 +469,51 @@ def _placement_problems(placement: PlacementModel) -> list[Problem]:
                     f"{show(placement.reach)}, got {distance:.6g} m",
                 )
             )
+    return problems
+
+
+def _payload_problems(payload: PayloadModel | None, robot: Robot) -> list[Problem]:
+    """A case's payload: physical, and on a robot with dynamics."""
+    if payload is None:
+        return []
+    problems = payload_problems(payload, ("payload",))
+    if robot.dynamics is None:
+        problems.append(
+            (("payload",), f"robot {robot.name} has no dynamic parameters to carry a payload")
+        )
+    return problems
+
+
+def _objective_kind_problems(objective: ObjectiveModel, robot: Robot) -> list[Problem]:
+    """``weighted`` needs a mix of known objectives; torque-based ones need dynamics."""
+    problems: list[Problem] = []
+    if objective.kind == "weighted":
+        if not objective.mix:
+            problems.append(
+                (("objective", "kind"), "weighted needs objective.mix, e.g. {travel: 1, time: 0.5}")
+            )
+        for name in objective.mix or {}:
+            if name not in OBJECTIVES:
+                problems.append(
+                    (
+                        ("objective", "mix", name),
+                        f"unknown objective {name!r}: use {', '.join(OBJECTIVES)}",
+                    )
+                )
+    elif objective.mix is not None:
+        problems.append((("objective", "mix"), "mix is only used with kind: weighted"))
+    if not problems and robot.dynamics is None:
+        names = (objective.mix or {}) if objective.kind == "weighted" else [objective.kind]
+        for name in names:
+            if OBJECTIVES[name].needs_dynamics:
+                problems.append(
+                    (
+                        ("objective", "kind"),
+                        f"{name} needs joint torques, but robot {robot.name} has no dynamic "
+                        "parameters (docs/dynamics.md)",
+                    )
+                )
+                break
     return problems
 
 

@@ -112,6 +112,17 @@ def _cell_summary(check: CheckReport) -> dict:
     }
 
 
+def _energy_summary(result: PlanResult) -> dict:
+    """Energy figures of ``result.json`` (None without dynamics or without a trajectory)."""
+    energy = result.energy
+    return {
+        "mechanical_energy": None if energy is None else energy.mechanical_energy,
+        "copper_loss": None if energy is None else energy.copper_loss,
+        "copper_loss_unit": None if energy is None else energy.copper_loss_unit,
+        "peak_torque_ratio": None if energy is None else energy.peak_torque_ratio,
+    }
+
+
 def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
     """The ``result.json`` content of a plan (plain JSON types)."""
     check = result.check
@@ -128,6 +139,7 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
         "max_orientation_error": float(check.max_orientation_error),
         "rated_speed_fraction": float(result.rated_speed_fraction),
         "min_corner_speed": float(result.min_corner_speed),
+        **_energy_summary(result),
         "margins": {
             **{
                 kind: dict(zip(joint_names, map(float, values), strict=True))

@@ -12,6 +12,14 @@ Format (see ``docs/files.md``)::
 
 Lengths in metres, angles in radians, limits in rad/s, rad/s², rad/s³.
 ``T_flange_tool = Trans(xyz) · RPY(rpy)`` with ``RPY = Rz(yaw) · Ry(pitch) · Rx(roll)``.
+
+Dynamics (optional, see ``docs/dynamics.md``): per joint ``mass`` (kg), ``com`` (m, DH link
+frame), ``inertia`` ``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]`` (kg·m², about the centre of mass, DH
+link frame axes) and ``torque`` (N·m, link side), given for every joint or none; optionally
+``motor_inertia`` (kg·m²), ``gear_ratio``, ``viscous`` (N·m·s/rad) and ``coulomb``
+``[Tc+, Tc-]`` (N·m), all on the motor side, and ``motor_constant`` (N·m/√W). Beside the
+joints: ``gravity`` (m/s², base frame, default ``[0, 0, -9.81]``) and ``payload``
+``{mass, com, inertia}`` at the tool centre point (TCP frame).
 """
 
 from __future__ import annotations
@@ -27,6 +35,7 @@ from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_from_matrix, rpy_matrix
 from trackplan.io.yaml_input import (
     NonEmptyStr,
+    NonNegative,
     Positive,
     Problem,
     Range,
@@ -40,9 +49,21 @@ from trackplan.io.yaml_input import (
     validate_model,
 )
 from trackplan.robots.builtin import builtin_robot
+from trackplan.robots.dynamics.parameters import (
+    STANDARD_GRAVITY,
+    Payload,
+    RobotDynamics,
+    inertia_matrix,
+    inertia_problem,
+    inertials_from_dh,
+)
 from trackplan.robots.model import Robot
 
 ROBOT_FILE_SUFFIXES = (".yaml", ".yml")
+
+
+Inertia6 = Annotated[list[float], Field(min_length=6, max_length=6)]
+"""``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]``, kg·m²."""
 
 
 class JointModel(StrictModel):
@@ -56,6 +77,27 @@ class JointModel(StrictModel):
     velocity: Positive
     acceleration: Positive
     jerk: Positive
+    mass: float | None = None
+    com: Vec3 | None = None
+    inertia: Inertia6 | None = None
+    torque: float | None = None
+    motor_inertia: NonNegative = 0.0
+    gear_ratio: float = 1.0
+    viscous: NonNegative = 0.0
+    coulomb: Annotated[list[float], Field(min_length=2, max_length=2)] = list_default(0.0, 0.0)
+    motor_constant: Positive | None = None
+
+
+DYNAMICS_KEYS = ("mass", "com", "inertia", "torque")
+"""Per-joint keys that every joint needs once any joint has dynamics."""
+
+
+class PayloadModel(StrictModel):
+    """A load at the TCP: mass (kg), centre of mass and inertia about it (TCP frame)."""
+
+    mass: float
+    com: Vec3 = list_default(0.0, 0.0, 0.0)
+    inertia: Inertia6 = list_default(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 class ToolModel(StrictModel):
@@ -72,6 +114,8 @@ class RobotFileModel(StrictModel):
     source: str = ""
     joints: Annotated[list[JointModel], Field(min_length=1)]
     tool: ToolModel | None = None
+    gravity: Vec3 = list_default(*STANDARD_GRAVITY)
+    payload: PayloadModel | None = None
 
 
 def load_robot(file: str | Path) -> Robot:
@@ -124,6 +168,7 @@ def load_robot_text(text: str, file: str | None = None) -> Robot:
         for i, joint in enumerate(model.joints)
         if joint.position[0] >= joint.position[1]
     ]
+    problems += _dynamics_problems(model)
     raise_first(problems, data, file)
     tool = model.tool or ToolModel()
     columns = {
@@ -143,6 +188,98 @@ def load_robot_text(text: str, file: str | None = None) -> Robot:
         a_max=columns["acceleration"],
         j_max=columns["jerk"],
         T_flange_tool=pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy))),
+        source=model.source,
+        dynamics=_dynamics(model, columns),
+    )
+
+
+def payload_problems(payload: PayloadModel, loc: tuple[str | int, ...]) -> list[Problem]:
+    """Negative mass or an unphysical inertia of a payload."""
+    problems: list[Problem] = []
+    if payload.mass < 0:
+        problems.append(((*loc, "mass"), f"mass must be >= 0 kg, got {payload.mass:g}"))
+    problem = inertia_problem(inertia_matrix(payload.inertia))
+    if problem:
+        problems.append(((*loc, "inertia"), f"inertia {problem}"))
+    return problems
+
+
+def as_payload(payload: PayloadModel) -> Payload:
+    """The payload of a validated ``payload`` block."""
+    return Payload(
+        mass=payload.mass,
+        com=np.array(payload.com),
+        inertia=inertia_matrix(np.array(payload.inertia)),
+    )
+
+
+def _dynamics_problems(model: RobotFileModel) -> list[Problem]:
+    """Missing dynamic keys, negative masses, unphysical inertias, torque limits <= 0."""
+    problems: list[Problem] = []
+    given = [
+        any(getattr(joint, key) is not None for key in DYNAMICS_KEYS) for joint in model.joints
+    ]
+    if any(given):
+        for i, joint in enumerate(model.joints):
+            for key in DYNAMICS_KEYS:
+                if getattr(joint, key) is None:
+                    problems.append(
+                        (
+                            ("joints", i),
+                            f"missing {key}: give mass, com, inertia and torque for every joint "
+                            "or for none",
+                        )
+                    )
+                    break
+    for i, joint in enumerate(model.joints):
+        if joint.mass is not None and joint.mass < 0:
+            problems.append((("joints", i, "mass"), f"mass must be >= 0 kg, got {joint.mass:g}"))
+        if joint.torque is not None and joint.torque <= 0:
+            problems.append(
+                (("joints", i, "torque"), f"torque limit must be > 0 N·m, got {joint.torque:g}")
+            )
+        if joint.inertia is not None:
+            problem = inertia_problem(inertia_matrix(joint.inertia))
+            if problem:
+                problems.append((("joints", i, "inertia"), f"inertia {problem}"))
+        if joint.gear_ratio == 0:
+            problems.append((("joints", i, "gear_ratio"), "gear ratio must not be 0"))
+    if model.payload is not None:
+        problems += payload_problems(model.payload, ("payload",))
+        if not any(given):
+            problems.append(
+                (("payload",), "a payload needs the robot's dynamics (mass, com, inertia, torque)")
+            )
+    return problems
+
+
+def _dynamics(model: RobotFileModel, columns: dict[str, np.ndarray]) -> RobotDynamics | None:
+    """The robot's dynamics from a validated file, inertials converted to child frames."""
+    joints = model.joints
+    if joints[0].mass is None:
+        return None
+    com, inertia = inertials_from_dh(
+        columns["d"],
+        columns["a"],
+        columns["alpha"],
+        np.array([joint.com for joint in joints]),
+        inertia_matrix(np.array([joint.inertia for joint in joints])),
+    )
+    motor_constants = [joint.motor_constant for joint in joints]
+    return RobotDynamics(
+        mass=np.array([joint.mass for joint in joints]),
+        com=com,
+        inertia=inertia,
+        torque_max=np.array([joint.torque for joint in joints]),
+        motor_inertia=np.array([joint.motor_inertia for joint in joints]),
+        gear_ratio=np.array([joint.gear_ratio for joint in joints]),
+        viscous=np.array([joint.viscous for joint in joints]),
+        coulomb=np.array([joint.coulomb for joint in joints]),
+        motor_constant=(
+            None if any(k is None for k in motor_constants) else np.array(motor_constants)
+        ),
+        gravity=np.array(model.gravity),
+        payload=None if model.payload is None else as_payload(model.payload),
         source=model.source,
     )
 

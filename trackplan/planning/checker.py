@@ -7,6 +7,7 @@ joint, and every violation with its time window and worst value.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -16,6 +17,7 @@ from trackplan.derivatives import backward_derivatives
 from trackplan.paths import NominalPath
 from trackplan.planning.result import CheckReport, Violation
 from trackplan.planning.tracking import jump_allowance, locate_on_nominal
+from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 
@@ -27,6 +29,7 @@ UNITS = {
     "velocity": "rad/s",
     "acceleration": "rad/s²",
     "jerk": "rad/s³",
+    "torque": "N·m",
     "tracking": "m",
     "orientation": "rad",
     "speed": "m/s",
@@ -84,7 +87,8 @@ def check_trajectory(
 
     Derivatives are backward differences at Ts with the robot at rest before the first and
     after the last sample (docs/conventions.md), exactly what a controller consuming the
-    samples sees.
+    samples sees. A robot with dynamics also has its torques checked, from the same q, q̇,
+    q̈ (``docs/dynamics.md``).
 
     Parameters
     ----------
@@ -125,6 +129,11 @@ def check_trajectory(
         "acceleration": (qdd, np.abs(qdd) / robot.a_max),
         "jerk": (qddd, np.abs(qddd) / robot.j_max),
     }
+    if robot.dynamics is not None:
+        q_held = np.concatenate([q, np.repeat(q[-1:], len(qd) - len(q), axis=0)])
+        torque = inverse_dynamics(robot, q_held, qd, qdd)
+        bounds["torque"] = robot.dynamics.torque_max
+        signals["torque"] = (torque, np.abs(torque) / robot.dynamics.torque_max)
     for kind, (values, use) in signals.items():
         margins[kind] = _met(1.0 - use.max(axis=0), RELATIVE_SLACK)
         worst_joint = int(np.argmax(use.max(axis=0)))
@@ -138,6 +147,8 @@ def check_trajectory(
             violations.append(
                 _violation(kind, int(j) + 1, t, values[:, j], use[:, j], float(limit))
             )
+    if robot.dynamics is not None:
+        violations = [_at_any_speed(robot, q_held, t, v) for v in violations]
 
     task_margins: dict[str, float] = {}
     max_tracking = 0.0
@@ -177,6 +188,23 @@ def _met(margin: np.ndarray | float, slack: float) -> np.ndarray:
     """A margin within the round-off slack of a limit counts as met: reported as 0, not < 0."""
     margin = np.asarray(margin, dtype=float)
     return np.where((margin < 0) & (margin >= -slack), 0.0, margin)
+
+
+def _at_any_speed(robot: Robot, q: np.ndarray, t: np.ndarray, violation: Violation) -> Violation:
+    """A torque violation that holding still against gravity already causes, said so."""
+    if violation.limit != "torque" or violation.joint is None:
+        return violation
+    j = violation.joint - 1
+    zero = np.zeros_like(q)
+    holding = np.abs(inverse_dynamics(robot, q, zero, zero, friction=False)[:, j])
+    worst = int(np.argmax(holding))
+    if holding[worst] <= violation.bound * (1.0 + RELATIVE_SLACK):
+        return violation
+    message = (
+        f"{violation.message}; holding against gravity alone needs {holding[worst]:.4g} N·m "
+        f"at t = {t[worst]:.3f} s: infeasible at any speed"
+    )
+    return dataclasses.replace(violation, message=message)
 
 
 def _violation(

@@ -16,6 +16,7 @@ from trackplan.frames import as_placement, placement_transform, rpy_matrix
 from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import TrackingReference, check_trajectory
+from trackplan.planning.energy import energy_figures
 from trackplan.planning.objective import joint_travel
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.robots.kinematics import forward_kinematics
@@ -204,6 +205,11 @@ def _checked(case: Case, joint_path: JointPath, timed: TimeLaw) -> PlanResult:
         slowdowns=timed.slowdowns,
         references={},
         joint_path=joint_path,
+        energy=(
+            None
+            if case.robot.dynamics is None
+            else energy_figures(case.robot, timed.q, timed.sample_time)
+        ),
     )
 
 

@@ -8,6 +8,7 @@ import numpy as np
 
 from trackplan.jointpath import JointPath
 from trackplan.paths import NominalPath, Path
+from trackplan.planning.energy import EnergyFigures
 from trackplan.robots.model import LIMIT_KINDS
 from trackplan.status import Status
 from trackplan.timing.protocol import SlowDown
@@ -214,6 +215,10 @@ class PlanResult:
     joint_path
         The placed path's poses and IK on the planning grid
         (:class:`trackplan.jointpath.JointPath`).
+    energy
+        Mechanical energy, copper loss and peak torque ratio
+        (:class:`trackplan.planning.energy.EnergyFigures`) when the robot has dynamics and
+        a trajectory was built, else None.
     """
 
     case_name: str
@@ -233,6 +238,7 @@ class PlanResult:
     slowdowns: tuple[SlowDown, ...]
     references: dict[str, float]
     joint_path: JointPath
+    energy: EnergyFigures | None = None
 
     @property
     def planned_path(self) -> Path:

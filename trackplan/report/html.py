@@ -288,6 +288,7 @@ def _figures_table(result: PlanResult, case: Case) -> str:
             "worst margin",
             _percent(check.worst_margin()) if check.joint_margins or check.task_margins else "–",
         ),
+        *_energy_rows(result),
         ("time law, IK branch", f"{_esc(result.timing)}, branch {result.branch}"),
         (
             "samples",
@@ -298,11 +299,26 @@ def _figures_table(result: PlanResult, case: Case) -> str:
     return _key_values(rows)
 
 
+def _energy_rows(result: PlanResult) -> list[tuple[str, str]]:
+    """Energy figures of a robot with dynamics (``docs/dynamics.md``), else none."""
+    energy = result.energy
+    if energy is None:
+        return []
+    return [
+        ("mechanical energy", _num(energy.mechanical_energy, unit="J")),
+        ("copper loss", f"{_num(energy.copper_loss)} {_esc(energy.copper_loss_unit)}"),
+        (
+            "peak torque ratio",
+            f"{_num(energy.peak_torque_ratio)} (joint {energy.peak_torque_joint})",
+        ),
+    ]
+
+
 def _margins_table(result: PlanResult, case: Case) -> str:
     check = result.check
     n = case.robot.n_dof
     rows = []
-    for kind in LIMIT_KINDS:
+    for kind in (*LIMIT_KINDS, "torque"):
         margins = check.joint_margins.get(kind)
         if margins is None:
             continue

@@ -24,6 +24,7 @@ JOINT_QUANTITIES = {
     "velocity": ("velocity", "rad/s"),
     "acceleration": ("acceleration", "rad/s²"),
     "jerk": ("jerk", "rad/s³"),
+    "torque": ("torque", "N·m"),
 }
 
 

@@ -8,18 +8,26 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.robots.dynamics.builtin import puma560_dynamics
 from trackplan.robots.model import Robot
 
 HALF_PI = np.pi / 2
 
 
 def puma560() -> Robot:
-    """PUMA560 of the paper: DH of Table I (α = ±π/2 exactly), limits of Table II."""
+    """PUMA560 of the paper: DH of Table I (α = ±π/2 exactly), limits of Table II.
+
+    Dynamics: Corke and Armstrong-Hélouvry's parameters (see
+    :mod:`trackplan.robots.dynamics.builtin`).
+    """
+    d = np.array([0.0, 0.0, 0.15, 0.4318, 0.0, 0.0])
+    a = np.array([0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0])
+    alpha = np.array([HALF_PI, 0.0, -HALF_PI, HALF_PI, -HALF_PI, 0.0])
     return Robot(
         name="puma560",
-        d=np.array([0.0, 0.0, 0.15, 0.4318, 0.0, 0.0]),
-        a=np.array([0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0]),
-        alpha=np.array([HALF_PI, 0.0, -HALF_PI, HALF_PI, -HALF_PI, 0.0]),
+        d=d,
+        a=a,
+        alpha=alpha,
         offset=np.zeros(6),
         q_min=-np.array(
             [np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi, 0.75 * np.pi]
@@ -34,6 +42,7 @@ def puma560() -> Robot:
             "Reference paper, Tables I (DH, alpha = ±pi/2) and II (limits); "
             "base frame at the shoulder (d1 = 0)."
         ),
+        dynamics=puma560_dynamics(d, a, alpha),
     )
 
 

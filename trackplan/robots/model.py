@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.robots.dynamics.parameters import RobotDynamics
 
 LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk")
 
@@ -39,6 +40,9 @@ class Robot:
         Tool transform in the flange (DH frame n), shape (4, 4).
     source
         Where the numbers come from (free text, shown by ``trackplan robots``).
+    dynamics
+        Masses, inertias, actuators, friction and torque limits, or None when the robot has
+        no published dynamics (then it has no torque check).
     """
 
     name: str
@@ -53,6 +57,7 @@ class Robot:
     j_max: np.ndarray
     T_flange_tool: np.ndarray = field(default_factory=lambda: np.eye(4))
     source: str = ""
+    dynamics: RobotDynamics | None = None
 
     def __post_init__(self) -> None:
         n = len(self.d)
@@ -67,6 +72,10 @@ class Robot:
         tool = np.array(self.T_flange_tool, dtype=float)
         tool.flags.writeable = False
         object.__setattr__(self, "T_flange_tool", tool)
+        if self.dynamics is not None and self.dynamics.n_dof != n:
+            raise CaseError(
+                f"dynamics must have {n} joints, got {self.dynamics.n_dof}", key="dynamics"
+            )
 
     @property
     def n_dof(self) -> int:

@@ -26,6 +26,9 @@ Graded violation v (the smallest over the branches, in the order of the checks)
   of reach, ``s`` the share of poses where the branch switches (a singularity crossing)
   or jumps, ``l = min(1, excess / π)`` with ``excess`` how far (rad) the joint path leaves
   the position limits;
+- ``0.5 + min(1, r - 1)`` (robots with dynamics): every continuous branch within the joint
+  range needs more than a torque limit just to hold a pose against gravity, ``r`` being
+  the largest holding torque over its limit; no speed helps (``docs/dynamics.md``);
 - ``0.25 + 0.25 e / (e + 0.05 m)`` (in [0.25, 0.5)): geometrically feasible on some branch,
   but every such branch comes closer to the cell than its clearance (screened by the
   compiled kernel, :mod:`trackplan.cell.screening`), ``e`` the least shortfall in metres;
@@ -50,14 +53,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Case
+from trackplan.case import Case, Objective
 from trackplan.cell.screening import CellGeometry
 from trackplan.choices import Penalty
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.objective import joint_travel
+from trackplan.planning.objectives import ScreenInput, plan_objective, screen_objective
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
+from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.search.space import SearchSpace
@@ -96,6 +100,7 @@ class Finding(enum.IntEnum):
     POSITION_LIMITS = 4  # every continuous branch leaves the joint range
     CHECK = 5  # the planned trajectory fails the checker
     COLLISION = 6  # every geometrically feasible branch breaks the cell clearance
+    HOLDING_TORQUE = 7  # holding still against gravity exceeds a torque limit somewhere
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,8 +114,9 @@ class Screening:
     fitness
         Eq. 30 as above, shape (B,).
     objective
-        J of Eq. 8 on the screening grid of the chosen branch (paper timing: of the
-        planned trajectory), shape (B,), NaN when infeasible.
+        The case's objective (``objective.kind``, Eq. 8 by default) on the screening grid
+        of the chosen branch (paper timing: of the planned trajectory), shape (B,), NaN
+        when infeasible.
     duration
         Duration of the planned trajectory, s, shape (B,); NaN when not planned.
     duration_bound
@@ -157,6 +163,36 @@ def plan_candidate(
     """:func:`plan_placement` of one ``(case, X, timing, branch, geometry)`` (for executors)."""
     case, X, timing, branch, geometry = args
     return plan_placement(case, X, timing=timing, branch=branch, geometry=geometry)
+
+
+@dataclass(frozen=True, eq=False)
+class BranchScreen:
+    """Every IK branch of B placements on the screening grid (K branches).
+
+    Attributes
+    ----------
+    grid
+        Joint paths (B, K, M, n) and least interval times (B, K, M - 1) for the objectives.
+    branches
+        The branch of each column, shape (K,), int.
+    ok
+        Geometrically feasible and able to hold its poses against gravity, shape (B, K).
+    violation
+        Graded violation, 0 where ``ok``, shape (B, K).
+    finding
+        :class:`Finding` code, shape (B, K), int.
+    """
+
+    grid: ScreenInput
+    branches: np.ndarray
+    ok: np.ndarray
+    violation: np.ndarray
+    finding: np.ndarray
+
+    def values(self, objective: Objective) -> np.ndarray:
+        """An objective on every branch, shape (B, K); inf where not ``ok``."""
+        with np.errstate(invalid="ignore"):
+            return np.where(self.ok, screen_objective(objective, self.grid), np.inf)
 
 
 class PlacementFitness:
@@ -254,49 +290,106 @@ class PlacementFitness:
             X, fitness, objective, duration, bound, feasible, branch, violation, finding
         )
 
-    def _screen(
-        self, X: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """J, branch, graded violation, finding and duration bound of placements inside the
-        reach interval."""
+    def screen_branches(self, X: np.ndarray) -> BranchScreen:
+        """Every IK branch of placements inside the reach interval, on the screening grid.
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6).
+
+        Returns
+        -------
+        BranchScreen
+        """
         poses = tool_poses(X, self.points, self.case.task.tool_rpy)
         paths = solve_path_ik_branches(self.case.robot, poses)
         n_poses = len(self.s_grid)
         with np.errstate(invalid="ignore"):
-            J = joint_travel(paths.q, self.weights)  # (B, K)
-        J = np.where(paths.success, J, np.inf)
+            joint_time = np.max(np.abs(np.diff(paths.q, axis=2)) / self.case.robot.v_max, axis=3)
         unreachable = 1.0 - paths.reachable_fraction
         switches = paths.n_switches / n_poses
         limits = np.minimum(1.0, np.maximum(0.0, -paths.margin) / np.pi)
         graded = GEOMETRY_LEVEL + unreachable + switches + limits  # (B, K)
-        geometric = paths.success.any(axis=1)
-        rows = np.arange(len(X))
-        if self.cell is not None:
-            J, graded = self._screen_cell(X, paths.q, J, graded)
-        any_ok = np.isfinite(J).any(axis=1)
-        choice = np.where(any_ok, np.argmin(J, axis=1), np.argmin(graded, axis=1))
-        objective = np.where(any_ok, J[rows, choice], np.nan)
-        violation = np.where(any_ok, 0.0, graded[rows, choice])
+        ok = paths.success
+        too_heavy = np.zeros_like(ok)
+        if self.case.robot.dynamics is not None:
+            holding = holding_torque_ratio(self.case.robot, paths.q)  # (B, K)
+            too_heavy = ok & (holding > 1.0)
+            ok = ok & ~too_heavy
+            graded = np.where(too_heavy, GEOMETRY_LEVEL + np.minimum(1.0, holding - 1.0), graded)
         finding = np.select(
-            [
-                any_ok,
-                geometric,
-                unreachable[rows, choice] > 0.0,
-                paths.n_switches[rows, choice] > 0,
-            ],
+            [ok, too_heavy, unreachable > 0.0, paths.n_switches > 0],
             [
                 int(Finding.FEASIBLE),
-                int(Finding.COLLISION),
+                int(Finding.HOLDING_TORQUE),
                 int(Finding.UNREACHABLE),
                 int(Finding.BRANCH_SWITCH),
             ],
             int(Finding.POSITION_LIMITS),
         )
-        steps = np.abs(np.diff(paths.q[rows, choice], axis=1))  # (B, M - 1, n)
-        with np.errstate(invalid="ignore"):
-            joint_time = np.max(steps / self.case.robot.v_max, axis=2)
-        bound = np.sum(np.maximum(self.tool_time, joint_time), axis=1)
-        return objective, paths.branches[choice], violation, finding, bound
+        dt = np.fmax(self.tool_time, joint_time)  # (B, K, M - 1), s
+        return BranchScreen(
+            ScreenInput(self.case.robot, paths.q, dt, self.weights),
+            paths.branches,
+            ok,
+            np.where(ok, 0.0, graded),
+            finding,
+        )
+
+    def screen_objectives(
+        self, X: np.ndarray, objectives: tuple[Objective, ...]
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Objectives of placements inside the reach interval, on one branch each.
+
+        Every branch is screened (:meth:`screen_branches`), then the cell's clearance on the
+        feasible branches best first by the first objective (:meth:`_screen_cell`); each
+        placement keeps its clear branch with the smallest first objective, else its least
+        violating branch.
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6).
+        objectives
+            One or more objectives; the first chooses the branch.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            Values ``(B, len(objectives))`` (NaN when infeasible), branch ``(B,)``, graded
+            violation ``(B,)``, :class:`Finding` ``(B,)`` and duration bound ``(B,)`` (s).
+        """
+        branches = self.screen_branches(X)
+        values = [branches.values(objective) for objective in objectives]
+        violation = branches.violation
+        finding = branches.finding
+        if self.cell is not None:
+            first, violation = self._screen_cell(X, branches.grid.q, values[0], violation)
+            blocked = np.isinf(first) & branches.ok
+            values = [np.where(blocked, np.inf, v) for v in values]
+            finding = np.where(blocked, int(Finding.COLLISION), finding)
+        any_ok = np.isfinite(values[0]).any(axis=1)
+        choice = np.where(any_ok, np.argmin(values[0], axis=1), np.argmin(violation, axis=1))
+        rows = np.arange(len(X))
+        chosen = np.stack([np.where(any_ok, v[rows, choice], np.nan) for v in values], axis=1)
+        return (
+            chosen,
+            branches.branches[choice],
+            np.where(any_ok, 0.0, violation[rows, choice]),
+            np.where(any_ok, int(Finding.FEASIBLE), finding[rows, choice]),
+            branches.grid.dt[rows, choice].sum(axis=1),
+        )
+
+    def _screen(
+        self, X: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Objective, branch, graded violation, finding and duration bound of placements
+        inside the reach interval."""
+        values, branch, violation, finding, bound = self.screen_objectives(
+            X, (self.case.objective,)
+        )
+        return values[:, 0], branch, violation, finding, bound
 
     def _screen_cell(
         self, X: np.ndarray, q: np.ndarray, J: np.ndarray, graded: np.ndarray
@@ -382,7 +475,7 @@ class PlacementFitness:
             duration[i] = plan.duration
             if plan.success:
                 if not self.law.follows_joint_path:
-                    objective[i] = plan.objective
+                    objective[i] = plan_objective(self.case.objective, plan)
                 fitness[i] = objective[i] + self.time_weight * plan.duration
             else:
                 finding[i] = int(Finding.CHECK)

@@ -10,8 +10,9 @@ A sample check is any callable ``check(q, sample_time) -> (sample, order, ratio)
   to ``v · ratio^(-1/order)``;
 - ``ratio``: the value over the level it must stay under, shape (V,), > 1.
 
-:class:`RateLimits` is the joint velocity, acceleration and jerk check; a new limit (motor
-torque, say) is one more callable handed to the law, without touching the law.
+:class:`RateLimits` is the joint velocity, acceleration and jerk check; :class:`TorqueLimits`
+the joint torque check of a robot with dynamics (``docs/dynamics.md``). :func:`robot_checks`
+is what a law checks by default: both, the second when the robot has dynamics.
 """
 
 from __future__ import annotations
@@ -22,12 +23,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.derivatives import backward_derivatives
+from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.model import Robot
 
 LIMIT_MARGIN = 1e-6
 """Relative margin kept under every limit a law plans against, so that round-off in the
 samples never fails the checker (which allows ``1e-9`` relative): a sample above
 ``(1 - LIMIT_MARGIN)`` of a limit counts as a violation."""
+
+MIN_SPEED_FACTOR = 0.1
+"""Smallest speed factor :class:`TorqueLimits` asks for in one round of the rebuild loop
+(a sample whose torque has almost no room above its speed-independent part would otherwise
+ask for a near-standstill at once; the next round asks again if needed)."""
 
 SampleCheck = Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, np.ndarray]]
 """``check(q (N, n), Ts) -> (sample (V,), order (V,), ratio (V,))`` (see the module)."""
@@ -66,6 +73,100 @@ class RateLimits:
             orders.append(np.full(bad.size, order))
             ratios.append(ratio[bad])
         return np.concatenate(samples), np.concatenate(orders), np.concatenate(ratios)
+
+
+@dataclass(frozen=True, eq=False)
+class TorqueLimits:
+    """Torque limits by inverse dynamics of the backward differences at Ts, as the checker.
+
+    The torque splits by how it scales with the path speed ``v`` along a fixed joint path:
+    ``τ = τ_s + τ_1 + τ_2`` with ``τ_s`` gravity plus Coulomb friction (independent of ``v``),
+    ``τ_1 = G² B q̇`` (∝ v) and ``τ_2`` the rest: inertia, Coriolis and motor inertia (∝ v²
+    at a steady speed). The check reports order 2 with the ratio that brings
+    ``|τ_s| + |τ_1| x + |τ_2| x²`` under the limit at the speed factor ``x = ratio^(-1/2)``.
+    Where ``|τ_s|`` alone exceeds the limit no speed helps: the check then asks for nothing
+    and leaves the trajectory to the checker, which names it "infeasible at any speed". One
+    round asks for a speed factor of at least :data:`MIN_SPEED_FACTOR`.
+
+    Attributes
+    ----------
+    robot
+        A robot with dynamics.
+    margin
+        Relative margin kept under each limit.
+    """
+
+    robot: Robot
+    margin: float = LIMIT_MARGIN
+
+    def __call__(
+        self, q: np.ndarray, sample_time: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Samples where a torque limit (less the margin) is exceeded and a slower speed helps.
+
+        Parameters
+        ----------
+        q
+            Joint positions at Ts, shape (N, n), rad, from rest to rest.
+        sample_time
+            Ts, s.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``sample (V,)`` (clipped to ``N - 1``), ``order (V,)`` (2) and ``ratio (V,)`` (> 1).
+        """
+        dynamics = self.robot.dynamics
+        if dynamics is None:
+            empty = np.zeros(0)
+            return empty.astype(int), empty.astype(int), empty
+        q = np.asarray(q, dtype=float)
+        qd, qdd, _ = backward_derivatives(q, sample_time, pad_end=True)
+        q_held = np.concatenate([q, np.repeat(q[-1:], len(qd) - len(q), axis=0)])
+        tau = inverse_dynamics(self.robot, q_held, qd, qdd)
+        cap = (1.0 - self.margin) * dynamics.torque_max
+        rows = np.flatnonzero((np.abs(tau) > cap).any(axis=1))
+        if not rows.size:
+            empty = np.zeros(0)
+            return empty.astype(int), empty.astype(int), empty
+        # only the breaking samples are split into their parts
+        q_held, qd, tau = q_held[rows], qd[rows], tau[rows]
+        zero = np.zeros_like(qd)
+        G = np.abs(np.asarray(dynamics.gear_ratio))
+        coulomb = np.asarray(dynamics.coulomb) * G[:, None]
+        static = inverse_dynamics(self.robot, q_held, zero, zero, friction=False)
+        static += np.where(qd > 0, coulomb[:, 0], np.where(qd < 0, coulomb[:, 1], 0.0))
+        first = G**2 * np.asarray(dynamics.viscous) * qd
+        second = tau - static - first
+        over = np.abs(tau) > cap
+        room = cap - np.abs(static)
+        if np.any(over & (room <= 0.0)):
+            # gravity (and Coulomb friction) alone break a limit: no speed helps, and slowing
+            # down elsewhere would not make the trajectory feasible
+            empty = np.zeros(0)
+            return empty.astype(int), empty.astype(int), empty
+        helps = over
+        a, b = np.abs(second), np.abs(first)
+        # largest x in (0, 1] with a x² + b x <= room (a, b >= 0, room > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            root = np.where(
+                a > 0.0,
+                (-b + np.sqrt(b * b + 4.0 * a * room)) / (2.0 * a),
+                room / b,
+            )
+        x = np.clip(np.where(helps, root, 1.0), MIN_SPEED_FACTOR, 1.0)
+        ratio_joint = np.where(helps, x**-2.0, 1.0)
+        ratio = ratio_joint.max(axis=1)
+        bad = ratio > 1.0
+        return np.minimum(rows[bad], len(q) - 1), np.full(int(bad.sum()), 2), ratio[bad]
+
+
+def robot_checks(robot: Robot) -> tuple[SampleCheck, ...]:
+    """The sample checks of a robot: its rate limits, and its torque limits when it has
+    dynamics."""
+    if robot.dynamics is None:
+        return (RateLimits(robot),)
+    return (RateLimits(robot), TorqueLimits(robot))
 
 
 def run_checks(

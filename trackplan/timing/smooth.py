@@ -52,7 +52,7 @@ from trackplan.timing.profile import (
     speed_change_time,
 )
 from trackplan.timing.protocol import SlowDown, TimeLaw, TimeLawSpec, unsampled
-from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, SampleCheck, run_checks
+from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, robot_checks, run_checks
 
 LIMIT_SHARE = 0.97
 """Share of each joint limit the planner aims at; the rest absorbs sampling effects."""
@@ -106,7 +106,8 @@ def plan_smooth_time_law(
         Rated and corner speeds (m/s) and the sample time Ts (s).
     sample_checks
         What the sampled joints must pass before the law returns
-        (:mod:`trackplan.timing.sample_checks`); default: the joint rate limits.
+        (:mod:`trackplan.timing.sample_checks`); default: the robot's joint rate limits, and
+        its torque limits when it has dynamics.
 
     Returns
     -------
@@ -115,7 +116,7 @@ def plan_smooth_time_law(
     """
     robot = joint_path.robot
     sample_time = task.sample_time
-    checks = sample_checks if sample_checks is not None else (RateLimits(robot),)
+    checks = sample_checks if sample_checks is not None else robot_checks(robot)
     zones = joint_path.geometry.zones()
     demands = _zone_demands(joint_path)
     zones, demands = _slow_down_windows(robot, zones, demands, task.rated_speed, task.corner_speed)

@@ -1,0 +1,1 @@
+"""Robot dynamics: parameters (:mod:`.parameters`), inverse dynamics (:mod:`.rne`)."""

@@ -1,0 +1,237 @@
+"""Inverse dynamics of a robot, batched over any leading axes (samples, candidates).
+
+``τ = RNE(q, q̇, q̈) + G² Jm q̈ + G² B q̇ + |G| Tc±``: the rigid-body torque plus motor
+inertia and friction, as roboticstoolbox computes it for its DH robots (``rne``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.robots.dynamics._kernels import rne_kernel
+from trackplan.robots.dynamics.parameters import (
+    JointChain,
+    RobotDynamics,
+    combine_payload,
+    dh_chain,
+)
+from trackplan.robots.model import Robot
+
+
+def robot_chain(robot: Robot) -> JointChain:
+    """The generic chain of a robot (joint frames, axes and flange).
+
+    Parameters
+    ----------
+    robot
+        Any robot.
+
+    Returns
+    -------
+    JointChain
+    """
+    return dh_chain(robot.d, robot.a, robot.alpha, robot.offset)
+
+
+@dataclass(frozen=True, eq=False)
+class _KernelArrays:
+    """The chain and inertials as the kernel takes them (payload merged into the last link)."""
+
+    T_parent_joint: np.ndarray
+    axis: np.ndarray
+    mass: np.ndarray
+    com: np.ndarray
+    inertia: np.ndarray
+    gravity: np.ndarray
+    armature: np.ndarray
+    viscous: np.ndarray
+    coulomb_pos: np.ndarray
+    coulomb_neg: np.ndarray
+
+
+def _kernel_arrays(
+    chain: JointChain, dynamics: RobotDynamics, T_last_tcp: np.ndarray, friction: bool
+) -> _KernelArrays:
+    """Arrays for :func:`rne_kernel`."""
+    mass = np.array(dynamics.mass)
+    com = np.array(dynamics.com)
+    inertia = np.array(dynamics.inertia)
+    if dynamics.payload is not None:
+        mass[-1], com[-1], inertia[-1] = combine_payload(
+            mass[-1], com[-1], inertia[-1], dynamics.payload, T_last_tcp
+        )
+    G = np.asarray(dynamics.gear_ratio)
+    coulomb = np.asarray(dynamics.coulomb) * np.abs(G)[:, None]
+    scale = 1.0 if friction else 0.0
+    return _KernelArrays(
+        T_parent_joint=np.ascontiguousarray(chain.T_parent_joint, dtype=float),
+        axis=np.ascontiguousarray(chain.axis, dtype=float),
+        mass=mass,
+        com=np.ascontiguousarray(com),
+        inertia=np.ascontiguousarray(inertia),
+        gravity=np.array(dynamics.gravity),
+        armature=G**2 * np.asarray(dynamics.motor_inertia),
+        viscous=scale * G**2 * np.asarray(dynamics.viscous),
+        coulomb_pos=scale * np.ascontiguousarray(coulomb[:, 0]),
+        coulomb_neg=scale * np.ascontiguousarray(coulomb[:, 1]),
+    )
+
+
+def chain_inverse_dynamics(
+    chain: JointChain,
+    dynamics: RobotDynamics,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    *,
+    T_flange_tcp: np.ndarray | None = None,
+    friction: bool = True,
+    gravity: np.ndarray | None = None,
+) -> np.ndarray:
+    """Joint torques of a generic chain, link side.
+
+    Parameters
+    ----------
+    chain
+        Joint frames and axes.
+    dynamics
+        Inertials in the chain's child frames, actuators, friction, gravity, payload.
+    q, qd, qdd
+        Joint positions, velocities and accelerations, shape (..., n), rad, rad/s, rad/s².
+    T_flange_tcp
+        The TCP in the flange frame, shape (4, 4) (where the payload sits); default identity.
+    friction
+        Include viscous and Coulomb friction.
+    gravity
+        Gravity in the base frame, shape (3,), m/s²; default ``dynamics.gravity``.
+
+    Returns
+    -------
+    numpy.ndarray
+        τ, shape (..., n), N·m.
+    """
+    T_tool = np.eye(4) if T_flange_tcp is None else np.asarray(T_flange_tcp, dtype=float)
+    arrays = _kernel_arrays(chain, dynamics, chain.T_last_flange @ T_tool, friction)
+    g = arrays.gravity if gravity is None else np.asarray(gravity, dtype=float)
+    q, qd, qdd = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (q, qd, qdd)))
+    shape = q.shape
+    q_flat, qd_flat, qdd_flat = (
+        np.ascontiguousarray(x.reshape(-1, shape[-1])) for x in (q, qd, qdd)
+    )
+    tau = np.empty_like(q_flat)
+    rne_kernel(
+        arrays.T_parent_joint,
+        arrays.axis,
+        arrays.mass,
+        arrays.com,
+        arrays.inertia,
+        g,
+        arrays.armature,
+        arrays.viscous,
+        arrays.coulomb_pos,
+        arrays.coulomb_neg,
+        q_flat,
+        qd_flat,
+        qdd_flat,
+        tau,
+    )
+    return tau.reshape(shape)
+
+
+def inverse_dynamics(
+    robot: Robot,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    *,
+    friction: bool = True,
+    gravity: np.ndarray | None = None,
+) -> np.ndarray:
+    """Joint torques needed for a motion, link side.
+
+    Parameters
+    ----------
+    robot
+        A robot with :attr:`~trackplan.robots.model.Robot.dynamics`.
+    q, qd, qdd
+        Joint positions, velocities and accelerations, shape (..., n), rad, rad/s, rad/s²
+        (batch axes first: candidates, samples).
+    friction
+        Include viscous and Coulomb friction.
+    gravity
+        Gravity in the base frame, shape (3,), m/s²; default the robot's.
+
+    Returns
+    -------
+    numpy.ndarray
+        τ, shape (..., n), N·m.
+
+    Raises
+    ------
+    ValueError
+        When the robot has no dynamic parameters.
+    """
+    return chain_inverse_dynamics(
+        robot_chain(robot),
+        _require(robot),
+        q,
+        qd,
+        qdd,
+        T_flange_tcp=robot.T_flange_tool,
+        friction=friction,
+        gravity=gravity,
+    )
+
+
+def gravity_load(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Torques that hold the robot still at ``q`` against gravity (no friction), N·m.
+
+    Parameters
+    ----------
+    robot
+        A robot with dynamics.
+    q
+        Joint positions, shape (..., n), rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (..., n), N·m.
+    """
+    zero = np.zeros_like(np.asarray(q, dtype=float))
+    return inverse_dynamics(robot, q, zero, zero, friction=False)
+
+
+def _require(robot: Robot) -> RobotDynamics:
+    """The robot's dynamics, or a clear error."""
+    if robot.dynamics is None:
+        raise ValueError(f"robot {robot.name!r} has no dynamic parameters")
+    return robot.dynamics
+
+
+def holding_torque_ratio(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Largest gravity-holding torque over the torque limit, along joint paths.
+
+    Above 1 the robot cannot hold the path's poses against gravity: no speed helps.
+
+    Parameters
+    ----------
+    robot
+        A robot with dynamics.
+    q
+        Joint paths, shape (..., M, n), rad; NaN entries (poses without a solution) count
+        as no load.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``max_k max_i |τ_g,i(q_k)| / τ_max,i``, shape (...).
+    """
+    dynamics = _require(robot)
+    q = np.asarray(q, dtype=float)
+    finite = np.isfinite(q).all(axis=-1, keepdims=True)
+    holding = gravity_load(robot, np.where(finite, q, 0.0))
+    ratio = np.where(finite, np.abs(holding) / dynamics.torque_max, 0.0)
+    return ratio.max(axis=(-2, -1))
