@@ -47,13 +47,15 @@ def test_optimize_writes_the_plan_files_and_the_search(
         "200",
         "--seed",
         "2",
+        "--method",
+        "ga",
         "--no-report",
     )
     assert code == ExitCode.OK
     assert sorted(p.name for p in out.iterdir()) == ["history.csv", "result.json", "trajectory.csv"]
     summary = json.loads((out / "result.json").read_text())
     optimizer = summary["optimizer"]
-    assert (optimizer["method"], optimizer["seed"]) == ("multistart", 2)
+    assert (optimizer["method"], optimizer["seed"]) == ("ga", 2)
     assert (optimizer["evaluations"], optimizer["stop_reason"]) == (200, "budget")
     assert optimizer["generations"] == 8 and optimizer["wall_time_s"] > 0
     initial = summary["initial"]
@@ -84,10 +86,17 @@ def test_ctrl_c_during_the_progress_bar_still_writes_everything(
     monkeypatch.setattr(Progress, "update", interrupting)
     out = tmp_path / "run"
     code, stdout, _ = run(
-        capsys, "optimize", str(CASES / "paper-corner.yaml"), "--out", str(out), "--no-report"
+        capsys,
+        "optimize",
+        str(CASES / "paper-corner.yaml"),
+        "--method",
+        "ga",
+        "--out",
+        str(out),
+        "--no-report",
     )
     assert code == ExitCode.INTERRUPTED
-    assert descriptions[0].startswith("generation 1  100 evaluations  best J")
+    assert descriptions[0].startswith("generation 1  30 evaluations  best J")
     assert "feasible" in descriptions[0] and "%" in descriptions[0]
     summary = json.loads((out / "result.json").read_text())
     assert summary["optimizer"]["stop_reason"] == "interrupted"
