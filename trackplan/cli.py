@@ -30,8 +30,6 @@ and lets :func:`main` report it; it prints results with :func:`_console` or
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import enum
 import os
 import sys
@@ -46,6 +44,7 @@ from rich.markup import escape
 from rich.table import Table
 
 import trackplan
+from trackplan.allocator import keep_freed_memory
 from trackplan.case import Case
 from trackplan.choices import Timing, choose
 from trackplan.errors import CaseError
@@ -105,27 +104,6 @@ def _options(
     # main() reads --debug from the arguments itself: it must know before parsing succeeds.
 
 
-MALLOC_MMAP_THRESHOLD = 64 * 2**20
-"""Bytes: glibc serves smaller allocations from its heap instead of fresh mmaps."""
-
-
-def _keep_freed_memory() -> None:
-    """Let glibc reuse freed memory for the batched arrays instead of mapping them anew.
-
-    By default glibc maps every allocation above 128 KiB (raised only gradually) and
-    unmaps it on free, so each generation of the placement search page-faults its (B, M, …)
-    arrays in again: measured 1.1 s of a 4 s search. The CLI owns its process, so it sets
-    a fixed 64 MiB threshold; elsewhere (not glibc) this does nothing.
-    """
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        m_trim_threshold, m_mmap_threshold = -1, -3  # mallopt parameters, <malloc.h>
-        libc.mallopt(m_mmap_threshold, MALLOC_MMAP_THRESHOLD)
-        libc.mallopt(m_trim_threshold, 2 * MALLOC_MMAP_THRESHOLD)
-    except (OSError, AttributeError):
-        pass
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the command line and return its exit code; never raises.
 
@@ -140,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
         An :class:`ExitCode` value (130 on Ctrl-C).
     """
     args = sys.argv[1:] if argv is None else list(argv)
-    _keep_freed_memory()
+    keep_freed_memory()
     debug = "--debug" in args or os.environ.get(DEBUG_ENV, "") not in ("", "0")
     try:
         command = typer.main.get_command(app)
@@ -563,11 +541,13 @@ def optimize(
     ``initial`` blocks, plots and report.html unless --no-report) plus history.csv. Ctrl-C
     stops the search and still writes everything for the best placement found.
     """
+    from trackplan.outputs import write_search_run
+
     loaded = load_case(case)
     result = _search(
         loaded, method=method, seed=seed, budget=budget, restarts=restarts, timing=_timing(timing)
     )
-    _write_search(out, result, loaded, report=report)
+    write_search_run(out, result, loaded, report=report)
     _print_search(result, out)
     return search_exit_code(result)
 
@@ -580,9 +560,11 @@ def demo(
     file = shipped_cases_dir() / "paper-corner.yaml"
     if not file.is_file():
         raise CaseError("the shipped demo case is missing (run from a source checkout)", str(file))
+    from trackplan.outputs import write_search_run
+
     loaded = load_case(file)
     result = _search(loaded)
-    _write_search(out, result, loaded, report=True)
+    write_search_run(out, result, loaded, report=True)
     _print_search(result, out)
     typer.echo(f"report: {(out / 'report.html').resolve()}")
     return search_exit_code(result)
@@ -663,17 +645,6 @@ def _search(case: Case, **options):  # type: ignore[no-untyped-def]
             )
 
         return optimize_placement(case, progress=show, **options)
-
-
-def _write_search(out: Path, result, case: Case, *, report: bool) -> None:  # type: ignore[no-untyped-def]
-    """trackplan.outputs.write_run for the final plan, with the search blocks and history.csv."""
-    from trackplan.io.history import optimizer_summary, write_history
-    from trackplan.outputs import write_run
-
-    history = {result.method: result.history.as_columns()} if len(result.history) else None
-    extra = optimizer_summary(result, case.robot.joint_names)
-    write_run(out, result.final, case, history=history, extra=extra, report=report)
-    write_history(result, out)
 
 
 def _print_search(result, out: Path) -> None:  # type: ignore[no-untyped-def]
