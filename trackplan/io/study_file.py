@@ -83,14 +83,18 @@ def load_study(file: str | Path) -> Study:
         (reported at the study's key when a study value is the cause).
     """
     source = str(file)
-    model = validate_model(StudyModel, parse_yaml(read_text(file, what="study file"), source), source)
+    model = validate_model(
+        StudyModel, parse_yaml(read_text(file, what="study file"), source), source
+    )
     base = Path(file).parent
     for key in model.set:
         check_set_key(key, source)
     _refuse_repeats(model, source)
     sweeps = _sweeps(model.set)
     swept = {key for key, values in model.set.items() if len(values) > 1}
-    robots: list[str | None] = [_robot_spec(robot, base) for robot in model.robots or [None]]
+    robots: list[str | None] = (
+        [_robot_spec(robot, base) for robot in model.robots] if model.robots else [None]
+    )
     jobs: list[Job] = []
     labels: dict[str, Path] = {}
     for case_file in _case_files(model.cases, base, source):
@@ -185,9 +189,9 @@ def _case_files(patterns: list[str], base: Path, source: str) -> list[Path]:
     return list(files)
 
 
-def _robot_spec(robot: str | None, base: Path) -> str | None:
+def _robot_spec(robot: str, base: Path) -> str:
     """A robot name, or a robot file's path relative to the study file made absolute."""
-    if robot is None or not is_robot_file(robot):
+    if not is_robot_file(robot):
         return robot
     return str((base / robot).resolve())
 
@@ -209,9 +213,7 @@ def _refuse_repeats(model: StudyModel, source: str) -> None:
     for key, items in lists:
         for index, value in enumerate(items):
             if value in items[:index]:
-                raise CaseError(
-                    f"{show(value)} is given twice", file=source, key=f"{key}[{index}]"
-                )
+                raise CaseError(f"{show(value)} is given twice", file=source, key=f"{key}[{index}]")
 
 
 def _job_case(
@@ -261,9 +263,7 @@ def _within(found: str, key: str) -> bool:
     return found == key or found.startswith((f"{key}.", f"{key}["))
 
 
-def _job(
-    label: str, case_file: Path, case: Case, sweep: Sweep, seed: int, swept: set[str]
-) -> Job:
+def _job(label: str, case_file: Path, case: Case, sweep: Sweep, seed: int, swept: set[str]) -> Job:
     """One job; its sweep label names the keys given more than one value (``swept``)."""
     pairs = tuple((key, value) for key, _, value in sweep)
     sweep_label = (

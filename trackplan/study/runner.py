@@ -214,7 +214,14 @@ def run_study(
             writer.add(row)
         with _client(client, workers) as active:
             interrupted = _run_jobs(
-                active, pending, out, report, writer, rows, len(study.jobs), len(skipped),
+                active,
+                pending,
+                out,
+                report,
+                writer,
+                rows,
+                len(study.jobs),
+                len(skipped),
                 progress,
             )
     finally:
@@ -374,15 +381,24 @@ def local_cluster(workers: int | None = None, preload: bool = True) -> Iterator:
         yield cluster
 
 
-def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Client:
+def connect(address: str, timeout: float | None = None) -> Client:
     """A client on the Dask scheduler at ``address`` (``tcp://HOST:PORT``).
+
+    Parameters
+    ----------
+    address
+        The scheduler's address.
+    timeout
+        Seconds to wait for it; default :data:`CONNECT_TIMEOUT_S`.
 
     Raises
     ------
     CaseError
-        When no scheduler answers there within ``timeout`` seconds.
+        When no scheduler answers there within the timeout.
     """
     from distributed import Client
+
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
 
     try:
         return Client(address, timeout=timeout)
