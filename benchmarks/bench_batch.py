@@ -9,9 +9,8 @@ no per-run report) is run, in one process and one run:
   shows how much the machine's load moves the timings);
 - by :func:`trackplan.run_study` on a local cluster of 1 worker, then of 2 workers.
 
-Every run starts warm (kernels compiled, glibc's allocator set as in the workers: this
-process runs the workers' preload) and the cluster start is timed apart. Prints the wall
-times, the speed-up of 2 workers over 1 (target ≥ 1.7× on 2 cores) and the engine's
+Every run starts warm (kernels compiled, glibc's allocator set: this process does what
+the workers' preload does) and the cluster start is timed apart. Prints the wall times, the speed-up of 2 workers over 1 (target ≥ 1.7× on 2 cores) and the engine's
 overhead per job with 1 worker (target < 5 %): against the plain loop, and as the time the
 batch took beyond the jobs' own wall times on the worker (submission, scheduling, results,
 summary files), which the machine's load moves much less.
@@ -25,9 +24,10 @@ from pathlib import Path
 
 from distributed import Client
 
+from trackplan.allocator import keep_freed_memory
 from trackplan.io.study_file import load_study
 from trackplan.study import Study, local_cluster, run_job, run_study
-from trackplan.study.preload import dask_setup
+from trackplan.study.preload import warm_up
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 CASE_NAMES = ("paper-line", "paper-circle", "paper-corner", "bracket-weld")
@@ -68,7 +68,8 @@ def _verdict(ok: bool) -> str:
 
 def main() -> None:
     """Run the benchmark and print its table."""
-    dask_setup(None)  # this process as a worker: allocator, warm kernels
+    keep_freed_memory()  # as in the workers (their preload)
+    warm_up()
     with tempfile.TemporaryDirectory(prefix="bench-batch-") as folder:
         root = Path(folder)
         cases = ", ".join(f"'{CASES / name}.yaml'" for name in CASE_NAMES)

@@ -34,6 +34,8 @@ Status, Timing, Method, Penalty
     The outcome vocabulary and the named choices.
 PlanResult, OptimizeResult, CheckReport, Trajectory, TimeLaw
     The results.
+run_study(study, out, client=None) -> StudyResult
+    Run a batch study (cases × robots × sweeps × seeds) on Dask (see ``docs/studies.md``).
 CaseError, TrackplanError
     Bad input (with the file and key path), and the root of trackplan's exceptions.
 
@@ -70,6 +72,7 @@ if TYPE_CHECKING:
     from trackplan.search import OptimizeResult, optimize_placement
     from trackplan.status import Status
     from trackplan.timing import TIME_LAWS, TimeLaw, time_law
+    from trackplan.study.runner import run_study
 
 try:
     __version__ = version("trackplan")
@@ -107,6 +110,7 @@ _EXPORTS = {
     "optimize_placement": "trackplan.search",
     "plan_placement": "trackplan.planning.plan",
     "time_law": "trackplan.timing",
+    "run_study": "trackplan.study.runner",
 }
 
 __all__ = [
@@ -137,6 +141,7 @@ __all__ = [
     "optimize_placement",
     "plan_placement",
     "time_law",
+    "run_study",
 ]
 
 

@@ -2,7 +2,7 @@
 
 ``dask worker tcp://HOST:8786 --nthreads 1 --preload trackplan.study.preload`` (and every
 local cluster :func:`trackplan.run_study` starts) runs :func:`dask_setup` in each worker
-process when it starts: it sets glibc's allocator as the CLI does
+process when it starts: it leaves Ctrl-C to the client, sets glibc's allocator as the CLI does
 (:func:`trackplan.allocator.keep_freed_memory`) and runs two tiny searches, one per IK
 family (closed form, numeric), so that numba compiles its kernels into its on-disk cache
 (or loads them from it) before any job is timed.
@@ -10,6 +10,8 @@ family (closed form, numeric), so that numba compiles its kernels into its on-di
 
 from __future__ import annotations
 
+import signal
+import threading
 from typing import Any
 
 from trackplan.allocator import keep_freed_memory
@@ -41,6 +43,13 @@ def warm_up() -> None:
 
 
 def dask_setup(worker: Any) -> None:
-    """Dask's preload hook: called once in each worker process as it starts."""
+    """Dask's preload hook: called once in each worker process as it starts.
+
+    The worker also ignores Ctrl-C (SIGINT), which a terminal sends to every process of
+    the batch: the client cancels the jobs, and the cluster or the worker's nanny stops
+    the worker.
+    """
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     keep_freed_memory()
     warm_up()

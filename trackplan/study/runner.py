@@ -224,6 +224,9 @@ def run_study(
                 len(skipped),
                 progress,
             )
+        for job in study.jobs:  # finished on disk, not yet collected when Ctrl-C came
+            if job.key not in rows and complete_run(out, job):
+                rows[job.key] = row_from_run(out / JOBS_DIR / job.key)
     finally:
         writer.close()
     ordered = tuple(rows[job.key] for job in study.jobs if job.key in rows)
@@ -375,7 +378,7 @@ def local_cluster(workers: int | None = None, preload: bool = True) -> Iterator:
         n_workers=n_workers,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        dashboard_address=":0",  # a free port: never clashes with another cluster
         preload=[PRELOAD] if preload else [],
     ) as cluster:
         yield cluster
