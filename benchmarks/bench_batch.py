@@ -10,10 +10,11 @@ no per-run report) is run, in one process and one run:
 - by :func:`trackplan.run_study` on a local cluster of 1 worker, then of 2 workers.
 
 Every run starts warm (kernels compiled, glibc's allocator set: this process does what
-the workers' preload does) and the cluster start is timed apart. Prints the wall times, the speed-up of 2 workers over 1 (target ≥ 1.7× on 2 cores) and the engine's
-overhead per job with 1 worker (target < 5 %): against the plain loop, and as the time the
-batch took beyond the jobs' own wall times on the worker (submission, scheduling, results,
-summary files), which the machine's load moves much less.
+the workers' preload does) and the cluster start is timed apart. Prints the wall times,
+the speed-up of 2 workers over 1 (target ≥ 1.7× on 2 cores) and the engine's overhead per
+job with 1 worker (target < 5 %): against the plain loop, and as the time the batch took
+beyond the jobs' own wall times on the worker (submission, scheduling, results, summary
+files), which the machine's load moves much less.
 """
 
 from __future__ import annotations
