@@ -71,6 +71,55 @@ def test_workers_and_scheduler_together_are_refused(
     assert code == ExitCode.BAD_INPUT and "give --workers or --scheduler, not both" in err
 
 
+def _two_jobs(folder: Path) -> Path:
+    return write_study(folder, f"cases: ['{CASES}/paper-circle.yaml']\nseeds: [0, 1]\n")
+
+
+def test_batch_prints_a_line_per_job_and_the_outcome(
+    capsys: pytest.CaptureFixture[str], client, tmp_path: Path
+) -> None:
+    out = tmp_path / "out"
+    address = client.scheduler.address  # the in-process cluster: reachable from this process
+    args = ("batch", str(_two_jobs(tmp_path)), "--out", str(out), "--scheduler", address)
+    code, stdout, _ = run(capsys, *args, "--no-report")
+    rows = read_summary_csv(out / "summary.csv")
+    assert code == (ExitCode.OK if all(row.success for row in rows) else ExitCode.INFEASIBLE)
+    lines = stdout.splitlines()
+    assert [line[:6] for line in lines[:2]] == ["[1/2] ", "[2/2] "]
+    printed = {line[6:].split(": ")[0]: line for line in lines[:2]}
+    assert sorted(printed) == sorted(row.job for row in rows)
+    for row in rows:
+        assert f": {row.status} (" in printed[row.job] and row.worker in printed[row.job]
+    assert lines[2].startswith("study: 2 jobs: ") and f"summary in {out}" in lines[3]
+    code, _, err = run(capsys, *args)
+    assert code == ExitCode.BAD_INPUT and "add --resume" in err
+
+
+def test_batch_draws_a_progress_bar_on_a_terminal(
+    capsys: pytest.CaptureFixture[str],
+    client,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from rich.progress import Progress
+
+    monkeypatch.setenv("TTY_COMPATIBLE", "1")  # rich draws the bar as on a terminal
+    update = Progress.update
+    states: list[tuple[object, object, object]] = []
+
+    def record(self: Progress, task: object, **fields: object) -> None:
+        states.append((fields.get("completed"), fields.get("total"), fields.get("failed")))
+        update(self, task, **fields)
+
+    monkeypatch.setattr(Progress, "update", record)
+    out = tmp_path / "out"
+    args = ("batch", str(_two_jobs(tmp_path)), "--out", str(out), "--no-report")
+    code, stdout, _ = run(capsys, *args, "--scheduler", client.scheduler.address)
+    assert code in (ExitCode.OK, ExitCode.INFEASIBLE)
+    assert states[-1] == (2, 2, 0) and (1, 2, 0) in states
+    assert "[1/2]" not in stdout and "study: 2 jobs" in stdout
+
+
 @pytest.mark.slow
 def test_a_killed_batch_resumes_with_only_the_unfinished_jobs(client, tmp_path: Path) -> None:
     """The CLI on a local cluster of its own is killed (with its workers) after two jobs."""
