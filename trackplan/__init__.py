@@ -71,8 +71,8 @@ if TYPE_CHECKING:
     from trackplan.robots.model import Robot
     from trackplan.search import OptimizeResult, optimize_placement
     from trackplan.status import Status
-    from trackplan.timing import TIME_LAWS, TimeLaw, time_law
     from trackplan.study.runner import run_study
+    from trackplan.timing import TIME_LAWS, TimeLaw, time_law
 
 try:
     __version__ = version("trackplan")
@@ -140,8 +140,8 @@ __all__ = [
     "load_robot",
     "optimize_placement",
     "plan_placement",
-    "time_law",
     "run_study",
+    "time_law",
 ]
 
 

@@ -69,7 +69,8 @@ class ExitCode(enum.IntEnum):
     BAD_INPUT = 2
     INFEASIBLE = 3
     INTERRUPTED = 130
-    """Ctrl-C stopped a search; the best placement found was still planned and written."""
+    """Ctrl-C stopped a search (the best placement found was still planned and written) or a
+    batch (pending jobs cancelled, the summary of the finished ones written)."""
 
 
 def search_exit_code(result: OptimizeResult) -> ExitCode:
@@ -724,7 +725,7 @@ def batch(
         if row.failed:
             console.print(f"  FAILED {escape(row.job)}: {escape(row.message)}")
     console.print(f"  summary in {escape(str(out / 'summary.csv'))} and summary.html")
-    if result.n_cancelled:
+    if result.status is Status.INTERRUPTED:
         return ExitCode.INTERRUPTED
     if result.n_failed:
         return ExitCode.INTERNAL_ERROR

@@ -6,13 +6,12 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import CASES
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import robot_to_yaml
 from trackplan.io.study_file import check_set_key, load_study
 from trackplan.robots.builtin import puma560
-
-CASES = Path(__file__).resolve().parents[2] / "cases"
 
 
 def study(tmp_path: Path, text: str) -> Path:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-CASES = Path(__file__).resolve().parents[2] / "cases"
+from tests.conftest import CASES
 
 TINY = """
 set:

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.study.conftest import CASES, six_jobs, write_study
+from tests.conftest import CASES, REPO
+from tests.study.conftest import six_jobs, write_study
 from trackplan.cli import ExitCode, main
 from trackplan.io.study_file import load_study
 from trackplan.study import read_summary_csv, run_study
@@ -125,7 +126,7 @@ def test_a_killed_batch_resumes_with_only_the_unfinished_jobs(client, tmp_path: 
     """The CLI on a local cluster of its own is killed (with its workers) after two jobs."""
     file = six_jobs(tmp_path)
     out = tmp_path / "out"
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
     command = [sys.executable, "-m", "trackplan", "batch", str(file), "--out", str(out)]
     batch = subprocess.Popen(
         [*command, "--workers", "1", "--no-report"],

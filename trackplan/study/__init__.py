@@ -10,7 +10,6 @@ from trackplan.study.jobs import Job, Study, run_job
 from trackplan.study.runner import (
     StudyProgress,
     StudyResult,
-    StudyStatus,
     connect,
     local_cluster,
     run_study,
@@ -24,7 +23,6 @@ __all__ = [
     "Study",
     "StudyProgress",
     "StudyResult",
-    "StudyStatus",
     "connect",
     "local_cluster",
     "read_summary_csv",

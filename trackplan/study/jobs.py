@@ -22,6 +22,8 @@ from pathlib import Path
 from typing import Any
 
 from trackplan.case import Case
+from trackplan.run_files import RESULT_FILE
+from trackplan.status import Status
 from trackplan.study.summary import JOB_FILE, JobRow, failed_row, row_from_run
 
 JOBS_DIR = "jobs"
@@ -139,7 +141,7 @@ def run_job(job: Job, out_dir: str | Path, report: bool = True) -> JobRow:
     worker = worker_name()
     try:
         result = optimize_placement(job.case, seed=job.seed)
-        if result.stop_reason == "interrupted":
+        if result.status is Status.INTERRUPTED:
             raise KeyboardInterrupt  # a search cut short is not a result to keep
         write_search_run(partial, result, job.case, report=report)
         record = {
@@ -186,4 +188,4 @@ def worker_name() -> str:
 def complete_run(out_dir: str | Path, job: Job) -> bool:
     """True when the job's run folder holds a complete result (``--resume`` skips it)."""
     folder = Path(out_dir) / JOBS_DIR / job.key
-    return (folder / JOB_FILE).is_file() and (folder / "result.json").is_file()
+    return (folder / JOB_FILE).is_file() and (folder / RESULT_FILE).is_file()

@@ -11,7 +11,6 @@ failed; Ctrl-C cancels the pending jobs and still writes the summary of what fin
 
 from __future__ import annotations
 
-import enum
 import math
 import os
 import shutil
@@ -24,6 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from trackplan.errors import CaseError
+from trackplan.status import Status
 from trackplan.study.jobs import (
     JOBS_DIR,
     PARTIAL_SUFFIX,
@@ -55,13 +55,6 @@ POLL_S = 0.2
 
 PRELOAD = "trackplan.study.preload"
 """Module every worker of a local cluster runs at start (allocator, numba warm-up)."""
-
-
-class StudyStatus(enum.Enum):
-    """How a batch ended."""
-
-    COMPLETED = "completed"  # every job ran (feasible, infeasible or failed)
-    INTERRUPTED = "interrupted"  # Ctrl-C: pending jobs were cancelled
 
 
 @dataclass(frozen=True)
@@ -107,7 +100,9 @@ class StudyResult:
     success
         True when every job ran and found a feasible placement.
     status
-        :class:`StudyStatus`.
+        The first that applies: ``INTERRUPTED`` (Ctrl-C), ``FAILED`` (a job raised or lost
+        its workers), the status of the first job without a feasible placement, else
+        ``FEASIBLE``.
     message
         One line: how many jobs were feasible, infeasible, failed, skipped, cancelled.
     rows
@@ -125,7 +120,7 @@ class StudyResult:
     """
 
     success: bool
-    status: StudyStatus
+    status: Status
     message: str
     rows: tuple[JobRow, ...]
     n_jobs: int
@@ -235,10 +230,10 @@ def run_study(
 
     write_study_report(study, ordered, out)
     n_cancelled = len(study.jobs) - len(ordered)
-    success = not interrupted and all(row.success for row in ordered)
+    status = _status(ordered, interrupted)
     return StudyResult(
-        success=success,
-        status=StudyStatus.INTERRUPTED if interrupted else StudyStatus.COMPLETED,
+        success=status.success,
+        status=status,
         message=_message(ordered, len(study.jobs), len(skipped), n_cancelled),
         rows=ordered,
         n_jobs=len(study.jobs),
@@ -411,6 +406,15 @@ def connect(address: str, timeout: float | None = None) -> Client:
             f"no Dask scheduler answers at {address} within {timeout:g} s ({detail})",
             key="--scheduler",
         ) from None
+
+
+def _status(rows: tuple[JobRow, ...], interrupted: bool) -> Status:
+    """The batch's status (see :class:`StudyResult`)."""
+    if interrupted:
+        return Status.INTERRUPTED
+    if any(row.failed for row in rows):
+        return Status.FAILED
+    return next((Status(row.status) for row in rows if not row.success), Status.FEASIBLE)
 
 
 def _message(rows: tuple[JobRow, ...], total: int, skipped: int, cancelled: int) -> str:

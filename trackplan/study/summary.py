@@ -15,12 +15,15 @@ from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from trackplan.run_files import RESULT_FILE
+from trackplan.status import Status
+
 JOB_FILE = "job.json"
 """The job's keys, wall time and worker, written last into a run folder."""
 
 SUMMARY_CSV = "summary.csv"
 
-FAILED = "failed"
+FAILED = Status.FAILED.value
 """Status of a job that raised, or whose workers died too often."""
 
 
@@ -87,7 +90,7 @@ def row_from_run(folder: str | Path) -> JobRow:
     """The summary row of a complete run folder (its ``job.json`` and ``result.json``)."""
     folder = Path(folder)
     job = json.loads((folder / JOB_FILE).read_text())
-    result = json.loads((folder / "result.json").read_text())
+    result = json.loads((folder / RESULT_FILE).read_text())
     n_samples = int(result["n_samples"])
     return JobRow(
         job=job["job"],
