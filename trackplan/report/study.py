@@ -81,7 +81,7 @@ def write_study_report(study: Study, rows: Sequence[JobRow], out_dir: str | Path
             "<h2>Best robot per part</h2>",
             '<p class="muted">Per case and sweep, the feasible job with the least joint travel J '
             "(ties: the shorter cycle time), over every seed.</p>",
-            _best_table(study, rows, out_dir),
+            _best_table(rows, out_dir),
             "<h2>Feasibility</h2>",
             '<p class="muted">Share of the jobs of each robot and case (over sweeps and seeds) '
             "whose final plan passed the checker.</p>",
@@ -199,7 +199,7 @@ def _rank(row: JobRow) -> tuple[float, float]:
     return (row.J, row.cycle_time_s)
 
 
-def _best_table(study: Study, rows: Sequence[JobRow], out_dir: Path) -> str:
+def _best_table(rows: Sequence[JobRow], out_dir: Path) -> str:
     header = ("case", "sweep", "best robot", "J rad", "cycle time s", "seed", "feasible robots")
     lines = []
     for (case, sweep), row in best_per_part(rows).items():
