@@ -1,7 +1,7 @@
 """The ``trackplan`` command line.
 
-Commands: ``validate``, ``robots``, ``cases``, ``plan``, ``check``, ``optimize``, ``export``
-and ``demo`` (the README has the command table).
+Commands: ``validate``, ``robots``, ``cases``, ``plan``, ``check``, ``optimize``, ``export``,
+``demo`` and ``batch`` (the README has the command table).
 
 Exit codes: 0 ok, 1 internal error, 2 bad input, 3 infeasible (:class:`ExitCode`).
 :func:`main` never raises: a :class:`~trackplan.errors.CaseError` becomes one line on
