@@ -19,6 +19,7 @@ files), which the machine's load moves much less.
 
 from __future__ import annotations
 
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -63,6 +64,17 @@ def _dask(study: Study, out: Path, workers: int) -> tuple[float, float, float]:
     return started, batch, sum(row.wall_time_s for row in result.rows)
 
 
+def _autogroup() -> str:
+    """A note when the kernel shares the CPU between sessions, not processes."""
+    flag = Path("/proc/sys/kernel/sched_autogroup_enabled")
+    if flag.is_file() and flag.read_text().strip() == "1":
+        return (
+            "; the kernel's autogroup scheduling is on: under load, this session's processes "
+            "share one session's CPU share, however many workers run"
+        )
+    return ""
+
+
 def _verdict(ok: bool) -> str:
     return "met" if ok else "NOT met"
 
@@ -71,6 +83,7 @@ def main() -> None:
     """Run the benchmark and print its table."""
     keep_freed_memory()  # as in the workers (their preload)
     warm_up()
+    load_start = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="bench-batch-") as folder:
         root = Path(folder)
         cases = ", ".join(f"'{CASES / name}.yaml'" for name in CASE_NAMES)
@@ -81,7 +94,10 @@ def main() -> None:
         runs = {workers: _dask(study, root / f"dask-{workers}", workers) for workers in (1, 2)}
         after, _ = _loop(study, root / "loop-after")
     loop = (before + after) / 2
-    print(f"{n} jobs; times under the machine's load at the time of the run")
+    print(
+        f"{n} jobs on {os.cpu_count()} cores; load average {load_start:.1f} at the start, "
+        f"{os.getloadavg()[0]:.1f} at the end{_autogroup()}"
+    )
     print(f"{'run':<22}{'cluster start s':>16}{'batch s':>10}{'per job s':>11}")
     for label, wall in (("plain loop, before", before), ("plain loop, after", after)):
         print(f"{label:<22}{'–':>16}{wall:>10.2f}{wall / n:>11.2f}")
