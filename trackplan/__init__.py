@@ -44,6 +44,8 @@ Status, Timing, Method, Penalty
     The outcome vocabulary and the named choices.
 PlanResult, OptimizeResult, CheckReport, Trajectory, TimeLaw
     The results.
+run_study(study, out, client=None) -> StudyResult
+    Run a batch study (cases × robots × sweeps × seeds) on Dask (see ``docs/studies.md``).
 CaseError, TrackplanError
     Bad input (with the file and key path), and the root of trackplan's exceptions.
 
@@ -84,6 +86,7 @@ if TYPE_CHECKING:
     from trackplan.search import OptimizeResult, optimize_placement
     from trackplan.search.pareto import ParetoResult, pareto_front
     from trackplan.status import Status
+    from trackplan.study.runner import run_study
     from trackplan.timing import TIME_LAWS, TimeLaw, time_law
 
 try:
@@ -131,6 +134,7 @@ _EXPORTS = {
     "pareto_front": "trackplan.search.pareto",
     "plan_placement": "trackplan.planning.plan",
     "time_law": "trackplan.timing",
+    "run_study": "trackplan.study.runner",
 }
 
 __all__ = [
@@ -169,6 +173,7 @@ __all__ = [
     "optimize_placement",
     "pareto_front",
     "plan_placement",
+    "run_study",
     "time_law",
 ]
 

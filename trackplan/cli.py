@@ -1,7 +1,7 @@
 """The ``trackplan`` command line.
 
-Commands: ``validate``, ``robots``, ``cases``, ``plan``, ``check``, ``optimize``, ``export``
-and ``demo`` (the README has the command table).
+Commands: ``validate``, ``robots``, ``cases``, ``plan``, ``check``, ``optimize``, ``export``,
+``demo`` and ``batch`` (the README has the command table).
 
 Exit codes: 0 ok, 1 internal error, 2 bad input, 3 infeasible (:class:`ExitCode`).
 :func:`main` never raises: a :class:`~trackplan.errors.CaseError` becomes one line on
@@ -30,12 +30,11 @@ and lets :func:`main` report it; it prints results with :func:`_console` or
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import enum
 import os
 import sys
 import traceback
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -46,6 +45,7 @@ from rich.markup import escape
 from rich.table import Table
 
 import trackplan
+from trackplan.allocator import keep_freed_memory
 from trackplan.case import Case
 from trackplan.choices import Timing, choose
 from trackplan.errors import CaseError
@@ -69,7 +69,8 @@ class ExitCode(enum.IntEnum):
     BAD_INPUT = 2
     INFEASIBLE = 3
     INTERRUPTED = 130
-    """Ctrl-C stopped a search; the best placement found was still planned and written."""
+    """Ctrl-C stopped a search (the best placement found was still planned and written) or a
+    batch (pending jobs cancelled, the summary of the finished ones written)."""
 
 
 def search_exit_code(result: OptimizeResult) -> ExitCode:
@@ -105,27 +106,6 @@ def _options(
     # main() reads --debug from the arguments itself: it must know before parsing succeeds.
 
 
-MALLOC_MMAP_THRESHOLD = 64 * 2**20
-"""Bytes: glibc serves smaller allocations from its heap instead of fresh mmaps."""
-
-
-def _keep_freed_memory() -> None:
-    """Let glibc reuse freed memory for the batched arrays instead of mapping them anew.
-
-    By default glibc maps every allocation above 128 KiB (raised only gradually) and
-    unmaps it on free, so each generation of the placement search page-faults its (B, M, …)
-    arrays in again: measured 1.1 s of a 4 s search. The CLI owns its process, so it sets
-    a fixed 64 MiB threshold; elsewhere (not glibc) this does nothing.
-    """
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        m_trim_threshold, m_mmap_threshold = -1, -3  # mallopt parameters, <malloc.h>
-        libc.mallopt(m_mmap_threshold, MALLOC_MMAP_THRESHOLD)
-        libc.mallopt(m_trim_threshold, 2 * MALLOC_MMAP_THRESHOLD)
-    except (OSError, AttributeError):
-        pass
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the command line and return its exit code; never raises.
 
@@ -140,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
         An :class:`ExitCode` value (130 on Ctrl-C).
     """
     args = sys.argv[1:] if argv is None else list(argv)
-    _keep_freed_memory()
+    keep_freed_memory()
     debug = "--debug" in args or os.environ.get(DEBUG_ENV, "") not in ("", "0")
     try:
         command = typer.main.get_command(app)
@@ -586,6 +566,8 @@ def optimize(
     ``initial`` blocks, plots and report.html unless --no-report) plus history.csv. Ctrl-C
     stops the search and still writes everything for the best placement found.
     """
+    from trackplan.outputs import write_search_run
+
     loaded = load_case(case)
     if objective is not None:
         from trackplan.planning.objectives import with_objective
@@ -596,7 +578,7 @@ def optimize(
     result = _search(
         loaded, method=method, seed=seed, budget=budget, restarts=restarts, timing=_timing(timing)
     )
-    _write_search(out, result, loaded, report=report)
+    write_search_run(out, result, loaded, report=report)
     _print_search(result, out)
     return search_exit_code(result)
 
@@ -609,9 +591,11 @@ def demo(
     file = shipped_cases_dir() / "paper-corner.yaml"
     if not file.is_file():
         raise CaseError("the shipped demo case is missing (run from a source checkout)", str(file))
+    from trackplan.outputs import write_search_run
+
     loaded = load_case(file)
     result = _search(loaded)
-    _write_search(out, result, loaded, report=True)
+    write_search_run(out, result, loaded, report=True)
     _print_search(result, out)
     typer.echo(f"report: {(out / 'report.html').resolve()}")
     return search_exit_code(result)
@@ -721,17 +705,6 @@ def _search(case: Case, **options):  # type: ignore[no-untyped-def]
         return optimize_placement(case, progress=show, **options)
 
 
-def _write_search(out: Path, result, case: Case, *, report: bool) -> None:  # type: ignore[no-untyped-def]
-    """trackplan.outputs.write_run for the final plan, with the search blocks and history.csv."""
-    from trackplan.io.history import optimizer_summary, write_history
-    from trackplan.outputs import write_run
-
-    history = {result.method: result.history.as_columns()} if len(result.history) else None
-    extra = optimizer_summary(result, case.robot.joint_names)
-    write_run(out, result.final, case, history=history, extra=extra, report=report)
-    write_history(result, out)
-
-
 def _print_search(result, out: Path) -> None:  # type: ignore[no-untyped-def]
     """The search summary, then the final plan's summary."""
     console = _console()
@@ -760,3 +733,106 @@ def _print_search(result, out: Path) -> None:  # type: ignore[no-untyped-def]
 
 def _vector(values: np.ndarray) -> str:
     return "(" + ", ".join(f"{v:.4f}" for v in values) + ")"
+
+
+# --------------------------------------------------------------------------- batch studies
+
+
+@app.command()
+def batch(
+    study: Annotated[Path, typer.Argument(help="Study file.", show_default=False)],
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/batch"),
+    workers: Annotated[
+        int | None,
+        typer.Option("--workers", help="Local worker processes (default: one per core)."),
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option("--scheduler", help="Run on an existing Dask cluster: tcp://HOST:PORT."),
+    ] = None,
+    resume: Annotated[
+        bool, typer.Option("--resume", help="Keep the jobs already complete in --out.")
+    ] = False,
+    report: Annotated[bool, typer.Option(help="Write each run's plots and report.html.")] = True,
+) -> ExitCode:
+    """Run a study (cases × robots × sweeps × seeds) on Dask; write summary.csv and summary.html.
+
+    Exit code 0 when every job found a feasible placement, 3 when some did not, 1 when a
+    job failed, 130 on Ctrl-C (pending jobs cancelled, the summary of the finished written).
+    """
+    from trackplan.io.study_file import load_study
+    from trackplan.study import connect, run_study
+
+    if workers is not None and scheduler is not None:
+        raise CaseError("give --workers or --scheduler, not both", key="--scheduler")
+    loaded = load_study(study)
+    client = connect(scheduler) if scheduler is not None else None
+    try:
+        with _study_progress(len(loaded.jobs)) as show:
+            result = run_study(
+                loaded, out, client, workers=workers, resume=resume, report=report, progress=show
+            )
+    finally:
+        if client is not None:
+            client.close()
+    console = _console()
+    console.print(f"{escape(loaded.name)}: {escape(result.message)} in {result.wall_time_s:.1f} s")
+    for row in result.rows:
+        if row.failed:
+            console.print(f"  FAILED {escape(row.job)}: {escape(row.message)}")
+    console.print(f"  summary in {escape(str(out / 'summary.csv'))} and summary.html")
+    if result.status is Status.INTERRUPTED:
+        return ExitCode.INTERRUPTED
+    if result.n_failed:
+        return ExitCode.INTERNAL_ERROR
+    return ExitCode.OK if result.success else ExitCode.INFEASIBLE
+
+
+@contextmanager
+def _study_progress(total: int):  # type: ignore[no-untyped-def]
+    """A progress callback for run_study: a rich bar on a terminal, else one line per job."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    console = Console(stderr=True)
+    if not console.is_terminal:
+
+        def line(state) -> None:  # type: ignore[no-untyped-def]
+            row = state.last
+            if row is not None:
+                figures = f"J = {row.J:.4f}, " if row.success else ""
+                typer.echo(
+                    f"[{state.done}/{state.total}] {row.job}: {row.status} "
+                    f"({figures}{row.wall_time_s:.1f} s on {row.worker})"
+                )
+
+        yield line
+        return
+    columns = (
+        TextColumn("batch"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[running]} running, {task.fields[failed]} failed"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, console=console, transient=True) as bar:
+        task = bar.add_task("batch", total=total, running=0, failed=0)
+
+        def update(state) -> None:  # type: ignore[no-untyped-def]
+            bar.update(
+                task,
+                total=state.total - state.skipped,
+                completed=state.done - state.skipped,
+                running=state.running,
+                failed=state.failed,
+            )
+
+        yield update

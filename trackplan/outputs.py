@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from trackplan.case import Case
 from trackplan.io.results import write_plan_files
 from trackplan.planning.result import PlanResult
+
+if TYPE_CHECKING:  # the search (pymoo) is not needed to write a plan
+    from trackplan.search import OptimizeResult
 
 
 def write_run(
@@ -47,4 +51,33 @@ def write_run(
 
         plots = write_plots(result, case, out_dir, history)
         write_report(result, case, out_dir, plots, history=history, optimizer_info=extra)
+    return summary
+
+
+def write_search_run(out_dir: Path, result: OptimizeResult, case: Case, *, report: bool) -> dict:
+    """Write a placement search's run folder: :func:`write_run` for the final plan, with the
+    ``optimizer`` and ``initial`` blocks in ``result.json``, and ``history.csv``.
+
+    Parameters
+    ----------
+    out_dir
+        Output folder (created).
+    result
+        The search.
+    case
+        Its case.
+    report
+        Also write the plots and the HTML report.
+
+    Returns
+    -------
+    dict
+        The ``result.json`` content.
+    """
+    from trackplan.io.history import optimizer_summary, write_history
+
+    history = {result.method: result.history.as_columns()} if len(result.history) else None
+    extra = optimizer_summary(result, case.robot.joint_names)
+    summary = write_run(out_dir, result.final, case, history=history, extra=extra, report=report)
+    write_history(result, Path(out_dir))
     return summary

@@ -245,7 +245,31 @@ def load_case_text(text: str, file: str | None = None, base_dir: str | Path | No
         See :func:`load_case`.
     """
     base = Path(base_dir) if base_dir is not None else Path(file).parent if file else Path()
-    data = parse_yaml(text, file)
+    return load_case_data(parse_yaml(text, file), file, base)
+
+
+def load_case_data(data: Any, file: str | None, base_dir: str | Path) -> Case:
+    """Build a case from the parsed data of a case file (a study's overrides applied to it).
+
+    Parameters
+    ----------
+    data
+        The YAML document as loaded: a mapping in the case file format.
+    file
+        The file the data came from, for messages and :attr:`Case.source`.
+    base_dir
+        Folder that relative robot and points file names start from.
+
+    Returns
+    -------
+    Case
+
+    Raises
+    ------
+    CaseError
+        See :func:`load_case`.
+    """
+    base = Path(base_dir)
     model = validate_model(CaseModel, data, file)
     robot = load_robot_spec(model.robot, base, case_file=file)
     start = _array(model.path.start)

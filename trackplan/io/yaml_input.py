@@ -321,7 +321,7 @@ def _entries(n: int) -> str:
 
 def _unknown_key_message(model: type[BaseModel], loc: Loc) -> str:
     names = [part for part in loc if isinstance(part, str)]
-    parent = _model_at(model, names[:-1])
+    parent = model_at(model, names[:-1])
     if parent is None:
         return "unknown key"
     allowed = list(parent.model_fields)
@@ -330,7 +330,7 @@ def _unknown_key_message(model: type[BaseModel], loc: Loc) -> str:
     return f"unknown key; {hint}expected one of: {', '.join(allowed)}"
 
 
-def _model_at(model: type[BaseModel], names: Sequence[str]) -> type[BaseModel] | None:
+def model_at(model: type[BaseModel], names: Sequence[str]) -> type[BaseModel] | None:
     """The schema of the mapping at a path of field names (list indices left out)."""
     current: type[BaseModel] | None = model
     for name in names:

@@ -1,0 +1,229 @@
+"""One summary row per job, read from its run folder, and ``summary.csv``.
+
+A row is built from the files a job wrote (``result.json`` and ``job.json``), both for a
+job that just finished and for one a resumed batch skips, so the summary always says
+what the run folders hold.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Iterable
+from dataclasses import astuple, dataclass, fields
+from pathlib import Path
+from typing import Any, TextIO
+
+from trackplan.run_files import RESULT_FILE
+from trackplan.status import Status
+
+JOB_FILE = "job.json"
+"""The job's keys, wall time and worker, written last into a run folder."""
+
+SUMMARY_CSV = "summary.csv"
+
+FAILED = Status.FAILED.value
+"""Status of a job that raised, or whose workers died too often."""
+
+
+@dataclass(frozen=True)
+class JobRow:
+    """The summary of one job (a row of ``summary.csv``).
+
+    Attributes
+    ----------
+    job
+        The job's key (its run folder's name).
+    case, robot, sweep, seed
+        The job's keys (see :class:`~trackplan.study.jobs.Job`).
+    status
+        The final plan's status (``feasible``, ``limits_violated``, ``unreachable``, …)
+        or ``failed`` when the job raised or lost its workers.
+    success
+        True when the final plan passed the checker.
+    J
+        Joint travel of the final plan (Eq. 8), rad (NaN without a trajectory).
+    duration_s
+        Duration of the path motion, s.
+    cycle_time_s
+        Time from the first to the last sample of the written trajectory (rest to rest), s.
+    tracking_error_m
+        Largest distance of the tool point from the nominal path, m.
+    worst_margin
+        Smallest unused fraction over every limit (negative: a limit is broken).
+    wall_time_s
+        Wall time of the job on its worker, s.
+    worker
+        The Dask worker's address (``host:pid`` outside Dask).
+    message
+        The plan's one-line outcome, or why the job failed.
+    """
+
+    job: str
+    case: str
+    robot: str
+    sweep: str
+    seed: int
+    status: str
+    success: bool
+    J: float
+    duration_s: float
+    cycle_time_s: float
+    tracking_error_m: float
+    worst_margin: float
+    wall_time_s: float
+    worker: str
+    message: str
+
+    @property
+    def failed(self) -> bool:
+        """True when the job produced no result."""
+        return self.status == FAILED
+
+
+COLUMNS = tuple(field.name for field in fields(JobRow))
+"""Columns of ``summary.csv``."""
+
+
+def row_from_run(folder: str | Path) -> JobRow:
+    """The summary row of a complete run folder (its ``job.json`` and ``result.json``)."""
+    folder = Path(folder)
+    job = json.loads((folder / JOB_FILE).read_text())
+    result = json.loads((folder / RESULT_FILE).read_text())
+    n_samples = int(result["n_samples"])
+    return JobRow(
+        job=job["job"],
+        case=job["case"],
+        robot=job["robot"],
+        sweep=job["sweep"],
+        seed=int(job["seed"]),
+        status=str(result["status"]),
+        success=bool(result["feasible"]),
+        J=float(result["objective"]),
+        duration_s=float(result["duration"]),
+        cycle_time_s=(n_samples - 1) * float(result["sample_time"]) if n_samples else math.nan,
+        tracking_error_m=float(result["max_tracking_error"]),
+        worst_margin=worst_margin(result["margins"]),
+        wall_time_s=float(job["wall_time_s"]),
+        worker=str(job["worker"]),
+        message=str(result["message"]),
+    )
+
+
+def failed_row(job: dict[str, Any], reason: str, wall_time_s: float, worker: str) -> JobRow:
+    """The row of a job without a result.
+
+    Parameters
+    ----------
+    job
+        The job's keys (:meth:`~trackplan.study.jobs.Job.describe`).
+    reason
+        Why it failed, one line.
+    wall_time_s
+        Time spent before it failed, s (NaN when unknown).
+    worker
+        Where it failed (empty when unknown).
+    """
+    nan = math.nan
+    return JobRow(
+        job=job["job"],
+        case=job["case"],
+        robot=job["robot"],
+        sweep=job["sweep"],
+        seed=int(job["seed"]),
+        status=FAILED,
+        success=False,
+        J=nan,
+        duration_s=nan,
+        cycle_time_s=nan,
+        tracking_error_m=nan,
+        worst_margin=nan,
+        wall_time_s=wall_time_s,
+        worker=worker,
+        message=reason,
+    )
+
+
+def worst_margin(margins: dict[str, Any]) -> float:
+    """The smallest margin of ``result.json``'s ``margins`` block (per joint or per task).
+
+    NaN when there is none (no trajectory).
+    """
+    values = [
+        float(value)
+        for entry in margins.values()
+        for value in (entry.values() if isinstance(entry, dict) else (entry,))
+    ]
+    finite = [value for value in values if math.isfinite(value)]
+    return min(finite) if finite else math.nan
+
+
+class SummaryWriter:
+    """``summary.csv`` written row by row as jobs complete (flushed after each row).
+
+    Parameters
+    ----------
+    file
+        The CSV file (replaced).
+    """
+
+    def __init__(self, file: str | Path):
+        self.file = Path(file)
+        self._handle: TextIO = self.file.open("w", newline="", encoding="utf-8")
+        self._writer = csv.writer(self._handle)
+        self._writer.writerow(COLUMNS)
+        self._handle.flush()
+
+    def add(self, row: JobRow) -> None:
+        """Append one row."""
+        self._writer.writerow(_cells(row))
+        self._handle.flush()
+
+    def close(self) -> None:
+        """Close the file."""
+        self._handle.close()
+
+
+def write_summary_csv(rows: Iterable[JobRow], file: str | Path) -> None:
+    """Write ``summary.csv`` with the given rows."""
+    writer = SummaryWriter(file)
+    try:
+        for row in rows:
+            writer.add(row)
+    finally:
+        writer.close()
+
+
+def read_summary_csv(file: str | Path) -> list[JobRow]:
+    """Read ``summary.csv`` back into rows."""
+    with Path(file).open(newline="", encoding="utf-8") as handle:
+        return [_row(cells) for cells in csv.DictReader(handle)]
+
+
+def _cells(row: JobRow) -> list[str]:
+    """CSV cells: floats in full precision (``repr``), booleans as true/false."""
+    cells = []
+    for value in astuple(row):
+        if isinstance(value, bool):
+            cells.append("true" if value else "false")
+        elif isinstance(value, float):
+            cells.append(repr(value))
+        else:
+            cells.append(str(value))
+    return cells
+
+
+def _row(cells: dict[str, str]) -> JobRow:
+    values: dict[str, Any] = {}
+    for field in fields(JobRow):
+        text = cells[field.name]
+        if field.type == "bool":
+            values[field.name] = text == "true"
+        elif field.type == "int":
+            values[field.name] = int(text)
+        elif field.type == "float":
+            values[field.name] = float(text)
+        else:
+            values[field.name] = text
+    return JobRow(**values)
