@@ -133,7 +133,8 @@ def test_bad_method_exits_2(capsys: pytest.CaptureFixture[str], tmp_path: Path) 
     code, _, err = run(
         capsys, "optimize", str(CASES / "paper-line.yaml"), "--method", "pso", "--out", "x"
     )
-    assert code == ExitCode.BAD_INPUT and "method must be one of multistart, ga, cmaes, de, random" in err
+    assert code == ExitCode.BAD_INPUT
+    assert "method must be one of multistart, ga, cmaes, de, random" in err
 
 
 def test_history_round_trip(tmp_path: Path) -> None:
