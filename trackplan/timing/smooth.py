@@ -39,11 +39,9 @@ from trackplan.status import Status
 from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
-    change_distances,
     cruise_cap,
     speed_change,
     uniform_change_bounds,
-    uniform_change_bounds_many,
 )
 from trackplan.timing.profile import (
     SpeedProfile,
@@ -305,18 +303,14 @@ class _ZonePlanner:
         """
         s0, s1, _ = self.zones[z]
         share = LIMIT_SHARE * self.change_scale[z]
-        demand = self.demands[z]
-        top = np.maximum(v_from, v_to)
-        accel, jerk = uniform_change_bounds_many(self.robot, demand.peaks(), top, share)
-        distance = change_distances(v_from, v_to, accel, jerk)
-        rise = bool(np.all(v_to >= v_from))
-        stretch = np.minimum(distance, s1 - s0)
-        local = demand.stretch_peaks(np.where(np.isfinite(stretch), stretch, 0.0), rise)
-        local_accel, local_jerk = uniform_change_bounds_many(self.robot, local, top, share)
-        refined = change_distances(
-            v_from, v_to, np.maximum(accel, local_accel), np.maximum(jerk, local_jerk)
+        return self.demands[z].quick_distances(
+            np.asarray(v_from, dtype=float),
+            np.asarray(v_to, dtype=float),
+            bool(np.all(v_to >= v_from)),
+            s1 - s0,
+            share * self.robot.a_max,
+            share * self.robot.j_max,
         )
-        return np.where(np.isfinite(distance) & (distance < s1 - s0), refined, distance)
 
     def quick_change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
         """One change of :meth:`quick_distances`, with its bounds."""
