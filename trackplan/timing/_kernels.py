@@ -23,7 +23,7 @@ MAX_PATH_JERK = 5000.0
 
 
 @njit(cache=True)
-def _bounds(
+def change_bounds(
     q1: np.ndarray,
     q2: np.ndarray,
     q3: np.ndarray,
@@ -31,7 +31,11 @@ def _bounds(
     a_limit: np.ndarray,
     j_limit: np.ndarray,
 ) -> tuple[float, float]:
-    """Path acceleration and jerk bounds at one top speed (``uniform_change_bounds``)."""
+    """Path acceleration and jerk bounds at one top speed, m/s² and m/s³.
+
+    :func:`~trackplan.timing.demand.uniform_change_bounds` for peaks ``q1, q2, q3`` (n,)
+    and the shares of the joint limits ``a_limit, j_limit`` (n,).
+    """
     accel_ratio = np.inf
     coupling_ratio = np.inf
     for i in range(q1.size):
@@ -106,7 +110,7 @@ def quick_distances(
     out = np.empty(v_from.size)
     for k in range(v_from.size):
         top = max(v_from[k], v_to[k])
-        accel, jerk = _bounds(peaks[0], peaks[1], peaks[2], top, a_limit, j_limit)
+        accel, jerk = change_bounds(peaks[0], peaks[1], peaks[2], top, a_limit, j_limit)
         distance = _distance(v_from[k], v_to[k], accel, jerk)
         if not (np.isfinite(distance) and distance < length):
             out[k] = distance
@@ -119,7 +123,7 @@ def quick_distances(
             row = np.searchsorted(s, s[-1] - stretch, side="right") - 2
             row = min(max(row, 0), n_grid - 1)
         local = running[row]
-        local_accel, local_jerk = _bounds(local[0], local[1], local[2], top, a_limit, j_limit)
+        local_accel, local_jerk = change_bounds(local[0], local[1], local[2], top, a_limit, j_limit)
         out[k] = _distance(v_from[k], v_to[k], max(accel, local_accel), max(jerk, local_jerk))
     return out
 

@@ -218,8 +218,10 @@ def uniform_change_bounds(
     tuple of float
         ``(accel, jerk)``, m/s² and m/s³ (≤ 0 when the top speed leaves no room).
     """
-    accel, jerk = uniform_change_bounds_many(robot, peaks, np.array([top_speed]), share)
-    return float(accel[0]), float(jerk[0])
+    q1, q2, q3 = (np.asarray(p, dtype=float) for p in peaks)
+    return _kernels.change_bounds(  # type: ignore[no-any-return]
+        q1, q2, q3, float(top_speed), share * robot.a_max, share * robot.j_max
+    )
 
 
 def uniform_change_bounds_many(
