@@ -223,3 +223,67 @@ def changes_within_limits(
             if not ok[k]:
                 break
     return ok, distance
+
+
+@njit(cache=True)
+def _runs(level: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """First and last index of each run of equal values, each shape (R,)."""
+    n_runs = 1
+    for k in range(1, level.size):
+        if level[k] != level[k - 1]:
+            n_runs += 1
+    starts = np.empty(n_runs, dtype=np.int64)
+    ends = np.empty(n_runs, dtype=np.int64)
+    starts[0] = 0
+    r = 0
+    for k in range(1, level.size):
+        if level[k] != level[k - 1]:
+            ends[r] = k - 1
+            r += 1
+            starts[r] = k
+    ends[r] = level.size - 1
+    return starts, ends
+
+
+@njit(cache=True)
+def level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> tuple[np.ndarray, np.ndarray]:
+    """Runs of equal speed level along a zone's grid, runs under ``shortest`` merged.
+
+    The shortest run under ``shortest`` (m) joins its slower neighbour (the higher level;
+    the earlier one on a tie); when it is itself the slowest, that neighbour slows down
+    to it. Repeated until no run is short or one run is left.
+
+    Parameters
+    ----------
+    s
+        Grid, shape (G,), m, increasing (G ≥ 1).
+    level
+        Speed level of each grid point, shape (G,), int (higher is slower).
+    shortest
+        Shortest run kept, m.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        First and last grid index of each run, each shape (R,).
+    """
+    level = level.copy()
+    while True:
+        starts, ends = _runs(level)
+        if starts.size == 1:
+            return starts, ends
+        k = -1
+        for r in range(starts.size):
+            length = s[ends[r]] - s[starts[r]]
+            if length < shortest and (k < 0 or length < s[ends[k]] - s[starts[k]]):
+                k = r
+        if k < 0:
+            return starts, ends
+        own = level[starts[k]]
+        slower = k - 1 if k > 0 else k + 1
+        if k + 1 < starts.size and level[starts[k + 1]] > level[starts[slower]]:
+            slower = k + 1
+        if level[starts[slower]] >= own:
+            level[starts[k] : ends[k] + 1] = level[starts[slower]]
+        else:
+            level[starts[slower] : ends[slower] + 1] = own

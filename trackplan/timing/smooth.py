@@ -36,6 +36,7 @@ from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
 from trackplan.robots.model import Robot
 from trackplan.status import Status
+from trackplan.timing import _kernels
 from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
@@ -243,24 +244,9 @@ def _slow_down_windows(
 
 def _level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> list[tuple[int, int]]:
     """Runs (first, last grid index) of equal level, runs under ``shortest`` (m) merged
-    into slower ones."""
-    level = level.copy()
-    while True:
-        edges = np.flatnonzero(np.diff(level)) + 1
-        starts = np.concatenate([[0], edges])
-        ends = np.concatenate([edges - 1, [len(level) - 1]])
-        lengths = s[ends] - s[starts]
-        short = np.flatnonzero(lengths < shortest)
-        if short.size == 0 or len(starts) == 1:
-            return list(zip(starts.tolist(), ends.tolist(), strict=True))
-        k = int(short[np.argmin(lengths[short])])
-        own = int(level[starts[k]])
-        neighbours = [j for j in (k - 1, k + 1) if 0 <= j < len(starts)]
-        slower = max(neighbours, key=lambda j: int(level[starts[j]]))
-        if int(level[starts[slower]]) >= own:  # join the slower neighbour
-            level[starts[k] : ends[k] + 1] = level[starts[slower]]
-        else:  # the short run is the slowest: its slower neighbour slows down to it
-            level[starts[slower] : ends[slower] + 1] = own
+    into slower ones (compiled: :func:`trackplan.timing._kernels.level_runs`)."""
+    starts, ends = _kernels.level_runs(s, level.astype(np.int64), shortest)
+    return list(zip(starts.tolist(), ends.tolist(), strict=True))
 
 
 class _ZonePlanner:
