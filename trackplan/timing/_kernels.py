@@ -287,3 +287,45 @@ def level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> tuple[np.nd
             level[starts[k] : ends[k] + 1] = level[starts[slower]]
         else:
             level[starts[slower] : ends[slower] + 1] = own
+
+
+@njit(cache=True)
+def rate_ratios(q: np.ndarray, steps: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    """Largest joint velocity, acceleration and jerk over their limits, per sample.
+
+    Backward differences at rest before the first sample and for the three samples after
+    the last, as :func:`trackplan.derivatives.backward_derivatives` with ``pad_end``
+    computes them (same differences, same order of operations).
+
+    Parameters
+    ----------
+    q
+        Joint positions, shape (N, n), rad (N ≥ 1).
+    steps
+        ``Ts, Ts², Ts³``, shape (3,).
+    limits
+        The velocity, acceleration and jerk each ratio is taken against, shape (3, n).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N + 3, 3): max over the joints of ``|derivative| / limit``, per order.
+    """
+    n_samples, n_dof = q.shape
+    out = np.zeros((n_samples + 3, 3))
+    for r in range(n_samples + 3):
+        for i in range(n_dof):
+            p0 = q[min(max(r - 3, 0), n_samples - 1), i]
+            p1 = q[min(max(r - 2, 0), n_samples - 1), i]
+            p2 = q[min(max(r - 1, 0), n_samples - 1), i]
+            p3 = q[min(r, n_samples - 1), i]
+            first_a = p1 - p0
+            first_b = p2 - p1
+            first_c = p3 - p2
+            second_b = first_c - first_b
+            second_a = first_b - first_a
+            third = second_b - second_a
+            out[r, 0] = max(out[r, 0], abs(first_c / steps[0]) / limits[0, i])
+            out[r, 1] = max(out[r, 1], abs(second_b / steps[1]) / limits[1, i])
+            out[r, 2] = max(out[r, 2], abs(third / steps[2]) / limits[2, i])
+    return out

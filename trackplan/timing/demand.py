@@ -51,12 +51,14 @@ class ZoneDemand:
     d3: np.ndarray
     _abs: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
     _peaks: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
+    _peak_array: np.ndarray = field(init=False, repr=False)
     _maxima: list[np.ndarray | None] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         absolute = (np.abs(self.d1), np.abs(self.d2), np.abs(self.d3))
         object.__setattr__(self, "_abs", absolute)
         object.__setattr__(self, "_peaks", tuple(d.max(axis=0) for d in absolute))
+        object.__setattr__(self, "_peak_array", np.stack(self._peaks))
         object.__setattr__(self, "_maxima", [None, None])
 
     @property
@@ -135,7 +137,7 @@ class ZoneDemand:
         """
         return _kernels.quick_distances(  # type: ignore[no-any-return]
             self.s,
-            np.stack(self._peaks),
+            self._peak_array,
             self._running(0 if rise else 1),
             v_from,
             v_to,
