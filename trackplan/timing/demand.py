@@ -352,7 +352,7 @@ def speed_change(
     for factors in (BOUND_FACTORS, FINE_FACTORS):
         a_trial = np.minimum(best.accel * factors, MAX_PATH_ACCELERATION)
         j_trial = np.minimum(best.jerk * factors, MAX_PATH_JERK)
-        a_grid, j_grid = (g.ravel() for g in np.meshgrid(a_trial, j_trial, indexing="ij"))
+        a_grid, j_grid = np.repeat(a_trial, j_trial.size), np.tile(j_trial, a_trial.size)
         ok, distance = _changes_within_limits(
             robot, demand, s_start, s_end, v_from, v_to, at_start, share, a_grid, j_grid
         )
