@@ -38,7 +38,10 @@ def backward_derivatives(
     if pad_end:
         parts.append(np.repeat(q[-1:], REST_PADDING, axis=0))
     padded = np.concatenate(parts, axis=0)
-    qd = np.diff(padded, 1, axis=0) / sample_time
-    qdd = np.diff(padded, 2, axis=0) / sample_time**2
-    qddd = np.diff(padded, 3, axis=0) / sample_time**3
+    first = np.diff(padded, axis=0)
+    second = np.diff(first, axis=0)  # np.diff(padded, 2) exactly
+    third = np.diff(second, axis=0)
+    qd = first / sample_time
+    qdd = second / sample_time**2
+    qddd = third / sample_time**3
     return qd[REST_PADDING - 1 :], qdd[REST_PADDING - 2 :], qddd

@@ -10,6 +10,7 @@ search's final plan read it; only the trajectory samples themselves need the IK 
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,21 +98,13 @@ class JointPath:
         """
         placement = np.asarray(placement, dtype=float)
         tool_rpy = np.asarray(tool_rpy, dtype=float)
-        grids = geometry.zone_grids()
-        zones = geometry.zones()
-        s = np.concatenate(grids)
-        zone = np.repeat(np.arange(len(grids)), [len(g) for g in grids])
-        lo = np.array([z[0] for z in zones])[zone]
-        hi = np.array([z[1] for z in zones])[zone]
-        steps = np.array([(g[-1] - g[0]) / max(len(g) - 1, 1) for g in grids])
-        h = STENCIL_FRACTION * steps[zone]
-        points, offset = stencil_points(s, lo, hi, h)
-        poses = tool_poses(placement, geometry.planned.sample(points.ravel()).position, tool_rpy)
+        grid = _planning_grid(geometry)
+        poses = tool_poses(placement, grid.positions, tool_rpy)
         ik = solve_path_ik(robot, poses[None], branch=branch)
-        q_points = ik.q[0].reshape(*points.shape, robot.n_dof)
-        dq, ddq, dddq = stencil_derivatives(q_points, offset, h)
-        q = q_points[np.arange(len(s)), offset]
-        return cls(robot, geometry, placement, tool_rpy, s, zone, q, dq, ddq, dddq, ik)
+        q_points = ik.q[0].reshape(*grid.points.shape, robot.n_dof)
+        dq, ddq, dddq = stencil_derivatives(q_points, grid.offset, grid.h)
+        q = q_points[np.arange(len(grid.s)), grid.offset]
+        return cls(robot, geometry, placement, tool_rpy, grid.s, grid.zone, q, dq, ddq, dddq, ik)
 
     @property
     def success(self) -> bool:
@@ -205,3 +198,50 @@ class JointPath:
         points, offset = stencil_points(np.asarray(s, dtype=float), lo, hi, spacing)
         q = self.joints(points.ravel()).reshape(*points.shape, self.robot.n_dof)
         return stencil_derivatives(q, offset, spacing)
+
+
+@dataclass(frozen=True, eq=False)
+class _PlanningGrid:
+    """The planning grid of a path geometry and its stencils: the same for every placement.
+
+    Attributes
+    ----------
+    s, zone
+        Grid arc lengths (G,), m, and the zone of each, (G,).
+    points, offset
+        Stencil arc lengths (G, W), m, and the column of each grid point in them, (G,).
+    h
+        Stencil spacing of each grid point, (G,), m.
+    positions
+        Planned-path points at the stencils, shape (G·W, 3), m, definition frame.
+    """
+
+    s: np.ndarray
+    zone: np.ndarray
+    points: np.ndarray
+    offset: np.ndarray
+    h: np.ndarray
+    positions: np.ndarray
+
+
+_GRIDS: weakref.WeakKeyDictionary[PathGeometry, _PlanningGrid] = weakref.WeakKeyDictionary()
+"""Planning grids of the geometries alive (a search plans many placements on one)."""
+
+
+def _planning_grid(geometry: PathGeometry) -> _PlanningGrid:
+    """The geometry's planning grid (:meth:`PathGeometry.zone_grids`), built once per geometry."""
+    if geometry not in _GRIDS:
+        grids = geometry.zone_grids()
+        zones = geometry.zones()
+        s = np.concatenate(grids)
+        zone = np.repeat(np.arange(len(grids)), [len(g) for g in grids])
+        lo = np.array([z[0] for z in zones])[zone]
+        hi = np.array([z[1] for z in zones])[zone]
+        steps = np.array([(g[-1] - g[0]) / max(len(g) - 1, 1) for g in grids])
+        h = STENCIL_FRACTION * steps[zone]
+        points, offset = stencil_points(s, lo, hi, h)
+        positions = geometry.planned.sample(points.ravel()).position
+        for array in (s, zone, points, offset, h, positions):
+            array.flags.writeable = False
+        _GRIDS[geometry] = _PlanningGrid(s, zone, points, offset, h, positions)
+    return _GRIDS[geometry]

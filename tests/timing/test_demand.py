@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from trackplan.timing.demand import (
     ZoneDemand,
+    _changes_within_limits,
     change_distances,
     speed_change,
     uniform_change_bounds,
@@ -122,3 +123,104 @@ def test_stretch_peaks_are_the_maxima_over_the_stretch():
             got = demand.stretch_peaks(np.array([distance]), at_start)[0]
             stretch = (0.0, distance) if at_start else (0.1 - distance, 0.1)
             np.testing.assert_array_equal(got, np.array(demand.peaks(*stretch)))
+
+
+@settings(max_examples=20, deadline=None, derandomize=True)
+@given(
+    amplitude=st.floats(0.0, 0.1),
+    rate=st.floats(1.0, 40.0),
+    slope=st.floats(-3.0, 3.0),
+    share=st.floats(0.5, 1.0),
+    rise=st.booleans(),
+)
+def test_compiled_quick_distances_match_the_numpy_bounds(puma, amplitude, rate, slope, share, rise):
+    """The kernel against its numpy composition: zone-wide bounds, then stretch bounds."""
+    joints = np.arange(6.0)
+    path = _wavy_path(
+        np.full(6, amplitude), rate * (1 + 0.1 * joints), joints, slope * (1 - 0.2 * joints)
+    )
+    demand = _demand(path)
+    speeds = np.linspace(0.0, 0.3, 25)[1:]
+    v_from, v_to = (np.zeros_like(speeds), speeds) if rise else (speeds, np.zeros_like(speeds))
+    got = demand.quick_distances(v_from, v_to, rise, LENGTH, share * puma.a_max, share * puma.j_max)
+    accel, jerk = uniform_change_bounds_many(puma, demand.peaks(), speeds, share)
+    distance = change_distances(v_from, v_to, accel, jerk)
+    stretch = np.minimum(distance, LENGTH)
+    local = demand.stretch_peaks(np.where(np.isfinite(stretch), stretch, 0.0), rise)
+    local_accel, local_jerk = uniform_change_bounds_many(puma, local, speeds, share)
+    refined = change_distances(
+        v_from, v_to, np.maximum(accel, local_accel), np.maximum(jerk, local_jerk)
+    )
+    expected = np.where(np.isfinite(distance) & (distance < LENGTH), refined, distance)
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0.0)
+    assert np.isfinite(got).any()
+
+
+def _changes_within_limits_numpy(
+    demand, s_start, s_end, v_from, v_to, at_start, a_lim, j_lim, accel, jerk
+):  # type: ignore[no-untyped-def]
+    """Reference of the compiled check in numpy: every candidate's check points at once."""
+    delta = abs(v_to - v_from)
+    sign = 1.0 if v_to > v_from else -1.0
+    full = delta * jerk >= accel * accel
+    peak = np.where(full, accel, np.sqrt(delta * jerk))
+    t_jerk = peak / jerk
+    t_hold = np.where(full, delta / np.where(full, accel, 1.0) - t_jerk, 0.0)
+    distance = 0.5 * (v_from + v_to) * (2 * t_jerk + t_hold)
+    tau = np.stack([t_jerk, t_hold, t_jerk], axis=1)[:, :, None] * np.linspace(0.0, 1.0, 6)
+    j = (sign * jerk[:, None] * np.array([1.0, 0.0, -1.0]))[:, :, None]
+    a0 = np.stack([np.zeros_like(peak), sign * peak, sign * peak], axis=1)[:, :, None]
+    v1 = v_from + sign * 0.5 * jerk * t_jerk**2
+    v2 = v1 + sign * peak * t_hold
+    v0 = np.stack([np.full_like(peak, v_from), v1, v2], axis=1)[:, :, None]
+    s1 = v_from * t_jerk + sign * jerk * t_jerk**3 / 6.0
+    s2 = s1 + v1 * t_hold + sign * peak * t_hold**2 / 2.0
+    s0 = np.stack([np.zeros_like(peak), s1, s2], axis=1)[:, :, None]
+    a = a0 + j * tau
+    v = v0 + a0 * tau + j * tau**2 / 2.0
+    s = s0 + v0 * tau + a0 * tau**2 / 2 + j * tau**3 / 6
+    origin = np.where(at_start, s_start, s_end - distance)
+    where = np.clip(origin[:, None, None] + s, s_start, s_end).ravel()
+    d1, d2, d3 = (
+        np.stack([np.interp(where, demand.s, d[:, i]) for i in range(d.shape[1])], axis=1)
+        for d in (demand.d1, demand.d2, demand.d3)
+    )
+    j = np.broadcast_to(j, tau.shape)
+    v, a, j = v.ravel()[:, None], a.ravel()[:, None], j.ravel()[:, None]
+    joint_accel = np.abs(d1 * a + d2 * v * v) / a_lim
+    joint_jerk = np.abs(d1 * j + 3.0 * d2 * v * a + d3 * v**3) / j_lim
+    worst = np.maximum(joint_accel, joint_jerk).max(axis=1).reshape(len(accel), -1).max(axis=1)
+    return worst, distance
+
+
+@settings(max_examples=20, deadline=None, derandomize=True)
+@given(
+    amplitude=st.floats(0.0, 0.1),
+    rate=st.floats(1.0, 40.0),
+    slope=st.floats(-3.0, 3.0),
+    v_from=st.floats(0.0, 0.2),
+    v_to=st.floats(0.0, 0.2),
+    at_start=st.booleans(),
+)
+def test_compiled_change_check_matches_numpy(puma, amplitude, rate, slope, v_from, v_to, at_start):
+    """Which candidate bounds pass, kernel against numpy (where not within round-off of a limit)."""
+    if v_from == v_to:
+        return
+    joints = np.arange(6.0)
+    path = _wavy_path(
+        np.full(6, amplitude), rate * (1 + 0.1 * joints), joints, slope * (1 - 0.2 * joints)
+    )
+    demand = _demand(path)
+    accel, jerk = (
+        g.ravel() for g in np.meshgrid(np.geomspace(0.05, 20, 8), np.geomspace(1, 2000, 8))
+    )
+    a_lim, j_lim = SHARE * puma.a_max, SHARE * puma.j_max
+    ok, distance = _changes_within_limits(
+        puma, demand, 0.0, LENGTH, v_from, v_to, at_start, SHARE, accel, jerk
+    )
+    worst, expected = _changes_within_limits_numpy(
+        demand, 0.0, LENGTH, v_from, v_to, at_start, a_lim, j_lim, accel, jerk
+    )
+    np.testing.assert_allclose(distance, expected, rtol=1e-12)
+    clear = np.abs(worst - 1.0) > 1e-9
+    np.testing.assert_array_equal(ok[clear], (worst <= 1.0)[clear])

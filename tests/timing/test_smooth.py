@@ -32,6 +32,37 @@ def test_level_runs_merge_short_runs_into_slower_ones():
     assert covering[1] - covering[0] >= 4
 
 
+def _level_runs_reference(s, level, shortest):  # type: ignore[no-untyped-def]
+    """The merge rule in plain numpy, one merge per pass (reference of the compiled one)."""
+    level = level.copy()
+    while True:
+        edges = np.flatnonzero(np.diff(level)) + 1
+        starts = np.concatenate([[0], edges])
+        ends = np.concatenate([edges - 1, [len(level) - 1]])
+        lengths = s[ends] - s[starts]
+        short = np.flatnonzero(lengths < shortest)
+        if short.size == 0 or len(starts) == 1:
+            return list(zip(starts.tolist(), ends.tolist(), strict=True))
+        k = int(short[np.argmin(lengths[short])])
+        own = int(level[starts[k]])
+        neighbours = [j for j in (k - 1, k + 1) if 0 <= j < len(starts)]
+        slower = max(neighbours, key=lambda j: int(level[starts[j]]))
+        if int(level[starts[slower]]) >= own:
+            level[starts[k] : ends[k] + 1] = level[starts[slower]]
+        else:
+            level[starts[slower] : ends[slower] + 1] = own
+
+
+def test_level_runs_match_the_plain_merge_rule():
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        n = int(rng.integers(1, 120))
+        s = np.cumsum(rng.uniform(0.0, 2e-3, n))
+        level = np.repeat(rng.integers(0, 4, n), rng.integers(1, 6, n))[:n]
+        shortest = float(rng.uniform(0.0, 0.02))
+        assert _level_runs(s, level, shortest) == _level_runs_reference(s, level, shortest)
+
+
 def test_a_joint_limit_forces_a_reported_slow_down(tmp_path):
     case = load_case(CASES / "paper-corner.yaml")
     slow_robot = replace(case.robot, v_max=case.robot.v_max * np.array([1, 1, 1, 0.1, 1, 1]))

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -87,12 +88,20 @@ class PathGeometry:
 
     def corner_intervals(self) -> np.ndarray:
         """Nominal arc-length intervals where the corner speed applies, shape (K, 2)."""
+        return self._corner_intervals
+
+    @cached_property
+    def _corner_intervals(self) -> np.ndarray:
+        """:meth:`corner_intervals`, computed once (read-only)."""
         curved = [(s0, s1) for s0, s1, kind in self.planned.zones if kind == "curved"]
         if not curved:
-            return np.zeros((0, 2))
-        ends = self.planned.sample(np.asarray(curved).ravel()).position
-        s_nominal, _ = self.nominal.project(ends)
-        return np.sort(s_nominal.reshape(-1, 2), axis=1)
+            intervals = np.zeros((0, 2))
+        else:
+            ends = self.planned.sample(np.asarray(curved).ravel()).position
+            s_nominal, _ = self.nominal.project(ends)
+            intervals = np.sort(s_nominal.reshape(-1, 2), axis=1)
+        intervals.flags.writeable = False
+        return intervals
 
     def zone_grids(self) -> list[np.ndarray]:
         """The planning grid of each zone of :meth:`zones`, in order.

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -76,10 +77,15 @@ def evaluate_pieces(pieces: Sequence[Piece], s: np.ndarray) -> tuple[CurveJet, n
     starts = np.array([piece.s_start for piece in pieces])
     index = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(pieces) - 1)
     fields = [np.empty((s.size, 3)) for _ in range(4)]
-    for k in np.unique(index):
-        mask = index == k
-        piece = pieces[k]
-        sigma = np.clip(s[mask] - piece.s_start, 0.0, piece.length)
+    if np.all(index[1:] >= index[:-1]):  # in order (a trajectory's samples): one slice a piece
+        edges = np.searchsorted(index, np.arange(len(pieces) + 1))
+        rows = [slice(a, b) for a, b in itertools.pairwise(edges)]
+    else:
+        rows = [index == k for k in range(len(pieces))]
+    for piece, selected in zip(pieces, rows, strict=True):
+        sigma = np.clip(s[selected] - piece.s_start, 0.0, piece.length)
+        if sigma.size == 0:
+            continue
         for out, value in zip(fields, piece.curve.evaluate(sigma), strict=True):
-            out[mask] = value
+            out[selected] = value
     return CurveJet(*fields), index

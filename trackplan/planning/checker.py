@@ -135,10 +135,11 @@ def check_trajectory(
         bounds["torque"] = robot.dynamics.torque_max
         signals["torque"] = (torque, np.abs(torque) / robot.dynamics.torque_max)
     for kind, (values, use) in signals.items():
-        margins[kind] = _met(1.0 - use.max(axis=0), RELATIVE_SLACK)
-        worst_joint = int(np.argmax(use.max(axis=0)))
+        peak = use.max(axis=0)
+        margins[kind] = _met(1.0 - peak, RELATIVE_SLACK)
+        worst_joint = int(np.argmax(peak))
         binding[kind] = (worst_joint + 1, float(t[int(np.argmax(use[:, worst_joint]))]))
-        for j in np.flatnonzero(use.max(axis=0) > 1.0 + RELATIVE_SLACK):
+        for j in np.flatnonzero(peak > 1.0 + RELATIVE_SLACK):
             if kind == "position":
                 above = values[np.argmax(use[:, j]), j] > centre[j]
                 limit = robot.q_max[j] if above else robot.q_min[j]

@@ -21,12 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from trackplan.robots.model import Robot
+from trackplan.timing import _kernels
+from trackplan.timing._kernels import MAX_PATH_ACCELERATION, MAX_PATH_JERK
 from trackplan.timing.profile import speed_change_distance
-
-MAX_PATH_ACCELERATION = 50.0
-"""Upper bound on |s̈|, m/s², where no joint bounds it (a joint path that does not move)."""
-MAX_PATH_JERK = 5000.0
-"""Upper bound on |s⃛|, m/s³, likewise."""
 
 
 def safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
@@ -54,12 +51,14 @@ class ZoneDemand:
     d3: np.ndarray
     _abs: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
     _peaks: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
+    _peak_array: np.ndarray = field(init=False, repr=False)
     _maxima: list[np.ndarray | None] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         absolute = (np.abs(self.d1), np.abs(self.d2), np.abs(self.d3))
         object.__setattr__(self, "_abs", absolute)
         object.__setattr__(self, "_peaks", tuple(d.max(axis=0) for d in absolute))
+        object.__setattr__(self, "_peak_array", np.stack(self._peaks))
         object.__setattr__(self, "_maxima", [None, None])
 
     @property
@@ -102,6 +101,51 @@ class ZoneDemand:
             return self._running(0)[np.clip(stop, 1, len(self.s)) - 1]
         first = np.searchsorted(self.s, self.s[-1] - distance, side="right") - 2
         return self._running(1)[np.clip(first, 0, len(self.s) - 1)]
+
+    def quick_distances(
+        self,
+        v_from: np.ndarray,
+        v_to: np.ndarray,
+        rise: bool,
+        length: float,
+        a_limit: np.ndarray,
+        j_limit: np.ndarray,
+    ) -> np.ndarray:
+        """Distances of speed changes under bounds valid over the stretch each covers, m.
+
+        First the bounds over the whole zone at the top speed
+        (:func:`uniform_change_bounds_many` on :meth:`peaks`, :func:`change_distances`);
+        where that change fits the zone, the larger bounds over the shorter stretch it
+        covers (:meth:`stretch_peaks`). Compiled:
+        :func:`trackplan.timing._kernels.quick_distances`.
+
+        Parameters
+        ----------
+        v_from, v_to
+            Speeds before and after, shape (V,), m/s; all rises (``rise``) or all falls.
+        rise
+            True when the changes start at the zone start, False when they end at its end.
+        length
+            The zone's length, m.
+        a_limit, j_limit
+            Share of the joint acceleration and jerk limits planned against, shape (n,).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (V,), m (inf where the joints leave no room).
+        """
+        return _kernels.quick_distances(  # type: ignore[no-any-return]
+            self.s,
+            self._peak_array,
+            self._running(0 if rise else 1),
+            v_from,
+            v_to,
+            rise,
+            length,
+            a_limit,
+            j_limit,
+        )
 
     def _running(self, backward: int) -> np.ndarray:
         """Running maxima of |q'|, |q''|, |q'''| from the zone start (0) or from its end (1),
@@ -176,8 +220,10 @@ def uniform_change_bounds(
     tuple of float
         ``(accel, jerk)``, m/s² and m/s³ (≤ 0 when the top speed leaves no room).
     """
-    accel, jerk = uniform_change_bounds_many(robot, peaks, np.array([top_speed]), share)
-    return float(accel[0]), float(jerk[0])
+    q1, q2, q3 = (np.asarray(p, dtype=float) for p in peaks)
+    return _kernels.change_bounds(  # type: ignore[no-any-return]
+        q1, q2, q3, float(top_speed), share * robot.a_max, share * robot.j_max
+    )
 
 
 def uniform_change_bounds_many(
@@ -306,7 +352,7 @@ def speed_change(
     for factors in (BOUND_FACTORS, FINE_FACTORS):
         a_trial = np.minimum(best.accel * factors, MAX_PATH_ACCELERATION)
         j_trial = np.minimum(best.jerk * factors, MAX_PATH_JERK)
-        a_grid, j_grid = (g.ravel() for g in np.meshgrid(a_trial, j_trial, indexing="ij"))
+        a_grid, j_grid = np.repeat(a_trial, j_trial.size), np.tile(j_trial, a_trial.size)
         ok, distance = _changes_within_limits(
             robot, demand, s_start, s_end, v_from, v_to, at_start, share, a_grid, j_grid
         )
@@ -323,6 +369,7 @@ FINE_FACTORS = np.geomspace(0.85, 1.15, 3)
 """Multiples of the best first-round bounds tried second (each axis)."""
 PHASE_POINTS = 6
 """Check points in each of a change's constant-jerk phases (both ends included)."""
+_PHASE_SHARES = np.linspace(0.0, 1.0, PHASE_POINTS)
 
 
 def _changes_within_limits(
@@ -339,6 +386,10 @@ def _changes_within_limits(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Which candidate speed changes meet the joint limits along their own stretch.
 
+    Each is checked at :data:`PHASE_POINTS` points of each of its constant-jerk phases,
+    with the signed joint-path derivatives interpolated linearly from the zone's grid
+    (compiled: :func:`trackplan.timing._kernels.changes_within_limits`).
+
     Parameters
     ----------
     accel, jerk
@@ -351,47 +402,19 @@ def _changes_within_limits(
     distance : numpy.ndarray
         Path length of each change, shape (K,), m.
     """
-    delta = abs(v_to - v_from)
-    sign = 1.0 if v_to > v_from else -1.0
-    # trapezoid (hold phase) or triangle (accel not reached) per candidate
-    full = delta * jerk >= accel * accel
-    peak = np.where(full, accel, np.sqrt(delta * jerk))
-    t_jerk = peak / jerk
-    t_hold = np.where(full, delta / np.where(full, accel, 1.0) - t_jerk, 0.0)
-    distance = 0.5 * (v_from + v_to) * (2 * t_jerk + t_hold)
-    # check points: PHASE_POINTS per phase, phase-local time tau (K, 3, P)
-    u = np.linspace(0.0, 1.0, PHASE_POINTS)
-    durations = np.stack([t_jerk, t_hold, t_jerk], axis=1)  # (K, 3)
-    tau = durations[:, :, None] * u  # (K, 3, P)
-    j_phase = sign * jerk[:, None] * np.array([1.0, 0.0, -1.0])  # (K, 3)
-    a0 = np.stack([np.zeros_like(peak), sign * peak, sign * peak], axis=1)
-    v1 = v_from + sign * 0.5 * jerk * t_jerk**2
-    v2 = v1 + sign * peak * t_hold
-    v0 = np.stack([np.full_like(peak, v_from), v1, v2], axis=1)
-    s1 = v_from * t_jerk + sign * jerk * t_jerk**3 / 6.0
-    s2 = s1 + v1 * t_hold + sign * peak * t_hold**2 / 2.0
-    s0 = np.stack([np.zeros_like(peak), s1, s2], axis=1)
-    j = j_phase[:, :, None]
-    a = a0[:, :, None] + j * tau
-    v = v0[:, :, None] + a0[:, :, None] * tau + j * tau**2 / 2.0
-    s = s0[:, :, None] + v0[:, :, None] * tau + a0[:, :, None] * tau**2 / 2 + j * tau**3 / 6
-    origin = np.where(at_start, s_start, s_end - distance)  # (K,)
-    where = np.clip(origin[:, None, None] + s, s_start, s_end).ravel()
-    d1, d2, d3 = _interpolate(demand, where)  # (M, n)
-    j = np.broadcast_to(j, tau.shape)
-    v, a, j = v.ravel()[:, None], a.ravel()[:, None], j.ravel()[:, None]
-    joint_accel = np.abs(d1 * a + d2 * v * v) / (share * robot.a_max)
-    joint_jerk = np.abs(d1 * j + 3.0 * d2 * v * a + d3 * v**3) / (share * robot.j_max)
-    worst = np.maximum(joint_accel, joint_jerk).max(axis=1).reshape(len(accel), -1)
-    return worst.max(axis=1) <= 1.0, distance
-
-
-def _interpolate(demand: ZoneDemand, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Signed q', q'', q''' at ``s`` (M,) by linear interpolation of the grid, each (M, n)."""
-    grid = demand.s
-    k = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
-    span = grid[k + 1] - grid[k]
-    w = np.clip((s - grid[k]) / np.where(span > 0, span, 1.0), 0.0, 1.0)[:, None]
-    return tuple(  # type: ignore[return-value]
-        d[k] + w * (d[k + 1] - d[k]) for d in (demand.d1, demand.d2, demand.d3)
+    return _kernels.changes_within_limits(  # type: ignore[no-any-return]
+        demand.s,
+        demand.d1,
+        demand.d2,
+        demand.d3,
+        s_start,
+        s_end,
+        v_from,
+        v_to,
+        at_start,
+        share * robot.a_max,
+        share * robot.j_max,
+        np.ascontiguousarray(accel, dtype=float),
+        np.ascontiguousarray(jerk, dtype=float),
+        _PHASE_SHARES,
     )

@@ -25,6 +25,7 @@ import numpy as np
 from trackplan.derivatives import backward_derivatives
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.model import Robot
+from trackplan.timing import _kernels
 
 LIMIT_MARGIN = 1e-6
 """Relative margin kept under every limit a law plans against, so that round-off in the
@@ -44,6 +45,8 @@ SampleCheck = Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, np.nda
 class RateLimits:
     """Joint velocity, acceleration and jerk by backward differences at Ts, as the checker.
 
+    One compiled pass over the samples (:func:`trackplan.timing._kernels.rate_ratios`).
+
     Attributes
     ----------
     robot
@@ -59,19 +62,18 @@ class RateLimits:
         self, q: np.ndarray, sample_time: float
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Samples where a rate limit (less the margin) is exceeded; see the module."""
-        qd, qdd, qddd = backward_derivatives(q, sample_time, pad_end=True)
         scale = 1.0 - self.margin
+        limits = np.stack(
+            [scale * self.robot.v_max, scale * self.robot.a_max, scale * self.robot.j_max]
+        )
+        steps = np.array([sample_time, sample_time**2, sample_time**3])
+        ratio = _kernels.rate_ratios(np.ascontiguousarray(q, dtype=float), steps, limits)
         samples, orders, ratios = [], [], []
-        for order, values, bound in (
-            (1, qd, self.robot.v_max),
-            (2, qdd, self.robot.a_max),
-            (3, qddd, self.robot.j_max),
-        ):
-            ratio = (np.abs(values) / (scale * bound)).max(axis=1)
-            bad = np.flatnonzero(ratio > 1.0)
+        for order in (1, 2, 3):
+            bad = np.flatnonzero(ratio[:, order - 1] > 1.0)
             samples.append(np.minimum(bad, len(q) - 1))
             orders.append(np.full(bad.size, order))
-            ratios.append(ratio[bad])
+            ratios.append(ratio[bad, order - 1])
         return np.concatenate(samples), np.concatenate(orders), np.concatenate(ratios)
 
 

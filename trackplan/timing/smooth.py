@@ -36,14 +36,13 @@ from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
 from trackplan.robots.model import Robot
 from trackplan.status import Status
+from trackplan.timing import _kernels
 from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
-    change_distances,
     cruise_cap,
     speed_change,
     uniform_change_bounds,
-    uniform_change_bounds_many,
 )
 from trackplan.timing.profile import (
     SpeedProfile,
@@ -245,24 +244,9 @@ def _slow_down_windows(
 
 def _level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> list[tuple[int, int]]:
     """Runs (first, last grid index) of equal level, runs under ``shortest`` (m) merged
-    into slower ones."""
-    level = level.copy()
-    while True:
-        edges = np.flatnonzero(np.diff(level)) + 1
-        starts = np.concatenate([[0], edges])
-        ends = np.concatenate([edges - 1, [len(level) - 1]])
-        lengths = s[ends] - s[starts]
-        short = np.flatnonzero(lengths < shortest)
-        if short.size == 0 or len(starts) == 1:
-            return list(zip(starts.tolist(), ends.tolist(), strict=True))
-        k = int(short[np.argmin(lengths[short])])
-        own = int(level[starts[k]])
-        neighbours = [j for j in (k - 1, k + 1) if 0 <= j < len(starts)]
-        slower = max(neighbours, key=lambda j: int(level[starts[j]]))
-        if int(level[starts[slower]]) >= own:  # join the slower neighbour
-            level[starts[k] : ends[k] + 1] = level[starts[slower]]
-        else:  # the short run is the slowest: its slower neighbour slows down to it
-            level[starts[slower] : ends[slower] + 1] = own
+    into slower ones (compiled: :func:`trackplan.timing._kernels.level_runs`)."""
+    starts, ends = _kernels.level_runs(s, level.astype(np.int64), shortest)
+    return list(zip(starts.tolist(), ends.tolist(), strict=True))
 
 
 class _ZonePlanner:
@@ -305,18 +289,14 @@ class _ZonePlanner:
         """
         s0, s1, _ = self.zones[z]
         share = LIMIT_SHARE * self.change_scale[z]
-        demand = self.demands[z]
-        top = np.maximum(v_from, v_to)
-        accel, jerk = uniform_change_bounds_many(self.robot, demand.peaks(), top, share)
-        distance = change_distances(v_from, v_to, accel, jerk)
-        rise = bool(np.all(v_to >= v_from))
-        stretch = np.minimum(distance, s1 - s0)
-        local = demand.stretch_peaks(np.where(np.isfinite(stretch), stretch, 0.0), rise)
-        local_accel, local_jerk = uniform_change_bounds_many(self.robot, local, top, share)
-        refined = change_distances(
-            v_from, v_to, np.maximum(accel, local_accel), np.maximum(jerk, local_jerk)
+        return self.demands[z].quick_distances(
+            np.asarray(v_from, dtype=float),
+            np.asarray(v_to, dtype=float),
+            bool(np.all(v_to >= v_from)),
+            s1 - s0,
+            share * self.robot.a_max,
+            share * self.robot.j_max,
         )
-        return np.where(np.isfinite(distance) & (distance < s1 - s0), refined, distance)
 
     def quick_change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
         """One change of :meth:`quick_distances`, with its bounds."""
