@@ -110,6 +110,10 @@ def test_rebuilds_until_the_sampled_trajectory_meets_every_limit(monkeypatch):
     assert result.feasible, result.message
 
 
+CELL_LIMITS = ("collision", "clearance")
+"""Violations of the work cell, which the geometry decides and no time law changes."""
+
+
 @pytest.mark.parametrize("name", SHIPPED_CASES)
 def test_random_placements_of_every_case_pass_the_checker(name):
     """Wherever the path has a joint path the robot can hold against gravity, the smooth
@@ -129,9 +133,12 @@ def test_random_placements_of_every_case_pass_the_checker(name):
             continue
         if case.robot.dynamics and holding_torque_ratio(case.robot, result.joint_path.q) > 1:
             continue  # the robot cannot hold the path still: no time law helps
+        report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
+        timing_violations = [v for v in report.violations if v.limit not in CELL_LIMITS]
+        if len(timing_violations) < len(report.violations):
+            continue  # the placement collides with the cell: no time law helps
         planned += 1
         assert result.success, (X, result.message)
-        report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
         assert report.success, (X, report.violations)
         if planned == PLACEMENTS_PER_CASE:
             break
