@@ -37,3 +37,14 @@ def ur():
 def rng():
     """A seeded random generator."""
     return np.random.default_rng(12345)
+
+
+def replace_dh(robot, **changes):
+    """``robot`` rebuilt from its DH table with some columns or limits replaced."""
+    from trackplan.robots.model import DH_COLUMNS, Robot
+
+    fields = {key: robot.dh[:, i] for i, key in enumerate(DH_COLUMNS)}
+    for key in ("q_min", "q_max", "v_max", "a_max", "j_max", "T_flange_tool", "source"):
+        fields[key] = getattr(robot, key)
+    fields.update(changes)
+    return Robot.from_dh(name=robot.name, **fields)

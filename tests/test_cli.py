@@ -46,7 +46,15 @@ def test_validate_reports_each_bad_case_and_goes_on(
 def test_robots_table_and_yaml(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "robots")
     assert code == 0
-    assert "puma560" in out and "ur5" in out and "[-135, 135]" in out and "0.089159" in out
+    for name in ("puma560", "ur5e", "kuka_kr6_r700_sixx", "abb_irb2400", "fanuc_m20ia"):
+        assert name in out
+    assert "opw" in out and "ur" in out and "1.162" in out  # family and reach columns
+    code, out, _ = run(capsys, "robots", "ur5")
+    assert code == 0
+    assert "[-360, 360]" in out and "IK family: ur" in out and "d1 = 0.089159" in out
+    code, out, _ = run(capsys, "robots", "kuka_kr6_r700_sixx")
+    assert "IK family: opw" in out and "a1 = 0.025" in out and "c4 = 0.08" in out
+    assert "assumption: acceleration and jerk limits are assumed" in out
     code, out, _ = run(capsys, "robots", "--yaml", "ur5")
     assert code == 0
     assert load_robot_text(out).name == ur5().name

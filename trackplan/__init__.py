@@ -10,8 +10,9 @@ load_case(file) -> Case
     Read and validate a case file (see ``docs/files.md``).
 load_robot(file) -> Robot
     Read and validate a robot file.
-builtin_robot(name) -> Robot, BUILTIN_ROBOTS
-    The built-in robots (``puma560`` of the reference paper, ``ur5``).
+builtin_robot(name) -> Robot, builtin_names() -> names
+    The built-in robots: the paper's ``puma560``, ``ur5`` and a library of industrial
+    arms read from URDFs (``docs/robots.md``).
 Case, Robot
     The validated case and the robot model: frozen dataclasses of numpy arrays.
 forward_kinematics(robot, q) -> T_base_tool
@@ -71,14 +72,13 @@ if TYPE_CHECKING:
     from trackplan.choices import Method, Penalty, Timing
     from trackplan.errors import CaseError, TrackplanError
     from trackplan.io.case_file import load_case
-    from trackplan.io.robot_file import load_robot
+    from trackplan.io.robot_file import BUILTIN_ROBOTS, builtin_names, builtin_robot, load_robot
     from trackplan.jointpath import JointPath
     from trackplan.planning.checker import check_trajectory
     from trackplan.planning.energy import EnergyFigures, energy_figures
     from trackplan.planning.objectives import OBJECTIVES
     from trackplan.planning.plan import check_case_trajectory, plan_placement
     from trackplan.planning.result import CheckReport, PlanResult, Trajectory
-    from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot
     from trackplan.robots.dynamics.parameters import Payload, RobotDynamics
     from trackplan.robots.dynamics.rne import gravity_load, inverse_dynamics
     from trackplan.robots.kinematics import forward_kinematics, jacobian
@@ -99,7 +99,7 @@ _EXPORTS = {
     "PlacementMap": "trackplan.search.placement_map",
     "CellReport": "trackplan.planning.result",
     "Cell": "trackplan.cell",
-    "BUILTIN_ROBOTS": "trackplan.robots.builtin",
+    "BUILTIN_ROBOTS": "trackplan.io.robot_file",
     "OBJECTIVES": "trackplan.planning.objectives",
     "TIME_LAWS": "trackplan.timing",
     "Case": "trackplan.case",
@@ -120,7 +120,8 @@ _EXPORTS = {
     "Timing": "trackplan.choices",
     "TrackplanError": "trackplan.errors",
     "Trajectory": "trackplan.planning.result",
-    "builtin_robot": "trackplan.robots.builtin",
+    "builtin_names": "trackplan.io.robot_file",
+    "builtin_robot": "trackplan.io.robot_file",
     "check_case_trajectory": "trackplan.planning.plan",
     "check_trajectory": "trackplan.planning.checker",
     "energy_figures": "trackplan.planning.energy",
@@ -160,6 +161,7 @@ __all__ = [
     "TrackplanError",
     "Trajectory",
     "__version__",
+    "builtin_names",
     "builtin_robot",
     "check_case_trajectory",
     "check_trajectory",

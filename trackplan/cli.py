@@ -50,9 +50,8 @@ from trackplan.case import Case
 from trackplan.choices import Timing, choose
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
-from trackplan.io.robot_file import robot_to_yaml
+from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot_spec, robot_to_yaml
 from trackplan.paths import NominalPath
-from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot
 from trackplan.robots.model import Robot
 from trackplan.run_files import TRAJECTORY_FILE
 from trackplan.status import Status
@@ -179,25 +178,79 @@ def validate(
     return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT
 
 
+AssumeLimitsOption = Annotated[
+    bool,
+    typer.Option(
+        "--assume-limits",
+        help="For a URDF robot without acceleration/jerk limits: assume acceleration = "
+        "velocity / 0.25 s and jerk = acceleration / 0.1 s (recorded in result.json).",
+    ),
+]
+
+
 @app.command()
 def robots(
+    name: Annotated[
+        str | None,
+        typer.Argument(
+            help="A built-in robot name or a robot file (.yaml/.urdf): show its chain, family "
+            "and derived IK parameters.",
+            show_default=False,
+        ),
+    ] = None,
     as_yaml: Annotated[
         str | None,
         typer.Option(
             "--yaml",
             metavar="NAME",
-            help="Print the built-in robot NAME as a robot file, to start your own from.",
+            help="Print the built-in DH robot NAME as a robot file, to start your own from.",
         ),
     ] = None,
+    assume_limits: AssumeLimitsOption = False,
 ) -> ExitCode:
-    """Show the built-in robots and their limits."""
+    """List the built-in robots (family, reach, source), or show one robot in detail."""
+    from trackplan.robots.describe import robot_info
+
     if as_yaml is not None:
         typer.echo(robot_to_yaml(builtin_robot(as_yaml)), nl=False)
         return ExitCode.OK
     console = _console()
-    for name in sorted(BUILTIN_ROBOTS):
-        console.print(robot_table(builtin_robot(name)))
+    if name is not None:
+        robot = load_robot_spec(name, Path.cwd(), assume_limits=assume_limits)
+        console.print(robot_table(robot))
+        info = robot_info(robot)
+        console.print(f"IK family: {info['family']}")
+        for key, value in info["parameters"].items():  # type: ignore[attr-defined]
+            console.print(f"  {key} = {_show_value(value)}")
+        console.print(f"reach: {info['reach']:.3f} m")
+        for note in robot.assumptions:
+            console.print(f"assumption: {escape(note)}")
+        if "redundancy_rule" in info:
+            console.print(f"redundancy: {escape(str(info['redundancy_rule']))}")
+        return ExitCode.OK
+    table = Table(title="built-in robots (trackplan robots NAME for details)")
+    for header in ("name", "joints", "family", "reach m", "source"):
+        table.add_column(header, justify="left" if header in ("name", "source") else "right")
+    for key in builtin_names():
+        info = robot_info(builtin_robot(key))
+        table.add_row(
+            key,
+            str(info["joints"]),
+            str(info["family"]),
+            f"{info['reach']:.3f}",
+            escape(str(info["source"])),
+        )
+    console.print(table)
     return ExitCode.OK
+
+
+def _show_value(value: object) -> str:
+    """A parameter value for display: numbers to 6 significant digits."""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_show_value(v) for v in value) + "]"
+    return str(value)
 
 
 @app.command()
@@ -288,17 +341,18 @@ def segment_corners(path: NominalPath) -> list[tuple[int, float]]:
 
 
 def robot_table(robot: Robot) -> Table:
-    """A table of one robot's DH parameters and joint limits."""
+    """A table of one robot's chain (origin and axis per joint) and joint limits."""
+    from trackplan.frames import rpy_from_matrix
+
     table = Table(
         title=escape(f"{robot.name} ({robot.n_dof} joints)"),
         caption=escape(robot.source) or None,
     )
     headers = (
         "joint",
-        "d m",
-        "a m",
-        "alpha °",
-        "offset °",
+        "origin xyz m",
+        "origin rpy °",
+        "axis",
         "position °",
         "velocity rad/s",
         "acceleration rad/s²",
@@ -306,13 +360,17 @@ def robot_table(robot: Robot) -> Table:
     )
     for header in headers:
         table.add_column(header, justify="right")
+
+    def triple(values: np.ndarray) -> str:
+        return " ".join(f"{v:.4g}" for v in np.where(np.abs(values) < 1e-12, 0.0, values))
+
     for i, joint in enumerate(robot.joint_names):
+        origin = robot.origins[i]
         table.add_row(
-            joint,
-            f"{robot.d[i]:g}",
-            f"{robot.a[i]:g}",
-            f"{np.degrees(robot.alpha[i]):g}",
-            f"{np.degrees(robot.offset[i]):g}",
+            escape(joint),
+            triple(origin[:3, 3]),
+            triple(np.degrees(rpy_from_matrix(origin[:3, :3]))),
+            triple(robot.axes[i]),
             f"[{np.degrees(robot.q_min[i]):g}, {np.degrees(robot.q_max[i]):g}]",
             f"{robot.v_max[i]:g}",
             f"{robot.a_max[i]:g}",
@@ -373,12 +431,13 @@ def plan(
         bool, typer.Option("--reference", help="Also compute toppra and TOPP3 durations.")
     ] = False,
     report: Annotated[bool, typer.Option(help="Write plots and report.html.")] = True,
+    assume_limits: AssumeLimitsOption = False,
 ) -> ExitCode:
     """Plan the case at one placement; write trajectory.csv, result.json, plots, report."""
     from trackplan.outputs import write_run
     from trackplan.planning.plan import plan_placement
 
-    loaded = load_case(case)
+    loaded = load_case(case, assume_limits=assume_limits)
     X = _placement(loaded, placement)
     result = plan_placement(loaded, X, timing=_timing(timing), branch=branch)
     if reference and result.trajectory.n_samples:
@@ -404,12 +463,13 @@ def check(
     run: Annotated[Path, typer.Argument(help="Folder with trajectory.csv (or the CSV itself).")],
     placement: PlacementOption = None,
     timing: TimingOption = None,
+    assume_limits: AssumeLimitsOption = False,
 ) -> ExitCode:
     """Re-check any trajectory.csv, whoever wrote it, against the case's limits and path."""
     from trackplan.io.results import read_trajectory_csv
     from trackplan.planning.plan import check_case_trajectory
 
-    loaded = load_case(case)
+    loaded = load_case(case, assume_limits=assume_limits)
     X = _placement(loaded, placement)
     csv = run / TRAJECTORY_FILE if run.is_dir() else run
     t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
@@ -559,6 +619,7 @@ def optimize(
             "of one placement; writes pareto.csv, pareto.png, pareto.html and front/NN/.",
         ),
     ] = None,
+    assume_limits: AssumeLimitsOption = False,
 ) -> ExitCode:
     """Search where to place the workpiece; write the best plan, history.csv and the report.
 
@@ -568,7 +629,7 @@ def optimize(
     """
     from trackplan.outputs import write_search_run
 
-    loaded = load_case(case)
+    loaded = load_case(case, assume_limits=assume_limits)
     if objective is not None:
         from trackplan.planning.objectives import with_objective
 

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 from trackplan.case import Case
 from trackplan.io.results import write_plan_files
 from trackplan.planning.result import PlanResult
+from trackplan.robots.describe import robot_info
 
 if TYPE_CHECKING:  # the search (pymoo) is not needed to write a plan
     from trackplan.search import OptimizeResult
@@ -35,7 +36,8 @@ def write_run(
     history
         Optimizer history per method (for ``convergence.png``), or None.
     extra
-        More keys for ``result.json`` (optimizer figures, the initial plan).
+        More keys for ``result.json`` (optimizer figures, the initial plan); the ``robot``
+        block (:func:`~trackplan.robots.describe.robot_info`) is always added.
     report
         Also write the plots and the HTML report (which embeds them).
 
@@ -45,6 +47,7 @@ def write_run(
         The ``result.json`` content.
     """
     out_dir = Path(out_dir)
+    extra = {"robot": robot_info(case.robot), **(extra or {})}
     summary = write_plan_files(result, case.robot.joint_names, out_dir, extra)
     if report:
         from trackplan.report import write_plots, write_report

@@ -7,20 +7,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.conftest import replace_dh
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_file import (
+    builtin_robot,
     is_robot_file,
     load_robot,
     load_robot_spec,
     load_robot_text,
     robot_to_yaml,
 )
-from trackplan.robots.builtin import BUILTIN_ROBOTS, builtin_robot, puma560
-from trackplan.robots.model import Robot
+from trackplan.robots.builtin import DH_ROBOTS, puma560
+from trackplan.robots.model import DH_COLUMNS, Robot
 
 ROBOTS = Path(__file__).resolve().parents[2] / "robots"
-ARRAYS = ("d", "a", "alpha", "offset", "q_min", "q_max", "v_max", "a_max", "j_max")
+ARRAYS = ("dh", "origins", "axes", "T_tip", "q_min", "q_max", "v_max", "a_max", "j_max")
 
 
 def assert_same_robot(actual: Robot, expected: Robot, atol: float = 0.0) -> None:
@@ -31,7 +33,7 @@ def assert_same_robot(actual: Robot, expected: Robot, atol: float = 0.0) -> None
     np.testing.assert_allclose(actual.T_flange_tool, expected.T_flange_tool, rtol=0, atol=atol)
 
 
-@pytest.mark.parametrize("name", sorted(BUILTIN_ROBOTS))
+@pytest.mark.parametrize("name", sorted(DH_ROBOTS))
 def test_builtin_robots_round_trip_exactly(tmp_path: Path, name: str) -> None:
     robot = builtin_robot(name)
     file = tmp_path / f"{name}.yaml"
@@ -44,10 +46,7 @@ def test_robot_with_a_tool_round_trips(rng: np.random.Generator) -> None:
     for _ in range(20):
         xyz = rng.uniform(-0.2, 0.2, 3)
         rpy = rng.uniform([-np.pi, -np.pi / 2, -np.pi], [np.pi, np.pi / 2, np.pi])
-        robot = Robot(
-            **{key: getattr(base, key) for key in ("name", "source", *ARRAYS)},
-            T_flange_tool=pose_matrix(xyz, rpy_matrix(rpy)),
-        )
+        robot = replace_dh(base, T_flange_tool=pose_matrix(xyz, rpy_matrix(rpy)))
         assert_same_robot(load_robot_text(robot_to_yaml(robot)), robot, atol=1e-12)
 
 
@@ -63,7 +62,7 @@ def test_tool_and_offset_default_to_zero() -> None:
         " velocity: 1, acceleration: 2, jerk: 3}\n"
     )
     assert robot.n_dof == 1 and not robot.has_tool
-    np.testing.assert_array_equal(robot.offset, [0.0])
+    np.testing.assert_array_equal(robot.dh[:, DH_COLUMNS.index("offset")], [0.0])
     np.testing.assert_array_equal([robot.q_min[0], robot.q_max[0]], [-1.0, 1.0])
 
 

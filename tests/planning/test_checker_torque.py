@@ -30,9 +30,9 @@ def rtb_puma(robot):
     return rtb.DHRobot(
         [
             rtb.RevoluteDH(
-                d=robot.d[i],
-                a=robot.a[i],
-                alpha=robot.alpha[i],
+                d=robot.dh[i, 0],
+                a=robot.dh[i, 1],
+                alpha=robot.dh[i, 2],
                 m=link.m,
                 r=link.r,
                 I=link.I,

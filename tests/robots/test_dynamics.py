@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from tests.conftest import replace_dh
 from trackplan.errors import CaseError
 from trackplan.robots.dynamics.builtin import puma560_dynamics
 from trackplan.robots.dynamics.parameters import (
@@ -40,9 +41,7 @@ def rtb_puma_as_robot(puma):
     """Our robot with roboticstoolbox's Puma560 geometry (pedestal d1, d3 = 0.15005)."""
     ref = rtb.models.DH.Puma560()
     d, a, alpha = (np.array([getattr(link, k) for link in ref.links]) for k in ("d", "a", "alpha"))
-    return ref, dataclasses.replace(
-        puma, d=d, a=a, alpha=alpha, dynamics=puma560_dynamics(d, a, alpha)
-    )
+    return ref, replace_dh(puma, d=d, a=a, alpha=alpha, dynamics=puma560_dynamics(d, a, alpha))
 
 
 def rtb_robot_from(robot):
@@ -52,10 +51,10 @@ def rtb_robot_from(robot):
     for i, link in enumerate(ref.links):
         links.append(
             rtb.RevoluteDH(
-                d=robot.d[i],
-                a=robot.a[i],
-                alpha=robot.alpha[i],
-                offset=robot.offset[i],
+                d=robot.dh[i, 0],
+                a=robot.dh[i, 1],
+                alpha=robot.dh[i, 2],
+                offset=robot.dh[i, 3],
                 m=link.m,
                 r=link.r,
                 I=link.I,
@@ -259,8 +258,10 @@ def test_rne_matches_pinocchio_on_random_chains(rng):
 
 
 def test_dh_chain_is_the_dh_forward_kinematics(puma, rng):
-    chain = dh_chain(puma.d, puma.a, puma.alpha, np.array([0.1, -0.2, 0.3, 0, 0.5, -0.4]))
-    robot = dataclasses.replace(puma, offset=np.array([0.1, -0.2, 0.3, 0, 0.5, -0.4]))
+    chain = dh_chain(*puma.dh[:, :3].T, np.array([0.1, -0.2, 0.3, 0, 0.5, -0.4]))
+    robot = replace_dh(
+        puma, offset=np.array([0.1, -0.2, 0.3, 0, 0.5, -0.4]), dynamics=puma.dynamics
+    )
     q = rng.uniform(-3, 3, 6)
     T = np.eye(4)
     for i in range(6):

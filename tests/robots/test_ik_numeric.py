@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 
+from tests.conftest import replace_dh
 from trackplan.errors import CaseError
 from trackplan.robots.ik_numeric import solve_ik_numeric
 from trackplan.robots.kinematics import forward_kinematics
@@ -65,12 +64,12 @@ def test_other_chain_lengths(ur, rng, n_dof):
     extra = n_dof - 6
     pad = np.zeros(abs(extra))
     if extra > 0:  # a redundant arm: one more joint about z at the flange
-        robot = replace(
+        robot = replace_dh(
             ur,
-            d=np.r_[ur.d, 0.05],
-            a=np.r_[ur.a, pad],
-            alpha=np.r_[ur.alpha, pad],
-            offset=np.r_[ur.offset, pad],
+            d=np.r_[ur.dh[:, 0], 0.05],
+            a=np.r_[ur.dh[:, 1], pad],
+            alpha=np.r_[ur.dh[:, 2], pad],
+            offset=np.r_[ur.dh[:, 3], pad],
             q_min=np.r_[ur.q_min, -np.pi],
             q_max=np.r_[ur.q_max, np.pi],
             v_max=np.r_[ur.v_max, 1.0],
@@ -78,13 +77,9 @@ def test_other_chain_lengths(ur, rng, n_dof):
             j_max=np.r_[ur.j_max, 1.0],
         )
     else:
-        robot = replace(
-            ur,
-            **{
-                k: getattr(ur, k)[:n_dof]
-                for k in ("d", "a", "alpha", "offset", "q_min", "q_max", "v_max", "a_max", "j_max")
-            },
-        )
+        columns = dict(zip(("d", "a", "alpha", "offset"), ur.dh[:n_dof].T, strict=True))
+        limits = {k: getattr(ur, k)[:n_dof] for k in ("q_min", "q_max", "v_max", "a_max", "j_max")}
+        robot = replace_dh(ur, **columns, **limits)
     q = rng.uniform(-np.pi, np.pi, (200, n_dof))
     T = forward_kinematics(robot, q)
     ik = solve_ik_numeric(robot, T, q + rng.normal(0.0, 0.05, q.shape))

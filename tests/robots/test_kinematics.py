@@ -8,7 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from trackplan.robots.ik_numeric import chain_arrays, fk_jacobian_into
+from trackplan.robots._kernels import fk_jacobian_into
+from trackplan.robots.ik_numeric import chain_arrays
 from trackplan.robots.kinematics import forward_kinematics, jacobian
 
 N_CONFIGS = 1000
@@ -20,8 +21,7 @@ def rtb_robot(robot):
         warnings.simplefilter("ignore")
         import roboticstoolbox as rtb
     links = [
-        rtb.RevoluteDH(d=d, a=a, alpha=alpha, offset=offset)
-        for d, a, alpha, offset in zip(robot.d, robot.a, robot.alpha, robot.offset, strict=True)
+        rtb.RevoluteDH(d=d, a=a, alpha=alpha, offset=offset) for d, a, alpha, offset in robot.dh
     ]
     return rtb.DHRobot(links, name=robot.name)
 
@@ -60,13 +60,14 @@ def test_jacobian_matches_finite_differences(name, request, rng):
 @pytest.mark.parametrize("name", ["puma", "ur"])
 def test_compiled_fk_jacobian_matches_numpy(name, request, rng):
     robot = request.getfixturevalue(name)
-    dh, tool = chain_arrays(robot)
+    tool = np.eye(4)
     tool[:3, 3] = (0.01, -0.02, 0.1)  # a tool offset exercises the last transform
     robot_with_tool = replace(robot, T_flange_tool=tool)
+    chain, tail = chain_arrays(robot_with_tool)
     T = np.empty((4, 4))
     J = np.empty((6, robot.n_dof))
     axes = np.empty((robot.n_dof, 6))
     for q in rng.uniform(-np.pi, np.pi, (50, robot.n_dof)):
-        fk_jacobian_into(dh, tool, q, T, J, axes)
+        fk_jacobian_into(chain, tail, q, T, J, axes)
         assert np.abs(T - forward_kinematics(robot_with_tool, q)).max() < 1e-14
         assert np.abs(J - jacobian(robot_with_tool, q)).max() < 1e-14

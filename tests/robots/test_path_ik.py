@@ -7,9 +7,9 @@ import pytest
 
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform, pose_matrix, rpy_matrix
-from trackplan.robots.ik_closed_form import solve_ik_closed_form
+from trackplan.robots.families import solve_ik
 from trackplan.robots.kinematics import forward_kinematics
-from trackplan.robots.path_ik import numeric_seeds, solve_path_ik
+from trackplan.robots.path_ik import numeric_seeds, solve_path_ik, solve_path_ik_branches
 from trackplan.status import Status
 
 # A 1 m line with constant tool orientation that the PUMA follows within its limits.
@@ -70,7 +70,7 @@ def test_default_branch_is_the_ok_one_with_the_largest_margin(puma):
 
 def test_forced_branch_is_honoured_and_is_that_closed_form_branch(puma):
     T = feasible_line(200)
-    closed = solve_ik_closed_form(puma, T).q
+    closed = solve_ik(puma, T).q
     candidates = np.stack([T, T, T])
     branches = np.array([5, 0, 3])
     result = solve_path_ik(puma, candidates, branch=branches)
@@ -104,9 +104,7 @@ def wrist_singular_line(robot, n_poses):
     q_singular = np.array([0.1, -0.5, 0.3, 0.4, 0.0, 0.2])
     T_mid = forward_kinematics(robot, q_singular)
     T = line(T_mid[:3, 3], np.array([0.0, 1.0, 0.2]), T_mid[:3, :3], 0.1, n_poses)
-    branch = int(
-        np.argmin(np.abs(wrapped(solve_ik_closed_form(robot, T_mid).q - q_singular)).max(-1))
-    )
+    branch = int(np.argmin(np.abs(wrapped(solve_ik(robot, T_mid).q - q_singular)).max(-1)))
     return T, branch
 
 
@@ -123,13 +121,13 @@ def test_wrist_singularity_crossing_is_a_branch_switch(puma):
             f"joint 5 crosses the wrist singularity near pose {flagged.min()}" in result.message[0]
         )
     # On one closed-form label, q5 touches 0 there and q4 turns by about π in one step.
-    q = solve_ik_closed_form(puma, T).q[:, branch]
+    q = solve_ik(puma, T).q[:, branch]
     assert np.abs(q[99:102, 4]).min() < 0.01
     assert np.abs(wrapped(np.diff(q[:, 3]))).max() > 2.0
 
 
 def test_elbow_and_shoulder_singularities_are_branch_switches(puma):
-    beta = np.arctan2(puma.d[3], puma.a[2])
+    beta = np.arctan2(puma.dh[3, 0], puma.dh[2, 1])
     t = np.linspace(-0.1, 0.1, 101)[:, None]
     q = np.array([0.3, -0.4, -beta, 0.2, 0.9, 0.1]) + t * np.array([0.2, 0.3, 3.0, 0.4, 0.1, 0.2])
     stretched = forward_kinematics(puma, q)  # the elbow angle crosses 0 at t = 0
@@ -151,7 +149,7 @@ def test_unreachable_pose_is_reported(puma):
     direction = LINE_DIRECTION / np.linalg.norm(LINE_DIRECTION)
     start = LINE_CENTRE - 0.5 * direction  # the feasible line, continued 0.6 m further
     T = line(start + 0.8 * direction, direction, rpy_matrix(LINE_RPY), 1.6, 101)
-    reachable = solve_ik_closed_form(puma, T).reachable
+    reachable = solve_ik(puma, T).reachable
     first_out = int(np.argmin(reachable))
     assert 0 < first_out < 100
     result = solve_path_ik(puma, T[None])
@@ -201,16 +199,17 @@ def test_bad_arguments_raise(puma):
         solve_path_ik(puma, T[0])
 
 
-def test_ur5_numeric_path_is_continuous_on_a_line(ur):
+@pytest.mark.parametrize("method", ["auto", "numeric"])
+def test_ur5_path_is_continuous_on_a_line(ur, method):
     q_mid = np.array([0.3, -1.2, 1.4, -1.6, -1.5, 0.2])
     T_mid = forward_kinematics(ur, q_mid)
     T = line(T_mid[:3, 3], np.array([0.3, 1.0, -0.2]), T_mid[:3, :3], 0.4, 400)[None]
-    result = solve_path_ik(ur, T)
-    assert result.method == "numeric"
+    result = solve_path_ik(ur, T, method=method)
+    assert result.method == ("closed_form" if method == "auto" else "numeric")
     assert result.success[0], result.message[0]
     assert_follows(ur, result, T, tol=1e-9)
     assert np.abs(np.diff(result.q[0], axis=0)).max() < 0.02
-    forced = solve_path_ik(ur, T, branch=int(result.branch[0]))
+    forced = solve_path_ik(ur, T, branch=int(result.branch[0]), method=method)
     np.testing.assert_array_equal(forced.q, result.q)
     assert numeric_seeds(ur).shape == (8, 6)
 
@@ -222,7 +221,7 @@ def test_numeric_mode_agrees_with_closed_form(puma):
     assert numeric.success[0]
     assert_follows(puma, numeric, T)
     # The numeric branch is one of the closed-form branches along the whole path.
-    branches = solve_ik_closed_form(puma, T[0]).q
+    branches = solve_ik(puma, T[0]).q
     gap = np.abs(wrapped(numeric.q[0][:, None] - branches)).max(axis=(0, 2))
     assert gap.min() < 1e-8
     assert numeric.margin[0] <= closed.margin[0] + 1e-9
@@ -234,3 +233,52 @@ def test_numeric_mode_flags_a_singularity_crossing(puma):
         solve_path_ik(puma, T[None], branch=b, method="numeric").status[0] for b in range(8)
     }
     assert Status.BRANCH_SWITCH in statuses
+
+
+def test_seven_joint_arm_plans_numerically_and_continuously():
+    """A redundant URDF arm: numeric path IK, seeded sample to sample, continuous."""
+    from pathlib import Path
+
+    from trackplan.io.robot_file import load_robot
+    from trackplan.robots.describe import robot_info
+
+    robot = load_robot(
+        Path(__file__).resolve().parents[1] / "io" / "data" / "tilted7.urdf", assume_limits=True
+    )
+    q_mid = np.array([0.3, -0.5, 0.8, 0.4, 0.6, -0.3, 0.2])
+    T_mid = forward_kinematics(robot, q_mid)
+    T = line(T_mid[:3, 3], np.array([0.2, 1.0, -0.3]), T_mid[:3, :3], 0.1, 200)[None]
+    result = solve_path_ik(robot, T)
+    assert result.method == "numeric"
+    assert result.success[0], result.message[0]
+    assert_follows(robot, result, T, tol=1e-9)
+    assert np.abs(np.diff(result.q[0], axis=0)).max() < 0.02
+    assert "continuous" in robot_info(robot)["redundancy_rule"]
+
+
+def test_windings_of_wide_joints_are_enumerated_and_the_widest_margin_kept(puma):
+    from trackplan.io.robot_file import builtin_robot
+
+    for name, wide in (("ur5e", [0, 1, 2, 3, 4, 5]), ("kuka_kr6_r700_sixx", [5])):
+        robot = builtin_robot(name)
+        # q6 = 1 rad: a KUKA A6 (±350°) has a second winding only beyond ±10°.
+        q_mid = 0.5 * (robot.q_min + robot.q_max) + np.array([0.3, -0.4, 0.5, 0.2, 0.6, 1.0])
+        T_mid = forward_kinematics(robot, q_mid)
+        T = line(T_mid[:3, 3], np.array([0.0, 1.0, 0.2]), T_mid[:3, :3], 0.05, 50)[None]
+        result = solve_path_ik(robot, T)
+        assert result.success[0], result.message[0]
+        narrow = [j for j in range(6) if j not in wide]
+        assert np.all(result.windings[0, wide] >= 2) and np.all(result.windings[0, narrow] == 1)
+        path = result.q[0]
+        for j in wide:  # every other winding that fits has no larger margin to the limits
+
+            def margin(values, j=j, robot=robot):
+                return min(values.min() - robot.q_min[j], robot.q_max[j] - values.max())
+
+            kept = margin(path[:, j])
+            others = [margin(path[:, j] + 2 * np.pi * turns) for turns in (-2, -1, 1, 2)]
+            fitting = [m for m in others if m >= 0.0]
+            assert len(fitting) == result.windings[0, j] - 1
+            assert all(m <= kept for m in fitting)
+    branches = solve_path_ik_branches(puma, feasible_line(50)[None])
+    assert branches.windings.shape == (1, 8, 6) and branches.windings.max() <= 1

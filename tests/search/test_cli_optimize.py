@@ -170,3 +170,29 @@ def test_demo_writes_the_report(
     for name in ("trajectory.csv", "result.json", "history.csv", "convergence.png"):
         assert (out / name).is_file(), name
     assert json.loads((out / "result.json").read_text())["optimizer"]["stop_reason"] == "converged"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("case", "family"), [("kuka-weld", "opw"), ("ur5e-glue", "ur")])
+def test_robot_library_cases_optimize_to_a_checked_feasible_placement(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, case: str, family: str
+) -> None:
+    out = tmp_path / case
+    code, _, _ = run(
+        capsys, "optimize", str(CASES / f"{case}.yaml"), "--out", str(out), "--no-report"
+    )
+    assert code == ExitCode.OK
+    summary = json.loads((out / "result.json").read_text())
+    assert summary["feasible"]
+    robot = summary["robot"]
+    assert robot["family"] == family and "assumed" in robot["assumptions"][0]
+    placement = [summary["placement"][key] for key in ("x", "y", "z", "roll", "pitch", "yaw")]
+    code, stdout, _ = run(
+        capsys,
+        "check",
+        str(CASES / f"{case}.yaml"),
+        str(out),
+        "--placement",
+        *(repr(value) for value in placement),
+    )
+    assert code == ExitCode.OK and stdout.rstrip().endswith("feasible")

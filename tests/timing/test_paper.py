@@ -46,7 +46,7 @@ def kinds(result) -> set[str]:
 
 def test_published_line_placement_is_out_of_reach(line_case):
     # The start (x, y) is 0.146 m from joint 1's axis, inside the 0.15 m shoulder offset d3.
-    assert np.hypot(*LINE_PUBLISHED[:2]) < line_case.robot.d[2]
+    assert np.hypot(*LINE_PUBLISHED[:2]) < line_case.robot.dh[2, 0]
     result = plan_placement(line_case, LINE_PUBLISHED, timing="paper")
     assert result.status is Status.UNREACHABLE
     assert result.trajectory.n_samples == 0

@@ -61,9 +61,6 @@ POSITION_RANGE = (-0.87, 0.87)
 ANGLE_RANGE = (-1.57, 1.57)
 """Default search range of roll, pitch, yaw, rad (the paper's Eq. 31)."""
 
-REACH = (0.150333, 0.853756)
-"""Default reach range, m: sqrt(0.0226) and sqrt(0.7289) of the paper's Eq. 32, rounded inwards."""
-
 MIN_POINTS = 2
 """Fewest points of a ``points`` segment (one point is a ``line``)."""
 
@@ -156,7 +153,7 @@ class PlacementModel(StrictModel):
     roll: Range = list_default(*ANGLE_RANGE)
     pitch: Range = list_default(*ANGLE_RANGE)
     yaw: Range = list_default(*ANGLE_RANGE)
-    reach: Range = list_default(*REACH)
+    reach: Range | None = None  # default: the robot's default_placement_reach
     example: Vec6 | None = None
 
 
@@ -198,7 +195,7 @@ class CaseModel(StrictModel):
 # --------------------------------------------------------------------------- loading
 
 
-def load_case(file: str | Path) -> Case:
+def load_case(file: str | Path, *, assume_limits: bool = False) -> Case:
     """Read a case file.
 
     Parameters
@@ -206,6 +203,9 @@ def load_case(file: str | Path) -> Case:
     file
         Path of the YAML case file. Robot files and points files it names are read
         relative to its folder.
+    assume_limits
+        Fill a URDF robot's missing acceleration and jerk limits by the documented rule
+        (``docs/robots.md``) instead of refusing it; the robot records the assumption.
 
     Returns
     -------
@@ -219,10 +219,18 @@ def load_case(file: str | Path) -> Case:
         points file, then bad values (in file order).
     """
     text = read_text(file, what="case file")
-    return load_case_text(text, file=str(file), base_dir=Path(file).parent)
+    return load_case_text(
+        text, file=str(file), base_dir=Path(file).parent, assume_limits=assume_limits
+    )
 
 
-def load_case_text(text: str, file: str | None = None, base_dir: str | Path | None = None) -> Case:
+def load_case_text(
+    text: str,
+    file: str | None = None,
+    base_dir: str | Path | None = None,
+    *,
+    assume_limits: bool = False,
+) -> Case:
     """Build a case from the text of a case file.
 
     Parameters
@@ -234,6 +242,8 @@ def load_case_text(text: str, file: str | None = None, base_dir: str | Path | No
     base_dir
         Folder that relative robot and points file names start from; by default the
         folder of ``file``, else the working directory.
+    assume_limits
+        As for :func:`load_case`.
 
     Returns
     -------
@@ -245,10 +255,12 @@ def load_case_text(text: str, file: str | None = None, base_dir: str | Path | No
         See :func:`load_case`.
     """
     base = Path(base_dir) if base_dir is not None else Path(file).parent if file else Path()
-    return load_case_data(parse_yaml(text, file), file, base)
+    return load_case_data(parse_yaml(text, file), file, base, assume_limits=assume_limits)
 
 
-def load_case_data(data: Any, file: str | None, base_dir: str | Path) -> Case:
+def load_case_data(
+    data: Any, file: str | None, base_dir: str | Path, *, assume_limits: bool = False
+) -> Case:
     """Build a case from the parsed data of a case file (a study's overrides applied to it).
 
     Parameters
@@ -259,6 +271,8 @@ def load_case_data(data: Any, file: str | None, base_dir: str | Path) -> Case:
         The file the data came from, for messages and :attr:`Case.source`.
     base_dir
         Folder that relative robot and points file names start from.
+    assume_limits
+        As for :func:`load_case`.
 
     Returns
     -------
@@ -271,7 +285,7 @@ def load_case_data(data: Any, file: str | None, base_dir: str | Path) -> Case:
     """
     base = Path(base_dir)
     model = validate_model(CaseModel, data, file)
-    robot = load_robot_spec(model.robot, base, case_file=file)
+    robot = load_robot_spec(model.robot, base, case_file=file, assume_limits=assume_limits)
     start = _array(model.path.start)
     segments = tuple(
         _segment(segment, base, file, ("path", "segments", k))
@@ -279,7 +293,7 @@ def load_case_data(data: Any, file: str | None, base_dir: str | Path) -> Case:
     )
     problems = [
         *_path_problems(start, segments, model, base),
-        *_placement_problems(model.placement),
+        *_placement_problems(model.placement, _reach(model.placement, robot)),
         *_objective_problems(model.objective, robot),
         *(cell_problems(model.cell, robot.n_dof) if model.cell is not None else []),
         *_objective_kind_problems(model.objective, robot),
@@ -328,7 +342,7 @@ def _case(
         bounds=PlacementBounds(
             lower=_array(ranges[:, 0]),
             upper=_array(ranges[:, 1]),
-            reach=(placement.reach[0], placement.reach[1]),
+            reach=_reach(placement, robot),
             example=None if placement.example is None else _array(placement.example),
         ),
         objective=Objective(
@@ -457,7 +471,14 @@ def _points_file(model: CaseModel, loc: tuple[str | int, ...]) -> str | None:
     return None
 
 
-def _placement_problems(placement: PlacementModel) -> list[Problem]:
+def _reach(placement: PlacementModel, robot: Robot) -> tuple[float, float]:
+    """The placement reach range: the case's, else the robot's default, m."""
+    if placement.reach is None:
+        return robot.default_placement_reach
+    return (placement.reach[0], placement.reach[1])
+
+
+def _placement_problems(placement: PlacementModel, reach: tuple[float, float]) -> list[Problem]:
     problems: list[Problem] = []
     for key in PLACEMENT_KEYS:
         low, high = getattr(placement, key)
@@ -465,7 +486,7 @@ def _placement_problems(placement: PlacementModel) -> list[Problem]:
             problems.append(
                 (("placement", key), f"expected [min, max] with min ≤ max, got {show([low, high])}")
             )
-    low, high = placement.reach
+    low, high = reach
     if not 0.0 <= low <= high:
         problems.append(
             (
@@ -485,12 +506,12 @@ def _placement_problems(placement: PlacementModel) -> list[Problem]:
         ]
         problems.extend(outside)
         distance = math.dist(placement.example[:3], (0.0, 0.0, 0.0))
-        if not outside and not placement.reach[0] <= distance <= placement.reach[1]:
+        if not outside and not low <= distance <= high:
             problems.append(
                 (
                     ("placement", "example"),
                     f"expected a distance from the base origin within placement.reach "
-                    f"{show(placement.reach)}, got {distance:.6g} m",
+                    f"{show(list(reach))}, got {distance:.6g} m",
                 )
             )
     return problems

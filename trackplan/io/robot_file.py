@@ -1,6 +1,6 @@
-"""Robot files (YAML): a standard-DH serial chain with per-joint limits.
+"""Robot files: a standard-DH robot YAML, a URDF, or a robot YAML pointing at a URDF.
 
-Format (see ``docs/files.md``)::
+A DH robot file (see ``docs/files.md``)::
 
     name: puma560
     source: "where the numbers come from"      # optional
@@ -20,10 +20,31 @@ link frame axes) and ``torque`` (N·m, link side), given for every joint or none
 ``[Tc+, Tc-]`` (N·m), all on the motor side, and ``motor_constant`` (N·m/√W). Beside the
 joints: ``gravity`` (m/s², base frame, default ``[0, 0, -9.81]``) and ``payload``
 ``{mass, com, inertia}`` at the tool centre point (TCP frame).
+
+A robot file for a URDF (paths relative to the file; see ``docs/robots.md``)::
+
+    name: my-irb2400
+    urdf: irb2400.urdf
+    base_link: base_link          # default: the URDF's root link
+    tip_link: tool0               # default: the single leaf of the chain
+    tool: {xyz: [0, 0, 0.25], rpy: [0, 0.3, 0]}
+    limits:                       # per joint, in chain order
+      acceleration: [5, 5, 5, 10, 10, 15]
+      jerk: [25, 25, 25, 50, 50, 75]
+      velocity: [2.6, 2.6, 2.6, 6.2, 6.2, 7.8]   # optional override of the URDF
+    continuous_range: 6.283185307179586          # optional: continuous joints' half range
+    source: "where the numbers come from"        # optional
+    assumptions: ["acceleration and jerk assumed: …"]   # optional
+
+A URDF gives no acceleration or jerk limits. Without them the robot is refused, unless
+``assume_limits`` is set: then acceleration = velocity / :data:`ASSUMED_ACCELERATION_TIME`
+and jerk = acceleration / :data:`ASSUMED_JERK_TIME`, recorded in ``Robot.assumptions``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -33,6 +54,7 @@ from pydantic import Field
 
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_from_matrix, rpy_matrix
+from trackplan.io.urdf import DEFAULT_CONTINUOUS_RANGE, read_urdf_chain
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -48,7 +70,7 @@ from trackplan.io.yaml_input import (
     show,
     validate_model,
 )
-from trackplan.robots.builtin import builtin_robot
+from trackplan.robots.builtin import DH_ROBOTS
 from trackplan.robots.dynamics.parameters import (
     STANDARD_GRAVITY,
     Payload,
@@ -59,7 +81,13 @@ from trackplan.robots.dynamics.parameters import (
 )
 from trackplan.robots.model import Robot
 
-ROBOT_FILE_SUFFIXES = (".yaml", ".yml")
+ROBOT_FILE_SUFFIXES = (".yaml", ".yml", ".urdf")
+ASSUMED_ACCELERATION_TIME = 0.25
+"""s: with ``assume_limits``, a joint reaches its rated velocity in this time."""
+ASSUMED_JERK_TIME = 0.1
+"""s: with ``assume_limits``, a joint reaches its acceleration limit in this time."""
+LIBRARY_DIR = Path(__file__).resolve().parent.parent / "robots" / "library"
+"""Package data: one URDF and one robot file per built-in industrial arm."""
 
 
 Inertia6 = Annotated[list[float], Field(min_length=6, max_length=6)]
@@ -107,8 +135,30 @@ class ToolModel(StrictModel):
     rpy: Vec3 = list_default(0.0, 0.0, 0.0)
 
 
+class LimitsModel(StrictModel):
+    """Per-joint limits that a URDF lacks or that override it, in chain order."""
+
+    acceleration: list[Positive] | None = None
+    jerk: list[Positive] | None = None
+    velocity: list[Positive] | None = None
+
+
+class URDFRobotFileModel(StrictModel):
+    """Schema of a robot file that points at a URDF."""
+
+    name: NonEmptyStr
+    urdf: NonEmptyStr
+    source: str = ""
+    base_link: NonEmptyStr | None = None
+    tip_link: NonEmptyStr | None = None
+    tool: ToolModel | None = None
+    limits: LimitsModel = Field(default_factory=LimitsModel)
+    continuous_range: Positive = DEFAULT_CONTINUOUS_RANGE
+    assumptions: list[str] = Field(default_factory=list)
+
+
 class RobotFileModel(StrictModel):
-    """Schema of a robot file."""
+    """Schema of a DH robot file."""
 
     name: NonEmptyStr
     source: str = ""
@@ -118,13 +168,16 @@ class RobotFileModel(StrictModel):
     payload: PayloadModel | None = None
 
 
-def load_robot(file: str | Path) -> Robot:
-    """Read a robot file.
+def load_robot(file: str | Path, *, assume_limits: bool = False) -> Robot:
+    """Read a robot file: a DH robot YAML, a URDF, or a robot YAML pointing at a URDF.
 
     Parameters
     ----------
     file
-        Path of the YAML robot file.
+        Path of the robot file (``.yaml``/``.yml`` or ``.urdf``).
+    assume_limits
+        Fill missing acceleration and jerk limits by the documented rule (module
+        docstring) instead of refusing the robot; the robot records the assumption.
 
     Returns
     -------
@@ -136,10 +189,27 @@ def load_robot(file: str | Path) -> Robot:
         When the file is missing or unreadable, is not valid YAML, or any value is
         wrong; the error names the file and the key (``joints[2].velocity``).
     """
-    return load_robot_text(read_text(file, what="robot file"), file=str(file))
+    if str(file).lower().endswith(".urdf"):
+        return robot_from_urdf_file(file, assume_limits=assume_limits)
+    text = read_text(file, what="robot file")
+    return load_robot_text(text, file=str(file), assume_limits=assume_limits)
 
 
-def load_robot_text(text: str, file: str | None = None) -> Robot:
+def robot_from_urdf_file(file: str | Path, *, assume_limits: bool = False) -> Robot:
+    """A robot from a URDF alone: its chain from the root to the single leaf.
+
+    Raises
+    ------
+    CaseError
+        As :func:`~trackplan.io.urdf.read_urdf_chain`, and when limits are missing.
+    """
+    chain = read_urdf_chain(file)
+    return _urdf_robot(
+        chain, chain.name, LimitsModel(), np.eye(4), "", [], assume_limits, str(file)
+    )
+
+
+def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool = False) -> Robot:
     """Build a robot from the text of a robot file.
 
     Parameters
@@ -159,6 +229,8 @@ def load_robot_text(text: str, file: str | None = None) -> Robot:
         On the first problem in the text.
     """
     data = parse_yaml(text, file)
+    if isinstance(data, dict) and "urdf" in data:
+        return _load_urdf_robot_file(data, file, assume_limits)
     model = validate_model(RobotFileModel, data, file)
     problems: list[Problem] = [
         (
@@ -176,7 +248,7 @@ def load_robot_text(text: str, file: str | None = None) -> Robot:
         for key in ("d", "a", "alpha", "offset", "velocity", "acceleration", "jerk")
     }
     position = np.array([joint.position for joint in model.joints], dtype=float)
-    return Robot(
+    return Robot.from_dh(
         name=model.name,
         d=columns["d"],
         a=columns["a"],
@@ -284,10 +356,143 @@ def _dynamics(model: RobotFileModel, columns: dict[str, np.ndarray]) -> RobotDyn
     )
 
 
+def _load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Robot:
+    """A robot from the data of a robot file with a ``urdf`` key."""
+    model = validate_model(URDFRobotFileModel, data, file)
+    base = Path(file).parent if file else Path(".")
+    chain = read_urdf_chain(
+        base / model.urdf,
+        model.base_link,
+        model.tip_link,
+        continuous_range=model.continuous_range,
+        referrer=file,
+    )
+    n = len(chain.joint_names)
+    problems: list[Problem] = [
+        (
+            ("limits", key),
+            f"expected {n} entries, one per joint of the chain "
+            f"({', '.join(chain.joint_names)}), got {len(values)}",
+        )
+        for key in ("acceleration", "jerk", "velocity")
+        if (values := getattr(model.limits, key)) is not None and len(values) != n
+    ]
+    raise_first(problems, data, file)
+    tool = model.tool or ToolModel()
+    T_tool = pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy)))
+    return _urdf_robot(
+        chain,
+        model.name,
+        model.limits,
+        T_tool,
+        model.source,
+        model.assumptions,
+        assume_limits,
+        file,
+    )
+
+
+def _urdf_robot(
+    chain: Any,
+    name: str,
+    limits: LimitsModel,
+    T_tool: np.ndarray,
+    source: str,
+    assumptions: list[str],
+    assume_limits: bool,
+    file: str | None,
+) -> Robot:
+    """The robot of a URDF chain with the limits a robot file adds (or assumed ones)."""
+    notes = list(assumptions)
+    velocity = chain.v_max if limits.velocity is None else np.array(limits.velocity)
+    if np.any(np.isnan(velocity)):
+        missing = [chain.joint_names[i] for i in np.flatnonzero(np.isnan(velocity))]
+        raise CaseError(
+            f"no velocity limit for joints {', '.join(missing)}: add velocity to their "
+            "<limit> in the URDF or limits.velocity to a robot file",
+            file=file,
+        )
+    acceleration = None if limits.acceleration is None else np.array(limits.acceleration)
+    jerk = None if limits.jerk is None else np.array(limits.jerk)
+    if acceleration is None or jerk is None:
+        missing_keys = [
+            key for key, value in (("acceleration", acceleration), ("jerk", jerk)) if value is None
+        ]
+        if not assume_limits:
+            raise CaseError(
+                f"a URDF gives no {' or '.join(missing_keys)} limits: add "
+                f"{', '.join('limits.' + key for key in missing_keys)} (one per joint) to a "
+                "robot file pointing at the URDF (docs/robots.md), or pass --assume-limits",
+                file=file,
+            )
+        if acceleration is None:
+            acceleration = velocity / ASSUMED_ACCELERATION_TIME
+            notes.append(
+                f"acceleration assumed: velocity / {ASSUMED_ACCELERATION_TIME} s (--assume-limits)"
+            )
+        if jerk is None:
+            jerk = acceleration / ASSUMED_JERK_TIME
+            notes.append(f"jerk assumed: acceleration / {ASSUMED_JERK_TIME} s (--assume-limits)")
+    return Robot(
+        name=name,
+        origins=chain.origins,
+        axes=chain.axes,
+        q_min=chain.q_min,
+        q_max=chain.q_max,
+        v_max=velocity,
+        a_max=acceleration,
+        j_max=jerk,
+        T_tip=chain.T_tip,
+        T_flange_tool=T_tool,
+        source=source,
+        joint_names=chain.joint_names,
+        assumptions=tuple(notes),
+    )
+
+
+def library_robots() -> dict[str, Path]:
+    """The built-in URDF robots: name → robot file in the package data."""
+    return {path.stem: path for path in sorted(LIBRARY_DIR.glob("*.yaml"))}
+
+
+def builtin_names() -> tuple[str, ...]:
+    """Names of every built-in robot (DH and URDF), sorted."""
+    return tuple(sorted({*DH_ROBOTS, *library_robots()}))
+
+
+BUILTIN_ROBOTS: dict[str, Callable[[], Robot]] = {
+    **DH_ROBOTS,
+    **{name: partial(load_robot, path) for name, path in library_robots().items()},
+}
+"""Every built-in robot: name → a function that builds it (``trackplan robots`` lists them)."""
+
+
+def builtin_robot(name: str) -> Robot:
+    """The built-in robot called ``name`` (``trackplan robots`` lists them).
+
+    Raises
+    ------
+    CaseError
+        When no built-in robot has that name.
+    """
+    key = name.lower()
+    if key in DH_ROBOTS:
+        return DH_ROBOTS[key]()
+    library = library_robots()
+    if key in library:
+        return load_robot(library[key])
+    raise CaseError(
+        f"unknown robot {name!r}: use one of {', '.join(builtin_names())} or a path to a "
+        "robot file (.yaml or .urdf)",
+        key="robot",
+    )
+
+
 def is_robot_file(name_or_path: str) -> bool:
     """True when a case file's ``robot`` value names a file rather than a built-in robot.
 
-    A value naming a file ends in ``.yaml`` or ``.yml`` or contains a path separator.
+    A value naming a file ends in ``.yaml``, ``.yml`` or ``.urdf`` or contains a path
+    separator.
     """
     return name_or_path.lower().endswith(ROBOT_FILE_SUFFIXES) or any(
         separator in name_or_path for separator in ("/", "\\")
@@ -295,7 +500,11 @@ def is_robot_file(name_or_path: str) -> bool:
 
 
 def load_robot_spec(
-    name_or_path: str, base_dir: str | Path, *, case_file: str | None = None
+    name_or_path: str,
+    base_dir: str | Path,
+    *,
+    case_file: str | None = None,
+    assume_limits: bool = False,
 ) -> Robot:
     """The robot a case file names: a built-in robot or a robot file.
 
@@ -309,6 +518,8 @@ def load_robot_spec(
     case_file
         The case file, so that an unknown name or a missing robot file is reported
         at its ``robot`` key.
+    assume_limits
+        As for :func:`load_robot`.
 
     Returns
     -------
@@ -322,8 +533,12 @@ def load_robot_spec(
     """
     if is_robot_file(name_or_path):
         path = Path(base_dir) / name_or_path
+        if name_or_path.lower().endswith(".urdf"):
+            if not path.is_file():
+                raise CaseError(f"robot file not found: {path}", file=case_file, key="robot")
+            return robot_from_urdf_file(path, assume_limits=assume_limits)
         text = read_text(path, what="robot file", referrer=case_file, key="robot")
-        return load_robot_text(text, file=str(path))
+        return load_robot_text(text, file=str(path), assume_limits=assume_limits)
     try:
         return builtin_robot(name_or_path)
     except CaseError as exc:
@@ -365,19 +580,30 @@ def robot_to_yaml(robot: Robot) -> str:
     Parameters
     ----------
     robot
-        Any robot.
+        A robot built from a DH table (``robot.dh`` is set).
 
     Returns
     -------
     str
         YAML text in the robot file format, with a comment header.
+
+    Raises
+    ------
+    CaseError
+        For a robot read from a URDF.
     """
+    if robot.dh is None:
+        raise CaseError(
+            f"robot {robot.name!r} is read from a URDF, not a DH table: copy its URDF and "
+            "robot file (docs/robots.md) instead",
+            key="robot",
+        )
     joints = [
         _FlowMapping(
-            d=float(robot.d[i]),
-            a=float(robot.a[i]),
-            alpha=float(robot.alpha[i]),
-            offset=float(robot.offset[i]),
+            d=float(robot.dh[i, 0]),
+            a=float(robot.dh[i, 1]),
+            alpha=float(robot.dh[i, 2]),
+            offset=float(robot.dh[i, 3]),
             position=[float(robot.q_min[i]), float(robot.q_max[i])],
             velocity=float(robot.v_max[i]),
             acceleration=float(robot.a_max[i]),

@@ -21,6 +21,7 @@ from trackplan.planning.result import LIMIT_KINDS, PlanResult
 from trackplan.report.figures import history_columns
 from trackplan.report.robot_view import VIEW_ID, robot_view_figure
 from trackplan.report.scene import JOINT_QUANTITIES
+from trackplan.robots.families import ik_family
 from trackplan.run_files import REPORT_FILE
 
 Cell = str | tuple[str, str]
@@ -169,10 +170,8 @@ def _case_section(result: PlanResult, case: Case) -> str:
     joint_rows = [
         [
             f"{j + 1} ({robot.joint_names[j]})",
-            _num(robot.d[j]),
-            _num(robot.a[j]),
-            _num(robot.alpha[j]),
-            _num(robot.offset[j]),
+            _vector(robot.origins[j][:3, 3]),
+            _vector(robot.axes[j]),
             f"[{_num(robot.q_min[j])}, {_num(robot.q_max[j])}]",
             _num(robot.v_max[j]),
             _num(robot.a_max[j]),
@@ -185,16 +184,16 @@ def _case_section(result: PlanResult, case: Case) -> str:
         [
             ("name", _esc(robot.name)),
             ("joints", str(robot.n_dof)),
-            ("tool offset", "yes" if robot.has_tool else "none (tool = DH frame n)"),
+            ("IK family", _esc(ik_family(robot).name)),
+            ("tool offset", "yes" if robot.has_tool else "none (tool = flange)"),
+            *(("assumption", _esc(note)) for note in robot.assumptions),
             ("source", _esc(robot.source or "–")),
         ]
     ) + _grid(
         [
             "joint",
-            "d [m]",
-            "a [m]",
-            "α [rad]",
-            "offset [rad]",
+            "origin xyz [m]",
+            "axis",
             "q range [rad]",
             "q̇ max [rad/s]",
             "q̈ max [rad/s²]",

@@ -1,17 +1,20 @@
-"""Built-in robots: the paper's PUMA560 (Tables I and II) and a UR5.
+"""Built-in robots given by a DH table: the paper's PUMA560 (Tables I and II) and a UR5.
 
-The robot file format (YAML, see the README) describes the same data for other arms.
+The industrial arms of the library are URDFs with robot files in ``library/``
+(``docs/robots.md``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from trackplan.errors import CaseError
 from trackplan.robots.dynamics.builtin import puma560_dynamics
 from trackplan.robots.model import Robot
 
 HALF_PI = np.pi / 2
+PUMA_PLACEMENT_REACH = (0.150333, 0.853756)
+"""The PUMA's placement reach range, m: sqrt(0.0226) and sqrt(0.7289) of the paper's Eq. 32,
+rounded inwards."""
 
 
 def puma560() -> Robot:
@@ -23,7 +26,7 @@ def puma560() -> Robot:
     d = np.array([0.0, 0.0, 0.15, 0.4318, 0.0, 0.0])
     a = np.array([0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0])
     alpha = np.array([HALF_PI, 0.0, -HALF_PI, HALF_PI, -HALF_PI, 0.0])
-    return Robot(
+    return Robot.from_dh(
         name="puma560",
         d=d,
         a=a,
@@ -43,6 +46,7 @@ def puma560() -> Robot:
             "base frame at the shoulder (d1 = 0)."
         ),
         dynamics=puma560_dynamics(d, a, alpha),
+        placement_reach=PUMA_PLACEMENT_REACH,
     )
 
 
@@ -57,7 +61,7 @@ def ur5() -> Robot:
     chosen here for process motion (state your own in a robot file if they differ).
     """
     two_pi = 2 * np.pi
-    return Robot(
+    return Robot.from_dh(
         name="ur5",
         d=np.array([0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823]),
         a=np.array([0.0, -0.425, -0.39225, 0.0, 0.0, 0.0]),
@@ -75,21 +79,6 @@ def ur5() -> Robot:
     )
 
 
-BUILTIN_ROBOTS = {"puma560": puma560, "ur5": ur5}
-
-
-def builtin_robot(name: str) -> Robot:
-    """The built-in robot called ``name``.
-
-    Raises
-    ------
-    CaseError
-        When no built-in robot has that name.
-    """
-    try:
-        return BUILTIN_ROBOTS[name.lower()]()
-    except KeyError:
-        known = ", ".join(sorted(BUILTIN_ROBOTS))
-        raise CaseError(
-            f"unknown robot {name!r}: use one of {known} or a path to a robot file", key="robot"
-        ) from None
+DH_ROBOTS = {"puma560": puma560, "ur5": ur5}
+"""The built-in robots defined by a DH table here; the URDF library is in ``library/``
+(:func:`trackplan.io.robot_file.builtin_robot` serves both)."""

@@ -1,18 +1,24 @@
-"""Batched forward kinematics and geometric Jacobian of DH chains.
+"""Batched forward kinematics and geometric Jacobian of serial chains.
 
-Every function takes configurations of any leading shape ``(..., n)``.
+Every function takes configurations of any leading shape ``(..., n)``. The chain is
+the model's :attr:`~trackplan.robots.model.Robot.kernel_chain`: every joint turns about
+the z axis of its frame.
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
+from trackplan.robots._kernels import fk_flat, frames_flat
 from trackplan.robots.model import Robot
 
 
-def link_transforms(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """DH link transforms ``A_i(q_i)``.
+def joint_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Frames of the chain in the base frame: base, links 1..n, then the tool.
+
+    Link frame i moves with link i: for a robot built from a DH table it is DH frame i (at
+    the link's far end), for a URDF chain the child link frame of joint i
+    (:attr:`Robot.link_frames`).
 
     Parameters
     ----------
@@ -24,49 +30,37 @@ def link_transforms(robot: Robot, q: np.ndarray) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Shape (..., n, 4, 4): ``A_i = Rz(q_i + offset_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``.
+        Shape (..., n + 2, 4, 4): ``[I, T_0_1, …, T_0_n, T_base_tool]``.
     """
-    q = np.asarray(q, dtype=float)
-    theta = q + robot.offset
-    ct, st = np.cos(theta), np.sin(theta)
-    ca, sa = np.cos(robot.alpha), np.sin(robot.alpha)
-    A = np.zeros((*q.shape, 4, 4))
-    A[..., 0, 0] = ct
-    A[..., 0, 1] = -st * ca
-    A[..., 0, 2] = st * sa
-    A[..., 0, 3] = robot.a * ct
-    A[..., 1, 0] = st
-    A[..., 1, 1] = ct * ca
-    A[..., 1, 2] = -ct * sa
-    A[..., 1, 3] = robot.a * st
-    A[..., 2, 1] = sa
-    A[..., 2, 2] = ca
-    A[..., 2, 3] = robot.d
-    A[..., 3, 3] = 1.0
-    return A
+    return _frames(robot, q, robot.link_frames)
 
 
-def joint_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Frames of the chain in the base frame: base, DH frames 1..n, then the tool.
+def axis_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Base, joint-axis frames 1..n and the tool: frame i has its origin on joint i's axis
+    and its z column along the axis (after the joint's rotation).
 
     Parameters
     ----------
+    robot
+        The robot.
     q
         Joint positions, shape (..., n), rad.
 
     Returns
     -------
     numpy.ndarray
-        Shape (..., n + 2, 4, 4): ``[I, T_0_1, …, T_0_n, T_0_n · T_flange_tool]``.
+        Shape (..., n + 2, 4, 4).
     """
-    A = link_transforms(robot, q)
-    n = robot.n_dof
-    frames = np.empty((*A.shape[:-3], n + 2, 4, 4))
-    frames[..., 0, :, :] = np.eye(4)
-    for i in range(n):
-        frames[..., i + 1, :, :] = frames[..., i, :, :] @ A[..., i, :, :]
-    frames[..., n + 1, :, :] = frames[..., n, :, :] @ robot.T_flange_tool
-    return frames
+    return _frames(robot, q, np.broadcast_to(np.eye(4), (robot.n_dof, 4, 4)))
+
+
+def _frames(robot: Robot, q: np.ndarray, links: np.ndarray) -> np.ndarray:
+    """Frames through the compiled kernel, with ``links`` (n, 4, 4) after each joint."""
+    q = np.asarray(q, dtype=float)
+    chain, tail = robot.kernel_chain
+    flat = np.ascontiguousarray(q.reshape(-1, robot.n_dof))
+    frames = frames_flat(chain, tail, np.ascontiguousarray(links), flat)
+    return frames.reshape(*q.shape[:-1], robot.n_dof + 2, 4, 4)
 
 
 def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -74,6 +68,8 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
+    robot
+        The robot.
     q
         Joint positions, shape (..., n), rad.
 
@@ -83,49 +79,9 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
         Shape (..., 4, 4).
     """
     q = np.asarray(q, dtype=float)
+    chain, tail = robot.kernel_chain
     flat = np.ascontiguousarray(q.reshape(-1, robot.n_dof))
-    T = _forward_kinematics_flat(
-        robot.d, robot.a, robot.alpha, robot.offset, robot.T_flange_tool, flat
-    )
-    return T.reshape(*q.shape[:-1], 4, 4)
-
-
-@numba.njit(cache=True)
-def _forward_kinematics_flat(
-    d: np.ndarray,
-    a: np.ndarray,
-    alpha: np.ndarray,
-    offset: np.ndarray,
-    tool: np.ndarray,
-    q: np.ndarray,
-) -> np.ndarray:
-    """Compiled FK over a flat batch: q (N, n) → T (N, 4, 4) (measured ~20× numpy here)."""
-    n_poses, n_dof = q.shape
-    out = np.zeros((n_poses, 4, 4))
-    ca = np.cos(alpha)
-    sa = np.sin(alpha)
-    T = np.empty((3, 4))
-    for k in range(n_poses):
-        T[:] = 0.0
-        T[0, 0] = T[1, 1] = T[2, 2] = 1.0
-        for i in range(n_dof):
-            ct = np.cos(q[k, i] + offset[i])
-            st = np.sin(q[k, i] + offset[i])
-            # T ← T · A_i with A_i = Rz(θ) Tz(d) Tx(a) Rx(α), its columns written out
-            for r in range(3):
-                x = T[r, 0]
-                y = T[r, 1]
-                z = T[r, 2]
-                T[r, 0] = x * ct + y * st
-                T[r, 1] = (y * ct - x * st) * ca[i] + z * sa[i]
-                T[r, 2] = (x * st - y * ct) * sa[i] + z * ca[i]
-                T[r, 3] += (x * ct + y * st) * a[i] + z * d[i]
-        for r in range(3):
-            for c in range(4):
-                out[k, r, c] = T[r, 0] * tool[0, c] + T[r, 1] * tool[1, c] + T[r, 2] * tool[2, c]
-            out[k, r, 3] += T[r, 3]
-        out[k, 3, 3] = 1.0
-    return out
+    return fk_flat(chain, tail, flat).reshape(*q.shape[:-1], 4, 4)
 
 
 def jacobian(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -135,6 +91,8 @@ def jacobian(robot: Robot, q: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
+    robot
+        The robot.
     q
         Joint positions, shape (..., n), rad.
 
@@ -143,9 +101,9 @@ def jacobian(robot: Robot, q: np.ndarray) -> np.ndarray:
     numpy.ndarray
         Shape (..., 6, n).
     """
-    frames = joint_frames(robot, q)
-    z = frames[..., :-2, :3, 2]  # axis of joint i is z of frame i-1: (..., n, 3)
-    origins = frames[..., :-2, :3, 3]
+    frames = axis_frames(robot, q)
+    z = frames[..., 1:-1, :3, 2]  # joint i turns about z of its axis frame: (..., n, 3)
+    origins = frames[..., 1:-1, :3, 3]
     p_tool = frames[..., -1, :3, 3]
     J = np.empty((*frames.shape[:-3], 6, robot.n_dof))
     J[..., :3, :] = np.swapaxes(np.cross(z, p_tool[..., None, :] - origins), -1, -2)

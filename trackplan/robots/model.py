@@ -1,12 +1,23 @@
-"""The robot model: a standard-DH serial chain with per-joint limits.
+"""The robot model: a generic serial chain of revolute joints with per-joint limits.
 
-The model is immutable and shared; every computation keeps its scratch space local
-(pinocchio's Model/Data split).
+The chain is written the way a URDF writes it (``docs/robots.md``): joint i has a fixed
+transform ``origin_i`` from the frame of joint i − 1 (the base frame for i = 1) and a unit
+axis ``axis_i`` in its own frame, so that
+
+    ``T_0_i(q) = T_0_{i-1}(q) · origin_i · Rot(axis_i, q_i)``,
+    ``T_base_tool(q) = T_0_n(q) · T_tip · T_flange_tool``.
+
+``T_tip`` is the fixed transform from the last joint's frame to the flange (the tip link);
+``T_flange_tool`` is the user's tool. A standard-DH table converts into this form
+(:meth:`Robot.from_dh`). The model is immutable and shared; every computation keeps its
+scratch space local (pinocchio's Model/Data split).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -14,78 +25,206 @@ from trackplan.errors import CaseError
 from trackplan.robots.dynamics.parameters import RobotDynamics
 
 LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk")
+DH_COLUMNS = ("d", "a", "alpha", "offset")
+REACH_SAMPLES = 20_000
+"""Configurations sampled to estimate :attr:`Robot.reach`."""
+PLACEMENT_REACH_FRACTIONS = (0.15, 0.9)
+"""Default placement reach range as fractions of :attr:`Robot.reach`."""
+_AXIS_TOL = 1e-9
+
+
+def _frozen(value: np.ndarray) -> np.ndarray:
+    array = np.array(value, dtype=float)
+    array.flags.writeable = False
+    return array
+
+
+def rotation_z_to(axis: np.ndarray) -> np.ndarray:
+    """A rotation matrix (3, 3) whose z column is the unit vector ``axis``.
+
+    The identity for +z, a half turn about x for −z, else the shortest rotation.
+    """
+    z = np.array([0.0, 0.0, 1.0])
+    c = float(np.dot(z, axis))
+    if c > 1.0 - 1e-15:
+        return np.eye(3)
+    if c < -1.0 + 1e-15:
+        return np.diag([1.0, -1.0, -1.0])
+    v = np.cross(z, axis)
+    s = np.linalg.norm(v)
+    k = v / s
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
+def dh_transform(d: float, a: float, alpha: float) -> np.ndarray:
+    """``Tz(d) · Tx(a) · Rx(alpha)``, shape (4, 4)."""
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    return np.array(
+        [[1.0, 0.0, 0.0, a], [0.0, ca, -sa, 0.0], [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]]
+    )
+
+
+def rz(theta: float) -> np.ndarray:
+    """Rotation about z, shape (4, 4)."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0, 0, 0, 1.0]])
 
 
 @dataclass(frozen=True, eq=False)
 class Robot:
-    """A serial robot described by standard DH parameters.
-
-    Link transform (docs/conventions.md):
-    ``A_i = Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i)``.
-    The world frame is the DH base frame; the end effector is DH frame n followed by
-    ``T_flange_tool``.
+    """A serial robot of revolute joints.
 
     Attributes
     ----------
     name
         Robot name.
-    d, a, alpha, offset
-        DH parameters, shape (n,), metres and radians.
+    origins
+        Fixed transform of each joint from the previous joint's frame, shape (n, 4, 4), m.
+    axes
+        Unit axis of each joint in its own frame, shape (n, 3).
     q_min, q_max
         Joint position limits, shape (n,), rad.
     v_max, a_max, j_max
         Symmetric joint velocity, acceleration and jerk limits, shape (n,),
         rad/s, rad/s², rad/s³.
+    T_tip
+        Fixed transform from the last joint's frame to the flange, shape (4, 4).
     T_flange_tool
-        Tool transform in the flange (DH frame n), shape (4, 4).
+        Tool transform in the flange, shape (4, 4).
     source
         Where the numbers come from (free text, shown by ``trackplan robots``).
+    joint_names
+        One name per joint; default ``q1 … qn`` (also used in exported trajectories).
+    assumptions
+        Limits that were assumed rather than published, one sentence each (recorded in
+        results).
+    dh
+        The standard-DH table the chain was built from, shape (n, 4): d, a, alpha,
+        offset (m, rad); None for a chain read from a URDF.
+    placement_reach
+        The default range [min, max] of the path's distance from the base origin for a
+        placement search, m; None: derived from :attr:`reach` (:attr:`default_placement_reach`).
     dynamics
         Masses, inertias, actuators, friction and torque limits, or None when the robot has
         no published dynamics (then it has no torque check).
     """
 
     name: str
-    d: np.ndarray
-    a: np.ndarray
-    alpha: np.ndarray
-    offset: np.ndarray
+    origins: np.ndarray
+    axes: np.ndarray
     q_min: np.ndarray
     q_max: np.ndarray
     v_max: np.ndarray
     a_max: np.ndarray
     j_max: np.ndarray
+    T_tip: np.ndarray = field(default_factory=lambda: np.eye(4))
     T_flange_tool: np.ndarray = field(default_factory=lambda: np.eye(4))
     source: str = ""
+    joint_names: tuple[str, ...] = ()
+    assumptions: tuple[str, ...] = ()
+    dh: np.ndarray | None = None
     dynamics: RobotDynamics | None = None
+    placement_reach: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        n = len(self.d)
-        for key in ("d", "a", "alpha", "offset", "q_min", "q_max", "v_max", "a_max", "j_max"):
+        origins = np.array(self.origins, dtype=float)
+        if origins.ndim != 3 or origins.shape[1:] != (4, 4) or origins.shape[0] < 1:
+            raise CaseError(f"origins must have shape (n, 4, 4), got {origins.shape}")
+        n = origins.shape[0]
+        axes = np.array(self.axes, dtype=float)
+        if axes.shape != (n, 3):
+            raise CaseError(f"axes must have shape ({n}, 3), got {axes.shape}")
+        norms = np.linalg.norm(axes, axis=1)
+        if not np.all(np.isfinite(axes)) or np.any(norms < _AXIS_TOL):
+            raise CaseError(f"every joint axis must be a non-zero vector, got {axes.tolist()}")
+        object.__setattr__(self, "origins", _frozen(origins))
+        object.__setattr__(self, "axes", _frozen(axes / norms[:, None]))
+        for key in ("q_min", "q_max", "v_max", "a_max", "j_max"):
             value = np.array(getattr(self, key), dtype=float)
             if value.shape != (n,):
                 raise CaseError(f"{key} must have {n} entries, got shape {value.shape}", key=key)
             if not np.all(np.isfinite(value)):
                 raise CaseError(f"{key} must be finite, got {value.tolist()}", key=key)
-            value.flags.writeable = False
-            object.__setattr__(self, key, value)
-        tool = np.array(self.T_flange_tool, dtype=float)
-        tool.flags.writeable = False
-        object.__setattr__(self, "T_flange_tool", tool)
+            object.__setattr__(self, key, _frozen(value))
+        for key in ("T_tip", "T_flange_tool"):
+            value = np.array(getattr(self, key), dtype=float)
+            if value.shape != (4, 4) or not np.all(np.isfinite(value)):
+                raise CaseError(f"{key} must be a finite (4, 4) transform")
+            object.__setattr__(self, key, _frozen(value))
+        names = tuple(self.joint_names) or tuple(f"q{i + 1}" for i in range(n))
+        if len(names) != n:
+            raise CaseError(f"joint_names must have {n} entries, got {len(names)}")
+        object.__setattr__(self, "joint_names", names)
+        object.__setattr__(self, "assumptions", tuple(self.assumptions))
+        if self.dh is not None:
+            object.__setattr__(self, "dh", _frozen(self.dh))
         if self.dynamics is not None and self.dynamics.n_dof != n:
             raise CaseError(
                 f"dynamics must have {n} joints, got {self.dynamics.n_dof}", key="dynamics"
             )
 
+    @classmethod
+    def from_dh(
+        cls,
+        *,
+        name: str,
+        d: np.ndarray,
+        a: np.ndarray,
+        alpha: np.ndarray,
+        offset: np.ndarray,
+        **limits_and_more: object,
+    ) -> Robot:
+        """A robot from a standard-DH table.
+
+        Link transform: ``A_i = Rz(q_i + offset_i) · Tz(d_i) · Tx(a_i) · Rx(alpha_i)``; the
+        flange is DH frame n. As a chain: ``origin_1 = Rz(offset_1)``,
+        ``origin_i = Tz(d_{i-1}) Tx(a_{i-1}) Rx(alpha_{i-1}) Rz(offset_i)``, every axis z,
+        ``T_tip = Tz(d_n) Tx(a_n) Rx(alpha_n)``.
+
+        Parameters
+        ----------
+        name
+            Robot name.
+        d, a, alpha, offset
+            DH parameters, shape (n,), m and rad.
+        **limits_and_more
+            The other :class:`Robot` fields (``q_min`` … ``j_max``, ``T_flange_tool``,
+            ``source`` …).
+
+        Raises
+        ------
+        CaseError
+            When the columns do not have one entry per joint or are not finite.
+        """
+        table = np.stack([np.asarray(c, dtype=float).ravel() for c in (d, a, alpha, offset)], 1)
+        columns = [np.asarray(c, dtype=float) for c in (d, a, alpha, offset)]
+        for key, column in zip(DH_COLUMNS, columns, strict=True):
+            if column.shape != columns[0].shape or column.ndim != 1:
+                raise CaseError(
+                    f"{key} must have {columns[0].size} entries, got shape {column.shape}", key=key
+                )
+            if not np.all(np.isfinite(column)):
+                raise CaseError(f"{key} must be finite, got {column.tolist()}", key=key)
+        n = table.shape[0]
+        origins = np.empty((n, 4, 4))
+        for i in range(n):
+            previous = np.eye(4) if i == 0 else dh_transform(*table[i - 1, :3])
+            origins[i] = previous @ rz(table[i, 3])
+        axes = np.tile([0.0, 0.0, 1.0], (n, 1))
+        return cls(
+            name=name,
+            origins=origins,
+            axes=axes,
+            T_tip=dh_transform(*table[-1, :3]),
+            dh=table,
+            **limits_and_more,  # type: ignore[arg-type]
+        )
+
     @property
     def n_dof(self) -> int:
         """Number of joints."""
-        return len(self.d)
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """Joint names ``q1 … qn`` (also used in exported trajectories)."""
-        return tuple(f"q{i + 1}" for i in range(self.n_dof))
+        return self.origins.shape[0]
 
     @property
     def has_tool(self) -> bool:
@@ -99,7 +238,68 @@ class Robot:
         """
         return {"velocity": self.v_max, "acceleration": self.a_max, "jerk": self.j_max}[kind]
 
-    @property
+    @cached_property
+    def kernel_chain(self) -> tuple[np.ndarray, np.ndarray]:
+        """The chain with every axis turned onto z, the layout of the compiled kernels.
+
+        Returns
+        -------
+        chain
+            Shape (n, 4, 4): ``C_i = R_{i-1}ᵀ · origin_i · R_i`` with ``R_i`` a rotation
+            whose z column is ``axis_i`` (``R_0 = I``), so ``T_0_n(q) = Π C_i Rz(q_i)``
+            up to the last ``R_n``.
+        tail
+            Shape (4, 4): ``R_nᵀ · T_tip · T_flange_tool``.
+        """
+        n = self.n_dof
+        chain = np.empty((n, 4, 4))
+        previous = np.eye(4)
+        for i in range(n):
+            turn = np.eye(4)
+            turn[:3, :3] = rotation_z_to(self.axes[i])
+            chain[i] = previous.T @ self.origins[i] @ turn
+            previous = turn
+        tail = previous.T @ self.T_tip @ self.T_flange_tool
+        chain.flags.writeable = False
+        tail.flags.writeable = False
+        return chain, tail
+
+    @cached_property
+    def link_frames(self) -> np.ndarray:
+        """Each link's frame relative to its joint's frame in :attr:`kernel_chain`, (n, 4, 4).
+
+        The frame a link is described in: for a robot built from a DH table, DH frame i
+        (``Tz(d_i) Tx(a_i) Rx(alpha_i)`` after joint i); for a URDF chain, the child link
+        frame of joint i (the axis turned back from z).
+        """
+        n = self.n_dof
+        links = np.empty((n, 4, 4))
+        for i in range(n):
+            if self.dh is not None:
+                links[i] = dh_transform(*self.dh[i, :3])
+            else:
+                links[i] = np.eye(4)
+                links[i, :3, :3] = rotation_z_to(self.axes[i]).T
+        links.flags.writeable = False
+        return links
+
+    @cached_property
     def reach(self) -> float:
-        """An upper bound of the distance from the base origin to the flange, m."""
-        return float(np.sum(np.abs(self.a)) + np.sum(np.abs(self.d)))
+        """The largest distance of the tool point from the base origin, m.
+
+        Estimated on :data:`REACH_SAMPLES` configurations drawn with a fixed seed inside the
+        position limits (a lower bound of the true maximum, within about 1 %).
+        """
+        from trackplan.robots.kinematics import forward_kinematics
+
+        rng = np.random.default_rng(0)
+        q = rng.uniform(self.q_min, self.q_max, (REACH_SAMPLES, self.n_dof))
+        return float(np.linalg.norm(forward_kinematics(self, q)[:, :3, 3], axis=1).max())
+
+    @property
+    def default_placement_reach(self) -> tuple[float, float]:
+        """:attr:`placement_reach`, or :data:`PLACEMENT_REACH_FRACTIONS` of :attr:`reach`, m."""
+        if self.placement_reach is not None:
+            return self.placement_reach
+        low, high = PLACEMENT_REACH_FRACTIONS
+        return (round(low * self.reach, 6), round(high * self.reach, 6))

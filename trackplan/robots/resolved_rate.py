@@ -31,15 +31,14 @@ import numpy as np
 from numba import njit
 
 from trackplan.errors import CaseError
-from trackplan.robots.ik_numeric import (
-    chain_arrays,
-    check_poses_and_joints,
+from trackplan.robots._kernels import (
     damped_solve_into,
     fk_jacobian_into,
     newton_into,
     pose_error_into,
     work_size_kernel,
 )
+from trackplan.robots.ik_numeric import chain_arrays, check_poses_and_joints
 from trackplan.robots.model import Robot
 
 MODES = ("paper", "uncompensated", "newton")
@@ -106,7 +105,7 @@ def solve_path_resolved_rate(
 
 @njit(cache=True, error_model="numpy")
 def _resolved_rate(
-    dh: np.ndarray,
+    chain: np.ndarray,
     tool: np.ndarray,
     T: np.ndarray,
     q0: np.ndarray,
@@ -117,7 +116,7 @@ def _resolved_rate(
 ) -> None:  # pragma: no cover - compiled
     """Kernel: resolved-rate paths q (P, M, n) through T (P, M, 4, 4) from q0 (P, n)."""
     n_paths, n_poses = T.shape[0], T.shape[1]
-    n = dh.shape[0]
+    n = chain.shape[0]
     T_a = np.empty((4, 4))
     J = np.empty((6, n))
     axes = np.empty((n, 6))
@@ -131,9 +130,9 @@ def _resolved_rate(
         for j in range(n):
             q[p, 0, j] = q0[p, j]
         if mode == _NEWTON:
-            newton_into(dh, tool, T[p, 0], q[p, 0], tol, max_iter, work)
+            newton_into(chain, tool, T[p, 0], q[p, 0], tol, max_iter, work)
         for k in range(n_poses - 1):
-            fk_jacobian_into(dh, tool, q[p, k], T_a, J, axes)  # step ii: the reached pose
+            fk_jacobian_into(chain, tool, q[p, k], T_a, J, axes)  # step ii: the reached pose
             source = T[p, k] if mode == _UNCOMPENSATED else T_a
             target = T[p, k + 1]
             if mode == _NEWTON:
@@ -144,7 +143,7 @@ def _resolved_rate(
             for j in range(n):
                 q[p, k + 1, j] = q[p, k, j] + dq[j]
             if mode == _NEWTON:
-                newton_into(dh, tool, target, q[p, k + 1], tol, max_iter, work)
+                newton_into(chain, tool, target, q[p, k + 1], tol, max_iter, work)
 
 
 @njit(cache=True, error_model="numpy")

@@ -15,7 +15,6 @@ from trackplan.robots.dynamics.parameters import (
     JointChain,
     RobotDynamics,
     combine_payload,
-    dh_chain,
 )
 from trackplan.robots.model import Robot
 
@@ -32,7 +31,7 @@ def robot_chain(robot: Robot) -> JointChain:
     -------
     JointChain
     """
-    return dh_chain(robot.d, robot.a, robot.alpha, robot.offset)
+    return JointChain(T_parent_joint=robot.origins, axis=robot.axes, T_last_flange=robot.T_tip)
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,0 +1,213 @@
+"""Reading a serial chain from a URDF file (yourdfpy, meshes never loaded).
+
+The chain runs from ``base_link`` (default: the URDF's root link) to ``tip_link``
+(default: the single leaf of the tree). Fixed joints are folded into the next joint's
+origin, or into the flange transform after the last moving joint. Revolute and
+continuous joints are supported; continuous joints get the range
+``[−continuous_range, continuous_range]``. Prismatic, floating and planar joints, and
+mimic joints, are refused with a clear error. See ``docs/robots.md``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from trackplan.errors import CaseError
+
+DEFAULT_CONTINUOUS_RANGE = 2 * np.pi
+"""Half range of a continuous joint, rad: [−2π, 2π] unless a robot file says otherwise."""
+
+
+@dataclass(frozen=True, eq=False)
+class URDFChain:
+    """The moving joints of a URDF chain, base to tip.
+
+    Attributes
+    ----------
+    name
+        The URDF's robot name.
+    joint_names
+        Names of the n moving joints.
+    origins
+        Shape (n, 4, 4): each joint's fixed transform from the previous joint's frame
+        (fixed joints before it folded in), m.
+    axes
+        Shape (n, 3): unit joint axes in the joint frames.
+    q_min, q_max
+        Position limits, shape (n,), rad.
+    v_max
+        Velocity limits, shape (n,), rad/s (NaN where the URDF gives none).
+    T_tip
+        Fixed transform from the last joint's frame to the tip link, shape (4, 4).
+    """
+
+    name: str
+    joint_names: tuple[str, ...]
+    origins: np.ndarray
+    axes: np.ndarray
+    q_min: np.ndarray
+    q_max: np.ndarray
+    v_max: np.ndarray
+    T_tip: np.ndarray
+
+
+def read_urdf_chain(
+    file: str | Path,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    *,
+    continuous_range: float = DEFAULT_CONTINUOUS_RANGE,
+    referrer: str | None = None,
+) -> URDFChain:
+    """The serial chain of a URDF between two links.
+
+    Parameters
+    ----------
+    file
+        Path of the URDF.
+    base_link, tip_link
+        The chain's first and last link; default the root and the single leaf.
+    continuous_range
+        Half range given to continuous joints, rad.
+    referrer
+        The robot file that names the URDF, for error messages about the link names.
+
+    Returns
+    -------
+    URDFChain
+
+    Raises
+    ------
+    CaseError
+        When the file is missing or malformed, a named link does not exist, the tree
+        branches and no tip link is named, or the chain holds a mimic, prismatic,
+        planar or floating joint.
+    """
+    import yourdfpy
+
+    path = str(file)
+    if not Path(path).is_file():
+        raise CaseError("URDF file not found", file=path)
+    logger = logging.getLogger("yourdfpy")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL)
+    try:
+        urdf = yourdfpy.URDF.load(
+            path, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
+        )
+    except Exception as exc:  # yourdfpy raises whatever its XML parsing meets
+        raise CaseError(
+            f"not a valid URDF ({type(exc).__name__}: {exc}): check the XML against the URDF "
+            "specification",
+            file=path,
+        ) from None
+    finally:
+        logger.setLevel(level)
+    robot = urdf.robot
+    links = {link.name for link in robot.links}
+    by_child = {}
+    children: dict[str, list[str]] = {name: [] for name in links}
+    for joint in robot.joints:
+        if joint.parent not in links or joint.child not in links:
+            raise CaseError(
+                f"joint {joint.name!r} connects links that are not defined "
+                f"({joint.parent!r} → {joint.child!r})",
+                file=path,
+            )
+        by_child[joint.child] = joint
+        children[joint.parent].append(joint.child)
+    roots = sorted(links - set(by_child))
+    if len(roots) != 1:
+        raise CaseError(f"a URDF must have one root link, found {roots}", file=path)
+    key_file = referrer or path
+    for key, link in (("base_link", base_link), ("tip_link", tip_link)):
+        if link is not None and link not in links:
+            known = ", ".join(sorted(links))
+            raise CaseError(
+                f"the URDF has no link {link!r}: use one of {known}", file=key_file, key=key
+            )
+    base = base_link or roots[0]
+    if tip_link is None:
+        leaves = sorted(name for name, below in children.items() if not below)
+        if len(leaves) != 1:
+            raise CaseError(
+                f"the URDF is a branching tree (leaves {', '.join(leaves)}): name the chain's "
+                "end with tip_link in a robot file",
+                file=path,
+            )
+        tip_link = leaves[0]
+    chain = []
+    link = tip_link
+    while link != base:
+        joint = by_child.get(link)
+        if joint is None:
+            raise CaseError(
+                f"link {tip_link!r} does not descend from {base!r}: choose base_link and "
+                "tip_link on one chain",
+                file=key_file,
+                key="tip_link",
+            )
+        chain.append(joint)
+        link = joint.parent
+    chain.reverse()
+    names: list[str] = []
+    origins: list[np.ndarray] = []
+    axes: list[np.ndarray] = []
+    limits: list[tuple[float, float, float]] = []
+    pending = np.eye(4)
+    for joint in chain:
+        origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, dtype=float)
+        if joint.mimic is not None:
+            raise CaseError(
+                f"joint {joint.name!r} is a mimic joint, which trackplan does not support: "
+                "remove it from the chain or make it fixed",
+                file=path,
+            )
+        if joint.type == "fixed":
+            pending = pending @ origin
+            continue
+        if joint.type not in ("revolute", "continuous"):
+            raise CaseError(
+                f"joint {joint.name!r} is {joint.type}: trackplan supports revolute and "
+                "continuous joints only",
+                file=path,
+            )
+        axis = np.array([1.0, 0.0, 0.0] if joint.axis is None else joint.axis, dtype=float)
+        if not np.linalg.norm(axis) > 0.0:
+            raise CaseError(f"joint {joint.name!r} has a zero axis", file=path)
+        limit = joint.limit
+        velocity = np.nan if limit is None or limit.velocity is None else float(limit.velocity)
+        if joint.type == "continuous":
+            low, high = -continuous_range, continuous_range
+        elif limit is None or limit.lower is None or limit.upper is None:
+            raise CaseError(
+                f"revolute joint {joint.name!r} has no lower/upper limit: add "
+                '<limit lower="…" upper="…" velocity="…" effort="…"/>',
+                file=path,
+            )
+        else:
+            low, high = float(limit.lower), float(limit.upper)
+            if not low < high:
+                raise CaseError(f"joint {joint.name!r} has lower {low} ≥ upper {high}", file=path)
+        names.append(joint.name)
+        origins.append(pending @ origin)
+        axes.append(axis / np.linalg.norm(axis))
+        limits.append((low, high, velocity))
+        pending = np.eye(4)
+    if not names:
+        raise CaseError(f"the chain {base!r} → {tip_link!r} has no moving joint", file=path)
+    table = np.array(limits)
+    return URDFChain(
+        name=robot.name,
+        joint_names=tuple(names),
+        origins=np.array(origins),
+        axes=np.array(axes),
+        q_min=table[:, 0],
+        q_max=table[:, 1],
+        v_max=table[:, 2],
+        T_tip=pending,
+    )

@@ -1,0 +1,99 @@
+"""The protocol every IK family implements, and the closed-form result type."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+N_BRANCHES = 8
+"""Number of closed-form solutions of a pose (and of numeric seeds)."""
+
+AUX_SIZE = 5
+"""Per pose and branch, the branch-defining quantities a closed-form solver writes: the
+shoulder measure (m, ≥ 0, zero at the shoulder singularity), the elbow measure
+(≥ 0, zero with the arm stretched or folded) and a wrist vector (3,) whose norm is zero
+at the wrist singularity and which reverses when the path crosses it."""
+
+
+def branch_bits(branch: int) -> tuple[int, int, int]:
+    """The (shoulder, elbow, wrist) bits of a branch number ``4·shoulder + 2·elbow + wrist``."""
+    return (branch >> 2) & 1, (branch >> 1) & 1, branch & 1
+
+
+def describe_bits(branch: int) -> str:
+    """A short name of a closed-form branch, e.g. ``"front/elbow up/wrist 0"``."""
+    shoulder, elbow, wrist = branch_bits(branch)
+    return "/".join(
+        (
+            ("front", "back")[shoulder],
+            ("elbow up", "elbow down")[elbow],
+            ("wrist 0", "wrist flipped")[wrist],
+        )
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class ClosedFormIK:
+    """All eight closed-form solutions of a batch of poses.
+
+    Attributes
+    ----------
+    q
+        Joint positions, shape (..., 8, n), rad, in (−π, π]; NaN where not ``valid``.
+        Axis −2 is the branch ``b = 4·shoulder + 2·elbow + wrist``.
+    valid
+        Shape (..., 8), bool: the branch reaches the pose (joint limits not applied).
+    """
+
+    q: np.ndarray
+    valid: np.ndarray
+
+    @property
+    def reachable(self) -> np.ndarray:
+        """Shape (...,), bool: at least one branch reaches the pose."""
+        return np.any(self.valid, axis=-1)
+
+
+class IKFamily(Protocol):
+    """What the path IK needs from a family of arms.
+
+    Attributes
+    ----------
+    name
+        ``"opw"``, ``"ur"`` or ``"numeric"``.
+    closed_form
+        True when :meth:`solve_flat` gives all eight branches in closed form; False for
+        the numeric family, whose branches are seeds
+        (:func:`trackplan.robots.path_ik.numeric_seeds`).
+    """
+
+    name: str
+    closed_form: bool
+
+    def parameters(self) -> dict[str, object]:
+        """The derived parameters, for display (lengths m, angles rad)."""
+        ...
+
+    def describe_branch(self, branch: int) -> str:
+        """A short human-readable name of a branch."""
+        ...
+
+    def solve_flat(
+        self, T_base_tool: np.ndarray, *, with_aux: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """All branches of a flat batch of tool poses (N, 4, 4).
+
+        ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
+
+        Returns
+        -------
+        q
+            Shape (N, 8, 6), rad in (−π, π], NaN where not valid.
+        valid
+            Shape (N, 8), bool.
+        aux
+            Shape (N, 8, :data:`AUX_SIZE`): the branch-defining quantities, NaN out of reach.
+        """
+        ...
