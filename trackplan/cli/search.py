@@ -197,21 +197,15 @@ def _pareto(
 
 def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> ExitCode:  # type: ignore[no-untyped-def]
     """Search (SIGINT and SIGTERM stop it), write the run, print it; the exit code."""
-    from trackplan.io.history import optimizer_summary
-    from trackplan.outputs import write_run
+    from trackplan.outputs import write_search_run
 
     with stop_on_signals() as signals:  # a second signal while writing stops the writing
         signals.deferring = True  # the search polls after each generation
         result = _search(case, signals, **options)
         signals.deferring = False
-        extra = optimizer_summary(result, case.robot.joint_names)
         interrupted = result.stop_reason == "interrupted" or signals.first is not None
-        if interrupted:
-            extra.update(_interrupted_marks(result, signals))
-        history = {result.method: result.history.as_columns()} if len(result.history) else None
-        write_run(
-            out, result.final, case, history=history, extra=extra, report=report, search=result
-        )
+        marks = _interrupted_marks(result, signals) if interrupted else None
+        write_search_run(out, result, case, report=report, extra=marks)
     print_search(console(), result, out)
     if interrupted:
         return ExitCode(signals.exit_code)
