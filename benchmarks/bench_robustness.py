@@ -1,14 +1,24 @@
-"""The smooth time law on random placements: every reachable one must pass the checker.
+"""Robustness: random placements, hostile inputs, and a large sampled path.
 
-Run with ``python -m benchmarks robustness``. For each shipped case, 150 placements drawn
-uniformly in the case's bounds and reach shell (seeded) are planned at full Ts. Prints how
-many were unreachable or left the joint ranges (geometry: no time law can help), how many
-planned feasibly, and how long they took against the path length at the rated speed; any
-reachable placement that fails the checker is listed (target: none).
+Run with ``python -m benchmarks robustness``. Three sections:
+
+1. The smooth time law on random placements: for each shipped case, 150 placements drawn
+   uniformly in the case's bounds and reach shell (seeded) are planned at full Ts. Prints
+   how many were unreachable or left the joint ranges (geometry: no time law can help), how
+   many planned feasibly, and how long they took against the path length at the rated
+   speed; any reachable placement that fails the checker is listed (target: none).
+2. Fuzzing (``tests/fuzzing.py``, seeded): mutants of the shipped case and robot files
+   validated, and those that validate planned. Prints the exit codes, exit-1s, tracebacks,
+   runs over 10 s and exit-2 messages that do not name the key (targets: 0 each).
+3. A 20,000-point smooth helix (a points file): wall time and peak memory of ``validate``,
+   ``plan`` and ``check``, each a fresh process (targets: 10 s and 1 GB each).
 """
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -26,8 +36,104 @@ SEED = 11
 GEOMETRIC = (Status.UNREACHABLE, Status.POSITION_LIMITS, Status.BRANCH_SWITCH)
 
 
+FUZZ_MUTANTS = 400
+FUZZ_PLANS = 60
+FUZZ_SEED = 7
+HELIX_POINTS = 20_000
+HELIX_PLACEMENT = ("0.5", "0", "0", "0", "0", "0")
+COMMAND_TIMEOUT_S = 300.0
+
+
 def main() -> None:
-    """Print one row per case."""
+    """Print the three sections."""
+    placements()
+    fuzzing()
+    helix()
+
+
+def fuzzing() -> None:
+    """Section 2: counts over a seeded fuzz run."""
+    from tests.fuzzing import RUN_LIMIT_S, fuzz
+
+    with tempfile.TemporaryDirectory() as folder:
+        counts = fuzz(Path(folder), FUZZ_MUTANTS, FUZZ_PLANS, FUZZ_SEED)
+    codes = ", ".join(f"exit {code}: {n}" for code, n in sorted(counts.exit_codes.items()))
+    print(f"\nfuzzing: {FUZZ_MUTANTS} mutants (seed {FUZZ_SEED}), {counts.runs} runs ({codes})")
+    print(
+        f"  exit 1: {len(counts.internal_errors)}  tracebacks: {counts.tracebacks}  "
+        f"runs over {RUN_LIMIT_S:g} s: {counts.hangs}  exit-2 messages not naming the key: "
+        f"{len(counts.bad_messages)}  slowest run {counts.slowest_s:.1f} s  (targets 0)"
+    )
+    for line in counts.internal_errors + counts.bad_messages:
+        print(f"  {line}")
+
+
+HELIX_CASE = """name: helix-20k
+robot: puma560
+path:
+  start: [0, 0, -0.001]
+  segments:
+    - points: {file: helix.csv}
+task:
+  rated_speed: 0.05
+  tolerance: 0.001
+  sample_time: 0.001
+  tool_rpy: [3.141592653589793, 0, 0]
+"""
+
+PEAK_MEMORY = (
+    "import resource, sys\n"
+    "from trackplan.cli import main\n"
+    "code = main(sys.argv[1:])\n"
+    "print('peak-kib', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
+    "sys.exit(code)\n"
+)
+
+
+def helix() -> None:
+    """Section 3: validate, plan and check a 20,000-point helix, each in a fresh process."""
+    print(f"\n{HELIX_POINTS}-point helix (r = 0.1 m, 3 turns, 0.3 m rise), fresh processes:")
+    with tempfile.TemporaryDirectory() as name:
+        folder = Path(name)
+        turns = np.linspace(0.0, 6.0 * np.pi, HELIX_POINTS)
+        points = np.column_stack(
+            [0.1 * np.cos(turns) - 0.1, 0.1 * np.sin(turns), 0.3 * turns / (6.0 * np.pi)]
+        )
+        np.savetxt(folder / "helix.csv", points, delimiter=",", header="x,y,z", comments="")
+        (folder / "helix.yaml").write_text(HELIX_CASE)
+        case, run = str(folder / "helix.yaml"), str(folder / "run")
+        for command in (
+            ["validate", case],
+            ["plan", case, "--out", run, "--no-report", "--placement", *HELIX_PLACEMENT],
+            ["check", case, run, "--placement", *HELIX_PLACEMENT],
+        ):
+            seconds, peak, code = _measure(command)
+            shown = f"{seconds:6.1f} s" if code is not None else f"> {COMMAND_TIMEOUT_S:g} s"
+            print(
+                f"  {command[0]:<9}{shown}  peak {peak / 2**30:6.2f} GiB  exit {code}"
+                "  (targets 10 s, 1 GB)"
+            )
+
+
+def _measure(command: list[str]) -> tuple[float, float, int | None]:
+    """Wall time (s), peak resident memory (bytes) and exit code of ``trackplan command``."""
+    start = time.perf_counter()
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", PEAK_MEMORY, *command],
+            capture_output=True,
+            text=True,
+            timeout=COMMAND_TIMEOUT_S,
+        )
+    except subprocess.TimeoutExpired:
+        return COMMAND_TIMEOUT_S, float("nan"), None
+    seconds = time.perf_counter() - start
+    peaks = [line.split()[1] for line in done.stderr.splitlines() if line.startswith("peak-kib")]
+    return seconds, float(peaks[-1]) * 1024 if peaks else float("nan"), done.returncode
+
+
+def placements() -> None:
+    """Section 1: one row per case."""
     header = (
         f"{'case':<14}{'planned':>8}{'geometry':>10}{'feasible':>10}{'failed':>8}"
         f"{'T/(L/v_r) median':>18}{'max':>7}{'ms each':>9}"

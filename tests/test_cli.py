@@ -13,6 +13,8 @@ import trackplan
 from tests.conftest import CASES, REPO
 from trackplan import cli
 from trackplan.cli import ExitCode, main
+from trackplan.cli import common as cli_common
+from trackplan.cli.common import shipped_cases_dir
 from trackplan.io.robot_file import load_robot_text
 from trackplan.robots.builtin import ur5
 
@@ -66,7 +68,7 @@ def test_robots_yaml_of_an_unknown_robot(capsys: pytest.CaptureFixture[str]) -> 
 
 
 def test_cases_lists_the_shipped_cases(capsys: pytest.CaptureFixture[str]) -> None:
-    assert cli.shipped_cases_dir() == CASES
+    assert shipped_cases_dir() == CASES
     code, out, err = run(capsys, "cases")
     assert (code, err) == (0, "")
     for name in ("paper-line", "paper-circle", "paper-corner", "ur5-bead"):
@@ -97,7 +99,7 @@ def test_internal_error_is_one_line_without_traceback(
     def broken(file: object) -> None:
         raise RuntimeError("boom\nsecond line")
 
-    monkeypatch.setattr(cli, "load_case", broken)
+    monkeypatch.setattr(cli_common, "load_case", broken)
     monkeypatch.delenv(cli.DEBUG_ENV, raising=False)
     code, _, err = run(capsys, "validate", "any.yaml")
     assert code == ExitCode.INTERNAL_ERROR
@@ -111,7 +113,7 @@ def test_debug_prints_the_traceback(
     def broken(file: object) -> None:
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(cli, "load_case", broken)
+    monkeypatch.setattr(cli_common, "load_case", broken)
     if how == "environment":
         monkeypatch.setenv(cli.DEBUG_ENV, "1")
         args: tuple[str, ...] = ("validate", "any.yaml")

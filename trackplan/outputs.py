@@ -1,4 +1,9 @@
-"""Everything a run writes into its folder: result files, plots and the HTML report."""
+"""Everything a run writes into its folder: result files, plots, report and search history.
+
+The folder is written as a whole (:func:`trackplan.io.run_folder.write_run_folder`): every
+file through a staging folder and an atomic rename, ``result.json`` last, and an earlier
+run's files that this run does not write are removed.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from trackplan.case import Case
 from trackplan.io.results import write_plan_files
+from trackplan.io.run_folder import write_run_folder
 from trackplan.planning.result import PlanResult
 from trackplan.robots.describe import robot_info
 
@@ -22,13 +28,14 @@ def write_run(
     history: dict | None = None,
     extra: dict | None = None,
     report: bool = True,
+    search: OptimizeResult | None = None,
 ) -> dict:
     """Write trajectory.csv, result.json and, with ``report``, the plots and report.html.
 
     Parameters
     ----------
     out_dir
-        Output folder (created).
+        Output folder (created). Outputs of an earlier run there are replaced or removed.
     result
         The plan to write.
     case
@@ -40,47 +47,67 @@ def write_run(
         block (:func:`~trackplan.robots.describe.robot_info`) is always added.
     report
         Also write the plots and the HTML report (which embeds them).
+    search
+        The :class:`~trackplan.search.optimize.OptimizeResult` whose ``history.csv`` to
+        write, or None.
 
     Returns
     -------
     dict
         The ``result.json`` content.
     """
-    out_dir = Path(out_dir)
     extra = {"robot": robot_info(case.robot), **(extra or {})}
-    summary = write_plan_files(result, case.robot.joint_names, out_dir, extra)
-    if report:
-        from trackplan.report import write_plots, write_report
+    written: dict = {}
 
-        plots = write_plots(result, case, out_dir, history)
-        write_report(result, case, out_dir, plots, history=history, optimizer_info=extra)
-    return summary
+    def write(folder: Path) -> None:
+        if report:
+            from trackplan.report import write_plots, write_report
+
+            plots = write_plots(result, case, folder, history)
+            write_report(result, case, folder, plots, history=history, optimizer_info=extra)
+        if search is not None:
+            from trackplan.io.history import write_history
+
+            write_history(search, folder)
+        written.update(write_plan_files(result, case.robot.joint_names, folder, extra))
+
+    write_run_folder(Path(out_dir), write)
+    return written
 
 
-def write_search_run(out_dir: Path, result: OptimizeResult, case: Case, *, report: bool) -> dict:
+def write_search_run(
+    out_dir: Path,
+    result: OptimizeResult,
+    case: Case,
+    *,
+    report: bool,
+    extra: dict | None = None,
+) -> dict:
     """Write a placement search's run folder: :func:`write_run` for the final plan, with the
-    ``optimizer`` and ``initial`` blocks in ``result.json``, and ``history.csv``.
+    ``optimizer`` and ``initial`` blocks (and ``extra``) in ``result.json``, and ``history.csv``.
 
     Parameters
     ----------
     out_dir
-        Output folder (created).
+        Output folder (created); written as a whole like :func:`write_run`.
     result
-        The search.
+        The search (:class:`~trackplan.search.optimize.OptimizeResult`).
     case
         Its case.
     report
         Also write the plots and the HTML report.
+    extra
+        More keys for ``result.json`` (an interrupted search's marks).
 
     Returns
     -------
     dict
         The ``result.json`` content.
     """
-    from trackplan.io.history import optimizer_summary, write_history
+    from trackplan.io.history import optimizer_summary
 
     history = {result.method: result.history.as_columns()} if len(result.history) else None
-    extra = optimizer_summary(result, case.robot.joint_names)
-    summary = write_run(out_dir, result.final, case, history=history, extra=extra, report=report)
-    write_history(result, Path(out_dir))
-    return summary
+    blocks = {**optimizer_summary(result, case.robot.joint_names), **(extra or {})}
+    return write_run(
+        out_dir, result.final, case, history=history, extra=blocks, report=report, search=result
+    )

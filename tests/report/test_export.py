@@ -11,6 +11,7 @@ import yaml
 from trackplan.errors import CaseError
 from trackplan.io.export import export_trajectory, read_trajectory_table
 from trackplan.io.results import trajectory_header, write_result_json, write_trajectory_csv
+from trackplan.io.run_folder import HASH_KEY, file_sha256
 
 # yaml.safe_load's constructors, in libyaml's C loader: ten times faster on 1834 points
 SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -21,7 +22,10 @@ NAMES = ["waist", "shoulder", "elbow", "wrist_roll", "wrist_pitch", "flange"]
 def run_dir(tmp_path, corner_result):
     """A run directory as ``trackplan plan`` leaves it: trajectory.csv and result.json."""
     write_trajectory_csv(corner_result.trajectory, tmp_path / "trajectory.csv")
-    write_result_json({"case": "paper-corner", "joint_names": NAMES}, tmp_path / "result.json")
+    digest = file_sha256(tmp_path / "trajectory.csv")
+    write_result_json(
+        {"case": "paper-corner", "joint_names": NAMES, HASH_KEY: digest}, tmp_path / "result.json"
+    )
     return tmp_path
 
 
@@ -105,9 +109,10 @@ def test_output_overrides_the_file_and_a_directory_takes_the_default_name(run_di
 def test_joint_names_default_to_q1_qn_without_result_json(tmp_path, corner_result):
     write_trajectory_csv(corner_result.trajectory, tmp_path / "trajectory.csv")
     assert read_trajectory_table(tmp_path).joint_names == tuple(f"q{i}" for i in range(1, 7))
-    message = yaml.load(
-        export_trajectory(tmp_path, "ros", frame_id="base").read_text(), SAFE_LOADER
-    )
+    with pytest.raises(CaseError, match=r"no result\.json beside trajectory\.csv"):
+        export_trajectory(tmp_path, "ros")  # a run folder must vouch for its trajectory
+    csv = tmp_path / "trajectory.csv"
+    message = yaml.load(export_trajectory(csv, "ros", frame_id="base").read_text(), SAFE_LOADER)
     assert message["joint_names"] == [f"q{i}" for i in range(1, 7)]
     assert message["header"]["frame_id"] == "base"
 
@@ -132,7 +137,7 @@ def _write(directory, header, rows):
 def test_malformed_trajectory_files_raise_case_error(tmp_path, header, rows, message):
     _write(tmp_path, header, rows)
     with pytest.raises(CaseError, match=message) as raised:
-        export_trajectory(tmp_path, "csv")
+        export_trajectory(tmp_path / "trajectory.csv", "csv")
     assert raised.value.file == str(tmp_path / "trajectory.csv")
 
 
@@ -144,10 +149,12 @@ def test_missing_trajectory_and_bad_arguments(tmp_path, run_dir):
         export_trajectory(run_dir, "xml")
     with pytest.raises(CaseError, match="6 distinct joint names"):
         export_trajectory(run_dir, "csv", joint_names=["a", "b"])
-    write_result_json({"joint_names": ["a", "a", "b", "c", "d", "e"]}, run_dir / "result.json")
+    digest = file_sha256(run_dir / "trajectory.csv")
+    names = ["a", "a", "b", "c", "d", "e"]
+    write_result_json({"joint_names": names, HASH_KEY: digest}, run_dir / "result.json")
     with pytest.raises(CaseError, match="distinct joint names") as raised:
         export_trajectory(run_dir, "csv")
     assert raised.value.file == str(run_dir / "result.json")
     (run_dir / "result.json").write_text("{not json")
-    with pytest.raises(CaseError, match="cannot read the run summary"):
+    with pytest.raises(CaseError, match=r"unreadable result\.json"):
         export_trajectory(run_dir, "csv")

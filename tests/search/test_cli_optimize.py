@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from tests.conftest import CASES
-from trackplan import cli
 from trackplan.cli import ExitCode, main
+from trackplan.cli.common import shipped_cases_dir
 from trackplan.errors import CaseError
 from trackplan.io.history import read_history_csv, write_history_csv
 from trackplan.run_files import HISTORY_FILE
@@ -100,6 +100,7 @@ def test_ctrl_c_during_the_progress_bar_still_writes_everything(
     assert "feasible" in descriptions[0] and "%" in descriptions[0]
     summary = json.loads((out / "result.json").read_text())
     assert summary["optimizer"]["stop_reason"] == "interrupted"
+    assert summary["status"] == "interrupted" and summary["interrupted"]["signal"] == "SIGINT"
     assert summary["optimizer"]["evaluations"] == 86 and summary["feasible"]
     assert len(read_history_csv(out / HISTORY_FILE)) == 3
     assert "stopped: interrupted" in stdout
@@ -129,12 +130,20 @@ def test_bounds_outside_the_reach_exit_2(capsys: pytest.CaptureFixture[str], tmp
     assert len(err.strip().splitlines()) == 1
 
 
-def test_bad_method_exits_2(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+@pytest.mark.parametrize("method", ["pso", ""])
+def test_bad_method_exits_2(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, method: str
+) -> None:
+    out = tmp_path / "x"
     code, _, err = run(
-        capsys, "optimize", str(CASES / "paper-line.yaml"), "--method", "pso", "--out", "x"
+        capsys, "optimize", str(CASES / "paper-line.yaml"), "--method", method, "--out", str(out)
     )
     assert code == ExitCode.BAD_INPUT
-    assert "method must be one of multistart, ga, cmaes, de, random" in err
+    assert (
+        err
+        == f"--method: --method must be one of multistart, ga, cmaes, de, random, got {method!r}\n"
+    )
+    assert not out.exists()
 
 
 def test_history_round_trip(tmp_path: Path) -> None:
@@ -161,7 +170,7 @@ def test_history_round_trip(tmp_path: Path) -> None:
 def test_demo_writes_the_report(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    assert (cli.shipped_cases_dir() / "paper-corner.yaml").is_file()
+    assert (shipped_cases_dir() / "paper-corner.yaml").is_file()
     out = tmp_path / "demo"
     code, stdout, _ = run(capsys, "demo", "--out", str(out))
     assert code == ExitCode.OK

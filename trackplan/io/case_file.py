@@ -26,9 +26,10 @@ from trackplan.case import (
     Task,
 )
 from trackplan.choices import Method, Penalty, Timing
-from trackplan.errors import CaseError
 from trackplan.io.cell_file import CellModel, build_cell, cell_problems
+from trackplan.io.points_file import MIN_POINTS, load_points_csv
 from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
+from trackplan.io.sizes import MAX_SAMPLE_TIME, size_problems
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -60,9 +61,6 @@ POSITION_RANGE = (-0.87, 0.87)
 
 ANGLE_RANGE = (-1.57, 1.57)
 """Default search range of roll, pitch, yaw, rad (the paper's Eq. 31)."""
-
-MIN_POINTS = 2
-"""Fewest points of a ``points`` segment (one point is a ``line``)."""
 
 
 # --------------------------------------------------------------------------- schema
@@ -139,7 +137,7 @@ class TaskModel(StrictModel):
     rated_speed: Positive
     corner_speed: Positive | None = None
     tolerance: Positive = 0.001
-    sample_time: Positive = 0.001
+    sample_time: Annotated[float, Field(gt=0, le=MAX_SAMPLE_TIME)] = 0.001
     tool_rpy: Vec3 = list_default(0.0, 0.0, 0.0)
     timing: Literal["smooth", "paper"] = "smooth"
 
@@ -300,6 +298,15 @@ def load_case_data(
         *_payload_problems(model.payload, robot),
     ]
     raise_first(problems, data, file)
+    sizes = size_problems(
+        start,
+        segments,
+        n_dof=robot.n_dof,
+        rated_speed=model.task.rated_speed,
+        sample_time=model.task.sample_time,
+        population=model.optimizer.population,
+    )
+    raise_first(sizes, data, file)
     if model.payload is not None and robot.dynamics is not None:
         dynamics = dataclasses.replace(robot.dynamics, payload=as_payload(model.payload))
         robot = dataclasses.replace(robot, dynamics=dynamics)
@@ -383,68 +390,6 @@ def _segment(
         key = key_path((*loc, "points", "file"))
         return PointsSpec(points=_array(load_points_csv(base / segment.points.file, file, key)))
     return PointsSpec(points=_array(segment.points))
-
-
-def load_points_csv(
-    file: str | Path, case_file: str | None = None, key: str | None = None
-) -> np.ndarray:
-    """Read the points of a sampled curve from a CSV file.
-
-    One point per row: ``x,y,z`` in metres, comma separated. Blank lines and lines
-    starting with ``#`` are skipped; the first row may be a header (``x,y,z``).
-
-    Parameters
-    ----------
-    file
-        The CSV file.
-    case_file, key
-        The case file and key that name the CSV, where a missing file is reported.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (K, 3), m, K ≥ 2.
-
-    Raises
-    ------
-    CaseError
-        When the file is missing or unreadable (reported at ``key`` of the case file),
-        or a row is not three finite numbers, or there are fewer than two points
-        (reported against the CSV file, with its line number as the key).
-    """
-    text = read_text(file, what="points file", referrer=case_file, key=key)
-    points: list[list[float]] = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        row = line.strip()
-        if not row or row.startswith("#"):
-            continue
-        fields = [field.strip() for field in row.split(",")]
-        try:
-            point = [float(field) for field in fields]
-        except ValueError:
-            if not points and not any(_is_number(field) for field in fields):
-                continue  # a header row
-            point = []
-        if len(point) != 3 or not all(math.isfinite(value) for value in point):
-            raise CaseError(
-                f"expected three finite numbers x,y,z, got {row!r}",
-                file=str(file),
-                key=f"line {number}",
-            )
-        points.append(point)
-    if len(points) < MIN_POINTS:
-        raise CaseError(
-            f"expected at least {MIN_POINTS} rows x,y,z, got {len(points)}", file=str(file)
-        )
-    return np.array(points, dtype=float)
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 # --------------------------------------------------------------------------- value checks

@@ -24,6 +24,7 @@ import yaml
 
 from trackplan.errors import CaseError
 from trackplan.io.results import trajectory_header
+from trackplan.io.run_folder import verified_trajectory, write_atomically
 from trackplan.planning.result import Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
@@ -327,7 +328,8 @@ def export_trajectory(
         table = TrajectoryTable.from_trajectory(source, joint_names)
         target = Path(output)
     else:
-        csv_file = _trajectory_file(Path(source))
+        source = Path(source)
+        csv_file = verified_trajectory(source) if source.is_dir() else _trajectory_file(source)
         table = read_trajectory_table(csv_file)
         if joint_names is not None:
             names = _checked_names(joint_names, table.q.shape[1], "joint_names", None)
@@ -337,9 +339,9 @@ def export_trajectory(
         target = target / EXPORT_FILES[fmt]
     target.parent.mkdir(parents=True, exist_ok=True)
     if fmt == "csv":
-        _write_csv(table, target)
+        write_atomically(target, lambda file: _write_csv(table, file))
     elif fmt == "json":
-        _write_json(table, target)
+        write_atomically(target, lambda file: _write_json(table, file))
     else:
-        _write_ros(table, target, frame_id)
+        write_atomically(target, lambda file: _write_ros(table, file, frame_id))
     return target

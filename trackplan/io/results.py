@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from trackplan.case import PLACEMENT_KEYS
 from trackplan.errors import CaseError
+from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
@@ -52,10 +55,13 @@ def write_trajectory_csv(trajectory: Trajectory, file: Path) -> None:
 def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Read the time and joint columns of a ``trajectory.csv``, whoever wrote it.
 
+    Columns are found by their header names, in any order: ``t`` and ``q1..qn``; other
+    columns are ignored.
+
     Parameters
     ----------
     file
-        The CSV file (header ``t,q1..qn,...``; extra columns are ignored).
+        The CSV file (a header row, then one row per sample).
     n_dof
         Expected number of joints, or None to take it from the header.
 
@@ -67,33 +73,48 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     Raises
     ------
     CaseError
-        When the file is missing, unreadable, or its columns are wrong.
+        When the file is missing or unreadable, a column is missing or named twice, a
+        value is not a finite number, or there are fewer than 2 samples.
     """
     file = Path(file)
     try:
-        with file.open() as handle:
-            header = handle.readline().strip().split(",")
+        with file.open(encoding="utf-8") as handle:
+            header = [name.strip() for name in handle.readline().strip().split(",")]
         data = np.loadtxt(file, delimiter=",", skiprows=1, ndmin=2)
-    except OSError as error:
-        raise CaseError(f"cannot read trajectory: {error.strerror}", file=str(file)) from None
+    except (OSError, UnicodeDecodeError) as error:
+        reason = getattr(error, "strerror", None) or type(error).__name__
+        raise CaseError(f"cannot read trajectory: {reason}", file=str(file)) from None
     except ValueError as error:
-        raise CaseError(f"not a numeric CSV table: {error}", file=str(file)) from None
-    if not header or header[0] != "t":
-        raise CaseError("the first column must be 't'", file=str(file), key="header")
+        text = str(error).splitlines()[0][:200]
+        raise CaseError(f"not a numeric CSV table: {text}", file=str(file)) from None
+    twice = sorted({name for name in header if header.count(name) > 1})
+    if twice:
+        raise CaseError(f"column {twice[0]!r} appears twice", file=str(file), key="header")
     joints = [name for name in header if name[:1] == "q" and name[1:].isdigit()]
-    if n_dof is not None and len(joints) != n_dof:
+    n = len(joints) if n_dof is None else n_dof
+    wanted = ["t", *(f"q{i + 1}" for i in range(n))]
+    missing = [name for name in wanted if name not in header]
+    if missing or (n_dof is not None and len(joints) != n_dof) or n == 0:
+        found = ",".join(header)[:120]
         raise CaseError(
-            f"expected columns q1..q{n_dof} for the robot, found {len(joints)}",
+            f"expected columns t,q1..q{n} (one per joint), missing {','.join(missing) or 'none'}"
+            f", found {len(joints)} joint columns in header {found!r}",
             file=str(file),
             key="header",
         )
+    if data.shape[1] != len(header):
+        raise CaseError(
+            f"rows have {data.shape[1]} values, the header names {len(header)} columns",
+            file=str(file),
+        )
     if data.shape[0] < 2:
         raise CaseError("the trajectory needs at least 2 samples", file=str(file))
+    index = [header.index(name) for name in wanted]
+    data = data[:, index]
     if not np.all(np.isfinite(data)):
         row = int(np.argwhere(~np.isfinite(data))[0, 0]) + 2
         raise CaseError(f"non-finite number on line {row}", file=str(file))
-    index = [header.index(name) for name in joints]
-    return data[:, 0], data[:, index]
+    return data[:, 0], data[:, 1:]
 
 
 def _cell_summary(check: CheckReport) -> dict:
@@ -181,9 +202,50 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
     }
 
 
+NULL_REASONS_KEY = "null_reasons"
+"""Key of ``result.json`` listing why a value is ``null``: ``{key path: reason}``."""
+
+
+def strict_json(value: Any, path: str = "") -> tuple[Any, dict[str, str]]:
+    """A copy of plain JSON data with every non-finite float replaced by None.
+
+    JSON has no NaN or infinity (RFC 8259): ``json.dumps`` would write the bare words
+    ``NaN``/``Infinity``, which strict readers refuse.
+
+    Returns
+    -------
+    tuple
+        The cleaned data, and ``{key path: reason}`` of each replaced value.
+    """
+    if isinstance(value, float | np.floating) and not math.isfinite(value):
+        return None, {path or "$": f"not a finite number ({float(value)!r})"}
+    if isinstance(value, dict):
+        cleaned, reasons = {}, {}
+        for key, item in value.items():
+            cleaned[key], found = strict_json(item, f"{path}.{key}" if path else str(key))
+            reasons.update(found)
+        return cleaned, reasons
+    if isinstance(value, list | tuple):
+        items, reasons = [], {}
+        for i, item in enumerate(value):
+            cleaned_item, found = strict_json(item, f"{path}[{i}]")
+            items.append(cleaned_item)
+            reasons.update(found)
+        return items, reasons
+    return value, {}
+
+
 def write_result_json(summary: dict, file: Path) -> None:
-    """Write a summary dict as indented JSON."""
-    Path(file).write_text(json.dumps(summary, indent=2, allow_nan=True) + "\n")
+    """Write a summary dict as indented, strict JSON.
+
+    A non-finite number (an objective with no trajectory, a margin of a limit that does
+    not apply) is written as ``null``, and its key path is listed with the reason under
+    :data:`NULL_REASONS_KEY`.
+    """
+    cleaned, reasons = strict_json(summary)
+    if reasons:
+        cleaned[NULL_REASONS_KEY] = reasons
+    Path(file).write_text(json.dumps(cleaned, indent=2, allow_nan=False) + "\n")
 
 
 def write_plan_files(
@@ -199,6 +261,10 @@ def write_plan_files(
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     write_trajectory_csv(result.trajectory, out_dir / TRAJECTORY_FILE)
-    summary = {**result_summary(result, joint_names), **(extra or {})}
+    summary = {
+        **result_summary(result, joint_names),
+        **(extra or {}),
+        HASH_KEY: file_sha256(out_dir / TRAJECTORY_FILE),
+    }
     write_result_json(summary, out_dir / RESULT_FILE)
     return summary

@@ -3,9 +3,10 @@
 Shared by the case and robot file loaders. The rules, in the order they are applied:
 
 1. The file must exist and be UTF-8 text.
-2. It must be valid YAML (YAML 1.1 as PyYAML reads it, plus YAML 1.2 floats such as
-   ``1e-3``; a key given twice in one mapping is an error). Syntax errors name the line
-   and column.
+2. It must be valid YAML with YAML 1.2 core-schema scalars (no ``yes``/``no`` booleans, no
+   sexagesimal ``1:30``), at most :data:`MAX_YAML_BYTES` long; a key given twice, a
+   complex key, a recursive alias, an alias bomb and nesting deeper than
+   :data:`MAX_DEPTH` are errors. Errors name the line and column.
 3. It must match the pydantic schema of the file. Of all schema problems, the one that
    comes first in the file is reported.
 4. Checks that need more than one value (bounds, geometry, robot joint count) are
@@ -68,13 +69,17 @@ def list_default(*values: float) -> Any:
     return Field(default_factory=lambda: list(values))
 
 
+MAX_COORDINATE = 1.0e3
+"""Largest |entry| of a vector (m or rad): far beyond any robot cell, far from overflow."""
+
 # Numbers are floats; an integer is accepted, and StrictModel forbids nan and inf.
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]
 NonEmptyStr = Annotated[str, Field(min_length=1)]
-Vec3 = Annotated[list[float], _fixed_length(3, "x, y, z")]
-Vec6 = Annotated[list[float], _fixed_length(6, "x, y, z, roll, pitch, yaw")]
-Range = Annotated[list[float], _fixed_length(2, "min, max")]
+Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+Vec3 = Annotated[list[Coordinate], _fixed_length(3, "x, y, z")]
+Vec6 = Annotated[list[Coordinate], _fixed_length(6, "x, y, z, roll, pitch, yaw")]
+Range = Annotated[list[Coordinate], _fixed_length(2, "min, max")]
 
 
 # --------------------------------------------------------------------------- files and YAML
@@ -120,31 +125,146 @@ def read_text(
         raise CaseError(f"cannot read {what}: {reason.lower()}", file=str(path)) from None
 
 
+MAX_DEPTH = 100
+"""Deepest nesting of lists and mappings accepted in a YAML file (a case file needs 6)."""
+
+MAX_ALIAS_EXPANSION = 100_000
+"""Most values that aliases (``*name``) may add to a YAML document when expanded."""
+
+MAX_YAML_BYTES = 16 * 2**20
+"""Largest YAML file read, bytes (long sampled curves belong in a points file)."""
+
+MAX_INTEGER = 2**63 - 1
+"""Largest |integer| in a YAML file."""
+
+
 class _Loader(yaml.SafeLoader):
-    """PyYAML's safe loader, with YAML 1.2 floats (``1e-3``) and duplicate keys refused."""
+    """PyYAML's safe loader with YAML 1.2 core-schema scalars and hostile input refused.
+
+    - Scalars resolve as in YAML 1.2's core schema: ``true``/``false`` (not ``yes``/``no``/
+      ``on``/``off``), decimal integers (``010`` is ten), ``0o`` and ``0x`` integers,
+      floats such as ``1e-3`` and ``.inf``, ``null``/``~``; anything else, such as the
+      YAML 1.1 sexagesimal ``1:30`` or a date, is a string.
+    - A key given twice, a list or mapping used as a key, nesting deeper than
+      :data:`MAX_DEPTH`, an alias inside the node it names (recursion), and aliases that
+      expand to more than :data:`MAX_ALIAS_EXPANSION` values ("billion laughs") are
+      errors at their line.
+    """
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+        self._open_anchors: set[str] = set()
+        self._sizes: dict[int, int] = {}
+        self._expanded = 0
+
+    def compose_node(self, parent: yaml.Node | None, index: Any) -> yaml.Node:
+        """Compose one node, refusing recursive aliases, alias bombs and deep nesting."""
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            anchor = event.anchor
+            if anchor in self._open_anchors:
+                raise yaml.composer.ComposerError(
+                    None,
+                    None,
+                    f"alias *{anchor} refers to a node that contains it (recursive alias)",
+                    event.start_mark,
+                )
+            node = super().compose_node(parent, index)
+            self._expanded += self._size(node)
+            if self._expanded > MAX_ALIAS_EXPANSION:
+                raise yaml.composer.ComposerError(
+                    None,
+                    None,
+                    f"alias *{anchor} expands the document beyond {MAX_ALIAS_EXPANSION} "
+                    "values; write the values out instead",
+                    event.start_mark,
+                )
+            return node
+        self._depth += 1
+        if self._depth > MAX_DEPTH:
+            raise yaml.composer.ComposerError(
+                None, None, f"nesting deeper than {MAX_DEPTH} levels", event.start_mark
+            )
+        anchor = getattr(event, "anchor", None)
+        if anchor is not None:
+            self._open_anchors.add(anchor)
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+            if anchor is not None:
+                self._open_anchors.discard(anchor)
+
+    def _size(self, node: yaml.Node) -> int:
+        """Number of nodes of ``node`` with every alias expanded (memoised per node)."""
+        known = self._sizes.get(id(node))
+        if known is not None:
+            return known
+        if isinstance(node, yaml.SequenceNode):
+            size = 1 + sum(self._size(item) for item in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            size = 1 + sum(self._size(key) + self._size(item) for key, item in node.value)
+        else:
+            size = 1
+        self._sizes[id(node)] = size
+        return size
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
-        """Build a mapping, refusing a key that occurs twice."""
+        """Build a mapping, refusing a key that occurs twice or that is a list or mapping."""
         seen: set[Any] = set()
         for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            if isinstance(key, typing.Hashable) and key in seen:
+            if not isinstance(key_node, yaml.ScalarNode):
                 raise yaml.constructor.ConstructorError(
-                    None, None, f"duplicate key {key!r}", key_node.start_mark
+                    None, None, "a list or mapping as a key is not supported", key_node.start_mark
+                )
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {show(key)}", key_node.start_mark
                 )
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
 
+    def construct_yaml_int(self, node: yaml.ScalarNode) -> int:
+        """A YAML 1.2 integer: decimal (leading zeros allowed), ``0o`` octal, ``0x`` hex."""
+        text = str(self.construct_scalar(node))
+        sign = -1 if text.startswith("-") else 1
+        digits = text.lstrip("+-")
+        if len(digits) > 20:
+            value = MAX_INTEGER + 1
+        elif digits[:2] in ("0o", "0x"):
+            value = int(digits[2:], 8 if digits[1] == "o" else 16)
+        else:
+            value = int(digits, 10)
+        if value > MAX_INTEGER:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"integer {show(text, 24)} is too large", node.start_mark
+            )
+        return sign * value
 
-# Copy the resolver table before adding to it: it is a class attribute of SafeLoader.
-_Loader.yaml_implicit_resolvers = {
-    first: list(resolvers) for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
-}
-_Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
-    list("-+0123456789"),
-)
+    def construct_yaml_bool(self, node: yaml.ScalarNode) -> bool:
+        """``true`` or ``false`` (any case the core schema allows)."""
+        return str(self.construct_scalar(node)).lower() == "true"
+
+
+# The YAML 1.2 core schema (https://yaml.org/spec/1.2.2/#1023-core-schema); a fresh table,
+# so that SafeLoader's YAML 1.1 resolvers (yes/no, 1:30, dates, merge keys) are not used.
+_Loader.yaml_implicit_resolvers = {}
+for _tag, _pattern, _first in (
+    ("tag:yaml.org,2002:null", r"^(?:~|null|Null|NULL|)$", ["~", "n", "N", ""]),
+    ("tag:yaml.org,2002:bool", r"^(?:true|True|TRUE|false|False|FALSE)$", list("tTfF")),
+    ("tag:yaml.org,2002:int", r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$", list("-+0123456789")),
+    (
+        "tag:yaml.org,2002:float",
+        r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$",
+        list("-+.0123456789"),
+    ),
+):
+    _Loader.add_implicit_resolver(_tag, re.compile(_pattern), _first)
+_Loader.add_constructor("tag:yaml.org,2002:int", _Loader.construct_yaml_int)
+_Loader.add_constructor("tag:yaml.org,2002:bool", _Loader.construct_yaml_bool)
 
 
 def parse_yaml(text: str, file: str | None) -> Any:
@@ -156,6 +276,12 @@ def parse_yaml(text: str, file: str | None) -> Any:
         On a syntax error (the message names line and column, counted from 1), a
         duplicate key, or an empty document.
     """
+    if len(text) > MAX_YAML_BYTES:
+        raise CaseError(
+            f"the file has {len(text)} characters, more than {MAX_YAML_BYTES} "
+            "(put long sampled curves in a points file)",
+            file=file,
+        )
     try:
         # _Loader derives from SafeLoader: no arbitrary Python objects.
         data = yaml.load(text, Loader=_Loader)
@@ -352,20 +478,54 @@ def _find_model(annotation: Any) -> type[BaseModel] | None:
     return None
 
 
+class _Full(Exception):
+    """The rendering of :func:`show` reached its limit."""
+
+
 def show(value: Any, limit: int = 60) -> str:
-    """A short YAML-like rendering of an input value for messages."""
-    if isinstance(value, bool):
-        text = "true" if value else "false"
-    elif value is None:
-        text = "null"
-    elif isinstance(value, float):
-        text = repr(value) if math.isfinite(value) else str(value)
-    elif isinstance(value, str):
-        text = repr(value)
-    elif isinstance(value, dict):
-        text = "{" + ", ".join(f"{key}: {show(item, limit)}" for key, item in value.items()) + "}"
-    elif isinstance(value, list | tuple):
-        text = "[" + ", ".join(show(item, limit) for item in value) + "]"
-    else:
-        text = str(value)
+    """A short YAML-like rendering of an input value for messages.
+
+    The work is bounded by ``limit`` whatever the value's size (an alias bomb expands to
+    billions of entries): rendering stops as soon as the text is long enough.
+    """
+    parts: list[str] = []
+    room = [limit + 1]
+
+    def emit(text: str) -> None:
+        if room[0] <= 0:
+            raise _Full
+        text = text[: room[0]]
+        parts.append(text)
+        room[0] -= len(text)
+
+    def walk(item: Any) -> None:
+        if isinstance(item, bool):
+            emit("true" if item else "false")
+        elif item is None:
+            emit("null")
+        elif isinstance(item, float):
+            emit(repr(item) if math.isfinite(item) else str(item))
+        elif isinstance(item, str):
+            emit(repr(item[: limit + 2]))
+        elif isinstance(item, dict):
+            emit("{")
+            for i, (key, entry) in enumerate(item.items()):
+                emit(", " if i else "")
+                emit(f"{str(key)[: limit + 1]}: ")
+                walk(entry)
+            emit("}")
+        elif isinstance(item, list | tuple):
+            emit("[")
+            for i, entry in enumerate(item):
+                emit(", " if i else "")
+                walk(entry)
+            emit("]")
+        else:
+            emit(str(item)[: limit + 1])
+
+    try:
+        walk(value)
+    except _Full:
+        pass
+    text = "".join(parts)
     return text if len(text) <= limit else text[: limit - 1] + "…"

@@ -22,6 +22,10 @@ PERPENDICULAR_TOLERANCE = 1e-6
 #: Smallest |angle| of an arc (rad).
 ANGLE_TOLERANCE = 1e-12
 
+#: Largest turn between consecutive chords of a sampled curve (rad): a curve that turns
+#: further doubles back on itself, which has no tangent to fit there.
+MAX_POINTS_TURN = np.radians(179.0)
+
 
 def _format(vector: np.ndarray) -> str:
     return "(" + ", ".join(f"{x:.6g}" for x in np.ravel(vector)) + ")"
@@ -106,6 +110,19 @@ def _check_points(key: str, spec: PointsSpec, current: np.ndarray) -> tuple[list
     for k in np.flatnonzero(gaps <= LENGTH_TOLERANCE):
         what = "the current point" if k == 0 else f"point {k - 1}"
         message = f"point {_format(points[k])} m repeats {what}: consecutive points must differ"
+        problems.append((f"{key}.points[{k}]", message))
+    if problems:
+        return problems, points[-1]
+    chords = np.diff(np.vstack([current[None], points]), axis=0)
+    chords /= np.linalg.norm(chords, axis=1, keepdims=True)
+    cosine = np.einsum("ij,ij->i", chords[:-1], chords[1:])
+    for k in np.flatnonzero(cosine < np.cos(MAX_POINTS_TURN)):
+        degrees = np.degrees(np.arccos(max(-1.0, float(cosine[k]))))
+        message = (
+            f"the curve doubles back at point {_format(points[k])} m (turns by {degrees:.1f}°, "
+            f"more than {np.degrees(MAX_POINTS_TURN):.0f}°): end the segment at this point "
+            "and continue in a new segment"
+        )
         problems.append((f"{key}.points[{k}]", message))
     return problems, points[-1]
 

@@ -8,7 +8,7 @@ joint, and every violation with its time window and worst value.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -16,7 +16,7 @@ import numpy as np
 from trackplan.derivatives import backward_derivatives
 from trackplan.paths import NominalPath
 from trackplan.planning.result import CheckReport, Violation
-from trackplan.planning.tracking import jump_allowance, locate_on_nominal
+from trackplan.planning.tracking import between_samples, jump_allowance, locate_on_nominal
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
@@ -259,11 +259,28 @@ def _check_task(
     # tracking error and the position along the nominal path, in order of travel
     velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
     s_nominal, distance, piece = locate_on_nominal(ref.nominal, p_part, velocity, ref.tolerance)
-    margins["tracking"] = float(_met(1.0 - distance.max() / ref.tolerance, RELATIVE_SLACK))
-    if margins["tracking"] < 0:
+    worst = float(distance.max())
+    if distance.max() > ref.tolerance * (1 + RELATIVE_SLACK):
         violations.append(
             _violation("tracking", None, t, distance, distance / ref.tolerance, ref.tolerance)
         )
+    # ... and between the samples, along the joint-space interpolation a controller follows
+    q_between, t_between = between_samples(q, p_part, ref.tolerance)
+    if len(q_between):
+        T_between = forward_kinematics(robot, q_between)
+        p_between = (T_between[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
+        _, d_between = ref.nominal.project(p_between)
+        worst = max(worst, float(d_between.max()))
+        if d_between.max() > ref.tolerance * (1 + RELATIVE_SLACK) and not violations_of(
+            violations, "tracking"
+        ):
+            t_b = t_between * sample_time
+            found = _violation(
+                "tracking", None, t_b, d_between, d_between / ref.tolerance, ref.tolerance
+            )
+            message = found.message.replace("tracking", "tracking between samples", 1)
+            violations.append(replace(found, message=message))
+    margins["tracking"] = float(_met(1.0 - worst / ref.tolerance, RELATIVE_SLACK))
 
     # Cartesian speed against the cap that applies where the tool is
     speed = np.linalg.norm(velocity, axis=1)
@@ -284,7 +301,12 @@ def _check_task(
     coverage = _coverage_violations(ref, t, s_nominal, piece, speed, sample_time)
     margins["coverage"] = 1.0 if not coverage else -1.0
     violations.extend(coverage)
-    return (margins, violations), float(distance.max()), float(orientation_error.max())
+    return (margins, violations), worst, float(orientation_error.max())
+
+
+def violations_of(violations: list[Violation], limit: str) -> list[Violation]:
+    """The violations of one limit."""
+    return [violation for violation in violations if violation.limit == limit]
 
 
 def _coverage_violations(

@@ -118,3 +118,50 @@ def jump_allowance(nominal, tolerance: float) -> np.ndarray:
         cap = lengths[p] + (lengths[p + 1] if p + 1 < len(lengths) else 0.0)
         allowance[p] = min(2.0 * tolerance * np.tan(half), cap)
     return allowance
+
+
+BETWEEN_STEP = 0.25
+"""Largest chord between checked points, as a fraction of ρ (see :func:`between_samples`)."""
+
+MAX_BETWEEN_PER_PERIOD = 10_000
+"""Most points checked inside one controller period."""
+
+
+def between_samples(
+    q: np.ndarray, points: np.ndarray, tolerance: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Joint positions inside each controller period where the tool path must be checked.
+
+    A controller interpolating the joint positions linearly at Ts moves the tool along a
+    curve between two samples, not through the samples only. Each period k → k+1 is split
+    into m_k = max(2, ceil(|p_k+1 − p_k| / (BETWEEN_STEP · ρ))) equal parts of q, and the
+    interior points are returned: at least the midpoint, and points no more than ρ/4 of
+    chord apart (a period that jumps across a corner is sampled densely enough to see it).
+
+    Parameters
+    ----------
+    q
+        Joint positions at the samples, shape (N, n), rad.
+    points
+        Tool points at the samples, shape (N, 3), m.
+    tolerance
+        ρ, m.
+
+    Returns
+    -------
+    q_between
+        Shape (K, n), rad.
+    t_between
+        Their times in periods from the first sample (k + j/m_k), shape (K,).
+    """
+    if len(q) < 2:
+        return np.zeros((0, q.shape[1] if q.ndim == 2 else 0)), np.zeros(0)
+    chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    parts = np.ceil(chord / (BETWEEN_STEP * tolerance))
+    parts = np.clip(np.nan_to_num(parts, nan=2.0), 2, MAX_BETWEEN_PER_PERIOD).astype(int)
+    period = np.repeat(np.arange(len(parts)), parts - 1)  # (K,)
+    first = np.cumsum(parts - 1) - (parts - 1)  # index of each period's first interior point
+    j = np.arange(len(period)) - np.repeat(first, parts - 1) + 1
+    fraction = j / parts[period]
+    q_between = q[period] + fraction[:, None] * (q[period + 1] - q[period])
+    return q_between, period + fraction

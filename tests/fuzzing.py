@@ -1,0 +1,199 @@
+"""Seeded mutants of the shipped case and robot files, and a harness that runs the CLI on them.
+
+Used by ``tests/test_fuzz.py`` (a fast subset) and ``python -m benchmarks robustness`` (a
+larger run). A mutant replaces, deletes or duplicates one value of a shipped file, or
+damages its text; the harness runs ``validate`` and, for mutants that validate, ``plan``,
+and classifies the outcome. The contract: no exit 1, no traceback, every run within
+:data:`RUN_LIMIT_S`, every exit-2 message one line naming the key (or line) at fault.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from trackplan.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+CASE_FILES = sorted((ROOT / "cases").glob("*.yaml"))
+ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))
+RUN_LIMIT_S = 10.0
+"""Longest time one command may take on a mutant, s."""
+
+HOSTILE_VALUES: tuple[Any, ...] = (
+    0,
+    -1,
+    1e308,
+    -1e308,
+    1e-300,
+    10**30,
+    float("nan"),
+    float("inf"),
+    "",
+    "yes",
+    "1:30",
+    "x" * 5000,
+    None,
+    True,
+    [],
+    {},
+    [1, 2],
+    [0.0, 0.0, 0.0],
+    [1e200, 0, 0],
+    {"a": 1},
+    0.5,
+    2.0,
+    1e6,
+)
+
+TEXT_DAMAGE = ("delete line", "duplicate line", "truncate", "indent", "bracket", "alias")
+
+
+def _paths(data: Any, prefix: tuple = ()) -> list[tuple]:
+    """Every key path of a loaded YAML document (mappings and lists)."""
+    found = [prefix] if prefix else []
+    if isinstance(data, dict):
+        for key, value in data.items():
+            found += _paths(value, (*prefix, key))
+    elif isinstance(data, list):
+        for i, value in enumerate(data):
+            found += _paths(value, (*prefix, i))
+    return found
+
+
+def _set(data: Any, path: tuple, value: Any, delete: bool = False) -> None:
+    node = data
+    for part in path[:-1]:
+        node = node[part]
+    if delete:
+        del node[path[-1]]
+    else:
+        node[path[-1]] = value
+
+
+def mutate(text: str, rng: np.random.Generator) -> str:
+    """One mutant of a YAML file's text."""
+    if rng.random() < 0.25:
+        return _damage_text(text, rng)
+    data = yaml.safe_load(text)
+    paths = _paths(data)
+    path = paths[int(rng.integers(len(paths)))]
+    if rng.random() < 0.15:
+        _set(data, path, None, delete=True)
+    else:
+        _set(data, path, HOSTILE_VALUES[int(rng.integers(len(HOSTILE_VALUES)))])
+    return yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+
+
+def _damage_text(text: str, rng: np.random.Generator) -> str:
+    lines = text.splitlines()
+    k = int(rng.integers(len(lines)))
+    kind = TEXT_DAMAGE[int(rng.integers(len(TEXT_DAMAGE)))]
+    if kind == "delete line":
+        del lines[k]
+    elif kind == "duplicate line":
+        lines.insert(k, lines[k])
+    elif kind == "truncate":
+        return text[: int(rng.integers(len(text)))]
+    elif kind == "indent":
+        lines[k] = "   " + lines[k]
+    elif kind == "bracket":
+        lines[k] = lines[k].replace("]", "", 1) if "]" in lines[k] else lines[k] + " ["
+    else:
+        lines.insert(0, "anchors: &a [1, 2, 3]")
+        lines[min(k + 1, len(lines) - 1)] += " *a"
+    return "\n".join(lines) + "\n"
+
+
+@dataclass
+class FuzzCounts:
+    """Outcomes of a fuzz run."""
+
+    runs: int = 0
+    exit_codes: dict[int, int] = field(default_factory=dict)
+    tracebacks: int = 0
+    hangs: int = 0
+    bad_messages: list[str] = field(default_factory=list)
+    internal_errors: list[str] = field(default_factory=list)
+    slowest_s: float = 0.0
+
+    def add(self, code: int, err: str, seconds: float) -> None:
+        """Count one command's outcome."""
+        self.runs += 1
+        self.exit_codes[code] = self.exit_codes.get(code, 0) + 1
+        self.slowest_s = max(self.slowest_s, seconds)
+        if "Traceback" in err:
+            self.tracebacks += 1
+        if seconds > RUN_LIMIT_S:
+            self.hangs += 1
+        if code == 1:
+            self.internal_errors.append(err.strip()[:300])
+        if code == 2 and not _names_the_fault(err):
+            self.bad_messages.append(err.strip()[:300])
+
+
+def _names_the_fault(err: str) -> bool:
+    """One line ``file: key: message`` or ``file: YAML ... at line L, column C: ...``."""
+    lines = err.strip().splitlines()
+    if len(lines) != 1:
+        return False
+    line = lines[0]
+    return bool(
+        re.search(r"\.(yaml|csv): [\w.\[\]-]+: ", line)
+        or re.search(r"at line \d+, column \d+", line)
+        or re.search(r"\.(yaml|csv): (the file|case file|robot file|points file)", line)
+    )
+
+
+def run_cli(args: list[str]) -> tuple[int, str, float]:
+    """Run ``trackplan args`` in this process: exit code, stderr, seconds."""
+    out, err = io.StringIO(), io.StringIO()
+    start = time.perf_counter()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(args)
+    return code, err.getvalue(), time.perf_counter() - start
+
+
+def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
+    """Validate ``n_mutants`` mutants and plan up to ``n_plans`` of those that validate.
+
+    Case mutants are written beside copies of the shipped files they refer to; robot
+    mutants are referred to by a copy of ``paper-line.yaml``.
+    """
+    rng = np.random.default_rng(seed)
+    shutil.copy(ROOT / "cases" / "bead.csv", folder / "bead.csv")
+    base_case = (ROOT / "cases" / "paper-line.yaml").read_text()
+    counts = FuzzCounts()
+    planned = 0
+    # warm-up, not counted: the first plan in a process compiles the numba kernels
+    warm = folder / "warm-up.yaml"
+    warm.write_text(base_case)
+    run_cli(["plan", str(warm), "--out", str(folder / "warm-up"), "--no-report"])
+    for i in range(n_mutants):
+        if ROBOT_FILES and rng.random() < 0.2:
+            robot = folder / f"robot-{i}.yaml"
+            robot.write_text(mutate(ROBOT_FILES[0].read_text(), rng))
+            text = base_case.replace("robot: puma560", f"robot: {robot.name}")
+        else:
+            text = mutate(CASE_FILES[int(rng.integers(len(CASE_FILES)))].read_text(), rng)
+        case = folder / f"case-{i}.yaml"
+        case.write_text(text)
+        code, err, seconds = run_cli(["validate", str(case)])
+        counts.add(code, err, seconds)
+        if code == 0 and planned < n_plans:
+            planned += 1
+            args = ["plan", str(case), "--out", str(folder / f"run-{i}"), "--no-report"]
+            if "example:" not in text:
+                args += ["--placement", "0.3", "0.1", "0.2", "0", "0", "0"]
+            code, err, seconds = run_cli(args)
+            counts.add(code, err, seconds)
+    return counts

@@ -1,0 +1,63 @@
+"""The ``trackplan`` command line (entry point :func:`main`).
+
+Commands, one module per group, each a thin parse → API → save → exit code:
+:mod:`~trackplan.cli.cases` (``validate``, ``robots``, ``cases``),
+:mod:`~trackplan.cli.plan` (``plan``, ``check``, ``export``) and
+:mod:`~trackplan.cli.search` (``optimize``, ``demo``). Text summaries are in
+:mod:`~trackplan.cli.summaries`, argument checks in :mod:`~trackplan.cli.common`.
+
+Exit codes: 0 ok, 1 internal error, 2 bad input, 3 infeasible (:class:`ExitCode`), and
+128 + the signal number when SIGINT (130) or SIGTERM (143) stopped the command.
+:func:`main` never raises: a :class:`~trackplan.errors.CaseError` becomes one line on
+stderr and exit code 2; any other exception one line ``internal error: ...`` and exit
+code 1, with the traceback only under ``trackplan --debug`` or ``TRACKPLAN_DEBUG=1``.
+
+This module imports nothing heavy, so that Ctrl-C while the command starts up (numpy,
+typer and the planner are imported inside :func:`main`) ends with exit 130 and no traceback.
+"""
+
+from __future__ import annotations
+
+import enum
+import os
+import signal
+import sys
+
+
+class ExitCode(enum.IntEnum):
+    """Process exit codes of every command."""
+
+    OK = 0
+    INTERNAL_ERROR = 1
+    BAD_INPUT = 2
+    INFEASIBLE = 3
+    INTERRUPTED = 128 + signal.SIGINT
+    TERMINATED = 128 + signal.SIGTERM
+
+
+DEBUG_ENV = "TRACKPLAN_DEBUG"
+"""Set to 1 to print tracebacks of internal errors."""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line and return its exit code; never raises.
+
+    Parameters
+    ----------
+    argv
+        The arguments after the program name; ``sys.argv[1:]`` when None.
+
+    Returns
+    -------
+    int
+        An :class:`ExitCode` value.
+    """
+    args = sys.argv[1:] if argv is None else list(argv)
+    debug = "--debug" in args or os.environ.get(DEBUG_ENV, "") not in ("", "0")
+    try:
+        from trackplan.cli.app import run
+
+        return run(args, debug=debug)
+    except KeyboardInterrupt as exc:  # during start-up, or a second signal while writing
+        print("interrupted", file=sys.stderr, flush=True)
+        return 128 + int(getattr(exc, "signum", signal.SIGINT))

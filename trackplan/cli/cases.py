@@ -1,0 +1,129 @@
+"""Commands on inputs: ``validate`` (case files), ``robots`` (built-in robots), ``cases``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.markup import escape
+from rich.table import Table
+
+from trackplan.cli import ExitCode
+from trackplan.cli.common import (
+    AssumeLimitsOption,
+    app,
+    console,
+    error,
+    load_each,
+    shipped_cases_dir,
+)
+from trackplan.cli.summaries import describe_case, robot_table, segment_corners
+from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot_spec, robot_to_yaml
+from trackplan.paths import NominalPath
+
+
+@app.command()
+def validate(
+    cases: Annotated[list[Path], typer.Argument(help="Case files to check.", show_default=False)],
+) -> ExitCode:
+    """Check case files and their robots; print a summary of each valid case."""
+    loaded = load_each(cases)
+    for file, case in loaded:
+        if case is not None:
+            typer.echo("\n".join(describe_case(case, file)))
+    return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT
+
+
+@app.command()
+def robots(
+    name: Annotated[
+        str | None,
+        typer.Argument(
+            help="A built-in robot name or a robot file (.yaml/.urdf): show its chain, family "
+            "and derived IK parameters.",
+            show_default=False,
+        ),
+    ] = None,
+    as_yaml: Annotated[
+        str | None,
+        typer.Option(
+            "--yaml",
+            metavar="NAME",
+            help="Print the built-in DH robot NAME as a robot file, to start your own from.",
+        ),
+    ] = None,
+    assume_limits: AssumeLimitsOption = False,
+) -> ExitCode:
+    """List the built-in robots (family, reach, source), or show one robot in detail."""
+    from trackplan.robots.describe import robot_info
+
+    if as_yaml is not None:
+        typer.echo(robot_to_yaml(builtin_robot(as_yaml)), nl=False)
+        return ExitCode.OK
+    out = console()
+    if name is not None:
+        robot = load_robot_spec(name, Path.cwd(), assume_limits=assume_limits)
+        out.print(robot_table(robot))
+        info = robot_info(robot)
+        out.print(f"IK family: {info['family']}")
+        for key, value in info["parameters"].items():  # type: ignore[attr-defined]
+            out.print(f"  {key} = {_show_value(value)}")
+        out.print(f"reach: {info['reach']:.3f} m")
+        for note in robot.assumptions:
+            out.print(f"assumption: {escape(note)}")
+        if "redundancy_rule" in info:
+            out.print(f"redundancy: {escape(str(info['redundancy_rule']))}")
+        return ExitCode.OK
+    table = Table(title="built-in robots (trackplan robots NAME for details)")
+    for header in ("name", "joints", "family", "reach m", "source"):
+        table.add_column(header, justify="left" if header in ("name", "source") else "right")
+    for key in builtin_names():
+        info = robot_info(builtin_robot(key))
+        table.add_row(
+            key,
+            str(info["joints"]),
+            str(info["family"]),
+            f"{info['reach']:.3f}",
+            escape(str(info["source"])),
+        )
+    out.print(table)
+    return ExitCode.OK
+
+
+def _show_value(value: object) -> str:
+    """A parameter value for display: numbers to 6 significant digits."""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_show_value(v) for v in value) + "]"
+    return str(value)
+
+
+@app.command()
+def cases() -> ExitCode:
+    """List the cases shipped in the repository's cases/ folder."""
+    folder = shipped_cases_dir()
+    files = sorted(folder.glob("*.yaml")) if folder.is_dir() else []
+    if not files:
+        error(f"no shipped cases found in {folder}")
+        return ExitCode.OK
+    table = Table(title=f"Cases in {folder}")
+    for column in ("case", "robot", "segments", "length m", "corners", "file"):
+        table.add_column(column, justify="right" if column in ("segments", "length m") else "left")
+    loaded = load_each(files)
+    for file, case in loaded:
+        if case is None:
+            table.add_row(escape(file.stem), "", "", "", "invalid", escape(file.name))
+            continue
+        path = NominalPath.from_specs(case.start, case.segments)
+        table.add_row(
+            escape(case.name),
+            escape(case.robot.name),
+            str(len(case.segments)),
+            f"{path.length:.4f}",
+            ", ".join(f"{angle:.1f}°" for _, angle in segment_corners(path)) or "none",
+            escape(file.name),
+        )
+    console().print(table)
+    return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT

@@ -1,0 +1,175 @@
+"""What every command shares: the typer app, output helpers and argument checks.
+
+Every argument is checked before any work starts (a search may run for minutes): the
+output folder can be written, numbers are finite, names are known. A bad one raises
+:class:`~trackplan.errors.CaseError` naming the option: exit code 2.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+
+import trackplan
+from trackplan.case import Case
+from trackplan.choices import Method, Timing, choose
+from trackplan.errors import CaseError
+from trackplan.io.case_file import load_case
+
+PIPE_WIDTH = 160
+"""Width of tables written to something other than a terminal, characters."""
+
+app = typer.Typer(
+    name="trackplan",
+    help="Offline trajectory planning for robots following a path, with placement search.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+@app.callback()
+def _options(
+    debug: Annotated[
+        bool,
+        typer.Option("--debug", help="Print tracebacks of internal errors (or TRACKPLAN_DEBUG=1)."),
+    ] = False,
+) -> None:
+    """Offline trajectory planning for robots following a path, with placement search."""
+    # main() reads --debug from the arguments itself: it must know before parsing succeeds.
+
+
+def error(line: str) -> None:
+    """One line on stderr."""
+    print(line, file=sys.stderr, flush=True)
+
+
+def console() -> Console:
+    """A console on the current stdout (created per command, so tests can capture it).
+
+    Output that is not a terminal (a pipe, a file, a test) is laid out 160 columns wide
+    rather than rich's 80, so that tables keep their numbers whole.
+    """
+    return Console(highlight=False, width=None if sys.stdout.isatty() else PIPE_WIDTH)
+
+
+def shipped_cases_dir() -> Path:
+    """The ``cases/`` folder next to the package (present in a source checkout)."""
+    return Path(trackplan.__file__).resolve().parents[1] / "cases"
+
+
+def load_each(files: list[Path]) -> list[tuple[Path, Case | None]]:
+    """Load case files one by one; a bad one is reported on stderr and comes with None."""
+    loaded: list[tuple[Path, Case | None]] = []
+    for file in files:
+        try:
+            loaded.append((file, load_case(file)))
+        except CaseError as exc:
+            error(exc.one_line())
+            loaded.append((file, None))
+    return loaded
+
+
+# --------------------------------------------------------------------------- options
+
+PlacementOption = Annotated[
+    tuple[float, float, float, float, float, float] | None,
+    typer.Option(
+        "--placement",
+        help="X Y Z ROLL PITCH YAW of the path's frame in the robot base frame (m, rad); "
+        "default: the case's placement.example.",
+        show_default=False,
+    ),
+]
+TimingOption = Annotated[
+    str | None,
+    typer.Option("--timing", help="smooth or paper (default: the case's task.timing)."),
+]
+
+AssumeLimitsOption = Annotated[
+    bool,
+    typer.Option(
+        "--assume-limits",
+        help="For a URDF robot without acceleration/jerk limits: assume acceleration = "
+        "velocity / 0.25 s and jerk = acceleration / 0.1 s (recorded in result.json).",
+    ),
+]
+
+MAX_PLACEMENT = 1.0e3
+"""Largest |value| of a --placement entry: m for x, y, z and rad for the angles."""
+
+
+def placement_option(values: tuple[float, ...] | None) -> np.ndarray | None:
+    """Check a --placement value: six finite numbers of sane size.
+
+    Raises
+    ------
+    CaseError
+        Naming ``--placement`` and the bad entry.
+    """
+    if values is None:
+        return None
+    for name, value in zip(("X", "Y", "Z", "ROLL", "PITCH", "YAW"), values, strict=True):
+        if not math.isfinite(value) or abs(value) > MAX_PLACEMENT:
+            raise CaseError(
+                f"{name} must be a finite number with |{name}| ≤ {MAX_PLACEMENT:g}, got {value!r}",
+                key="--placement",
+            )
+    return np.asarray(values, dtype=float)
+
+
+def placement(case: Case, values: np.ndarray | None) -> np.ndarray:
+    """The placement given on the command line, else the case's example placement."""
+    if values is not None:
+        return values
+    if case.bounds.example is None:
+        raise CaseError(
+            "no placement: give --placement X Y Z ROLL PITCH YAW or set placement.example",
+            file=case.source,
+            key="placement.example",
+        )
+    return np.asarray(case.bounds.example, dtype=float)
+
+
+def timing_option(value: str | None) -> Timing | None:
+    """Check a --timing value."""
+    return None if value is None else choose(Timing, value, "--timing")
+
+
+def method_option(value: str | None) -> Method | None:
+    """Check a --method value (an empty name is refused too)."""
+    return None if value is None else choose(Method, value, "--method")
+
+
+def output_folder(out: Path, option: str = "--out") -> Path:
+    """Check that ``out`` can be the folder of a run's files, before any work starts.
+
+    It may exist (a folder: its earlier run's files are replaced) or not (it is created,
+    with any missing parents). It must not be a file, lie under a file, or be somewhere
+    this process cannot write.
+
+    Raises
+    ------
+    CaseError
+        Naming ``option`` and what is in the way.
+    """
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise CaseError(f"{str(out)!r} is a file, expected a folder", key=option)
+    existing = out
+    while not existing.exists():
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise CaseError(f"{str(out)!r} lies under the file {str(existing)!r}", key=option)
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise CaseError(f"cannot write into {str(existing)!r} (permission denied)", key=option)
+    return out

@@ -1,0 +1,125 @@
+"""Commands on one placement: ``plan``, ``check`` (any trajectory.csv) and ``export``."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from trackplan.cli import ExitCode
+from trackplan.cli.common import (
+    AssumeLimitsOption,
+    PlacementOption,
+    TimingOption,
+    app,
+    console,
+    output_folder,
+    placement,
+    placement_option,
+    timing_option,
+)
+from trackplan.cli.summaries import print_check, print_plan
+from trackplan.errors import CaseError
+from trackplan.io.case_file import load_case
+
+
+@app.command()
+def plan(
+    case: Annotated[Path, typer.Argument(help="Case file.", show_default=False)],
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/plan"),
+    placement_values: PlacementOption = None,
+    timing: TimingOption = None,
+    branch: Annotated[
+        int | None,
+        typer.Option("--branch", min=0, help="Force an IK branch (closed form: 0-7)."),
+    ] = None,
+    reference: Annotated[
+        bool, typer.Option("--reference", help="Also compute toppra and TOPP3 durations.")
+    ] = False,
+    report: Annotated[bool, typer.Option(help="Write plots and report.html.")] = True,
+    assume_limits: AssumeLimitsOption = False,
+) -> ExitCode:
+    """Plan the case at one placement; write trajectory.csv, result.json, plots, report."""
+    from trackplan.outputs import write_run
+    from trackplan.planning.plan import plan_placement
+
+    out = output_folder(out)
+    X_given = placement_option(placement_values)
+    timing = timing_option(timing)
+    loaded = load_case(case, assume_limits=assume_limits)
+    X = placement(loaded, X_given)
+    result = plan_placement(loaded, X, timing=timing, branch=branch)
+    if reference and result.trajectory.n_samples:
+        from trackplan.timing.references import reference_durations
+
+        references = reference_durations(result.joint_path, loaded.task)
+        result = replace(result, references={**result.references, **references})
+    write_run(out, result, loaded, report=report)
+    print_plan(console(), result, out)
+    return ExitCode.OK if result.feasible else ExitCode.INFEASIBLE
+
+
+@app.command()
+def check(
+    case: Annotated[Path, typer.Argument(help="Case file.", show_default=False)],
+    run: Annotated[Path, typer.Argument(help="Run folder (or any trajectory CSV file).")],
+    placement_values: PlacementOption = None,
+    timing: TimingOption = None,
+    assume_limits: AssumeLimitsOption = False,
+) -> ExitCode:
+    """Re-check any trajectory.csv, whoever wrote it, against the case's limits and path.
+
+    A run folder must be consistent (its result.json written with its trajectory.csv);
+    a CSV file is read as it is, columns t and q1..qn found by their header names.
+    """
+    from trackplan.io.results import read_trajectory_csv
+    from trackplan.io.run_folder import verified_trajectory
+    from trackplan.planning.plan import check_case_trajectory
+
+    X_given = placement_option(placement_values)
+    timing = timing_option(timing)
+    loaded = load_case(case, assume_limits=assume_limits)
+    X = placement(loaded, X_given)
+    csv = verified_trajectory(run)
+    t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
+    sample_time = float(np.median(np.diff(t)))
+    if not sample_time > 0 or not np.allclose(np.diff(t), sample_time, rtol=1e-6, atol=1e-9):
+        raise CaseError("samples are not evenly spaced in t", file=str(csv), key="t")
+    report = check_case_trajectory(loaded, X, q, sample_time, timing=timing)
+    print_check(console(), str(csv), len(t), sample_time, report)
+    return ExitCode.OK if report.success else ExitCode.INFEASIBLE
+
+
+@app.command()
+def export(
+    run: Annotated[Path, typer.Argument(help="Run folder (or its trajectory.csv).")],
+    format: Annotated[
+        str, typer.Option("--format", help="csv, json or ros (ROS 2 JointTrajectory YAML).")
+    ] = "ros",
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", help="File to write (default: next to trajectory.csv)."),
+    ] = None,
+    joint_names: Annotated[
+        str | None,
+        typer.Option(
+            "--joint-names",
+            help="Comma-separated joint names for the export (default: result.json's).",
+        ),
+    ] = None,
+    frame_id: Annotated[
+        str, typer.Option("--frame-id", help="header.frame_id of the ROS message.")
+    ] = "",
+) -> ExitCode:
+    """Export a run's trajectory as CSV, JSON or a ROS 2 trajectory_msgs/JointTrajectory."""
+    from trackplan.io.export import export_trajectory
+
+    if output is not None and not output.is_dir():
+        output_folder(output.parent, "--output")
+    names = [name.strip() for name in joint_names.split(",")] if joint_names else None
+    written = export_trajectory(run, format, output, joint_names=names, frame_id=frame_id)
+    typer.echo(f"wrote {written}")
+    return ExitCode.OK

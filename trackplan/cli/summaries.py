@@ -1,0 +1,195 @@
+"""The text the commands print: case descriptions, robot tables, plan and search summaries."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from trackplan.case import Case
+from trackplan.paths import NominalPath
+from trackplan.planning.result import CheckReport, PlanResult
+from trackplan.robots.model import Robot
+
+
+def describe_case(case: Case, file: Path | str) -> list[str]:
+    """Summary lines of a valid case: name, robot, path length, segments, corner angles."""
+    path = NominalPath.from_specs(case.start, case.segments)
+    task = case.task
+    corners = "; ".join(
+        f"{angle:.1f}° between segments[{segment - 1}] and segments[{segment}]"
+        for segment, angle in segment_corners(path)
+    )
+    return [
+        f"{file}: ok",
+        f"  name      {case.name}",
+        f"  robot     {case.robot.name} ({case.robot.n_dof} joints)",
+        f"  path      {_count(len(case.segments), 'segment')}, length {path.length:.4f} m",
+        f"  corners   {corners or 'none'}",
+        f"  task      rated speed {task.rated_speed:g} m/s, corner speed "
+        f"{task.corner_speed:g} m/s, tolerance {task.tolerance * 1e3:g} mm, "
+        f"sample time {task.sample_time * 1e3:g} ms, timing {task.timing}",
+    ]
+
+
+def segment_corners(path: NominalPath) -> list[tuple[int, float]]:
+    """The corners where one segment meets the next, as the user sees them.
+
+    Returns
+    -------
+    list of (int, float)
+        Per corner: the index of the segment that starts there, and the angle between
+        the two legs in degrees (180 for no turn; the β of the paper's Eq. 9). The turns
+        between the points of one ``points`` segment are left out: they sample a curve.
+    """
+    owner = path.segment_index
+    return [
+        (int(owner[corner.junction + 1]), float(np.degrees(np.pi - corner.angle)))
+        for corner in path.corners
+        if owner[corner.junction] != owner[corner.junction + 1]
+    ]
+
+
+def robot_table(robot: Robot) -> Table:
+    """A table of one robot's chain (origin and axis per joint) and joint limits."""
+    from trackplan.frames import rpy_from_matrix
+
+    table = Table(
+        title=escape(f"{robot.name} ({robot.n_dof} joints)"),
+        caption=escape(robot.source) or None,
+    )
+    headers = (
+        "joint",
+        "origin xyz m",
+        "origin rpy °",
+        "axis",
+        "position °",
+        "velocity rad/s",
+        "acceleration rad/s²",
+        "jerk rad/s³",
+    )
+    for header in headers:
+        table.add_column(header, justify="right")
+
+    def triple(values: np.ndarray) -> str:
+        return " ".join(f"{v:.4g}" for v in np.where(np.abs(values) < 1e-12, 0.0, values))
+
+    for i, joint in enumerate(robot.joint_names):
+        origin = robot.origins[i]
+        table.add_row(
+            escape(joint),
+            triple(origin[:3, 3]),
+            triple(np.degrees(rpy_from_matrix(origin[:3, :3]))),
+            triple(robot.axes[i]),
+            f"[{np.degrees(robot.q_min[i]):g}, {np.degrees(robot.q_max[i]):g}]",
+            f"{robot.v_max[i]:g}",
+            f"{robot.a_max[i]:g}",
+            f"{robot.j_max[i]:g}",
+        )
+    return table
+
+
+def print_check(
+    console: Console, source: str, n_samples: int, ts: float, report: CheckReport
+) -> None:
+    """What ``trackplan check`` found: margins per limit, tracking error, violations."""
+    console.print(f"{escape(source)}: {_count(n_samples, 'sample')} at Ts = {ts:g} s")
+    for kind, margin in report.joint_margins.items():
+        cells = "  ".join(f"{m:+.3f}" for m in margin)
+        console.print(f"  {kind:<13} margin per joint: {cells}")
+    for kind, task_margin in report.task_margins.items():
+        console.print(f"  {kind:<13} margin: {task_margin:+.3f}")
+    console.print(f"  max tracking error {report.max_tracking_error * 1e3:.4f} mm")
+    for violation in report.violations:
+        console.print(f"  VIOLATION {escape(violation.message)}")
+    count = _count(len(report.violations), "violation")
+    console.print("feasible" if report.success else f"infeasible: {count}")
+
+
+def print_plan(console: Console, result: PlanResult, out: Path) -> None:
+    """A few lines on what a plan achieved and where its files are."""
+    violations = result.check.violations
+    if result.feasible:
+        console.print(f"{escape(result.case_name)}: {escape(result.message)}")
+    elif violations:  # the list below says it all; the message would repeat its first line
+        console.print(
+            f"{escape(result.case_name)}: INFEASIBLE ({result.status.value}): "
+            f"{_count(len(violations), 'violation')}"
+        )
+    else:
+        console.print(
+            f"{escape(result.case_name)}: INFEASIBLE ({result.status.value}): "
+            f"{escape(result.message)}"
+        )
+    if result.trajectory.n_samples:
+        console.print(
+            f"  J = {result.objective:.4f}  duration = {result.duration:.3f} s  "
+            f"rated speed on {100 * result.rated_speed_fraction:.1f} % of the path  "
+            f"min corner speed = {result.min_corner_speed:.4f} m/s  "
+            f"max tracking error = {result.check.max_tracking_error * 1e3:.4f} mm  "
+            f"branch {result.branch}"
+        )
+        cell = result.check.cell
+        if cell is not None:
+            console.print(
+                f"  min clearance = {1e3 * cell.min_clearance:.1f} mm "
+                f"({escape(cell.closest[0])} – {escape(cell.closest[1])} at "
+                f"t = {cell.t_closest:.3f} s; required {1e3 * cell.clearance:.1f} mm)"
+            )
+        if result.energy is not None:
+            energy = result.energy
+            console.print(
+                f"  copper loss = {energy.copper_loss:.4g} {escape(energy.copper_loss_unit)}  "
+                f"mechanical energy = {energy.mechanical_energy:.4g} J  peak torque = "
+                f"{100 * energy.peak_torque_ratio:.1f} % of the limit (joint "
+                f"{energy.peak_torque_joint})"
+            )
+        for slow in result.slowdowns:
+            console.print(
+                f"  slow-down: s = {slow.s_start:.4f}..{slow.s_end:.4f} m at "
+                f"{slow.speed:.4f} m/s ({100 * (1 - slow.speed / slow.rated_speed):.1f} % below "
+                f"rated): {escape(slow.limit)}"
+            )
+        for key, value in result.references.items():
+            console.print(f"  {key} = {value:.4f} s")
+    for violation in violations[:8]:
+        console.print(f"  VIOLATION {escape(violation.message)}")
+    if len(violations) > 8:
+        console.print(f"  ... and {len(violations) - 8} more in result.json")
+    console.print(f"  results in {escape(str(out))}/")
+
+
+def print_search(console: Console, result, out: Path) -> None:  # type: ignore[no-untyped-def]
+    """The search summary, then the final plan's summary."""
+    initial = result.initial
+    before = (
+        f"J = {initial.objective:.4f}"
+        if initial.feasible
+        else f"infeasible ({initial.status.value})"
+    )
+    console.print(
+        f"{escape(result.method)} (seed {result.seed}): {result.evaluations} evaluations in "
+        f"{_count(result.generations, 'generation')} over {_count(result.runs, 'run')}, "
+        f"{result.wall_time_s:.2f} s, "
+        f"last run stopped: {escape(result.stop_reason)}"
+    )
+    console.print(f"  before (centre of the bounds, X = {_vector(initial.placement)}): {before}")
+    after = (
+        escape(result.message)
+        if result.success
+        else f"no feasible placement in {_count(result.evaluations, 'evaluation')}; "
+        "the closest one is planned below"
+    )
+    console.print(f"  after  (X = {_vector(result.X)}): {after}")
+    print_plan(console, result.final, out)
+
+
+def _vector(values: np.ndarray) -> str:
+    return "(" + ", ".join(f"{v:.4f}" for v in values) + ")"
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
