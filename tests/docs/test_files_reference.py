@@ -39,7 +39,7 @@ def _schema(model: type[BaseModel], prefix: str = "") -> dict[str, object]:
     a key that holds further keys)."""
     keys: dict[str, object] = {}
     for name, field in model.model_fields.items():
-        key = f"{prefix}{name}"
+        key = f"{prefix}{field.alias or name}"
         origin = typing.get_origin(field.annotation)
         inner = _nested_model(field.annotation)
         if inner is not None and key != "path.segments":
