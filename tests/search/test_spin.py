@@ -157,3 +157,15 @@ def test_part_frame_cases_get_no_tool_figure():
     from trackplan.report.figures import shows_tool
 
     assert not shows_tool(load_case(CASES / "paper-corner.yaml"))
+
+
+def test_seam_weld_on_an_industrial_robot_optimises_with_a_free_spin():
+    case = load_case(CASES / "seam-weld-free.yaml")
+    assert case.robot.name == "kuka_kr6_r700_sixx" and case.task.tool.n_spin == 1
+    result = optimize_placement(case, budget=2000, restarts=1)
+    assert result.success, result.message
+    spin = result.final.joint_path.tool.spin
+    assert len(spin.coefficients) == 1
+    assert np.ptp(result.final.trajectory.spin) == 0.0  # one constant spin
+    check = check_case_trajectory(case, result.X, result.final.trajectory.q, case.task.sample_time)
+    assert check.success and check.max_orientation_error < 0.06
