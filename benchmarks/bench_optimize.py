@@ -113,7 +113,7 @@ def _rtb_rate(case, geometry, X: np.ndarray) -> tuple[float, int]:  # type: igno
     puma.links[0].d = 0.0
     puma.links[2].d = 0.15
     points = geometry.planned.sample(screening_grid(geometry)).position
-    poses = tool_poses(X[:RTB_PLACEMENTS], points, case.task.tool_rpy)
+    poses = tool_poses(X[:RTB_PLACEMENTS], points, case.task.tool.base_rotations(points)[0])
     puma.ikine_a(poses[0, 0])  # warm-up
     start = time.perf_counter()
     for placement in poses:

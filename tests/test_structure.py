@@ -19,9 +19,9 @@ def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
     calls: list[tuple[str, int]] = []
     real_poses, real_ik = jointpath.tool_poses, jointpath.solve_path_ik
 
-    def poses(X, positions, tool_rpy):
+    def poses(X, positions, R_part_tool):
         calls.append(("poses", len(positions)))
-        return real_poses(X, positions, tool_rpy)
+        return real_poses(X, positions, R_part_tool)
 
     def ik(robot, T, *args, **kwargs):
         calls.append(("ik", T.shape[1]))

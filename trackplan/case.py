@@ -14,6 +14,7 @@ from trackplan.cell.model import Cell
 from trackplan.choices import Method, Penalty, Timing, choose
 from trackplan.paths.specs import SegmentSpec
 from trackplan.robots.model import Robot
+from trackplan.tool import ToolSpec
 
 PLACEMENT_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
 
@@ -32,8 +33,8 @@ class Task:
         Largest distance of the tool point from the nominal path, ρ, m.
     sample_time
         Controller period Ts, s.
-    tool_rpy
-        Tool orientation in the definition frame (roll, pitch, yaw), shape (3,), rad.
+    tool
+        How the tool is held along the path (:class:`trackplan.tool.ToolSpec`).
     timing
         The time law: ``smooth`` (jerk-limited, G2 blends) or ``paper`` (Section 3.1 as
         written).
@@ -43,7 +44,7 @@ class Task:
     corner_speed: float
     tolerance: float
     sample_time: float
-    tool_rpy: np.ndarray
+    tool: ToolSpec = field(default_factory=ToolSpec)
     timing: Timing = Timing.SMOOTH
 
     def __post_init__(self) -> None:

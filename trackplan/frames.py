@@ -111,8 +111,8 @@ def pose_matrix(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     return T
 
 
-def tool_poses(X: np.ndarray, positions: np.ndarray, tool_rpy: np.ndarray) -> np.ndarray:
-    """``T_base_tool = T_X · [R_tool  p; 0 1]`` for every placement and path point.
+def tool_poses(X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray) -> np.ndarray:
+    """``T_base_tool = T_X · [R_part_tool  p; 0 1]`` for every placement and path point.
 
     Parameters
     ----------
@@ -120,8 +120,9 @@ def tool_poses(X: np.ndarray, positions: np.ndarray, tool_rpy: np.ndarray) -> np
         Placements, shape (B, 6) (or (6,)), metres and radians.
     positions
         Path points in the definition frame, shape (M, 3), m.
-    tool_rpy
-        Tool orientation in the definition frame, shape (3,), rad.
+    R_part_tool
+        Tool orientation in the definition frame: one rotation (3, 3), one per point
+        (M, 3, 3), or one per placement and point (B, M, 3, 3) (:mod:`trackplan.tool`).
 
     Returns
     -------
@@ -132,8 +133,11 @@ def tool_poses(X: np.ndarray, positions: np.ndarray, tool_rpy: np.ndarray) -> np
     single = X.ndim == 1
     T_base_part = placement_transform(np.atleast_2d(X))  # (B, 4, 4)
     R = T_base_part[:, :3, :3]
+    R_part_tool = np.asarray(R_part_tool, dtype=float)
+    if R_part_tool.ndim < 4:
+        R_part_tool = R_part_tool.reshape(1, -1, 3, 3)  # (1, 1 or M, 3, 3)
     poses = np.empty((len(R), len(positions), 4, 4))
-    poses[..., :3, :3] = (R @ rpy_matrix(np.asarray(tool_rpy, dtype=float)))[:, None]
+    poses[..., :3, :3] = R[:, None] @ R_part_tool
     poses[..., :3, 3] = np.asarray(positions, dtype=float) @ R.transpose(0, 2, 1)
     poses[..., :3, 3] += T_base_part[:, None, :3, 3]
     poses[..., 3, :3] = 0.0

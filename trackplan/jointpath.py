@@ -15,12 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.frames import placement_transform, rpy_matrix, tool_poses
+from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import PathIK, solve_path_ik
 from trackplan.status import Status
 from trackplan.stencils import stencil_derivatives, stencil_points
+from trackplan.tool import ToolOrientation
 
 STENCIL_FRACTION = 0.1
 """Stencil spacing as a share of the grid step: small against the scale on which the
@@ -39,8 +40,8 @@ class JointPath:
         The case's paths and zones.
     placement
         X = (x, y, z, roll, pitch, yaw), shape (6,), metres and radians.
-    tool_rpy
-        Tool orientation in the path's definition frame, shape (3,), rad.
+    tool
+        Tool orientation along the path (spec and chosen spin).
     s
         Planning grid, shape (G,), m, non-decreasing; a zone boundary appears once per
         zone it bounds (the derivatives there are one-sided, from inside each zone).
@@ -57,7 +58,7 @@ class JointPath:
     robot: Robot
     geometry: PathGeometry
     placement: np.ndarray
-    tool_rpy: np.ndarray
+    tool: ToolOrientation
     s: np.ndarray
     zone: np.ndarray
     q: np.ndarray
@@ -72,7 +73,7 @@ class JointPath:
         robot: Robot,
         geometry: PathGeometry,
         placement: np.ndarray,
-        tool_rpy: np.ndarray,
+        tool: ToolOrientation,
         branch: int | None = None,
     ) -> JointPath:
         """Poses and path IK of the planning grid, in one pose pass and one IK pass.
@@ -85,8 +86,8 @@ class JointPath:
             The case's paths (:meth:`PathGeometry.zone_grids` gives the grid).
         placement
             X, shape (6,), metres and radians.
-        tool_rpy
-            Tool orientation in the definition frame, shape (3,), rad.
+        tool
+            Tool orientation along the path (:class:`trackplan.tool.ToolOrientation`).
         branch
             Force an IK branch; default: the usable one with the largest margin.
 
@@ -97,14 +98,14 @@ class JointPath:
             switch or a joint range left shows in :attr:`status` and :attr:`message`.
         """
         placement = np.asarray(placement, dtype=float)
-        tool_rpy = np.asarray(tool_rpy, dtype=float)
         grid = _planning_grid(geometry)
-        poses = tool_poses(placement, grid.positions, tool_rpy)
+        rotations = tool.rotations(grid.points.ravel(), grid.tangents)
+        poses = tool_poses(placement, grid.positions, rotations)
         ik = solve_path_ik(robot, poses[None], branch=branch)
         q_points = ik.q[0].reshape(*grid.points.shape, robot.n_dof)
         dq, ddq, dddq = stencil_derivatives(q_points, grid.offset, grid.h)
         q = q_points[np.arange(len(grid.s)), grid.offset]
-        return cls(robot, geometry, placement, tool_rpy, grid.s, grid.zone, q, dq, ddq, dddq, ik)
+        return cls(robot, geometry, placement, tool, grid.s, grid.zone, q, dq, ddq, dddq, ik)
 
     @property
     def success(self) -> bool:
@@ -136,15 +137,16 @@ class JointPath:
         """The placement transform T_X, shape (4, 4)."""
         return placement_transform(self.placement)
 
-    @property
-    def R_part_tool(self) -> np.ndarray:
-        """Tool orientation in the path's definition frame, shape (3, 3)."""
-        return rpy_matrix(self.tool_rpy)
+    def R_part_tool(self, s: np.ndarray) -> np.ndarray:
+        """Tool orientation in the definition frame at arc lengths ``s`` (M,), shape (M, 3, 3)."""
+        sample = self.geometry.planned.sample(np.asarray(s, dtype=float))
+        return self.tool.rotations(sample.s, sample.tangent)
 
     def poses(self, s: np.ndarray) -> np.ndarray:
         """Tool poses in the base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
-        positions = self.geometry.planned.sample(np.asarray(s, dtype=float)).position
-        return tool_poses(self.placement, positions, self.tool_rpy)
+        sample = self.geometry.planned.sample(np.asarray(s, dtype=float))
+        rotations = self.tool.rotations(sample.s, sample.tangent)
+        return tool_poses(self.placement, sample.position, rotations)
 
     def joints(self, s: np.ndarray) -> np.ndarray:
         """Joint positions at arc lengths ``s`` by IK on this path's branch.
@@ -212,8 +214,9 @@ class _PlanningGrid:
         Stencil arc lengths (G, W), m, and the column of each grid point in them, (G,).
     h
         Stencil spacing of each grid point, (G,), m.
-    positions
-        Planned-path points at the stencils, shape (G·W, 3), m, definition frame.
+    positions, tangents
+        Planned-path points and unit tangents at the stencils, shape (G·W, 3), m and
+        unitless, definition frame.
     """
 
     s: np.ndarray
@@ -222,6 +225,7 @@ class _PlanningGrid:
     offset: np.ndarray
     h: np.ndarray
     positions: np.ndarray
+    tangents: np.ndarray
 
 
 _GRIDS: weakref.WeakKeyDictionary[PathGeometry, _PlanningGrid] = weakref.WeakKeyDictionary()
@@ -240,8 +244,9 @@ def _planning_grid(geometry: PathGeometry) -> _PlanningGrid:
         steps = np.array([(g[-1] - g[0]) / max(len(g) - 1, 1) for g in grids])
         h = STENCIL_FRACTION * steps[zone]
         points, offset = stencil_points(s, lo, hi, h)
-        positions = geometry.planned.sample(points.ravel()).position
-        for array in (s, zone, points, offset, h, positions):
+        sample = geometry.planned.sample(points.ravel())
+        positions, tangents = sample.position, sample.tangent
+        for array in (s, zone, points, offset, h, positions, tangents):
             array.flags.writeable = False
-        _GRIDS[geometry] = _PlanningGrid(s, zone, points, offset, h, positions)
+        _GRIDS[geometry] = _PlanningGrid(s, zone, points, offset, h, positions, tangents)
     return _GRIDS[geometry]

@@ -70,7 +70,7 @@ def test_paper_cases_load_with_the_paper_settings(name: str) -> None:
     np.testing.assert_array_equal(case.start, [0, 0, 0])
     assert (case.task.rated_speed, case.task.corner_speed) == (0.15, 0.15)
     assert (case.task.tolerance, case.task.sample_time) == (0.001, 0.001)
-    np.testing.assert_allclose(case.task.tool_rpy, [-np.pi / 2, 0, 0])
+    np.testing.assert_allclose(case.task.tool.rpy, [-np.pi / 2, 0, 0])
     np.testing.assert_array_equal(case.bounds.lower, [-0.87] * 3 + [-1.57] * 3)
     np.testing.assert_array_equal(case.bounds.upper, [0.87] * 3 + [1.57] * 3)
     np.testing.assert_allclose(np.square(case.bounds.reach), [0.0226, 0.7289], atol=1e-6)
@@ -115,7 +115,7 @@ def test_defaults(tmp_path: Path) -> None:
         0.001,
         "smooth",
     )
-    np.testing.assert_array_equal(case.task.tool_rpy, [0, 0, 0])
+    np.testing.assert_array_equal(case.task.tool.rpy, [0, 0, 0])
     np.testing.assert_array_equal(case.bounds.lower, [-0.87] * 3 + [-1.57] * 3)
     assert case.bounds.reach == (0.150333, 0.853756) and case.bounds.example is None
     np.testing.assert_array_equal(case.objective.weights, PAPER_WEIGHTS)

@@ -28,7 +28,7 @@ def test_feasible_plan_passes_every_check(corner_case, corner_geometry, corner_p
     assert report.max_tracking_error <= corner_case.task.tolerance
     for kind, margins in report.joint_margins.items():
         assert np.all(margins >= 0), kind
-    assert set(report.task_margins) == {"orientation", "tracking", "speed", "coverage"}
+    assert set(report.task_margins) == {"orientation", "spin", "tracking", "speed", "coverage"}
 
 
 def test_planted_acceleration_step_is_caught(corner_case, corner_geometry, corner_plan):
@@ -57,7 +57,7 @@ def test_planted_tracking_deviation_is_caught(corner_case, corner_geometry, corn
     bump = np.where(window, np.sin(np.pi * (s - 0.2) / 0.1) ** 2, 0.0)
     positions = corner_geometry.planned.sample(s).position
     positions[:, 1] += 2 * rho * bump  # y is normal to the x–z plane of the path
-    poses = tool_poses(X, positions, corner_case.task.tool_rpy)
+    poses = tool_poses(X, positions, corner_case.task.tool.base_rotations(np.zeros((1, 3)))[0])
     q = solve_path_ik(corner_case.robot, poses[None], branch=corner_plan.branch).q[0]
     report = _check(corner_case, corner_geometry, q, X)
     tracking = [v for v in report.violations if v.limit == "tracking"]
@@ -99,10 +99,18 @@ def test_skipped_segment_is_caught(three_segment_case):
 
 def test_orientation_error_is_caught(corner_case, corner_geometry, corner_plan):
     q = corner_plan.trajectory.q.copy()
-    q[:, 5] += 0.01  # a constant twist of the tool: smooth, but the wrong orientation
+    q[:, 4] += 0.01  # a constant tilt of the tool axis (the PUMA's tool point is on joint 5)
     report = _check(corner_case, corner_geometry, q, corner_plan.placement)
     assert ("orientation", None) in _kinds(report)
     assert report.max_orientation_error == pytest.approx(0.01, rel=1e-6)
+
+
+def test_a_twist_about_the_tool_axis_is_a_spin_error(corner_case, corner_geometry, corner_plan):
+    q = corner_plan.trajectory.q.copy()
+    q[:, 5] += 0.01  # the tool axis stays, the spin (fixed at 0) moves
+    report = _check(corner_case, corner_geometry, q, corner_plan.placement)
+    assert _kinds(report) == {("spin", None)}
+    assert report.task_margins["spin"] == pytest.approx(1.0 - 0.01 / 1e-3, rel=1e-6)
 
 
 def test_joint_limits_only_without_reference(corner_case, corner_plan):

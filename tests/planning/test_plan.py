@@ -101,8 +101,8 @@ def test_trajectory_csv_round_trip(corner_plan, tmp_path):
     np.testing.assert_array_equal(t, corner_plan.trajectory.t)
     np.testing.assert_array_equal(q, corner_plan.trajectory.q)
     header = file.read_text().splitlines()[0].split(",")
-    assert header[:2] == ["t", "q1"] and header[-4:] == ["x", "y", "z", "speed"]
-    assert len(header) == 1 + 4 * 6 + 4
+    assert header[:2] == ["t", "q1"] and header[-5:] == ["x", "y", "z", "speed", "spin"]
+    assert len(header) == 1 + 4 * 6 + 5
 
 
 def test_cli_plan_exit_codes_and_check_round_trip(tmp_path, capsys):

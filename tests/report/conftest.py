@@ -24,6 +24,7 @@ from trackplan.robots.builtin import puma560
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.timing import SlowDown
+from trackplan.tool import ToolSpec
 
 SAMPLE_TIME = 0.005  # s
 TOLERANCE = 0.001  # ρ, m
@@ -54,7 +55,7 @@ def corner_case(robot: Robot) -> Case:
             corner_speed=CORNER_SPEED_CAP,
             tolerance=TOLERANCE,
             sample_time=SAMPLE_TIME,
-            tool_rpy=TOOL_RPY,
+            tool=ToolSpec.part(TOOL_RPY),
         ),
         bounds=PlacementBounds(lower=lower, upper=-lower, reach=reach, example=PAPER_PLACEMENT),
         objective=Objective(weights=PAPER_WEIGHTS),

@@ -125,13 +125,13 @@ def _write(directory, header, rows):
 @pytest.mark.parametrize(
     ("header", "rows", "message"),
     [
-        (trajectory_header(2)[:-1], [[0.0] * 12], "header must be"),
-        (["t", "q2", "q1", *trajectory_header(2)[3:]], [[0.0] * 13], "header must be"),
+        (trajectory_header(2)[:-1], [[0.0] * 13], "header must be"),
+        (["t", "q2", "q1", *trajectory_header(2)[3:]], [[0.0] * 14], "header must be"),
         (trajectory_header(2), [], "no sample"),
-        (trajectory_header(2), [[0.0] * 13, [0.1] * 12], "malformed row"),
-        (trajectory_header(2), [[0.0] * 13, ["abc"] * 13], "malformed row"),
-        (trajectory_header(2), [[0.0] * 13, [0.1, "nan", *[0.0] * 11]], "non-finite q1 on line 3"),
-        (trajectory_header(2), [[0.1] * 13, [0.1] * 13], "increase"),
+        (trajectory_header(2), [[0.0] * 14, [0.1] * 13], "malformed row"),
+        (trajectory_header(2), [[0.0] * 14, ["abc"] * 14], "malformed row"),
+        (trajectory_header(2), [[0.0] * 14, [0.1, "nan", *[0.0] * 12]], "non-finite q1 on line 3"),
+        (trajectory_header(2), [[0.1] * 14, [0.1] * 14], "increase"),
     ],
 )
 def test_malformed_trajectory_files_raise_case_error(tmp_path, header, rows, message):

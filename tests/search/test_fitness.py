@@ -57,7 +57,9 @@ def test_every_branch_matches_the_single_branch_solver(case: Case, geometry: Pat
     space = SearchSpace.from_case(case)
     X = np.vstack([PAPER_X, GOOD_X, space.sample(rng, 10)])
     poses = tool_poses(
-        X, geometry.planned.sample(screening_grid(geometry)).position, case.task.tool_rpy
+        X,
+        geometry.planned.sample(screening_grid(geometry)).position,
+        case.task.tool.base_rotations(np.zeros((1, 3)))[0],
     )
     branches = solve_path_ik_branches(case.robot, poses)
     assert branches.q.shape == (12, 8, poses.shape[1], 6)
@@ -73,7 +75,7 @@ def test_branch_with_the_least_travel_is_chosen(case: Case, geometry: PathGeomet
     fitness = _fitness(case, geometry)
     result = fitness.evaluate(np.vstack([PAPER_X, GOOD_X]))
     assert result.feasible.all()
-    poses = tool_poses(np.vstack([PAPER_X, GOOD_X]), fitness.points, case.task.tool_rpy)
+    poses = tool_poses(np.vstack([PAPER_X, GOOD_X]), fitness.points, fitness.R_base)
     for i in range(2):
         travels = []
         for k in range(8):

@@ -12,6 +12,7 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
 from trackplan.status import Status
 from trackplan.timing import paper
+from trackplan.tool import ToolOrientation
 
 LINE_PUBLISHED = np.array([-0.1322, 0.0610, 0.1829, 0.0312, -0.4124, 0.5020])
 LINE_MOVED_OUT = np.array([-0.2230, 0.1029, 0.1829, 0.0312, -0.4124, 0.5020])
@@ -93,9 +94,9 @@ def test_corner_tracking_error_is_two_rho(corner_result, corner_case):
 
 def test_corner_arc_is_a_whole_number_of_periods(corner_case):
     geometry = PathGeometry.from_case(corner_case, "paper")
-    planner = paper._PaperPlanner(
-        corner_case.robot, corner_case.task, geometry.planned, CORNER_PUBLISHED, 3
-    )
+    tool = ToolOrientation.choose(corner_case.task.tool, geometry)
+    joint_path = JointPath.solve(corner_case.robot, geometry, CORNER_PUBLISHED, tool, branch=3)
+    planner = paper._PaperPlanner(corner_case.robot, corner_case.task, joint_path)
     arc = next(k for k, piece in enumerate(geometry.planned.pieces) if not piece.straight)
     steps = planner._arc_steps(arc)
     speed = planner._arc_speed(arc)
@@ -119,7 +120,11 @@ def test_arc_started_at_constant_speed_steps_the_velocity():
 def test_forced_branch_is_used_or_refused(corner_case):
     geometry = PathGeometry.from_case(corner_case, "paper")
     joint_path = JointPath.solve(
-        corner_case.robot, geometry, CORNER_PUBLISHED, corner_case.task.tool_rpy, branch=3
+        corner_case.robot,
+        geometry,
+        CORNER_PUBLISHED,
+        ToolOrientation.choose(corner_case.task.tool, geometry),
+        branch=3,
     )
     law = paper.plan_paper_trajectory(joint_path, corner_case.task)
     assert joint_path.branch == 3 and law.success and law.message == ""
@@ -134,9 +139,9 @@ def test_via_spacing_keeps_the_ramp_from_stalling(line_case):
     # With 1 mm vias at Ts = 1 ms, rounding each interval up to whole periods cancels the
     # acceleration: the forward piece stalls at 1 mm / (m Ts) below v_r.
     geometry = PathGeometry.from_case(line_case, "paper")
-    planner = paper._PaperPlanner(
-        line_case.robot, line_case.task, geometry.planned, LINE_MOVED_OUT, 2
-    )
+    tool = ToolOrientation.choose(line_case.task.tool, geometry)
+    joint_path = JointPath.solve(line_case.robot, geometry, LINE_MOVED_OUT, tool, branch=2)
+    planner = paper._PaperPlanner(line_case.robot, line_case.task, joint_path)
     piece = geometry.planned.pieces[0]
     q_start = plan_placement(line_case, LINE_MOVED_OUT, timing="paper").trajectory.q[0]
     rated = line_case.task.rated_speed

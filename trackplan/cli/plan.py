@@ -41,17 +41,42 @@ def plan(
     ] = False,
     report: Annotated[bool, typer.Option(help="Write plots and report.html.")] = True,
     assume_limits: AssumeLimitsOption = False,
+    spin: Annotated[
+        float | None, typer.Option("--spin", help="Constant spin about the tool axis, rad.")
+    ] = None,
+    spin_profile: Annotated[
+        Path | None,
+        typer.Option("--spin-profile", help="Spin profile file (or a result.json), rad."),
+    ] = None,
 ) -> ExitCode:
-    """Plan the case at one placement; write trajectory.csv, result.json, plots, report."""
+    """Plan the case at one placement; write trajectory.csv, result.json, plots, report.
+
+    With a free spin and neither --spin nor --spin-profile, the spin is optimised for the
+    placement (docs/tool.md).
+    """
     from trackplan.outputs import write_run
     from trackplan.planning.plan import plan_placement
+    from trackplan.search.spin import optimize_spin
+    from trackplan.tool import SpinProfile
 
     out = output_folder(out)
     X_given = placement_option(placement_values)
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
     X = placement(loaded, X_given)
-    result = plan_placement(loaded, X, timing=timing, branch=branch)
+    if spin is not None and spin_profile is not None:
+        raise CaseError("give --spin or --spin-profile, not both", key="--spin")
+    given = None
+    if spin is not None:
+        given = SpinProfile(np.array([spin]), 0.0)
+    elif spin_profile is not None:
+        from trackplan.io.tool_file import load_spin_profile
+
+        given = load_spin_profile(spin_profile)
+    if given is None and loaded.task.tool.n_spin and branch is None:
+        result = optimize_spin(loaded, X, timing=timing)
+    else:
+        result = plan_placement(loaded, X, timing=timing, branch=branch, spin=given)
     if reference and result.trajectory.n_samples:
         from trackplan.timing.references import reference_durations
 

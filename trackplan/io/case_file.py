@@ -30,6 +30,7 @@ from trackplan.io.cell_file import CellModel, build_cell, cell_problems
 from trackplan.io.points_file import MIN_POINTS, load_points_csv
 from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
 from trackplan.io.sizes import MAX_SAMPLE_TIME, size_problems
+from trackplan.io.tool_file import ToolModel, as_spec, tool_problems
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -48,7 +49,7 @@ from trackplan.io.yaml_input import (
     show,
     validate_model,
 )
-from trackplan.paths import check_segments
+from trackplan.paths import NominalPath, check_segments
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.objectives import OBJECTIVES
 from trackplan.robots.model import Robot
@@ -138,7 +139,8 @@ class TaskModel(StrictModel):
     corner_speed: Positive | None = None
     tolerance: Positive = 0.001
     sample_time: Annotated[float, Field(gt=0, le=MAX_SAMPLE_TIME)] = 0.001
-    tool_rpy: Vec3 = list_default(0.0, 0.0, 0.0)
+    tool_rpy: Vec3 | None = None
+    tool: ToolModel | None = None
     timing: Literal["smooth", "paper"] = "smooth"
 
 
@@ -297,6 +299,8 @@ def load_case_data(
         *_objective_kind_problems(model.objective, robot),
         *_payload_problems(model.payload, robot),
     ]
+    nominal = None if problems else NominalPath.from_specs(start, segments)
+    problems += tool_problems(model.task.tool, model.task.tool_rpy, nominal)
     raise_first(problems, data, file)
     sizes = size_problems(
         start,
@@ -343,7 +347,7 @@ def _case(
             corner_speed=task.rated_speed if task.corner_speed is None else task.corner_speed,
             tolerance=task.tolerance,
             sample_time=task.sample_time,
-            tool_rpy=_array(task.tool_rpy),
+            tool=as_spec(task.tool, task.tool_rpy),
             timing=Timing(task.timing),
         ),
         bounds=PlacementBounds(

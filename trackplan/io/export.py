@@ -1,7 +1,7 @@
 """Export a run's trajectory for other tools: plain CSV, JSON, or a ROS 2 JointTrajectory.
 
 The source is a run directory (or its ``trajectory.csv``, header
-``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed``) or a
+``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed,spin``) or a
 :class:`~trackplan.planning.result.Trajectory` in memory. Joint names come from
 ``result.json`` next to the CSV (key ``joint_names``) when it is there, else ``q1..qn``.
 
@@ -145,7 +145,7 @@ def read_trajectory_table(file: Path) -> TrajectoryTable:
     ------
     CaseError
         Naming the file and what is wrong: missing, unreadable, a header that is not
-        ``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed``, a non-numeric or short
+        ``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed,spin``, a non-numeric or short
         row, a non-finite value, no sample, or times that do not increase.
     """
     file = _trajectory_file(Path(file))
@@ -164,10 +164,10 @@ def read_trajectory_table(file: Path) -> TrajectoryTable:
         rows = np.loadtxt(body, delimiter=",", ndmin=2)
     except ValueError as error:
         raise CaseError(f"malformed row: {error}", file=where) from None
-    n_dof, rest = divmod(len(header) - 5, 4)
+    n_dof, rest = divmod(len(header) - 6, 4)
     if n_dof < 1 or rest or header != trajectory_header(n_dof):
         raise CaseError(
-            "header must be t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed, "
+            "header must be t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed,spin, "
             f"got {','.join(header)!r}",
             file=where,
             key="header",
@@ -191,8 +191,8 @@ def read_trajectory_table(file: Path) -> TrajectoryTable:
         qd=qd,
         qdd=qdd,
         qddd=qddd,
-        tool_position=rows[:, -4:-1],
-        speed=rows[:, -1],
+        tool_position=rows[:, -5:-2],
+        speed=rows[:, -2],
     )
 
 

@@ -17,11 +17,11 @@ from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
 
 def trajectory_header(n_dof: int) -> list[str]:
-    """Column names ``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed``."""
+    """Column names ``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed,spin``."""
     columns = ["t"]
     for prefix in ("q", "qd", "qdd", "qddd"):
         columns += [f"{prefix}{i + 1}" for i in range(n_dof)]
-    return [*columns, "x", "y", "z", "speed"]
+    return [*columns, "x", "y", "z", "speed", "spin"]
 
 
 def write_trajectory_csv(trajectory: Trajectory, file: Path) -> None:
@@ -37,10 +37,13 @@ def write_trajectory_csv(trajectory: Trajectory, file: Path) -> None:
                 trajectory.qddd,
                 trajectory.tool_position,
                 trajectory.speed,
+                trajectory.spin
+                if len(trajectory.spin) == trajectory.n_samples
+                else np.zeros(trajectory.n_samples),
             ]
         )
         if trajectory.n_samples
-        else np.zeros((0, 4 * n_dof + 5))
+        else np.zeros((0, 4 * n_dof + 6))
     )
     np.savetxt(
         file,
@@ -158,6 +161,8 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
         "path_length": float(result.path_length),
         "max_tracking_error": float(check.max_tracking_error),
         "max_orientation_error": float(check.max_orientation_error),
+        "tool": result.joint_path.tool.spec.describe(),
+        "spin": result.joint_path.tool.spin.as_dict(),
         "rated_speed_fraction": float(result.rated_speed_fraction),
         "min_corner_speed": float(result.min_corner_speed),
         **_energy_summary(result),

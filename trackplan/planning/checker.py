@@ -8,7 +8,7 @@ joint, and every violation with its time window and worst value.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -16,10 +16,12 @@ import numpy as np
 from trackplan.derivatives import backward_derivatives
 from trackplan.paths import NominalPath
 from trackplan.planning.result import CheckReport, Violation
+from trackplan.planning.tool_zones import nominal_tangents
 from trackplan.planning.tracking import between_samples, jump_allowance, locate_on_nominal
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
+from trackplan.tool import SpinMode, ToolSpec
 
 if TYPE_CHECKING:
     from trackplan.cell.screening import CellGeometry
@@ -32,6 +34,8 @@ UNITS = {
     "torque": "N·m",
     "tracking": "m",
     "orientation": "rad",
+    "spin": "rad",
+    "spin rate": "rad/m",
     "speed": "m/s",
     "coverage": "m",
     "clearance": "m",
@@ -54,25 +58,30 @@ class TrackingReference:
         The path as the user gave it (:class:`trackplan.paths.NominalPath`), definition frame.
     T_base_part
         Placement of the definition frame, shape (4, 4).
-    R_part_tool
-        Tool orientation in the definition frame, shape (3, 3).
+    tool
+        How the tool is held (:class:`trackplan.tool.ToolSpec`): the tool axis is checked
+        against it at every sample, the spin against its value, range and rate.
     tolerance
         ρ, m.
     rated_speed, corner_speed
         Speed caps on straight pieces and at corners, m/s.
     corner_intervals
         Arc-length intervals of the nominal path where the corner speed applies, shape (K, 2), m.
+    tool_zones
+        Transition zones (:func:`trackplan.planning.tool_zones.transition_zones`), shape
+        (K, 3): nominal arc lengths (m) and the extra tool axis deviation allowed (rad).
     orientation_tolerance
-        Largest tool orientation error, rad.
+        Largest tool axis error, and spin error of a fixed spin, rad.
     """
 
     nominal: NominalPath
     T_base_part: np.ndarray
-    R_part_tool: np.ndarray
+    tool: ToolSpec
     tolerance: float
     rated_speed: float
     corner_speed: float
     corner_intervals: np.ndarray
+    tool_zones: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     orientation_tolerance: float = ORIENTATION_TOLERANCE
 
 
@@ -242,20 +251,6 @@ def _check_task(
     violations: list[Violation] = []
     margins: dict[str, float] = {}
 
-    # tool orientation: angle of R_expected^T R_actual
-    R_expected = ref.T_base_part[:3, :3] @ ref.R_part_tool
-    R_err = np.einsum("ji,njk->nik", R_expected, T_base_tool[:, :3, :3])
-    cos_angle = np.clip((np.trace(R_err, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    orientation_error = np.arccos(cos_angle)
-    margins["orientation"] = float(
-        _met(1.0 - orientation_error.max() / ref.orientation_tolerance, RELATIVE_SLACK)
-    )
-    if margins["orientation"] < 0:
-        use = orientation_error / ref.orientation_tolerance
-        violations.append(
-            _violation("orientation", None, t, orientation_error, use, ref.orientation_tolerance)
-        )
-
     # tracking error and the position along the nominal path, in order of travel
     velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
     s_nominal, distance, piece = locate_on_nominal(ref.nominal, p_part, velocity, ref.tolerance)
@@ -282,6 +277,10 @@ def _check_task(
             violations.append(replace(found, message=message))
     margins["tracking"] = float(_met(1.0 - worst / ref.tolerance, RELATIVE_SLACK))
 
+    R_part_tool = np.einsum("ji,njk->nik", ref.T_base_part[:3, :3], T_base_tool[:, :3, :3])
+    orientation_error, tool_found = _check_tool(ref, R_part_tool, s_nominal, piece, t, margins)
+    violations.extend(tool_found)
+
     # Cartesian speed against the cap that applies where the tool is
     speed = np.linalg.norm(velocity, axis=1)
     in_corner = np.zeros(len(q), dtype=bool)
@@ -307,6 +306,87 @@ def _check_task(
 def violations_of(violations: list[Violation], limit: str) -> list[Violation]:
     """The violations of one limit."""
     return [violation for violation in violations if violation.limit == limit]
+
+
+def _check_tool(
+    ref: TrackingReference,
+    R_part_tool: np.ndarray,
+    s_nominal: np.ndarray,
+    piece: np.ndarray,
+    t: np.ndarray,
+    margins: dict[str, float],
+) -> tuple[np.ndarray, list[Violation]]:
+    """Tool axis against the spec on the nominal path; spin value, range and rate.
+
+    Outside transition zones the tool axis must match the spec to the orientation
+    tolerance; inside, to the tolerance plus the zone's bound. The spin is measured about
+    the actual tool axis from the spec's zero-spin frame, outside transition zones.
+
+    Returns
+    -------
+    tuple
+        The tool axis error per sample (N,), rad, and the violations found.
+    """
+    nominal, spec, tol = ref.nominal, ref.tool, ref.orientation_tolerance
+    R_spec = spec.base_rotations(nominal_tangents(nominal, s_nominal, piece))
+    axis_cos = np.einsum("ni,ni->n", R_spec[:, :, 2], R_part_tool[:, :, 2])
+    axis_error = np.arccos(np.clip(axis_cos, -1.0, 1.0))
+    allowed = np.full(len(t), tol)
+    for s0, s1, bound in np.asarray(ref.tool_zones).reshape(-1, 3):
+        allowed[(s_nominal >= s0) & (s_nominal <= s1)] += bound
+    found: list[Violation] = []
+    use = axis_error / allowed
+    margins["orientation"] = float(_met(1.0 - use.max(), RELATIVE_SLACK))
+    if margins["orientation"] < 0:
+        found.append(_violation("orientation", None, t, axis_error, use, tol))
+
+    outside = allowed == tol
+    if not outside.any():
+        return axis_error, found
+    x_actual = R_part_tool[outside, :, 0]
+    spin = np.unwrap(
+        np.arctan2(
+            np.einsum("ni,ni->n", x_actual, R_spec[outside, :, 1]),
+            np.einsum("ni,ni->n", x_actual, R_spec[outside, :, 0]),
+        )
+    )
+    t_out, s_out, piece_out = t[outside], s_nominal[outside], piece[outside]
+    if spec.spin is SpinMode.FIXED:
+        error = np.abs(np.angle(np.exp(1j * (spin - spec.spin_value))))
+        margins["spin"] = float(_met(1.0 - error.max() / tol, RELATIVE_SLACK))
+        if margins["spin"] < 0:
+            found.append(_violation("spin", None, t_out, spin, error / tol, spec.spin_value))
+        return axis_error, found
+    lo, hi = spec.spin_range
+    spin = spin + 2 * np.pi * np.round((0.5 * (lo + hi) - np.median(spin)) / (2 * np.pi))
+    excess = np.maximum(lo - spin, spin - hi)
+    margins["spin"] = float(_met(-excess.max() / max(hi - lo, tol), RELATIVE_SLACK)) + 0.0
+    if excess.max() > tol:
+        bound = hi if spin.max() > hi else lo
+        found.append(_violation("spin", None, t_out, spin, 1.0 + excess / tol, bound))
+    rate_cap = 0.0 if spec.spin is SpinMode.FREE else spec.spin_rate
+    ds = np.diff(s_out)
+    same = (piece_out[1:] == piece_out[:-1]) & (ds > 0.0)
+    step = np.abs(np.diff(spin))[same]
+    cap = rate_cap * ds[same] + tol * (1.0 if rate_cap == 0.0 else 1e-6)
+    if step.size and np.any(step > cap):
+        rate = step / np.maximum(ds[same], 1e-12)
+        worst = int(np.argmax(step / cap))
+        when = float(t_out[1:][same][worst])
+        found.append(
+            Violation(
+                limit="spin rate",
+                joint=None,
+                t_first=when,
+                t_last=when,
+                worst=float(rate[worst]),
+                bound=rate_cap,
+                message=(
+                    f"spin rate {rate[worst]:.4g} rad/m exceeds {rate_cap:.4g} at t = {when:.3f} s"
+                ),
+            )
+        )
+    return axis_error, found
 
 
 def _coverage_violations(

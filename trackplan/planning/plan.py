@@ -12,17 +12,24 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.cell.screening import CellGeometry
 from trackplan.derivatives import backward_derivatives
-from trackplan.frames import as_placement, placement_transform, rpy_matrix
+from trackplan.frames import as_placement, placement_transform
 from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import TrackingReference, check_trajectory
 from trackplan.planning.energy import energy_figures
 from trackplan.planning.objective import joint_travel
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
+from trackplan.planning.tool_zones import transition_zones
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.timing import TimeLaw, time_law
+from trackplan.tool import (
+    SpinMode,
+    SpinProfile,
+    ToolOrientation,
+    tool_axis_twist,
+)
 
 CELL_KINDS = ("collision", "clearance")
 """Violation kinds of the cell check."""
@@ -33,15 +40,18 @@ def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> Tra
     return TrackingReference(
         nominal=geometry.nominal,
         T_base_part=placement_transform(as_placement(X)),
-        R_part_tool=rpy_matrix(case.task.tool_rpy),
+        tool=case.task.tool,
         tolerance=case.task.tolerance,
         rated_speed=case.task.rated_speed,
         corner_speed=case.task.corner_speed,
         corner_intervals=geometry.corner_intervals(),
+        tool_zones=transition_zones(case.task.tool, geometry, case.task.tolerance),
     )
 
 
-def make_trajectory(robot: Robot, q: np.ndarray, s: np.ndarray, sample_time: float) -> Trajectory:
+def make_trajectory(
+    robot: Robot, q: np.ndarray, s: np.ndarray, sample_time: float, spin: np.ndarray | None = None
+) -> Trajectory:
     """Sampled trajectory with derivatives exactly as the checker computes them.
 
     Parameters
@@ -54,6 +64,8 @@ def make_trajectory(robot: Robot, q: np.ndarray, s: np.ndarray, sample_time: flo
         Arc length on the planned path per sample, shape (N,), m.
     sample_time
         Ts, s.
+    spin
+        Spin about the tool axis per sample, shape (N,), rad; default 0.
     """
     qd, qdd, qddd = backward_derivatives(q, sample_time)
     position = forward_kinematics(robot, q)[:, :3, 3]
@@ -68,6 +80,7 @@ def make_trajectory(robot: Robot, q: np.ndarray, s: np.ndarray, sample_time: flo
         qddd=qddd,
         tool_position=position,
         speed=speed,
+        spin=np.zeros(len(q)) if spin is None else np.asarray(spin, dtype=float),
     )
 
 
@@ -78,6 +91,7 @@ def plan_placement(
     timing: str | None = None,
     branch: int | None = None,
     geometry: PathGeometry | None = None,
+    spin: np.ndarray | SpinProfile | None = None,
 ) -> PlanResult:
     """Plan the case with the workpiece at placement X and check the result.
 
@@ -95,6 +109,11 @@ def plan_placement(
     geometry
         The case's paths when already built in the law's path mode (the optimizer
         shares them).
+    spin
+        Spin variables of the case's tool spec, shape (n_spin,) (:meth:`ToolSpec.profile`),
+        or a given :class:`~trackplan.tool.SpinProfile`; default: the middle of the spin
+        range. To choose them, see
+        :func:`trackplan.search.spin.optimize_spin`.
 
     Returns
     -------
@@ -111,13 +130,31 @@ def plan_placement(
     law = time_law(timing or case.task.timing)
     if geometry is None or geometry.mode != law.path_mode:
         geometry = PathGeometry.from_case(case, law.path_mode)
-    joint_path = JointPath.solve(case.robot, geometry, X, case.task.tool_rpy, branch)
+    tool = ToolOrientation.choose(case.task.tool, geometry, spin)
+    joint_path = JointPath.solve(case.robot, geometry, X, tool, branch)
     if not joint_path.success:
-        return _unplanned(case, joint_path, law.timing, joint_path.status, joint_path.message)
+        message = joint_path.message + _twist_note(joint_path)
+        return _unplanned(case, joint_path, law.timing, joint_path.status, message)
     timed = law.plan(joint_path, case.task)
     if not timed.s.size:
         return _unplanned(case, joint_path, law.timing, timed.status, timed.message)
     return _checked(case, joint_path, timed)
+
+
+def _twist_note(joint_path: JointPath) -> str:
+    """Why a fixed spin may run a joint out of range: the turn of the tool about its axis."""
+    tool = joint_path.tool
+    if tool.spec.spin is not SpinMode.FIXED:
+        return ""
+    twist = tool_axis_twist(joint_path.R_part_tool(np.unique(joint_path.s)))
+    turn = float(twist[-1])
+    if abs(turn) < np.pi:
+        return ""
+    return (
+        f"; with spin: fixed the tool turns {turn:.3f} rad ({turn / (2 * np.pi):.2f} turns) "
+        "about its own axis along the path, and the wrist must follow; spin: free-varying "
+        "lets the spin counter-rotate"
+    )
 
 
 def _unplanned(
@@ -169,7 +206,8 @@ def _unplanned(
 def _checked(case: Case, joint_path: JointPath, timed: TimeLaw) -> PlanResult:
     """Check the sampled trajectory and assemble the result."""
     geometry = joint_path.geometry
-    trajectory = make_trajectory(case.robot, timed.q, timed.s, timed.sample_time)
+    spin = joint_path.tool.spin.value(timed.s)
+    trajectory = make_trajectory(case.robot, timed.q, timed.s, timed.sample_time, spin)
     check = check_trajectory(
         case.robot,
         timed.q,

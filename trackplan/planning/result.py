@@ -37,6 +37,8 @@ class Trajectory:
         Tool point by FK in the base frame, shape (N, 3), m.
     speed
         Cartesian speed of the tool point (backward difference), shape (N,), m/s.
+    spin
+        Spin about the tool axis (``docs/tool.md``), shape (N,), rad.
     """
 
     sample_time: float
@@ -48,6 +50,7 @@ class Trajectory:
     qddd: np.ndarray
     tool_position: np.ndarray
     speed: np.ndarray
+    spin: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n_samples(self) -> int:

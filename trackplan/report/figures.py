@@ -507,6 +507,56 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
     return figure
 
 
+TOOL_FRAMES = 16
+"""Tool frames drawn along the path in ``tool.png``."""
+
+
+def shows_tool(case: Case) -> bool:
+    """Whether a run of this case gets ``tool.png``: a seam frame or a spin not fixed."""
+    tool = case.task.tool
+    return str(tool.frame) == "seam" or str(tool.spin) != "fixed"
+
+
+def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> Figure:
+    """The spin along the path and the tool frames it gives (docs/tool.md).
+
+    Left: spin about the tool axis against the arc length s of the planned path (rad),
+    with the spin range of ``free`` and ``free-varying`` (``gid="spin"``). Right: the placed
+    path with the tool frames at ``n_frames`` samples (x red, y green, z blue — the z axis
+    is the tool axis, the x axis turns with the spin; ``gid="tool-frames"``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A 2D and a 3D axes.
+    """
+    trajectory = result.trajectory
+    tool = case.task.tool
+    figure = _new_figure(13.0, 5.6)
+    ax_spin = figure.add_subplot(1, 2, 1)
+    ax_frames = figure.add_subplot(1, 2, 2, projection="3d")
+    if trajectory.n_samples and len(trajectory.spin) == trajectory.n_samples:
+        ax_spin.plot(trajectory.s, trajectory.spin, color=AFTER_COLOR, lw=1.8, gid="spin")
+    if str(tool.spin) != "fixed":
+        for bound in tool.spin_range:
+            ax_spin.axhline(bound, ls="--", color="0.4", lw=1.0)
+    ax_spin.set_xlabel("s along the planned path [m]")
+    ax_spin.set_ylabel("spin about the tool axis [rad]")
+    ax_spin.set_title(f"spin: {tool.spin}", fontsize=10)
+    ax_spin.grid(alpha=0.3)
+    _, points_base = path_points(result, case)
+    ax_frames.plot(*points_base.T, color=AFTER_COLOR, lw=1.5, gid="tool-path")
+    if trajectory.n_samples:
+        extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
+        idx = frame_indices(trajectory.n_samples, n_frames)
+        T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        _plot_triads(ax_frames, triad_lines(T_tool, 0.06 * extent), "tool-frames", "tool frames")
+    _set_equal(ax_frames, points_base)
+    ax_frames.set_title(f"tool frames ({tool.frame} frame)", fontsize=10)
+    figure.suptitle(_status_line(result), fontsize=10)
+    return figure
+
+
 def plot_figures(
     result: PlanResult, case: Case, history: Mapping[str, Mapping[str, np.ndarray]] | None = None
 ) -> dict[str, Callable[[], Figure]]:
@@ -520,6 +570,8 @@ def plot_figures(
         from trackplan.report.cell_figures import clearance_figure
 
         builders["clearance.png"] = lambda: clearance_figure(result)
+    if shows_tool(case):
+        builders["tool.png"] = lambda: tool_figure(result, case)
     if history:
         builders["convergence.png"] = lambda: convergence_figure(history)
     return builders
@@ -531,7 +583,7 @@ def write_plots(
     out_dir: Path,
     history: Mapping[str, Mapping[str, np.ndarray]] | None = None,
 ) -> list[Path]:
-    """Write ``joints.png``, ``path.png``, ``speed.png`` (and ``convergence.png``).
+    """Write ``joints.png``, ``path.png``, ``speed.png`` (``tool.png``, ``convergence.png``).
 
     Parameters
     ----------
@@ -543,7 +595,8 @@ def write_plots(
         Directory to write into (created when missing).
     history
         Optimizer history per method (see :func:`convergence_figure`); when given,
-        ``convergence.png`` is written too.
+        ``convergence.png`` is written too. ``tool.png`` is written for a seam frame or a
+        spin that is not fixed (:func:`shows_tool`).
 
     Returns
     -------

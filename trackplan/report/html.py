@@ -54,6 +54,12 @@ _PLOT_CAPTIONS = {
         "workpiece, non-adjacent links) at each sample, against the required clearance; the "
         "closest approach is marked with the pair it occurs between.",
     ),
+    "tool.png": (
+        "Tool orientation",
+        "Left: the spin about the tool axis along the planned path, with the spin range when "
+        "the spin is free. Right: tool frames along the placed path (x red, y green, z blue; "
+        "z is the tool axis).",
+    ),
     "convergence.png": (
         "Placement search",
         "Best and mean fitness and the share of feasible candidates per generation, placed at "
@@ -219,7 +225,7 @@ def _case_section(result: PlanResult, case: Case) -> str:
             ("corner speed cap v_t^max", _num(task.corner_speed, scale=1e3, unit="mm/s")),
             ("tolerance ρ", _num(task.tolerance, scale=1e3, unit="mm")),
             ("sample time Ts", _num(task.sample_time, scale=1e3, unit="ms")),
-            ("tool orientation (roll, pitch, yaw)", f"{_vector(task.tool_rpy)} rad"),
+            ("tool orientation", _tool_text(task.tool)),
             ("time law", _esc(task.timing)),
         ]
     )
@@ -552,3 +558,15 @@ def write_report(
     path = out_dir / REPORT_FILE
     path.write_text(page, encoding="utf-8")
     return path
+
+
+def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]
+    """The tool spec in one line (docs/tool.md)."""
+    if str(tool.frame) == "part":
+        where = f"part frame, roll/pitch/yaw {_vector(tool.rpy)} rad"
+    else:
+        where = (
+            f"seam frame, normal {_vector(tool.normal)}, work {tool.work_angle:.4g} rad, "
+            f"travel {tool.travel_angle:.4g} rad"
+        )
+    return f"{where}; spin {tool.spin}"

@@ -66,6 +66,7 @@ from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.search.space import SearchSpace
 from trackplan.timing import time_law
+from trackplan.tool import ToolOrientation, spin_rotations, spin_values
 
 SCREEN_POSES = 150
 """Target number of poses of the screening grid along the planned path."""
@@ -110,7 +111,8 @@ class Screening:
     Attributes
     ----------
     X
-        Placements, shape (B, 6), metres and radians.
+        Variables, shape (B, 6 + k): placements (metres and radians), then the k spin
+        variables of the tool (:meth:`trackplan.tool.ToolSpec.spin_coefficients`).
     fitness
         Eq. 30 as above, shape (B,).
     objective
@@ -160,9 +162,10 @@ def screening_grid(geometry: PathGeometry, n_poses: int = SCREEN_POSES) -> np.nd
 def plan_candidate(
     args: tuple[Case, np.ndarray, str, int, PathGeometry],
 ) -> PlanResult:
-    """:func:`plan_placement` of one ``(case, X, timing, branch, geometry)`` (for executors)."""
+    """:func:`plan_placement` of one ``(case, X, timing, branch, geometry)`` (for executors);
+    X holds the placement, then the spin variables."""
     case, X, timing, branch, geometry = args
-    return plan_placement(case, X, timing=timing, branch=branch, geometry=geometry)
+    return plan_placement(case, X[:6], timing=timing, branch=branch, geometry=geometry, spin=X[6:])
 
 
 @dataclass(frozen=True, eq=False)
@@ -231,7 +234,11 @@ class PlacementFitness:
         self.timing = timing
         self.law = time_law(timing)
         self.s_grid = screening_grid(geometry, n_poses)
-        self.points = geometry.planned.sample(self.s_grid).position
+        sample = geometry.planned.sample(self.s_grid)
+        self.points = sample.position
+        self.R_base = ToolOrientation.choose(case.task.tool, geometry).base_rotations(
+            self.s_grid, sample.tangent
+        )  # (M, 3, 3), zero spin
         self.weights = np.asarray(case.objective.weights, dtype=float)
         self.flat = case.objective.penalty == Penalty.FLAT
         self.penalty = float(case.objective.flat_penalty)
@@ -250,7 +257,8 @@ class PlacementFitness:
         Parameters
         ----------
         X
-            Placements, shape (B, 6), metres and radians.
+            Variables, shape (B, 6 + k): placements, metres and radians, then spin (or
+            (B, 6): the spin in the middle of its range).
         incumbent
             Best fitness found so far: with ``time_weight > 0`` a feasible candidate is
             timed only when ``J + time_weight · T_low`` (its lowest possible fitness)
@@ -262,6 +270,9 @@ class PlacementFitness:
         Screening
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
+        tool = self.case.task.tool
+        if X.shape[1] == 6 and tool.n_spin:  # placements alone: the middle of the spin range
+            X = np.hstack([X, np.tile(tool.default_variables(), (len(X), 1))])
         n = len(X)
         fitness = np.full(n, np.nan)
         objective = np.full(n, np.nan)
@@ -296,13 +307,13 @@ class PlacementFitness:
         Parameters
         ----------
         X
-            Placements, shape (B, 6).
+            Variables, shape (B, 6 + k).
 
         Returns
         -------
         BranchScreen
         """
-        poses = tool_poses(X, self.points, self.case.task.tool_rpy)
+        poses = tool_poses(X[:, :6], self.points, self.rotations(X[:, 6:]))
         paths = solve_path_ik_branches(self.case.robot, poses)
         n_poses = len(self.s_grid)
         with np.errstate(invalid="ignore"):
@@ -350,7 +361,7 @@ class PlacementFitness:
         Parameters
         ----------
         X
-            Placements, shape (B, 6).
+            Variables, shape (B, 6 + k).
         objectives
             One or more objectives; the first chooses the branch.
 
@@ -365,7 +376,7 @@ class PlacementFitness:
         violation = branches.violation
         finding = branches.finding
         if self.cell is not None:
-            first, violation = self._screen_cell(X, branches.grid.q, values[0], violation)
+            first, violation = self._screen_cell(X[:, :6], branches.grid.q, values[0], violation)
             blocked = np.isinf(first) & branches.ok
             values = [np.where(blocked, np.inf, v) for v in values]
             finding = np.where(blocked, int(Finding.COLLISION), finding)
@@ -451,6 +462,15 @@ class PlacementFitness:
             pending[todo, best[todo]] = False
             # a candidate with a clear branch is done
             pending[todo[~blocked]] = False
+
+    def rotations(self, spin: np.ndarray) -> np.ndarray:
+        """``R_part_tool`` on the screening grid for spin variables (B, k), (B, M, 3, 3)."""
+        tool = self.case.task.tool
+        if not tool.n_spin:
+            return self.R_base
+        length = self.geometry.planned.length
+        coefficients = tool.spin_coefficients(spin, length)
+        return spin_rotations(self.R_base, spin_values(coefficients, self.s_grid, length))
 
     def _time(
         self,

@@ -279,10 +279,12 @@ def optimize_placement(
         runs += 1
         if stop_reason in ("budget", "interrupted"):
             break
-    initial = plan_placement(case, space.anchor, timing=timing, geometry=geometry)
+    initial = plan_placement(
+        case, space.anchor[:6], timing=timing, geometry=geometry, spin=space.anchor[6:]
+    )
     final, rejected = _final_plan(case, problem, timing, geometry)
     archive = problem.archive
-    chosen = int(np.flatnonzero(np.all(archive.X == final.placement, axis=1))[0])
+    chosen = int(np.flatnonzero(np.all(archive.X[:, :6] == final.placement, axis=1))[0])
     if stop_reason == "interrupted":
         status = Status.INTERRUPTED
     else:
@@ -390,12 +392,14 @@ def _final_plan(
     for X, feasible, branch in zip(archive.X, archive.feasible, archive.branch, strict=True):
         if first is not None and not feasible:
             break
-        plan = plan_placement(case, X, timing=timing, branch=int(branch), geometry=geometry)
+        plan = plan_placement(
+            case, X[:6], timing=timing, branch=int(branch), geometry=geometry, spin=X[6:]
+        )
         if plan.feasible:
             return plan, rejected
         first = first or plan
         if feasible:
-            rejected.append(X)
+            rejected.append(X[:6])
     if first is None:
         raise CaseError("the search evaluated no placement (budget 0?)", key="budget")
     return first, rejected

@@ -1,6 +1,7 @@
 """The placement search as a pymoo Problem: vectorised evaluation and a record of the best.
 
-Every optimiser (GA, CMA-ES, DE, random) sees the same problem: six bounded variables
+Every optimiser (GA, CMA-ES, DE, random) sees the same problem: six bounded placement
+variables, plus the tool's spin variables when the spin is free (:mod:`trackplan.tool`),
 and one objective, the fitness of Eq. 30 (:mod:`trackplan.search.fitness`). The whole
 population is evaluated in one call. The problem also keeps what the search needs
 whatever the algorithm does with its population: the number of evaluations, the best
@@ -16,7 +17,7 @@ import numpy as np
 from pymoo.core.problem import Problem
 
 from trackplan.search.fitness import PlacementFitness, Screening
-from trackplan.search.space import N_VAR, SearchSpace
+from trackplan.search.space import SearchSpace
 
 ARCHIVE_SIZE = 8
 """Distinct candidates kept for the final re-check."""
@@ -31,7 +32,7 @@ class Archive:
     Attributes
     ----------
     X
-        Placements, shape (K, 6).
+        Variables (placement, then spin), shape (K, 6 + k).
     fitness
         Shape (K,).
     objective
@@ -49,10 +50,10 @@ class Archive:
     branch: np.ndarray
 
     @classmethod
-    def empty(cls) -> Archive:
-        """An archive with no candidate."""
+    def empty(cls, n_var: int) -> Archive:
+        """An archive with no candidate of ``n_var`` variables."""
         return cls(
-            np.zeros((0, N_VAR)), np.zeros(0), np.zeros(0), np.zeros(0, bool), np.zeros(0, int)
+            np.zeros((0, n_var)), np.zeros(0), np.zeros(0), np.zeros(0, bool), np.zeros(0, int)
         )
 
     def merged(self, screening: Screening, span: np.ndarray, size: int = ARCHIVE_SIZE) -> Archive:
@@ -63,7 +64,7 @@ class Archive:
         screening
             The batch.
         span
-            Ranges of the variables, shape (6,), for the distinctness test.
+            Ranges of the variables, shape (6 + k,), for the distinctness test.
         size
             Largest number of candidates kept.
         """
@@ -84,7 +85,7 @@ class Archive:
 
 
 class PlacementProblem(Problem):
-    """Six bounded variables X = (x, y, z, roll, pitch, yaw), one objective: Eq. 30.
+    """Bounded variables X = (x, y, z, roll, pitch, yaw, spin...), one objective: Eq. 30.
 
     Parameters
     ----------
@@ -104,11 +105,11 @@ class PlacementProblem(Problem):
     """
 
     def __init__(self, space: SearchSpace, fitness: PlacementFitness):
-        super().__init__(n_var=N_VAR, n_obj=1, xl=space.lower, xu=space.upper, vtype=float)
+        super().__init__(n_var=space.n_var, n_obj=1, xl=space.lower, xu=space.upper, vtype=float)
         self.space = space
         self.fitness = fitness
         self.n_evaluations = 0
-        self.archive = Archive.empty()
+        self.archive = Archive.empty(space.n_var)
         self.last: Screening | None = None
 
     @property
@@ -117,7 +118,7 @@ class PlacementProblem(Problem):
         return float(self.archive.fitness[0]) if len(self.archive.fitness) else np.inf
 
     def _evaluate(self, x: np.ndarray, out: dict, *args: object, **kwargs: object) -> None:
-        """Evaluate a batch, shape (B, 6), into ``out["F"]`` (B, 1)."""
+        """Evaluate a batch, shape (B, 6 + k), into ``out["F"]`` (B, 1)."""
         screening = self.fitness.evaluate(x, incumbent=self.best_fitness)
         self.n_evaluations += len(screening.X)
         self.archive = self.archive.merged(screening, self.space.span)

@@ -16,7 +16,7 @@ from trackplan.case import PLACEMENT_KEYS, Case, PlacementBounds
 from trackplan.errors import CaseError
 
 N_VAR = 6
-"""Number of placement variables."""
+"""Number of placement variables (the spin variables of the tool follow them)."""
 
 _REJECTION_ROUNDS = 200
 """Batches of rejection sampling before the remaining samples are repaired instead."""
@@ -61,6 +61,10 @@ class SearchSpace:
     anchor
         An admissible placement (the one nearest the box centre), shape (6,): the start of
         the "before" plan and the fallback target of :meth:`repair`.
+
+    With a ``free`` or ``free-varying`` tool spin (:class:`trackplan.tool.ToolSpec`) the
+    vectors hold 6 + k variables: the placement, then the k spin variables
+    (:meth:`ToolSpec.spin_bounds`), which only the box bounds.
     """
 
     lower: np.ndarray
@@ -78,7 +82,7 @@ class SearchSpace:
             When no point of the box satisfies the reach constraint (checked analytically:
             the box's nearest and farthest points from the origin against the interval).
         """
-        lower = np.asarray(bounds.lower, dtype=float)
+        lower = np.asarray(bounds.lower, dtype=float)  # placement only: 6 ranges
         upper = np.asarray(bounds.upper, dtype=float)
         r_min, r_max = (float(r) for r in bounds.reach)
         if lower.shape != (N_VAR,) or upper.shape != (N_VAR,) or np.any(lower > upper):
@@ -103,8 +107,24 @@ class SearchSpace:
 
     @classmethod
     def from_case(cls, case: Case) -> SearchSpace:
-        """The search space of a case (see :meth:`from_bounds`)."""
-        return cls.from_bounds(case.bounds, case.source)
+        """The search space of a case: placement (see :meth:`from_bounds`) and tool spin."""
+        space = cls.from_bounds(case.bounds, case.source)
+        tool = case.task.tool
+        if not tool.n_spin:
+            return space
+        lower, upper = tool.spin_bounds()
+        anchor = np.concatenate([space.anchor, tool.default_variables()])
+        return cls(
+            np.concatenate([space.lower, lower]),
+            np.concatenate([space.upper, upper]),
+            space.reach,
+            anchor,
+        )
+
+    @property
+    def n_var(self) -> int:
+        """Number of variables: 6, plus the tool's spin variables."""
+        return len(self.lower)
 
     @property
     def span(self) -> np.ndarray:
@@ -158,12 +178,14 @@ class SearchSpace:
         for _ in range(_REJECTION_ROUNDS):
             if count >= n:
                 break
-            X = rng.uniform(self.lower, self.upper, size=(batch, N_VAR))
+            X = rng.uniform(self.lower, self.upper, size=(batch, self.n_var))
             X = X[self.reach_excess(X) == 0.0]
             kept.append(X)
             count += len(X)
         if count < n:
-            kept.append(self.repair(rng.uniform(self.lower, self.upper, size=(n - count, N_VAR))))
+            kept.append(
+                self.repair(rng.uniform(self.lower, self.upper, size=(n - count, self.n_var)))
+            )
         return np.concatenate(kept)[:n]
 
     def repair(self, X: np.ndarray) -> np.ndarray:

@@ -49,7 +49,7 @@ import numpy as np
 
 from trackplan.case import Task
 from trackplan.choices import Timing
-from trackplan.frames import placement_transform, tool_poses
+from trackplan.frames import placement_transform
 from trackplan.jointpath import JointPath
 from trackplan.paths.geometry import unwrap_closed_arc
 from trackplan.robots.kinematics import forward_kinematics, jacobian
@@ -117,9 +117,7 @@ def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimeLaw:
         off the branch).
     """
     robot = joint_path.robot
-    planner = _PaperPlanner(
-        robot, task, joint_path.geometry.planned, joint_path.placement, joint_path.branch
-    )
+    planner = _PaperPlanner(robot, task, joint_path)
     try:
         q, s = planner.run(joint_path.q[0])
     except _PlanStop as stop:
@@ -138,16 +136,18 @@ def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimeLaw:
 class _PaperPlanner:
     """Walks the pieces of the planned path and appends their samples."""
 
-    def __init__(self, robot: Robot, task: Task, path, X: np.ndarray, branch: int) -> None:  # type: ignore[no-untyped-def]
+    def __init__(self, robot: Robot, task: Task, joint_path: JointPath) -> None:
         self.robot = robot
         self.task = task
-        self.path = path
+        self.joint_path = joint_path
+        self.path = joint_path.geometry.planned
+        X = joint_path.placement
         self.X = X
-        self.branch = branch
+        self.branch = joint_path.branch
         self.Ts = task.sample_time
         self.T_base_part = placement_transform(X)
-        self.pieces = tuple(path.pieces)
-        stops = np.asarray(list(path.stops), dtype=float)
+        self.pieces = tuple(self.path.pieces)
+        stops = np.asarray(list(self.path.stops), dtype=float)
         self.rest_at = [
             bool(np.any(np.abs(stops - piece.s_start) <= 1e-9)) for piece in self.pieces
         ]  # speed zero at the start of piece k
@@ -193,12 +193,10 @@ class _PaperPlanner:
             raise _PlanStop(Status.UNREACHABLE, "resolved-rate IK diverged (singularity)")
         return q, self._arc_lengths(q, np.concatenate(owner))
 
-    def _poses(self, positions: np.ndarray) -> np.ndarray:
-        return tool_poses(self.X, positions, self.task.tool_rpy)
-
-    def _resolved_rate(self, positions: np.ndarray, q0: np.ndarray) -> np.ndarray:
-        """Eq. 19–27 from q0 through the poses at ``positions`` (M, 3); row 0 is q0."""
-        q = np.asarray(solve_path_resolved_rate(self.robot, self._poses(positions), q0))
+    def _resolved_rate(self, s: np.ndarray, q0: np.ndarray) -> np.ndarray:
+        """Eq. 19–27 from q0 through the poses at arc lengths ``s`` (M,); row 0 is q0."""
+        poses = self.joint_path.poses(np.clip(s, 0.0, self.path.length))
+        q = np.asarray(solve_path_resolved_rate(self.robot, poses, q0))
         q = q.copy()
         q[0] = q0
         return q
@@ -209,7 +207,7 @@ class _PaperPlanner:
         steps = self._arc_steps(k)
         s = piece.s_start + np.linspace(0.0, piece.length, steps + 1)
         s[-1] = min(s[-1], self.path.length)
-        return self._resolved_rate(self.path.sample(s).position, q0)
+        return self._resolved_rate(s, q0)
 
     def _line(self, k: int, q_near: np.ndarray) -> np.ndarray:
         """Forward, middle and reverse pieces of line k (Eq. 13–18), from P1 to P2."""
@@ -217,7 +215,6 @@ class _PaperPlanner:
         fine = self._via_points(piece, MIN_VIA_SPACING, q_near)[1]
         spacing = self.via_spacing(fine, piece.length / (len(fine) - 1))
         sample, q_via = self._via_points(piece, spacing, q_near)
-        positions = sample.position
         direction = self.T_base_part[:3, :3] @ sample.tangent[0]
         v_start = self._junction_speed(k)
         v_end = self._junction_speed(k + 1)
@@ -232,7 +229,7 @@ class _PaperPlanner:
         if j_forward < j_reverse and forward.reached is not None and backward.reached is not None:
             head = forward.samples[: forward.via_sample[j_forward] + 1]
             tail = backward.samples[: backward.via_sample[last - j_reverse] + 1][::-1]
-            middle = self._middle(positions[j_forward], positions[j_reverse], head[-1])
+            middle = self._middle(sample.s[j_forward], sample.s[j_reverse], head[-1])
             return np.concatenate([head, middle[1:-1], tail])
         j_meet = self._meeting_via(forward, backward, last)
         head = forward.samples[: forward.via_sample[j_meet] + 1]
@@ -245,7 +242,7 @@ class _PaperPlanner:
         s_via = piece.s_start + np.linspace(0.0, piece.length, n_steps + 1)
         s_via[-1] = min(s_via[-1], self.path.length)
         sample = self.path.sample(s_via)
-        return sample, self._via_ik(sample.position, q_near)
+        return sample, self._via_ik(sample.s, q_near)
 
     def via_spacing(self, q_fine: np.ndarray, step: float) -> float:
         """Via spacing h of a line whose joint path is sampled every ``step`` m, m.
@@ -272,16 +269,17 @@ class _PaperPlanner:
                 return j
         return min(n_forward - 1, last) if n_forward - 1 >= first_reverse else first_reverse
 
-    def _middle(self, p_from: np.ndarray, p_to: np.ndarray, q0: np.ndarray) -> np.ndarray:
+    def _middle(self, s_from: float, s_to: float, q0: np.ndarray) -> np.ndarray:
         """Eq. 18 at (at most) v_r in equal steps, by resolved-rate IK, shape (N + 1, n)."""
-        length = float(np.linalg.norm(p_to - p_from))
+        length = float(s_to - s_from)
         steps = max(1, int(np.ceil(length / (self.task.rated_speed * self.Ts) - 1e-9)))
-        fraction = np.linspace(0.0, 1.0, steps + 1)[:, None]
-        return self._resolved_rate(p_from + fraction * (p_to - p_from), q0)
+        return self._resolved_rate(np.linspace(s_from, s_to, steps + 1), q0)
 
-    def _via_ik(self, positions: np.ndarray, q_near: np.ndarray) -> np.ndarray:
-        """Closed-form IK of the via poses on the branch, continuous with ``q_near``."""
-        result = solve_path_ik(self.robot, self._poses(positions)[None], branch=self.branch)
+    def _via_ik(self, s: np.ndarray, q_near: np.ndarray) -> np.ndarray:
+        """Closed-form IK of the via poses at arc lengths ``s`` on the branch, continuous
+        with ``q_near``."""
+        poses = self.joint_path.poses(s)
+        result = solve_path_ik(self.robot, poses[None], branch=self.branch)
         if not result.success[0]:
             raise _PlanStop(result.status[0], str(result.message[0]))
         q = result.q[0]

@@ -1,0 +1,152 @@
+"""The ``task.tool`` key of case files: schema, value checks and the :class:`ToolSpec` it gives.
+
+``task.tool_rpy: [r, p, y]`` stays an alias of ``task.tool: {frame: part, rpy: [r, p, y]}``;
+giving both is an error. The keys and conventions are in ``docs/tool.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from trackplan.errors import CaseError
+from trackplan.io.yaml_input import (
+    Loc,
+    Problem,
+    Range,
+    StrictModel,
+    Vec3,
+    list_default,
+    parse_yaml,
+    read_text,
+    show,
+)
+from trackplan.paths.nominal import NominalPath
+from trackplan.tool import (
+    DEFAULT_SPIN_RATE,
+    SpinMode,
+    SpinProfile,
+    ToolFrame,
+    ToolSpec,
+    seam_problems,
+)
+
+
+class ToolModel(StrictModel):
+    """``task.tool``: frame, normal, work and travel angles (rad), spin (rad, rad/m)."""
+
+    frame: Literal["part", "seam"] = "part"
+    rpy: Vec3 | None = None
+    normal: Vec3 | None = None
+    work_angle: float = 0.0
+    travel_angle: float = 0.0
+    spin: Literal["fixed", "free", "free-varying"] = "fixed"
+    spin_value: float = 0.0
+    spin_range: Range = list_default(-math.pi, math.pi)
+    spin_rate: float = DEFAULT_SPIN_RATE
+
+
+def tool_problems(
+    tool: ToolModel | None, tool_rpy: list[float] | None, nominal: NominalPath | None
+) -> list[Problem]:
+    """Bad values of ``task.tool`` (and its alias), located in the file.
+
+    Parameters
+    ----------
+    tool, tool_rpy
+        The validated ``task.tool`` and ``task.tool_rpy`` keys, either may be absent.
+    nominal
+        The case's nominal path (for the seam frame along it), None when the path is bad.
+    """
+    at: Loc = ("task", "tool")
+    if tool is not None and tool_rpy is not None:
+        return [
+            (
+                ("task", "tool_rpy"),
+                "give the tool orientation once: task.tool_rpy is the old spelling of "
+                "task.tool {frame: part, rpy: ...}; remove one of the two",
+            )
+        ]
+    if tool is None:
+        return []
+    problems: list[Problem] = []
+    if tool.frame == "seam":
+        if tool.normal is None:
+            problems.append(((*at, "frame"), "frame: seam needs task.tool.normal [x, y, z]"))
+        elif math.hypot(*tool.normal) == 0.0:
+            problems.append(
+                ((*at, "normal"), f"expected a nonzero surface normal, got {show(tool.normal)}")
+            )
+        elif nominal is not None:
+            problems += [((*at, "normal"), text) for text in seam_problems(as_spec(tool), nominal)]
+        if tool.rpy is not None:
+            problems.append(((*at, "rpy"), "rpy applies to frame: part; remove it or the frame"))
+    elif tool.normal is not None:
+        problems.append(((*at, "normal"), "normal applies to frame: seam; remove it or set it"))
+    low, high = tool.spin_range
+    if low > high:
+        problems.append(
+            (
+                (*at, "spin_range"),
+                f"expected [min, max] with min ≤ max, rad, got {show([low, high])}",
+            )
+        )
+    if not tool.spin_rate > 0.0:
+        problems.append(
+            ((*at, "spin_rate"), f"expected a rate > 0, rad/m of path, got {show(tool.spin_rate)}")
+        )
+    return problems
+
+
+def as_spec(tool: ToolModel | None, tool_rpy: list[float] | None = None) -> ToolSpec:
+    """The :class:`ToolSpec` of checked keys (the paper's tool when neither is given)."""
+    if tool is None:
+        return ToolSpec.part(np.array(tool_rpy if tool_rpy is not None else [0.0, 0.0, 0.0]))
+    return ToolSpec(
+        frame=ToolFrame(tool.frame),
+        rpy=np.array(tool.rpy if tool.rpy is not None else [0.0, 0.0, 0.0], dtype=float),
+        normal=None if tool.normal is None else np.array(tool.normal, dtype=float),
+        work_angle=tool.work_angle,
+        travel_angle=tool.travel_angle,
+        spin=SpinMode(tool.spin),
+        spin_value=tool.spin_value,
+        spin_range=(tool.spin_range[0], tool.spin_range[1]),
+        spin_rate=tool.spin_rate,
+    )
+
+
+def load_spin_profile(file: str | Path) -> SpinProfile:
+    """Read a spin profile: ``{value: v}`` or ``{coefficients: [...]}`` in YAML or JSON, rad.
+
+    A ``result.json`` of a run is accepted too (its ``spin`` entry). The coefficients are
+    those of a clamped cubic B-spline on uniform knots over the planned path
+    (``docs/tool.md``); the path length is the case's.
+
+    Raises
+    ------
+    CaseError
+        When the file is unreadable or holds neither a value nor coefficients.
+    """
+    text = read_text(file, what="spin profile")
+    data = parse_yaml(text, str(file))
+    if isinstance(data, dict) and isinstance(data.get("spin"), dict):
+        data = data["spin"]
+    if isinstance(data, dict) and "value" in data:
+        values = [data["value"]]
+    elif isinstance(data, dict) and "coefficients" in data:
+        values = data["coefficients"]
+    else:
+        raise CaseError(
+            "expected {value: rad} or {coefficients: [rad, ...]} (or a result.json)",
+            file=str(file),
+        )
+    try:
+        coefficients = np.array(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise CaseError(f"expected numbers, got {show(values)}", file=str(file)) from None
+    if not coefficients.size or not np.all(np.isfinite(coefficients)):
+        raise CaseError(f"expected finite numbers, got {show(values)}", file=str(file))
+    return SpinProfile(coefficients, 0.0)
