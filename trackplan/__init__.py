@@ -95,6 +95,8 @@ except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
 
 _EXPORTS = {
+    "optimize_spin": "trackplan.search.spin",
+    "ToolSpec": "trackplan.tool",
     "placement_map": "trackplan.search.placement_map",
     "PlacementMap": "trackplan.search.placement_map",
     "CellReport": "trackplan.planning.result",
