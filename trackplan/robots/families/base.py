@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -97,3 +98,67 @@ class IKFamily(Protocol):
             Shape (N, 8, :data:`AUX_SIZE`): the branch-defining quantities, NaN out of reach.
         """
         ...
+
+
+CHUNK = 2048
+"""Poses per pass of a closed-form solver: its scratch stays in the L2 cache."""
+
+
+def solve_in_chunks(
+    arguments: Callable[..., None],
+    assemble: Callable[..., None],
+    n_angles: int,
+    geometry: np.ndarray,
+    tail_inv: np.ndarray,
+    T_base_tool: np.ndarray,
+    with_aux: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Run a closed-form family's compiled kernels over poses, :data:`CHUNK` at a time.
+
+    A family's solver is two kernels around one vectorised ``arctan2``: ``arguments``
+    writes the sine and cosine arguments of every angle of every branch (and the validity
+    flags and branch quantities), ``assemble`` turns the angles into joint values.
+
+    Parameters
+    ----------
+    arguments, assemble
+        The family's kernels (``opw_*`` or ``ur_*`` of ``families/_kernels.py``).
+    n_angles
+        Angles the arguments kernel writes per pose.
+    geometry, tail_inv
+        The family's parameter array and the inverse of its tool transform, as the
+        kernels take them.
+    T_base_tool
+        Tool poses, shape (N, 4, 4), m.
+    with_aux
+        False skips the branch quantities (aux is then (1, 8, AUX_SIZE) scratch).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        q (N, 8, 6) rad, valid (N, 8) bool, aux (N, 8, AUX_SIZE).
+    """
+    T = np.ascontiguousarray(T_base_tool, dtype=float)
+    n_poses = T.shape[0]
+    q = np.empty((n_poses, N_BRANCHES, 6))
+    valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
+    aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
+    size = min(CHUNK, n_poses)
+    Y = np.zeros((size, n_angles))  # slots a pose leaves unset stay finite
+    X = np.ones((size, n_angles))
+    angles = np.empty((size, n_angles))
+    for start in range(0, n_poses, CHUNK):
+        stop = min(start + CHUNK, n_poses)
+        m = stop - start
+        arguments(
+            geometry,
+            tail_inv,
+            T[start:stop],
+            Y[:m],
+            X[:m],
+            valid[start:stop],
+            aux[start:stop] if with_aux else aux,
+        )
+        np.arctan2(Y[:m], X[:m], out=angles[:m])
+        assemble(geometry, angles[:m], valid[start:stop], q[start:stop])
+    return q, valid, aux

@@ -31,12 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.robots.families import _kernels as kern
-from trackplan.robots.families.base import AUX_SIZE, N_BRANCHES, describe_bits
+from trackplan.robots.families.base import describe_bits, solve_in_chunks
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
 
 _PARALLEL_TOL = 1e-9  # |sin| of the angle between axes that counts as parallel/perpendicular
-_CHUNK = 2048  # poses per pass: the scratch stays in the L2 cache
 _N_CHECK = 64  # random configurations the derived model must reproduce
 _CHECK_TOL = 1e-9  # m (and rad, relative to the reach)
 
@@ -302,27 +301,12 @@ class OPWFamily:
 
         ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
         """
-        T = np.ascontiguousarray(T_base_tool, dtype=float)
-        n_poses = T.shape[0]
-        q = np.empty((n_poses, N_BRANCHES, 6))
-        valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
-        aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
-        size = min(_CHUNK, n_poses)
-        Y = np.zeros((size, kern.O_N_ANGLES))  # slots a pose leaves unset stay finite
-        X = np.ones((size, kern.O_N_ANGLES))
-        angles = np.empty((size, kern.O_N_ANGLES))
-        for start in range(0, n_poses, _CHUNK):
-            stop = min(start + _CHUNK, n_poses)
-            m = stop - start
-            kern.opw_arguments(
-                self._geometry,
-                self._tail_inv,
-                T[start:stop],
-                Y[:m],
-                X[:m],
-                valid[start:stop],
-                aux[start:stop] if with_aux else aux,
-            )
-            np.arctan2(Y[:m], X[:m], out=angles[:m])
-            kern.opw_assemble(self._geometry, angles[:m], valid[start:stop], q[start:stop])
-        return q, valid, aux
+        return solve_in_chunks(
+            kern.opw_arguments,
+            kern.opw_assemble,
+            kern.O_N_ANGLES,
+            self._geometry,
+            self._tail_inv,
+            T_base_tool,
+            with_aux,
+        )

@@ -22,12 +22,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from trackplan.robots.families import _kernels as kern
-from trackplan.robots.families.base import AUX_SIZE, N_BRANCHES, branch_bits
+from trackplan.robots.families.base import branch_bits, solve_in_chunks
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
 _PARALLEL_TOL = 1e-9
-_CHUNK = 2048
 _N_CHECK = 64
 _CHECK_TOL = 1e-9
 UR_ALPHA = (np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0)
@@ -264,27 +263,12 @@ class URFamily:
 
         ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
         """
-        T = np.ascontiguousarray(T_base_tool, dtype=float)
-        n_poses = T.shape[0]
-        q = np.empty((n_poses, N_BRANCHES, 6))
-        valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
-        aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
-        size = min(_CHUNK, n_poses)
-        Y = np.zeros((size, kern.U_N_ANGLES))  # slots a pose leaves unset stay finite
-        X = np.ones((size, kern.U_N_ANGLES))
-        angles = np.empty((size, kern.U_N_ANGLES))
-        for start in range(0, n_poses, _CHUNK):
-            stop = min(start + _CHUNK, n_poses)
-            m = stop - start
-            kern.ur_arguments(
-                self._geometry,
-                self._tail_inv,
-                T[start:stop],
-                Y[:m],
-                X[:m],
-                valid[start:stop],
-                aux[start:stop] if with_aux else aux,
-            )
-            np.arctan2(Y[:m], X[:m], out=angles[:m])
-            kern.ur_assemble(self._geometry, angles[:m], valid[start:stop], q[start:stop])
-        return q, valid, aux
+        return solve_in_chunks(
+            kern.ur_arguments,
+            kern.ur_assemble,
+            kern.U_N_ANGLES,
+            self._geometry,
+            self._tail_inv,
+            T_base_tool,
+            with_aux,
+        )
