@@ -325,7 +325,8 @@ class PlacementFitness:
         ok = paths.success
         too_heavy = np.zeros_like(ok)
         if self.case.robot.dynamics is not None:
-            holding = holding_torque_ratio(self.case.robot, paths.q)  # (B, K)
+            holding = np.zeros(ok.shape)  # (B, K): only usable branches can be too heavy
+            holding[ok] = holding_torque_ratio(self.case.robot, paths.q[ok])
             too_heavy = ok & (holding > 1.0)
             ok = ok & ~too_heavy
             graded = np.where(too_heavy, GEOMETRY_LEVEL + np.minimum(1.0, holding - 1.0), graded)
