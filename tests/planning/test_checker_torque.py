@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from tests.oracles import rtb_robot_from
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
@@ -24,28 +25,6 @@ def payload_case():
     return load_case(CASES / "puma-payload.yaml")
 
 
-def rtb_puma(robot):
-    """roboticstoolbox DH robot with our table and the Corke/Armstrong link dynamics."""
-    ref = rtb.models.DH.Puma560()
-    return rtb.DHRobot(
-        [
-            rtb.RevoluteDH(
-                d=robot.dh[i, 0],
-                a=robot.dh[i, 1],
-                alpha=robot.dh[i, 2],
-                m=link.m,
-                r=link.r,
-                I=link.I,
-                Jm=link.Jm,
-                G=link.G,
-                B=link.B,
-                Tc=link.Tc,
-            )
-            for i, link in enumerate(ref.links)
-        ]
-    )
-
-
 def test_torque_margins_from_backward_differences(corner_case, corner_plan):
     """Margins are 1 - max|τ|/τmax with τ from rtb's rne on np.diff derivatives, robot at
     rest before and after."""
@@ -54,7 +33,7 @@ def test_torque_margins_from_backward_differences(corner_case, corner_plan):
     padded = np.concatenate([np.repeat(q[:1], 3, 0), q, np.repeat(q[-1:], 3, 0)])
     qd = np.diff(padded, 1, axis=0)[2:] / Ts
     qdd = np.diff(padded, 2, axis=0)[1:] / Ts**2
-    tau = rtb_puma(corner_case.robot).rne(padded[3:], qd, qdd)
+    tau = rtb_robot_from(corner_case.robot).rne(padded[3:], qd, qdd)
     expected = 1.0 - np.abs(tau).max(axis=0) / corner_case.robot.dynamics.torque_max
     report = check_trajectory(corner_case.robot, q, Ts)
     np.testing.assert_allclose(report.joint_margins["torque"], expected, rtol=0, atol=1e-9)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import replace_dh
+from tests.oracles import rtb_robot_from
 from trackplan.errors import CaseError
 from trackplan.robots.dynamics.builtin import puma560_dynamics
 from trackplan.robots.dynamics.parameters import (
@@ -42,29 +43,6 @@ def rtb_puma_as_robot(puma):
     ref = rtb.models.DH.Puma560()
     d, a, alpha = (np.array([getattr(link, k) for link in ref.links]) for k in ("d", "a", "alpha"))
     return ref, replace_dh(puma, d=d, a=a, alpha=alpha, dynamics=puma560_dynamics(d, a, alpha))
-
-
-def rtb_robot_from(robot):
-    """A roboticstoolbox DH robot with our robot's DH table and rtb's Puma560 dynamics."""
-    ref = rtb.models.DH.Puma560()
-    links = []
-    for i, link in enumerate(ref.links):
-        links.append(
-            rtb.RevoluteDH(
-                d=robot.dh[i, 0],
-                a=robot.dh[i, 1],
-                alpha=robot.dh[i, 2],
-                offset=robot.dh[i, 3],
-                m=link.m,
-                r=link.r,
-                I=link.I,
-                Jm=link.Jm,
-                G=link.G,
-                B=link.B,
-                Tc=link.Tc,
-            )
-        )
-    return rtb.DHRobot(links)
 
 
 def test_rne_matches_roboticstoolbox_puma560(puma, rng):
