@@ -34,7 +34,10 @@ def optimize(
     out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/optimize"),
     method: Annotated[
         str | None,
-        typer.Option("--method", help="ga, cmaes, de or random (default: optimizer.method)."),
+        typer.Option(
+            "--method",
+            help="multistart, ga (the paper's), cmaes, de or random (default: optimizer.method).",
+        ),
     ] = None,
     seed: Annotated[
         int | None,
