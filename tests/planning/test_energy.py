@@ -8,11 +8,12 @@ import json
 import numpy as np
 import pytest
 
+from tests.oracles import rtb_robot_from
 from trackplan.io.results import result_summary
 from trackplan.planning.energy import energy_figures
 from trackplan.robots.dynamics.rne import gravity_load
 
-from .test_checker_torque import rtb_puma
+pytest.importorskip("roboticstoolbox")
 
 
 def test_energy_figures_against_roboticstoolbox(corner_case, corner_plan):
@@ -21,7 +22,7 @@ def test_energy_figures_against_roboticstoolbox(corner_case, corner_plan):
     padded = np.concatenate([np.repeat(q[:1], 3, 0), q, np.repeat(q[-1:], 3, 0)])
     qd = np.diff(padded, 1, axis=0)[2:] / Ts
     qdd = np.diff(padded, 2, axis=0)[1:] / Ts**2
-    tau = rtb_puma(corner_case.robot).rne(padded[3:], qd, qdd)
+    tau = rtb_robot_from(corner_case.robot).rne(padded[3:], qd, qdd)
     dyn = corner_case.robot.dynamics
     figures = energy_figures(corner_case.robot, q, Ts)
     assert figures.mechanical_energy == pytest.approx(np.maximum(tau * qd, 0).sum() * Ts, rel=1e-9)
