@@ -107,6 +107,23 @@ def test_ur5_bead_reads_its_points_file() -> None:
     np.testing.assert_allclose(points[-1], [0.13, 0.26, 0.0])
 
 
+@pytest.mark.parametrize("robot", ["kuka_kr6_r700_sixx", "ur10e"])
+def test_default_position_range_is_the_robots_reach(tmp_path: Path, robot: str) -> None:
+    case = load_case(write_case(tmp_path, {"robot": robot}))
+    reach = np.floor(case.robot.reach * 100.0) / 100.0
+    assert reach > 1.0  # bigger than the PUMA560's 0.87 m
+    np.testing.assert_array_equal(case.bounds.lower, [-reach] * 3 + [-1.57] * 3)
+    np.testing.assert_array_equal(case.bounds.upper, [reach] * 3 + [1.57] * 3)
+
+
+def test_example_outside_the_default_range_names_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    file = write_case(tmp_path, {"placement": {"example": [0.9, 0, 0, 0, 0, 0]}})
+    line = validate_fails(capsys, str(file))
+    assert "placement.example" in line and "[-0.87, 0.87]" in line
+
+
 def test_defaults(tmp_path: Path) -> None:
     case = load_case(write_case(tmp_path))
     assert case.task.corner_speed == case.task.rated_speed == 0.15

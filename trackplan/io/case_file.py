@@ -57,9 +57,6 @@ from trackplan.robots.model import Robot
 PAPER_WEIGHTS = (0.3, 0.2, 0.2, 0.1, 0.1, 0.1)
 """C_i of the paper's Eq. 8 for a 6-joint arm (the paper prints five; the sixth is 0.1)."""
 
-POSITION_RANGE = (-0.87, 0.87)
-"""Default search range of x, y, z, m (the paper's Eq. 31)."""
-
 ANGLE_RANGE = (-1.57, 1.57)
 """Default search range of roll, pitch, yaw, rad (the paper's Eq. 31)."""
 
@@ -147,9 +144,9 @@ class TaskModel(StrictModel):
 class PlacementModel(StrictModel):
     """``placement``: search ranges [min, max] of X and the reach range, m and rad."""
 
-    x: Range = list_default(*POSITION_RANGE)
-    y: Range = list_default(*POSITION_RANGE)
-    z: Range = list_default(*POSITION_RANGE)
+    x: Range | None = None  # default: position_range(robot)
+    y: Range | None = None
+    z: Range | None = None
     roll: Range = list_default(*ANGLE_RANGE)
     pitch: Range = list_default(*ANGLE_RANGE)
     yaw: Range = list_default(*ANGLE_RANGE)
@@ -293,7 +290,9 @@ def load_case_data(
     )
     problems = [
         *_path_problems(start, segments, model, base),
-        *_placement_problems(model.placement, _reach(model.placement, robot)),
+        *_placement_problems(
+            model.placement, _ranges(model.placement, robot), _reach(model.placement, robot)
+        ),
         *_objective_problems(model.objective, robot),
         *(cell_problems(model.cell, robot.n_dof) if model.cell is not None else []),
         *_objective_kind_problems(model.objective, robot),
@@ -336,7 +335,7 @@ def _case(
     weights = objective.weights
     if weights is None:
         weights = list(PAPER_WEIGHTS) if robot.n_dof == len(PAPER_WEIGHTS) else [1.0] * robot.n_dof
-    ranges = np.array([getattr(placement, key) for key in PLACEMENT_KEYS], dtype=float)
+    ranges = np.array(list(_ranges(placement, robot).values()), dtype=float)
     return Case(
         name=model.name,
         robot=robot,
@@ -420,6 +419,27 @@ def _points_file(model: CaseModel, loc: tuple[str | int, ...]) -> str | None:
     return None
 
 
+def position_range(robot: Robot) -> tuple[float, float]:
+    """Default search range of x, y and z: ± the robot's reach, rounded down to the cm, m.
+
+    For the PUMA560 (reach 0.877 m) this is the paper's ±0.87 m (Eq. 31).
+    """
+    reach = math.floor(robot.reach * 100.0) / 100.0
+    return (-reach, reach)
+
+
+def _ranges(placement: PlacementModel, robot: Robot) -> dict[str, tuple[float, float]]:
+    """Search range [min, max] of each placement key: the case's, else the default."""
+    ranges = {}
+    for key in PLACEMENT_KEYS:
+        value = getattr(placement, key)
+        if value is None:
+            ranges[key] = position_range(robot)
+        else:
+            ranges[key] = (float(value[0]), float(value[1]))
+    return ranges
+
+
 def _reach(placement: PlacementModel, robot: Robot) -> tuple[float, float]:
     """The placement reach range: the case's, else the robot's default, m."""
     if placement.reach is None:
@@ -427,10 +447,12 @@ def _reach(placement: PlacementModel, robot: Robot) -> tuple[float, float]:
     return (placement.reach[0], placement.reach[1])
 
 
-def _placement_problems(placement: PlacementModel, reach: tuple[float, float]) -> list[Problem]:
+def _placement_problems(
+    placement: PlacementModel, ranges: dict[str, tuple[float, float]], reach: tuple[float, float]
+) -> list[Problem]:
     problems: list[Problem] = []
     for key in PLACEMENT_KEYS:
-        low, high = getattr(placement, key)
+        low, high = ranges[key]
         if low > high:
             problems.append(
                 (("placement", key), f"expected [min, max] with min ≤ max, got {show([low, high])}")
@@ -447,11 +469,11 @@ def _placement_problems(placement: PlacementModel, reach: tuple[float, float]) -
         outside = [
             (
                 ("placement", "example", i),
-                f"expected {key} within placement.{key} {show(getattr(placement, key))}, "
+                f"expected {key} within placement.{key} {show(list(ranges[key]))}, "
                 f"got {show(value)}",
             )
             for i, (key, value) in enumerate(zip(PLACEMENT_KEYS, placement.example, strict=True))
-            if not getattr(placement, key)[0] <= value <= getattr(placement, key)[1]
+            if not ranges[key][0] <= value <= ranges[key][1]
         ]
         problems.extend(outside)
         distance = math.dist(placement.example[:3], (0.0, 0.0, 0.0))
