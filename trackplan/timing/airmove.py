@@ -31,10 +31,12 @@ from typing import Any
 import numpy as np
 from ruckig import DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 
-from trackplan.timing.sample_checks import LIMIT_MARGIN
+from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, run_checks
 
 PLANNING_MARGIN = 2.0 * LIMIT_MARGIN
 """Relative margin under each joint limit that air moves are planned with (see the module)."""
+MAX_SLOWDOWNS = 8
+"""Rounds of slowing a move down for the sample checks it is given."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,11 +53,16 @@ class AirMove:
     via
         The via configuration the move passes through (at rest), shape (n,), rad; None for
         a direct move.
+    speed_factor
+        1, or the factor ``x`` < 1 the move was slowed down by for the sample checks it was
+        planned with (the time-optimal move at velocity, acceleration and jerk limits
+        ``x v``, ``x² a``, ``x³ j``: the full-speed move stretched in time by ``1/x``).
     """
 
     q: np.ndarray
     sample_time: float
     via: np.ndarray | None
+    speed_factor: float = 1.0
 
     @property
     def duration(self) -> float:
@@ -72,6 +79,7 @@ def plan_air_move(
     sample_time: float,
     *,
     via: np.ndarray | None = None,
+    checks: tuple[SampleCheck, ...] = (),
 ) -> AirMove:
     """The time-optimal jerk-limited move from rest at ``q_start`` to rest at ``q_end``.
 
@@ -87,6 +95,12 @@ def plan_air_move(
     via
         A configuration to pass through, shape (n,), rad: the move stops there (two
         rest-to-rest moves). None moves directly.
+    checks
+        Sample checks the move must pass besides the rate limits, e.g. the torque limits
+        (:func:`~trackplan.timing.sample_checks.robot_checks`). Where one fails, the whole
+        move is slowed down by the speed factor the check asks for (all limits scaled as a
+        stretch in time) and planned again, at most :data:`MAX_SLOWDOWNS` times; the last
+        move is returned either way, for the checker to judge.
 
     Returns
     -------
@@ -117,11 +131,26 @@ def plan_air_move(
         raise ValueError("air move: velocity, acceleration and jerk limits must be positive")
     if not sample_time > 0.0:
         raise ValueError(f"air move: sample_time {sample_time} must be positive")
-    scale = 1.0 - PLANNING_MARGIN
-    v_max, a_max, j_max = (scale * lim for lim in limits)
-    pieces = [_rest_to_rest(a, b, v_max, a_max, j_max, sample_time) for a, b in pairwise(points)]
-    q = np.concatenate([pieces[0], *(piece[1:] for piece in pieces[1:])])
-    return AirMove(q=q, sample_time=float(sample_time), via=None if via is None else points[1])
+    v_max, a_max, j_max = ((1.0 - PLANNING_MARGIN) * lim for lim in limits)
+    factor = 1.0
+    for round_ in range(MAX_SLOWDOWNS + 1):
+        pieces = [
+            _rest_to_rest(a, b, factor * v_max, factor**2 * a_max, factor**3 * j_max, sample_time)
+            for a, b in pairwise(points)
+        ]
+        q = np.concatenate([pieces[0], *(piece[1:] for piece in pieces[1:])])
+        if not checks or round_ == MAX_SLOWDOWNS:
+            break
+        _, order, ratio = run_checks(checks, q, sample_time)
+        if ratio.size == 0:
+            break
+        factor *= float(np.min(ratio ** (-1.0 / order)))
+    return AirMove(
+        q=q,
+        sample_time=float(sample_time),
+        via=None if via is None else points[1],
+        speed_factor=factor,
+    )
 
 
 def _rest_to_rest(

@@ -1,0 +1,157 @@
+"""Several seams: what jerk costs an air move, and what sequencing costs to compute.
+
+Run with ``python -m benchmarks seams``. Prints, in one run:
+
+- air moves (:func:`trackplan.timing.airmove.plan_air_move`, ruckig) between random pairs
+  of configurations of a built-in industrial robot inside its joint limits: the planned
+  duration against the jerk-unlimited (trapezoidal) time of the slowest joint, median and
+  worst ratio, "what jerk costs"; against the closed-form jerk-limited estimate the
+  sequencing uses (what synchronising the joints and rounding to whole periods add); the
+  compute time per move and per estimate;
+- sequencing (:func:`trackplan.planning.sequence.best_sequence`) on random geometric
+  instances (seams as segments in a square, air cost the distance between seam ends):
+  compute time for m = 4, 6, 8 (dynamic programming) and 12, 20 (heuristic), the cost
+  against the order as written; and the heuristic's gap to the optimum at m = 8, on such
+  instances and on independent random costs.
+
+Compute times are the least CPU time of several repeats (one thread).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from trackplan.io.robot_file import builtin_robot
+from trackplan.planning.sequence import best_sequence, given_sequence, sequence_cost
+from trackplan.timing.airmove import air_time_estimate, plan_air_move, trapezoid_time
+
+ROBOT = "kuka_kr10_r1420"
+SAMPLE_TIME = 0.004
+N_PAIRS = 200
+SEQUENCE_SIZES = (4, 6, 8, 12, 20)
+N_INSTANCES = 10
+N_GAP_INSTANCES = 40
+
+
+def best_time(function: Callable[[], object], repeats: int = 3) -> float:
+    """Shortest CPU time of this process over ``repeats`` calls after a warm-up call, s."""
+    function()
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        function()
+        times.append(time.process_time() - start)
+    return min(times)
+
+
+def air_moves() -> None:
+    """Planned air-move durations against the trapezoidal and closed-form estimates."""
+    robot = builtin_robot(ROBOT)
+    rng = np.random.default_rng(0)
+    start = rng.uniform(robot.q_min, robot.q_max, (N_PAIRS, robot.n_dof))
+    end = rng.uniform(robot.q_min, robot.q_max, (N_PAIRS, robot.n_dof))
+    limits = (robot.v_max, robot.a_max, robot.j_max)
+
+    def plan_all() -> list[float]:
+        return [
+            plan_air_move(a, b, *limits, SAMPLE_TIME).duration
+            for a, b in zip(start, end, strict=True)
+        ]
+
+    duration = np.array(plan_all())
+    seconds = best_time(plan_all)
+    trapezoid = trapezoid_time(start, end, robot.v_max, robot.a_max)
+    estimate = air_time_estimate(start, end, *limits)
+    estimate_seconds = best_time(lambda: air_time_estimate(start, end, *limits), repeats=20)
+    jerk = duration / trapezoid
+    sync = duration / estimate
+    print(
+        f"air moves: {N_PAIRS} random pairs of {ROBOT} configurations, Ts = "
+        f"{SAMPLE_TIME * 1e3:g} ms, median move {np.median(duration):.3f} s"
+    )
+    print(
+        f"  ruckig / trapezoid (what jerk costs): median {np.median(jerk):.3f}, "
+        f"worst {jerk.max():.3f}, best {jerk.min():.3f}"
+    )
+    print(
+        f"  ruckig / closed-form estimate (synchronising, whole periods): "
+        f"median {np.median(sync):.4f}, worst {sync.max():.4f}"
+    )
+    print(
+        f"  compute: {seconds / N_PAIRS * 1e3:.2f} ms per planned move (ruckig and sampling), "
+        f"{estimate_seconds / N_PAIRS * 1e6:.2f} µs per estimate (batched)"
+    )
+
+
+def geometric_instance(rng: np.random.Generator, m: int) -> tuple[np.ndarray, ...]:
+    """``m`` seams as segments in the unit square; air cost the distance between seam ends,
+    from and back to a home point; every seam reversible."""
+    a = rng.uniform(0.0, 1.0, (m, 2))
+    b = a + rng.uniform(-0.2, 0.2, (m, 2))
+    starts = np.stack([a, b], axis=1)
+    ends = np.stack([b, a], axis=1)
+    length = np.linalg.norm(b - a, axis=1)
+    home = np.array([0.5, -0.2])
+    air = np.linalg.norm(ends[:, :, None, None, :] - starts[None, None, :, :, :], axis=-1)
+    return (
+        np.stack([length, length], axis=1),
+        air,
+        np.linalg.norm(starts - home, axis=-1),
+        np.linalg.norm(ends - home, axis=-1),
+        np.ones(m, bool),
+    )
+
+
+def random_instance(rng: np.random.Generator, m: int) -> tuple[np.ndarray, ...]:
+    """``m`` seams with independent random costs (no triangle inequality), every seam
+    reversible."""
+    return (
+        rng.uniform(0.5, 2.0, (m, 2)),
+        rng.uniform(0.0, 1.0, (m, 2, m, 2)),
+        rng.uniform(0.0, 1.0, (m, 2)),
+        rng.uniform(0.0, 1.0, (m, 2)),
+        np.ones(m, bool),
+    )
+
+
+def sequencing() -> None:
+    """Sequencing compute time and quality."""
+    rng = np.random.default_rng(1)
+    print(f"sequencing: {N_INSTANCES} random geometric instances per size")
+    for m in SEQUENCE_SIZES:
+        instances = [geometric_instance(rng, m) for _ in range(N_INSTANCES)]
+        seconds = [best_time(lambda costs=costs: best_sequence(*costs)) for costs in instances]
+        found = [best_sequence(*costs) for costs in instances]
+        given = [sequence_cost(given_sequence(m).visits, *costs[:4]) for costs in instances]
+        ratio = np.array([f.cost for f in found]) / np.array(given)
+        kind = "dynamic programming" if found[0].exact else "heuristic"
+        print(
+            f"  m = {m:2d} ({kind:19s}): median {np.median(seconds) * 1e3:7.2f} ms, "
+            f"worst {max(seconds) * 1e3:7.2f} ms; cost / order as written: "
+            f"median {np.median(ratio):.3f}"
+        )
+    for kind, make in (("geometric", geometric_instance), ("random-cost", random_instance)):
+        gaps = []
+        for _ in range(N_GAP_INSTANCES):
+            costs = make(rng, 8)
+            exact = best_sequence(*costs)
+            heuristic = best_sequence(*costs, exact_up_to=0)
+            gaps.append(heuristic.cost / exact.cost - 1.0)
+        gap = np.array(gaps)
+        print(
+            f"  heuristic against the optimum at m = 8 ({N_GAP_INSTANCES} {kind} instances): "
+            f"mean gap {gap.mean():.2%}, worst {gap.max():.2%}, "
+            f"optimal on {np.mean(gap < 1e-9):.0%}"
+        )
+
+
+def main() -> None:
+    air_moves()
+    sequencing()
+
+
+if __name__ == "__main__":
+    main()
