@@ -14,8 +14,10 @@ the jerk at Ts = 4 ms). The margin is twice the
 pass the laws' own sample checks (:class:`~trackplan.timing.sample_checks.RateLimits`, which
 flag anything above ``1 - LIMIT_MARGIN`` of a limit), not only the checker.
 
-A move through a via configuration is two rest-to-rest moves (the community version of
-ruckig plans intermediate waypoints only online); the via is one of the samples.
+ruckig knows no dynamics: sample checks handed in (the torque limits) slow a move that
+fails them down as a whole, a stretch in time. A move through a via configuration is two
+rest-to-rest moves (the community version of ruckig plans intermediate waypoints only
+online); the via is one of the samples.
 
 :func:`air_time_estimate` and :func:`trapezoid_time` are closed forms, vectorised over any
 number of moves, for sequencing: the time of the slowest joint alone, with and without the
