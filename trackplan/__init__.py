@@ -41,6 +41,10 @@ JointPath
     Poses and IK of a placed path on its planning grid, computed once per plan.
 TIME_LAWS, time_law(name)
     The time laws by name (``smooth``, ``paper``).
+plan_air_move(q_start, q_end, ...) -> AirMove, air_time_estimate, trapezoid_time
+    Jerk-limited rest-to-rest joint moves through the air (ruckig), and their time estimates.
+best_sequence(...) -> Sequence, given_sequence, sequence_cost, Visit
+    The order and direction of several seams (``docs/seams.md``).
 Status, Timing, Method, Penalty
     The outcome vocabulary and the named choices.
 PlanResult, OptimizeResult, CheckReport, Trajectory, TimeLaw
@@ -79,6 +83,13 @@ if TYPE_CHECKING:
     from trackplan.planning.objectives import OBJECTIVES
     from trackplan.planning.plan import check_case_trajectory, plan_placement
     from trackplan.planning.result import CheckReport, PlanResult, Trajectory
+    from trackplan.planning.sequence import (
+        Sequence,
+        Visit,
+        best_sequence,
+        given_sequence,
+        sequence_cost,
+    )
     from trackplan.robots.dynamics.parameters import Payload, RobotDynamics
     from trackplan.robots.dynamics.rne import gravity_load, inverse_dynamics
     from trackplan.robots.kinematics import forward_kinematics, jacobian
@@ -88,6 +99,7 @@ if TYPE_CHECKING:
     from trackplan.status import Status
     from trackplan.study.runner import run_study
     from trackplan.timing import TIME_LAWS, TimeLaw, time_law
+    from trackplan.timing.airmove import AirMove, air_time_estimate, plan_air_move, trapezoid_time
 
 try:
     __version__ = version("trackplan")
@@ -138,12 +150,22 @@ _EXPORTS = {
     "plan_placement": "trackplan.planning.plan",
     "time_law": "trackplan.timing",
     "run_study": "trackplan.study.runner",
+    "AirMove": "trackplan.timing.airmove",
+    "plan_air_move": "trackplan.timing.airmove",
+    "air_time_estimate": "trackplan.timing.airmove",
+    "trapezoid_time": "trackplan.timing.airmove",
+    "Sequence": "trackplan.planning.sequence",
+    "Visit": "trackplan.planning.sequence",
+    "best_sequence": "trackplan.planning.sequence",
+    "given_sequence": "trackplan.planning.sequence",
+    "sequence_cost": "trackplan.planning.sequence",
 }
 
 __all__ = [
     "BUILTIN_ROBOTS",
     "OBJECTIVES",
     "TIME_LAWS",
+    "AirMove",
     "Case",
     "CaseError",
     "CheckReport",
@@ -157,18 +179,23 @@ __all__ = [
     "PlanResult",
     "Robot",
     "RobotDynamics",
+    "Sequence",
     "Status",
     "TimeLaw",
     "Timing",
     "TrackplanError",
     "Trajectory",
+    "Visit",
     "__version__",
+    "air_time_estimate",
+    "best_sequence",
     "builtin_names",
     "builtin_robot",
     "check_case_trajectory",
     "check_trajectory",
     "energy_figures",
     "forward_kinematics",
+    "given_sequence",
     "gravity_load",
     "inverse_dynamics",
     "jacobian",
@@ -176,9 +203,12 @@ __all__ = [
     "load_robot",
     "optimize_placement",
     "pareto_front",
+    "plan_air_move",
     "plan_placement",
     "run_study",
+    "sequence_cost",
     "time_law",
+    "trapezoid_time",
 ]
 
 
