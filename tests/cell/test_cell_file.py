@@ -120,7 +120,7 @@ def test_robot_without_capsule_model_needs_links(
     file.write_text(text + "cell:\n  clearance: 0.01\n", encoding="utf-8")
     code, err = validate(capsys, file)
     assert code == ExitCode.BAD_INPUT
-    assert err.startswith(f"{file}: cell: robot 'arm' has no built-in capsule model")
+    assert err.startswith(f"{file}: cell: robot 'arm' has no link capsules")
     links = "  links:\n    - {link: 2, from: [-0.4, 0, 0], to: [0, 0, 0], radius: 0.07}\n"
     file.write_text(text + "cell:\n" + links, encoding="utf-8")
     assert load_case(file).cell.links.name == ("link 2",)

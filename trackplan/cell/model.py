@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from trackplan.robots.collision import Capsules
+
 DEFAULT_CLEARANCE = 0.005
 """Least allowed distance between the robot and the cell when the case gives none, m."""
 
@@ -79,53 +81,6 @@ class Body:
 
 
 @dataclass(frozen=True, eq=False)
-class Capsules:
-    """Capsules attached to the frames of a chain (robot links, tool).
-
-    Attributes
-    ----------
-    frame
-        Index of the frame each capsule moves with, shape (K,), int: 0 the robot base,
-        i the frame of link i (1..n), n + 1 the TCP (see
-        :func:`trackplan.robots.kinematics.joint_frames`).
-    segment
-        End points of each capsule's axis in its frame, shape (K, 2, 3), m.
-    radius
-        Shape (K,), m.
-    name
-        Name of each capsule for reports (``link 3``, ``tool``), length K.
-    """
-
-    frame: np.ndarray
-    segment: np.ndarray
-    radius: np.ndarray
-    name: tuple[str, ...]
-
-    def __post_init__(self) -> None:
-        for key, dtype in (("frame", np.int64), ("segment", float), ("radius", float)):
-            value = np.array(getattr(self, key), dtype=dtype)
-            value.flags.writeable = False
-            object.__setattr__(self, key, value)
-        object.__setattr__(self, "segment", self.segment.reshape(-1, 2, 3))
-
-    @classmethod
-    def empty(cls) -> Capsules:
-        """No capsule."""
-        return cls(np.zeros(0, np.int64), np.zeros((0, 2, 3)), np.zeros(0), ())
-
-    def __len__(self) -> int:
-        return len(self.radius)
-
-    def __add__(self, other: Capsules) -> Capsules:
-        return Capsules(
-            np.concatenate([self.frame, other.frame]),
-            np.concatenate([self.segment, other.segment]),
-            np.concatenate([self.radius, other.radius]),
-            self.name + other.name,
-        )
-
-
-@dataclass(frozen=True, eq=False)
 class Cell:
     """The work cell of a case.
 
@@ -138,7 +93,7 @@ class Cell:
     tool
         Tool capsules in the TCP frame (their ``frame`` is ignored: always the TCP).
     links
-        Robot link capsules, or None for the built-in model of the case's robot
+        Robot link capsules, or None for the robot's own model
         (:func:`trackplan.cell.robot_bodies.builtin_link_capsules`).
     clearance
         Least allowed distance between the robot (links and tool) and the cell, and

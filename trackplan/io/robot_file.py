@@ -44,6 +44,7 @@ and jerk = acceleration / :data:`ASSUMED_JERK_TIME`, recorded in ``Robot.assumpt
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from typing import Annotated, Any
@@ -54,7 +55,7 @@ from pydantic import Field
 
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_from_matrix, rpy_matrix
-from trackplan.io.urdf import DEFAULT_CONTINUOUS_RANGE, read_urdf_chain
+from trackplan.io.urdf import DEFAULT_CONTINUOUS_RANGE, read_urdf_chain, read_urdf_link_geometry
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -71,6 +72,7 @@ from trackplan.io.yaml_input import (
     validate_model,
 )
 from trackplan.robots.builtin import DH_ROBOTS
+from trackplan.robots.collision import Capsules, frame_name, transform_capsule
 from trackplan.robots.dynamics.parameters import (
     STANDARD_GRAVITY,
     Payload,
@@ -135,6 +137,20 @@ class ToolModel(StrictModel):
     rpy: Vec3 = list_default(0.0, 0.0, 0.0)
 
 
+class CollisionCapsuleModel(StrictModel):
+    """A link capsule: the link (number 0..n, or a URDF link's name), axis end points
+    ``a``, ``b`` in that link's frame (m) and radius (m)."""
+
+    link: int | NonEmptyStr
+    a: Vec3
+    b: Vec3
+    radius: Positive
+
+
+Collision = Annotated[list[CollisionCapsuleModel], Field(min_length=1)]
+"""The ``collision:`` key of a robot file: the robot's link capsules (``docs/cell.md``)."""
+
+
 class LimitsModel(StrictModel):
     """Per-joint limits that a URDF lacks or that override it, in chain order."""
 
@@ -155,6 +171,7 @@ class URDFRobotFileModel(StrictModel):
     limits: LimitsModel = Field(default_factory=LimitsModel)
     continuous_range: Positive = DEFAULT_CONTINUOUS_RANGE
     assumptions: list[str] = Field(default_factory=list)
+    collision: Collision | None = None
 
 
 class RobotFileModel(StrictModel):
@@ -166,6 +183,7 @@ class RobotFileModel(StrictModel):
     tool: ToolModel | None = None
     gravity: Vec3 = list_default(*STANDARD_GRAVITY)
     payload: PayloadModel | None = None
+    collision: Collision | None = None
 
 
 def load_robot(file: str | Path, *, assume_limits: bool = False) -> Robot:
@@ -204,9 +222,11 @@ def robot_from_urdf_file(file: str | Path, *, assume_limits: bool = False) -> Ro
         As :func:`~trackplan.io.urdf.read_urdf_chain`, and when limits are missing.
     """
     chain = read_urdf_chain(file)
-    return _urdf_robot(
+    robot = _urdf_robot(
         chain, chain.name, LimitsModel(), np.eye(4), "", [], assume_limits, str(file)
     )
+    capsules = read_urdf_link_geometry(file, chain.joint_names).capsules
+    return replace(robot, collision=capsules) if len(capsules) else robot
 
 
 def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool = False) -> Robot:
@@ -241,6 +261,7 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
         if joint.position[0] >= joint.position[1]
     ]
     problems += _dynamics_problems(model)
+    problems += collision_problems(model.collision, len(model.joints), {})
     raise_first(problems, data, file)
     tool = model.tool or ToolModel()
     columns = {
@@ -262,6 +283,7 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
         T_flange_tool=pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy))),
         source=model.source,
         dynamics=_dynamics(model, columns),
+        collision=link_capsules(model.collision, {}),
     )
 
 
@@ -380,7 +402,7 @@ def _load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> R
     raise_first(problems, data, file)
     tool = model.tool or ToolModel()
     T_tool = pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy)))
-    return _urdf_robot(
+    robot = _urdf_robot(
         chain,
         model.name,
         model.limits,
@@ -390,6 +412,76 @@ def _load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> R
         assume_limits,
         file,
     )
+    return replace(robot, collision=_urdf_collision(model, base / model.urdf, chain, data, file))
+
+
+def collision_problems(
+    capsules: list[CollisionCapsuleModel] | None,
+    n_dof: int,
+    link_frames: dict[str, tuple[int, np.ndarray]],
+) -> list[Problem]:
+    """Link numbers past the chain and link names the URDF does not put on it."""
+    problems: list[Problem] = []
+    for i, capsule in enumerate(capsules or []):
+        if isinstance(capsule.link, int):
+            if not 0 <= capsule.link <= n_dof:
+                problems.append(
+                    (
+                        ("collision", i, "link"),
+                        f"expected a link number 0..{n_dof} (0 = base), got {capsule.link}",
+                    )
+                )
+        elif capsule.link not in link_frames:
+            if link_frames:
+                known = ", ".join(sorted(link_frames))
+                message = f"no link {capsule.link!r} on the URDF's chain: use one of {known}"
+            else:
+                message = (
+                    f"unknown link {capsule.link!r}: a DH robot numbers its links "
+                    f"0..{n_dof} (0 = base)"
+                )
+            problems.append((("collision", i, "link"), message))
+    return problems
+
+
+def link_capsules(
+    capsules: list[CollisionCapsuleModel] | None,
+    link_frames: dict[str, tuple[int, np.ndarray]],
+) -> Capsules | None:
+    """The validated ``collision:`` capsules on the chain's frames (None when not given).
+
+    A capsule given by a URDF link name is moved from that link's frame into the chain
+    frame the link is fixed to (:func:`~trackplan.io.urdf.read_urdf_link_geometry`).
+    """
+    if capsules is None:
+        return None
+    frames, segments, names = [], [], []
+    for capsule in capsules:
+        if isinstance(capsule.link, int):
+            frame, T_frame_link, name = capsule.link, np.eye(4), frame_name(capsule.link)
+        else:
+            (frame, T_frame_link), name = link_frames[capsule.link], capsule.link
+        frames.append(frame)
+        segments.append(transform_capsule(np.array([capsule.a, capsule.b]), T_frame_link))
+        names.append(name)
+    return Capsules(
+        np.array(frames), np.array(segments), np.array([c.radius for c in capsules]), names
+    )
+
+
+def _urdf_collision(
+    model: URDFRobotFileModel, urdf: Path, chain: Any, data: Any, file: str | None
+) -> Capsules | None:
+    """The link capsules of a URDF robot file: its ``collision:`` key, else the URDF's
+    ``<collision>`` elements fitted with capsules (None when it has neither)."""
+    geometry = read_urdf_link_geometry(
+        urdf, chain.joint_names, model.base_link, collisions=model.collision is None
+    )
+    if model.collision is None:
+        return geometry.capsules if len(geometry.capsules) else None
+    n_dof = len(chain.joint_names)
+    raise_first(collision_problems(model.collision, n_dof, geometry.link_frames), data, file)
+    return link_capsules(model.collision, geometry.link_frames)
 
 
 def _urdf_robot(

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from trackplan.robots.collision import puma560_capsules, ur5_capsules
 from trackplan.robots.dynamics.builtin import puma560_dynamics
 from trackplan.robots.model import Robot
 
@@ -47,6 +48,7 @@ def puma560() -> Robot:
         ),
         dynamics=puma560_dynamics(d, a, alpha),
         placement_reach=PUMA_PLACEMENT_REACH,
+        collision=puma560_capsules(),
     )
 
 
@@ -76,6 +78,7 @@ def ur5() -> Robot:
             "Universal Robots UR5 (CB3) published DH table and technical specifications "
             "(±360°, 180°/s); acceleration 15 rad/s² and jerk 150 rad/s³ are assumptions."
         ),
+        collision=ur5_capsules(),
     )
 
 

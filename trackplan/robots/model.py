@@ -22,6 +22,7 @@ from functools import cached_property
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.robots.collision import Capsules
 from trackplan.robots.dynamics.parameters import RobotDynamics
 
 LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk")
@@ -108,6 +109,9 @@ class Robot:
     dynamics
         Masses, inertias, actuators, friction and torque limits, or None when the robot has
         no published dynamics (then it has no torque check).
+    collision
+        Link capsules on frames 0 (base) to n (:mod:`trackplan.robots.collision`), or None
+        when the robot has no link geometry (then a cell case must give ``cell.links``).
     """
 
     name: str
@@ -126,6 +130,7 @@ class Robot:
     dh: np.ndarray | None = None
     dynamics: RobotDynamics | None = None
     placement_reach: tuple[float, float] | None = None
+    collision: Capsules | None = None
 
     def __post_init__(self) -> None:
         origins = np.array(self.origins, dtype=float)
@@ -163,6 +168,8 @@ class Robot:
             raise CaseError(
                 f"dynamics must have {n} joints, got {self.dynamics.n_dof}", key="dynamics"
             )
+        if self.collision is not None and np.any(self.collision.frame > n):
+            raise CaseError(f"link capsules must be on frames 0..{n}", key="collision")
 
     @classmethod
     def from_dh(
