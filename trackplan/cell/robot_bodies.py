@@ -54,3 +54,19 @@ def self_collision_pairs(frame: np.ndarray) -> np.ndarray:
     i, j = np.triu_indices(len(frame), k=1)
     keep = np.abs(rank[i] - rank[j]) > 1
     return np.stack([i[keep], j[keep]], axis=1).astype(np.int64)
+
+
+def link_capsules_line(robot: Robot) -> str:
+    """One line on the robot's link geometry, for ``trackplan robots NAME``.
+
+    ``link capsules: 9 on 6 bodies; 23 capsule pairs of non-adjacent bodies checked for
+    self-collision``, or what a cell case then needs.
+    """
+    if robot.collision is None:
+        return "link capsules: none (a cell case must give cell.links)"
+    frame = robot.collision.frame
+    n_pairs = len(self_collision_pairs(frame))
+    return (
+        f"link capsules: {len(frame)} on {len(np.unique(frame))} bodies; {n_pairs} capsule "
+        "pairs of non-adjacent bodies checked for self-collision"
+    )

@@ -18,6 +18,7 @@ from trackplan.cli.common import (
     load_each,
     shipped_cases_dir,
 )
+from trackplan.cell.robot_bodies import link_capsules_line
 from trackplan.cli.summaries import describe_case, robot_table, segment_corners
 from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot_spec, robot_to_yaml
 from trackplan.paths import NominalPath
@@ -55,7 +56,7 @@ def robots(
     ] = None,
     assume_limits: AssumeLimitsOption = False,
 ) -> ExitCode:
-    """List the built-in robots (family, reach, source), or show one robot in detail."""
+    """List the built-in robots (family, reach, link capsules, source), or show one robot."""
     from trackplan.robots.describe import robot_info
 
     if as_yaml is not None:
@@ -70,13 +71,14 @@ def robots(
         for key, value in info["parameters"].items():  # type: ignore[attr-defined]
             out.print(f"  {key} = {_show_value(value)}")
         out.print(f"reach: {info['reach']:.3f} m")
+        out.print(link_capsules_line(robot))
         for note in robot.assumptions:
             out.print(f"assumption: {escape(note)}")
         if "redundancy_rule" in info:
             out.print(f"redundancy: {escape(str(info['redundancy_rule']))}")
         return ExitCode.OK
     table = Table(title="built-in robots (trackplan robots NAME for details)")
-    for header in ("name", "joints", "family", "reach m", "source"):
+    for header in ("name", "joints", "family", "reach m", "capsules", "source"):
         table.add_column(header, justify="left" if header in ("name", "source") else "right")
     for key in builtin_names():
         info = robot_info(builtin_robot(key))
@@ -85,6 +87,7 @@ def robots(
             str(info["joints"]),
             str(info["family"]),
             f"{info['reach']:.3f}",
+            str(info["link_capsules"]),
             escape(str(info["source"])),
         )
     out.print(table)

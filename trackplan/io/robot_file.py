@@ -9,6 +9,8 @@ A DH robot file (see ``docs/files.md``)::
          position: [-3.141592653589793, 3.141592653589793],
          velocity: 8, acceleration: 10, jerk: 30}
     tool: {xyz: [0, 0, 0], rpy: [0, 0, 0]}     # optional
+    collision:                                 # optional: link capsules (docs/cell.md)
+      - {link: 2, a: [-0.4318, 0, 0.2435], b: [0, 0, 0.2435], radius: 0.07}
 
 Lengths in metres, angles in radians, limits in rad/s, rad/s², rad/s³.
 ``T_flange_tool = Trans(xyz) · RPY(rpy)`` with ``RPY = Rz(yaw) · Ry(pitch) · Rx(roll)``.
@@ -35,6 +37,13 @@ A robot file for a URDF (paths relative to the file; see ``docs/robots.md``)::
     continuous_range: 6.283185307179586          # optional: continuous joints' half range
     source: "where the numbers come from"        # optional
     assumptions: ["acceleration and jerk assumed: …"]   # optional
+    collision:                    # optional: replaces the URDF's <collision> elements
+      - {link: link_2, a: [0, 0, 0], b: [0, 0, 0.705], radius: 0.12}
+
+``collision`` lists link capsules: ``link`` is a frame number (0 the base, i the link of
+joint i) or, for a URDF, a link name; ``a`` and ``b`` are the axis end points in that link's
+frame (m, the DH frame for a DH robot). Without it, a URDF's ``<collision>`` boxes,
+cylinders, spheres and meshes are each fitted with an enclosing capsule.
 
 A URDF gives no acceleration or jerk limits. Without them the robot is refused, unless
 ``assume_limits`` is set: then acceleration = velocity / :data:`ASSUMED_ACCELERATION_TIME`
@@ -660,6 +669,7 @@ _HEADER = """\
 # trackplan robot file: standard DH, A_i = Rz(q_i + offset) · Tz(d) · Tx(a) · Rx(alpha).
 # Units: m and rad; per joint: position [min, max] rad, velocity rad/s,
 # acceleration rad/s², jerk rad/s³. tool: T_flange_tool = Trans(xyz) · RPY(rpy).
+# Link capsules (collision): axis end points a, b (m) in DH frame `link` (0 = base), radius m.
 """
 
 
@@ -712,5 +722,15 @@ def robot_to_yaml(robot: Robot) -> str:
             xyz=[float(value) for value in robot.T_flange_tool[:3, 3]],
             rpy=[float(value) for value in rpy_from_matrix(robot.T_flange_tool[:3, :3])],
         )
+    if robot.collision is not None:
+        data["collision"] = [
+            _FlowMapping(
+                link=int(robot.collision.frame[k]),
+                a=[float(value) for value in robot.collision.segment[k, 0]],
+                b=[float(value) for value in robot.collision.segment[k, 1]],
+                radius=float(robot.collision.radius[k]),
+            )
+            for k in range(len(robot.collision))
+        ]
     body = yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=1_000_000)
     return _HEADER + body

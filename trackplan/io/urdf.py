@@ -371,9 +371,13 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
     except Exception as exc:  # trimesh raises whatever its format readers meet
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise CaseError(
-            f"{where} mesh {mesh.filename!r} cannot be read: {reason}", file=path
+            f"{where} mesh {mesh.filename!r} cannot be read as a mesh: {reason}", file=path
         ) from None
     if len(vertices) == 0:
-        raise CaseError(f"{where} mesh {mesh.filename!r} has no vertices", file=path)
+        raise CaseError(
+            f"{where} mesh {mesh.filename!r} cannot be read as a mesh: no vertices found "
+            "(expected STL, OBJ, PLY, …)",
+            file=path,
+        )
     scale = 1.0 if mesh.scale is None else np.asarray(mesh.scale, dtype=float)
     return vertices * scale

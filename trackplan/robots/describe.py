@@ -18,8 +18,9 @@ def robot_info(robot: Robot) -> dict[str, object]:
     dict
         ``name``, ``joints``, ``family`` (opw, ur or numeric), ``parameters`` (the
         derived family parameters, m and rad), ``reach`` (m), ``source``, ``assumptions``
-        (limits that were assumed, one sentence each) and, for chains of more than six
-        joints, ``redundancy_rule``.
+        (limits that were assumed, one sentence each), ``link_capsules`` (how many
+        capsules model the links, 0 for none) and, for chains of more than six joints,
+        ``redundancy_rule``.
     """
     family = ik_family(robot)
     info: dict[str, object] = {
@@ -32,6 +33,7 @@ def robot_info(robot: Robot) -> dict[str, object]:
         "reach": round(robot.reach, 6),
         "source": robot.source,
         "assumptions": list(robot.assumptions),
+        "link_capsules": 0 if robot.collision is None else len(robot.collision),
     }
     if robot.n_dof > 6:
         info["redundancy_rule"] = REDUNDANCY_RULE

@@ -1,0 +1,124 @@
+"""The robots' link capsules in the cell: built-in models, self-collision, planted collisions."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from trackplan.cell.check import check_cell
+from trackplan.cell.model import Body, Cell, Shape
+from trackplan.cell.robot_bodies import builtin_link_capsules
+from trackplan.cell.screening import CellGeometry
+from trackplan.frames import pose_matrix
+from trackplan.io.case_file import load_case
+from trackplan.io.robot_file import builtin_names, builtin_robot
+from trackplan.planning.plan import plan_placement
+from trackplan.robots.kinematics import joint_frames
+
+REPO = Path(__file__).resolve().parents[2]
+TS = 0.01
+HALF_PI = np.pi / 2
+HOME = {
+    # KUKA's HOME: A2 = -90° (upper arm up), A3 = +90° (forearm level)
+    "kuka_kr6_r700_sixx": [0.0, -HALF_PI, HALF_PI, 0.0, HALF_PI, 0.0],
+    "kuka_kr10_r1420": [0.0, -HALF_PI, HALF_PI, 0.0, HALF_PI, 0.0],
+    # the UR arms upright, wrist 1 turned down
+    "ur5": [0.0, -HALF_PI, 0.0, -HALF_PI, 0.0, 0.0],
+    "ur5e": [0.0, -HALF_PI, 0.0, -HALF_PI, 0.0, 0.0],
+    "ur10e": [0.0, -HALF_PI, 0.0, -HALF_PI, 0.0, 0.0],
+    # ABB, Fanuc: q = 0 is the upright home; wrist bent
+    "abb_irb1600": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
+    "abb_irb2400": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
+    "fanuc_m20ia": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
+    "puma560": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
+}
+
+
+@pytest.mark.parametrize("name", builtin_names())
+def test_no_builtin_collides_with_itself_at_zero_and_home(name: str) -> None:
+    robot = builtin_robot(name)
+    geometry = CellGeometry.from_cell(Cell(), robot)
+    assert len(geometry.self_pairs) > 0
+    q = np.array([np.zeros(robot.n_dof), HOME[name]])
+    report = check_cell(geometry, robot, q, TS, np.eye(4))
+    assert report.success, report.violations[0].message
+    assert report.min_clearance > Cell().clearance
+
+
+def kuka_sweep() -> np.ndarray:
+    """KR6 R700 sixx at HOME, joint 1 sweeping 90°, shape (100, 6)."""
+    q = np.tile(HOME["kuka_kr6_r700_sixx"], (100, 1))
+    q[:, 0] = np.linspace(-HALF_PI / 2, HALF_PI / 2, 100)
+    return q
+
+
+def test_planted_obstacle_hits_a_urdf_robots_forearm() -> None:
+    robot = builtin_robot("kuka_kr6_r700_sixx")
+    q = kuka_sweep()
+    links = builtin_link_capsules(robot)
+    forearm = links.name.index("link_4")
+    frames = joint_frames(robot, q[50])
+    T = frames[links.frame[forearm]]
+    middle = T[:3, :3] @ links.segment[forearm].mean(axis=0) + T[:3, 3]
+    ball = Body("ball", Shape.SPHERE, pose_matrix(middle, np.eye(3)), [0.03, 0.0, 0.0])
+    geometry = CellGeometry.from_cell(Cell(obstacles=(ball,), clearance=0.01), robot)
+    report = check_cell(geometry, robot, q, TS, np.eye(4))
+    assert not report.success
+    worst = min(report.violations, key=lambda v: v.worst)
+    assert worst.message.startswith("collision: link_4 hits ball")
+    # the ball's centre is on the capsule's axis: 55 mm + 30 mm deep (coal, exactly)
+    assert worst.worst == pytest.approx(-(0.055 + 0.03), abs=1e-6)
+    assert worst.t_first <= 50 * TS <= worst.t_last
+    # 0.5 m above the forearm the same sweep is clear
+    above = Body("ball", Shape.SPHERE, pose_matrix(middle + [0, 0, 0.5], np.eye(3)), [0.03, 0, 0])
+    clear = CellGeometry.from_cell(Cell(obstacles=(above,), clearance=0.01), robot)
+    assert check_cell(clear, robot, q, TS, np.eye(4)).success
+
+
+def test_folded_kuka_collides_with_itself() -> None:
+    """Joint 3 folds the forearm back onto the upper arm: link_4 against link_2."""
+    robot = builtin_robot("kuka_kr6_r700_sixx")
+    q = np.tile(HOME["kuka_kr6_r700_sixx"], (50, 1))
+    q[:, 2] = np.linspace(HALF_PI, robot.q_max[2], 50)
+    report = check_cell(CellGeometry.from_cell(Cell(), robot), robot, q, TS, np.eye(4))
+    assert not report.success
+    hits = {v.message.split(" hits ")[0].removeprefix("collision: ") for v in report.violations}
+    assert "link_4" in hits or "link_2" in hits
+    assert report.violations[0].t_first > 0.0  # clear at HOME, colliding once folded
+
+
+def test_cell_case_on_a_kuka_checks_its_links(tmp_path: Path) -> None:
+    text = (REPO / "cases" / "kuka-weld.yaml").read_text(encoding="utf-8")
+    cell = "cell:\n  obstacles:\n    - {name: pillar, box: {size: [0.1, 0.1, 2], pose: [-0.5, 0, 0, 0, 0, 0]}}\n"
+    file = tmp_path / "kuka-cell.yaml"
+    file.write_text(text + cell, encoding="utf-8")
+    case = load_case(file)
+    assert case.cell is not None and case.cell.links is None
+    geometry = CellGeometry.from_cell(case.cell, case.robot)
+    checked = {who for who, other in geometry.pair_names() if other == "pillar"}
+    assert checked == {"link_1", "link_2", "link_3", "link_4", "link_5"}  # the base stands
+
+
+# Optimised placements of the shipped cases on the built-in arms (``trackplan optimize``,
+# default settings) and the least distance between non-adjacent links along each plan.
+SHIPPED_PLANS = {
+    "kuka-weld": [],
+    "ur5e-glue": [],
+    "seam-weld-fixed": [],
+    "ur5-bead": [],
+    "bracket-weld": [0.4676, -0.1793, -0.2823, 0.3, 0.0577, -2.1158],
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case_name", sorted(SHIPPED_PLANS))
+def test_shipped_plans_keep_clear_of_self_collision(case_name: str) -> None:
+    case = load_case(REPO / "cases" / f"{case_name}.yaml")
+    result = plan_placement(case, np.array(SHIPPED_PLANS[case_name]))
+    assert result.success
+    robot = case.robot
+    geometry = CellGeometry.from_cell(Cell(), robot)
+    report = check_cell(geometry, robot, result.trajectory.q, TS, np.eye(4))
+    assert report.success and report.min_clearance > Cell().clearance
