@@ -72,7 +72,8 @@ def test_planted_obstacle_hits_a_urdf_robots_forearm() -> None:
     assert worst.worst == pytest.approx(-(0.055 + 0.03), abs=1e-6)
     assert worst.t_first <= 50 * TS <= worst.t_last
     # 0.5 m above the forearm the same sweep is clear
-    above = Body("ball", Shape.SPHERE, pose_matrix(middle + [0, 0, 0.5], np.eye(3)), [0.03, 0, 0])
+    T_above = pose_matrix(middle + np.array([0.0, 0.0, 0.5]), np.eye(3))
+    above = Body("ball", Shape.SPHERE, T_above, [0.03, 0.0, 0.0])
     clear = CellGeometry.from_cell(Cell(obstacles=(above,), clearance=0.01), robot)
     assert check_cell(clear, robot, q, TS, np.eye(4)).success
 
@@ -91,7 +92,8 @@ def test_folded_kuka_collides_with_itself() -> None:
 
 def test_cell_case_on_a_kuka_checks_its_links(tmp_path: Path) -> None:
     text = (REPO / "cases" / "kuka-weld.yaml").read_text(encoding="utf-8")
-    cell = "cell:\n  obstacles:\n    - {name: pillar, box: {size: [0.1, 0.1, 2], pose: [-0.5, 0, 0, 0, 0, 0]}}\n"
+    pillar = "{name: pillar, box: {size: [0.1, 0.1, 2], pose: [-0.5, 0, 0, 0, 0, 0]}}"
+    cell = f"cell:\n  obstacles:\n    - {pillar}\n"
     file = tmp_path / "kuka-cell.yaml"
     file.write_text(text + cell, encoding="utf-8")
     case = load_case(file)
@@ -101,13 +103,16 @@ def test_cell_case_on_a_kuka_checks_its_links(tmp_path: Path) -> None:
     assert checked == {"link_1", "link_2", "link_3", "link_4", "link_5"}  # the base stands
 
 
-# Optimised placements of the shipped cases on the built-in arms (``trackplan optimize``,
-# default settings) and the least distance between non-adjacent links along each plan.
+# Optimised placements of the shipped cases on the built-in arms (``trackplan optimize
+# cases/NAME.yaml``, default settings; the README's for bracket-weld). The least distance
+# between non-adjacent links along each plan, as measured: kuka-weld 29.2 mm (link_2, link_4),
+# ur5e-glue 29.4 mm (base_link, link_2), seam-weld-fixed 33.7 mm (link_2, link_4), ur5-bead
+# 11.9 mm (base, link 2: the upper arm swinging past the base), bracket-weld 11.7 mm (same).
 SHIPPED_PLANS = {
-    "kuka-weld": [],
-    "ur5e-glue": [],
-    "seam-weld-fixed": [],
-    "ur5-bead": [],
+    "kuka-weld": [0.3147, -0.0547, 0.0948, 0.0057, -0.1603, -0.0140],
+    "ur5e-glue": [-0.2961, -0.4990, 0.2686, -0.2244, 0.0992, 2.4809],
+    "seam-weld-fixed": [0.5241, 0.2063, 0.0498, -0.2943, 0.2999, 2.4350],
+    "ur5-bead": [0.5961, -0.2199, -0.2935, -0.0136, -0.4994, -0.1238],
     "bracket-weld": [0.4676, -0.1793, -0.2823, 0.3, 0.0577, -2.1158],
 }
 

@@ -9,6 +9,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
+from trackplan.cell.robot_bodies import link_capsules_line
 from trackplan.cli import ExitCode
 from trackplan.cli.common import (
     AssumeLimitsOption,
@@ -18,7 +19,6 @@ from trackplan.cli.common import (
     load_each,
     shipped_cases_dir,
 )
-from trackplan.cell.robot_bodies import link_capsules_line
 from trackplan.cli.summaries import describe_case, robot_table, segment_corners
 from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot_spec, robot_to_yaml
 from trackplan.paths import NominalPath

@@ -474,7 +474,7 @@ def link_capsules(
         segments.append(transform_capsule(np.array([capsule.a, capsule.b]), T_frame_link))
         names.append(name)
     return Capsules(
-        np.array(frames), np.array(segments), np.array([c.radius for c in capsules]), names
+        np.array(frames), np.array(segments), np.array([c.radius for c in capsules]), tuple(names)
     )
 
 

