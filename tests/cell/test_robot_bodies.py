@@ -13,7 +13,7 @@ from trackplan.cell.robot_bodies import builtin_link_capsules
 from trackplan.cell.screening import CellGeometry
 from trackplan.frames import pose_matrix
 from trackplan.io.case_file import load_case
-from trackplan.io.robot_file import builtin_names, builtin_robot
+from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot
 from trackplan.planning.plan import plan_placement
 from trackplan.robots.kinematics import joint_frames
 
@@ -75,6 +75,49 @@ def test_planted_obstacle_hits_a_urdf_robots_forearm() -> None:
     T_above = pose_matrix(middle + np.array([0.0, 0.0, 0.5]), np.eye(3))
     above = Body("ball", Shape.SPHERE, T_above, [0.03, 0.0, 0.0])
     clear = CellGeometry.from_cell(Cell(obstacles=(above,), clearance=0.01), robot)
+    assert check_cell(clear, robot, q, TS, np.eye(4)).success
+
+
+TWO_LINK_URDF = """<?xml version="1.0"?>
+<robot name="two-link">
+  <link name="base"><collision><origin xyz="0 0 0.05"/>
+    <geometry><cylinder radius="0.08" length="0.1"/></geometry></collision></link>
+  <link name="upper"><collision><origin xyz="0.2 0 0" rpy="0 1.5707963267948966 0"/>
+    <geometry><cylinder radius="0.04" length="0.4"/></geometry></collision></link>
+  <link name="fore"><collision><origin xyz="0.15 0 0"/>
+    <geometry><box size="0.3 0.06 0.04"/></geometry></collision></link>
+  <link name="tip"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" velocity="2" effort="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" velocity="2" effort="1"/></joint>
+  <joint name="flange" type="fixed"><parent link="fore"/><child link="tip"/>
+    <origin xyz="0.3 0 0"/></joint>
+</robot>
+"""
+
+
+def test_planted_obstacle_hits_capsules_fitted_to_urdf_collisions(tmp_path: Path) -> None:
+    """A sphere on the forearm box's sweep (URDF <collision> elements, fitted capsules)."""
+    (tmp_path / "arm.urdf").write_text(TWO_LINK_URDF, encoding="utf-8")
+    robot = load_robot(tmp_path / "arm.urdf", assume_limits=True)
+    assert robot.collision is not None and robot.collision.name == ("base", "upper", "fore")
+    q = np.zeros((60, 2))
+    q[:, 0] = np.linspace(0.0, HALF_PI, 60)
+    # at q1 = π/4 the box's far end (0.7 m out, 0.3 m up) is at 45°
+    point = [0.7 * np.cos(np.pi / 4), 0.7 * np.sin(np.pi / 4), 0.3]
+    ball = Body("ball", Shape.SPHERE, pose_matrix(point, np.eye(3)), [0.02, 0.0, 0.0])
+    geometry = CellGeometry.from_cell(Cell(obstacles=(ball,)), robot)
+    report = check_cell(geometry, robot, q, TS, np.eye(4))
+    assert not report.success
+    assert report.violations[0].message.startswith("collision: fore hits ball")
+    assert report.violations[0].t_first <= 30 * TS <= report.violations[0].t_last
+    # just beyond the capsule (the box's half diagonal 0.036 m past its end) it is clear
+    beyond = [0.7 + 0.036 + 0.03, 0.0, 0.3]
+    ball = Body("ball", Shape.SPHERE, pose_matrix(beyond, np.eye(3)), [0.02, 0.0, 0.0])
+    clear = CellGeometry.from_cell(Cell(obstacles=(ball,)), robot)
     assert check_cell(clear, robot, q, TS, np.eye(4)).success
 
 
