@@ -310,23 +310,23 @@ def read_urdf_link_geometry(
             name = joint.parent
         else:
             link_frames[link.name] = (anchors[name], T_anchor_link)
-    capsules = Capsules.empty()
-    if collisions:
-        for link in robot.links:
-            if link.name not in link_frames:
-                continue
-            frame, T_frame_link = link_frames[link.name]
-            for collision in link.collisions:
-                segment, radius = _collision_capsule(collision, link.name, path)
-                T_link_shape = (
-                    np.eye(4) if collision.origin is None else np.asarray(collision.origin, float)
-                )
-                capsules = capsules + Capsules(
-                    np.array([frame]),
-                    transform_capsule(segment, T_frame_link @ T_link_shape)[None],
-                    np.array([radius]),
-                    (link.name,),
-                )
+    frames, segments, radii, names = [], [], [], []
+    for link in robot.links if collisions else ():
+        if link.name not in link_frames:
+            continue
+        frame, T_frame_link = link_frames[link.name]
+        for collision in link.collisions:
+            segment, radius = _collision_capsule(collision, link.name, path)
+            T_link_shape = (
+                np.eye(4) if collision.origin is None else np.asarray(collision.origin, float)
+            )
+            frames.append(frame)
+            segments.append(transform_capsule(segment, T_frame_link @ T_link_shape))
+            radii.append(radius)
+            names.append(link.name)
+    capsules = Capsules(
+        np.array(frames, dtype=np.int64), np.array(segments), np.array(radii), tuple(names)
+    )
     return URDFLinkGeometry(link_frames, capsules)
 
 
@@ -342,7 +342,9 @@ def _collision_capsule(collision: Any, link: str, path: str) -> tuple[np.ndarray
         return box_capsule(0.5 * size)
     if geometry.cylinder is not None:
         cylinder = geometry.cylinder
-        _positive(np.array([cylinder.radius, cylinder.length]), f"{where} cylinder", path)
+        _positive(
+            np.array([cylinder.radius, cylinder.length]), f"{where} cylinder radius, length", path
+        )
         return cylinder_capsule(float(cylinder.radius), float(cylinder.length))
     if geometry.sphere is not None:
         _positive(np.array([geometry.sphere.radius]), f"{where} sphere radius", path)
