@@ -103,8 +103,8 @@ def test_robot_file_collision_replaces_the_urdfs(tmp_path: Path) -> None:
     collision_urdf(tmp_path)
     (tmp_path / "arm.yaml").write_text(
         "name: arm\nurdf: arm.urdf\n" + LIMITS + "collision:\n"
-        "  - {link: l2b, a: [0, 0, 0], b: [0.1, 0, 0], radius: 0.03}\n"
-        "  - {link: 5, a: [0, 0, 0], b: [0, 0, 0.1], radius: 0.02}\n",
+        "  - {link: l2b, from: [0, 0, 0], to: [0.1, 0, 0], radius: 0.03}\n"
+        "  - {link: 5, from: [0, 0, 0], to: [0, 0, 0.1], radius: 0.02}\n",
         encoding="utf-8",
     )
     robot = load_robot(tmp_path / "arm.yaml")
@@ -153,7 +153,7 @@ def test_robots_command_counts_the_capsules(capsys: pytest.CaptureFixture[str]) 
     assert "link capsules: 9 on 6 bodies; 23 capsule pairs of non-adjacent bodies" in out
 
 
-DH_COLLISION = "collision:\n  - {link: 2, a: [0, 0, 0], b: [0.4, 0, 0], radius: 0.07}\n"
+DH_COLLISION = "collision:\n  - {link: 2, from: [0, 0, 0], to: [0.4, 0, 0], radius: 0.07}\n"
 
 
 @pytest.mark.parametrize(
@@ -164,9 +164,9 @@ DH_COLLISION = "collision:\n  - {link: 2, a: [0, 0, 0], b: [0.4, 0, 0], radius: 
         ("dh", "link: 2", "link: elbow", "collision[0].link: unknown link 'elbow'"),
         ("dh", "radius: 0.07", "radius: 0", "collision[0].radius: "),
         ("dh", "radius: 0.07", "radius: -0.1", "collision[0].radius: "),
-        ("dh", "b: [0.4, 0, 0]", "b: [.nan, 0, 0]", "collision[0].b"),
-        ("dh", "b: [0.4, 0, 0]", "b: [.inf, 0, 0]", "collision[0].b"),
-        ("dh", "b: [0.4, 0, 0]", "to: [0.4, 0, 0]", "collision[0]"),
+        ("dh", "to: [0.4, 0, 0]", "to: [.nan, 0, 0]", "collision[0].to"),
+        ("dh", "to: [0.4, 0, 0]", "to: [.inf, 0, 0]", "collision[0].to"),
+        ("dh", "to: [0.4, 0, 0]", "b: [0.4, 0, 0]", "collision[0]"),
         ("urdf", "link: l2b", "link: l9", "collision[0].link: no link 'l9' on the URDF's chain"),
         ("urdf", "link: l2b", "link: 8", "collision[0].link: expected a link number 0..7"),
         ("urdf", "radius: 0.03", "radius: 0", "collision[0].radius: "),
@@ -186,7 +186,7 @@ def test_bad_collision_key_is_one_line_exit_2(
         collision_urdf(tmp_path)
         text = (
             "name: arm\nurdf: arm.urdf\n" + LIMITS + "collision:\n"
-            "  - {link: l2b, a: [0, 0, 0], b: [0.1, 0, 0], radius: 0.03}\n"
+            "  - {link: l2b, from: [0, 0, 0], to: [0.1, 0, 0], radius: 0.03}\n"
         )
     assert old in text
     file = tmp_path / "robot.yaml"

@@ -10,7 +10,7 @@ A DH robot file (see ``docs/files.md``)::
          velocity: 8, acceleration: 10, jerk: 30}
     tool: {xyz: [0, 0, 0], rpy: [0, 0, 0]}     # optional
     collision:                                 # optional: link capsules (docs/cell.md)
-      - {link: 2, a: [-0.4318, 0, 0.2435], b: [0, 0, 0.2435], radius: 0.07}
+      - {link: 2, from: [-0.4318, 0, 0.2435], to: [0, 0, 0.2435], radius: 0.07}
 
 Lengths in metres, angles in radians, limits in rad/s, rad/s², rad/s³.
 ``T_flange_tool = Trans(xyz) · RPY(rpy)`` with ``RPY = Rz(yaw) · Ry(pitch) · Rx(roll)``.
@@ -38,7 +38,7 @@ A robot file for a URDF (paths relative to the file; see ``docs/robots.md``)::
     source: "where the numbers come from"        # optional
     assumptions: ["acceleration and jerk assumed: …"]   # optional
     collision:                    # optional: replaces the URDF's <collision> elements
-      - {link: link_2, a: [0, 0, 0], b: [0, 0, 0.705], radius: 0.12}
+      - {link: link_2, from: [0, 0, 0], to: [0, 0, 0.705], radius: 0.12}
 
 ``collision`` lists link capsules: ``link`` is a frame number (0 the base, i the link of
 joint i) or, for a URDF, a link name; ``a`` and ``b`` are the axis end points in that link's
@@ -148,11 +148,11 @@ class ToolModel(StrictModel):
 
 class CollisionCapsuleModel(StrictModel):
     """A link capsule: the link (number 0..n, or a URDF link's name), axis end points
-    ``a``, ``b`` in that link's frame (m) and radius (m)."""
+    ``from``, ``to`` in that link's frame (m) and radius (m)."""
 
     link: int | NonEmptyStr
-    a: Vec3
-    b: Vec3
+    from_: Vec3 = Field(alias="from")
+    to: Vec3
     radius: Positive
 
 
@@ -471,7 +471,7 @@ def link_capsules(
         else:
             (frame, T_frame_link), name = link_frames[capsule.link], capsule.link
         frames.append(frame)
-        segments.append(transform_capsule(np.array([capsule.a, capsule.b]), T_frame_link))
+        segments.append(transform_capsule(np.array([capsule.from_, capsule.to]), T_frame_link))
         names.append(name)
     return Capsules(
         np.array(frames), np.array(segments), np.array([c.radius for c in capsules]), tuple(names)
@@ -726,8 +726,8 @@ def robot_to_yaml(robot: Robot) -> str:
         data["collision"] = [
             _FlowMapping(
                 link=int(robot.collision.frame[k]),
-                a=[float(value) for value in robot.collision.segment[k, 0]],
-                b=[float(value) for value in robot.collision.segment[k, 1]],
+                **{"from": [float(value) for value in robot.collision.segment[k, 0]]},
+                to=[float(value) for value in robot.collision.segment[k, 1]],
                 radius=float(robot.collision.radius[k]),
             )
             for k in range(len(robot.collision))
