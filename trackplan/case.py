@@ -1,4 +1,4 @@
-"""A validated case: robot, path, task, placement bounds, objective and optimizer settings.
+"""A validated case: robot, path(s), task, placement bounds, objective and optimizer settings.
 
 Pure data. :func:`trackplan.io.case_file.load_case` builds it from a YAML file;
 a notebook can build it directly.
@@ -6,7 +6,7 @@ a notebook can build it directly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -143,6 +143,63 @@ class OptimizerSettings:
 
 
 @dataclass(frozen=True, eq=False)
+class Seam:
+    """One named path of a workpiece with several seams (``paths:`` in the case file).
+
+    Attributes
+    ----------
+    name
+        Seam name, unique in the case.
+    start
+        First point in the definition frame, shape (3,), m.
+    segments
+        The path segments, in order.
+    task
+        The seam's task: the case's ``task`` with the seam's own overrides.
+    reversible
+        Whether the seam may be welded end to start.
+    """
+
+    name: str
+    start: np.ndarray
+    segments: tuple[SegmentSpec, ...]
+    task: Task
+    reversible: bool = True
+
+
+SEQUENCE_MODES = ("optimize", "given")
+"""How the seams of a cycle are ordered: chosen (order and direction), or as written."""
+
+
+@dataclass(frozen=True, eq=False)
+class Cycle:
+    """Several seams welded at one placement, with the moves between them (``docs/seams.md``).
+
+    Attributes
+    ----------
+    seams
+        The seams as written, at least one.
+    sequence
+        ``optimize`` (order and directions chosen) or ``given`` (as written, forward).
+    approach
+        Approach and retract distance along the tool axis at each seam end, m (≥ 0).
+    home
+        Joint configuration the cycle starts from and returns to, shape (n,), rad, or
+        None to start at the first approach pose and end at the last retract pose.
+    """
+
+    seams: tuple[Seam, ...]
+    sequence: str = "optimize"
+    approach: float = 0.0
+    home: np.ndarray | None = None
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Seam names in the order written."""
+        return tuple(seam.name for seam in self.seams)
+
+
+@dataclass(frozen=True, eq=False)
 class Case:
     """Everything needed to plan and optimize one path-following task.
 
@@ -163,6 +220,10 @@ class Case:
         without collision checks.
     source
         The case file, if the case came from one.
+    cycle
+        Several seams (``paths:``), or None for the one path above. With a cycle,
+        ``start``, ``segments`` and ``task`` are those of its first seam, and
+        :meth:`seam_case` gives the single-path case of every seam.
     """
 
     name: str
@@ -175,3 +236,26 @@ class Case:
     optimizer: OptimizerSettings = field(default_factory=OptimizerSettings)
     source: str | None = None
     cell: Cell | None = None
+    cycle: Cycle | None = None
+
+    @property
+    def seams(self) -> tuple[Seam, ...]:
+        """The seams: the cycle's, or the one path of a single-path case."""
+        if self.cycle is not None:
+            return self.cycle.seams
+        return (Seam(self.name, self.start, self.segments, self.task, reversible=False),)
+
+    def seam_case(self, index: int) -> Case:
+        """The single-path case of seam ``index`` (its path and task, the case's robot,
+        cell, bounds, objective and optimizer; named after the seam)."""
+        seam = self.seams[index]
+        if self.cycle is None:
+            return self
+        return replace(
+            self,
+            name=seam.name,
+            start=seam.start,
+            segments=seam.segments,
+            task=seam.task,
+            cycle=None,
+        )

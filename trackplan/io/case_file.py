@@ -20,9 +20,11 @@ from pydantic_core import PydanticCustomError
 from trackplan.case import (
     PLACEMENT_KEYS,
     Case,
+    Cycle,
     Objective,
     OptimizerSettings,
     PlacementBounds,
+    Seam,
     Task,
 )
 from trackplan.choices import Method, Penalty, Timing
@@ -32,6 +34,8 @@ from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, p
 from trackplan.io.sizes import MAX_SAMPLE_TIME, size_problems
 from trackplan.io.tool_file import ToolModel, as_spec, tool_problems
 from trackplan.io.yaml_input import (
+    Coordinate,
+    Loc,
     NonEmptyStr,
     NonNegative,
     Positive,
@@ -141,6 +145,24 @@ class TaskModel(StrictModel):
     timing: Literal["smooth", "paper"] = "smooth"
 
 
+class SeamTaskModel(StrictModel):
+    """A seam's ``task``: overrides of the case's speeds (m/s), tolerance (m) and tool."""
+
+    rated_speed: Positive | None = None
+    corner_speed: Positive | None = None
+    tolerance: Positive | None = None
+    tool_rpy: Vec3 | None = None
+    tool: ToolModel | None = None
+
+
+class SeamModel(PathModel):
+    """One entry of ``paths``: a named path, its task overrides, whether it may be reversed."""
+
+    name: NonEmptyStr
+    task: SeamTaskModel | None = None
+    reversible: bool = True
+
+
 class PlacementModel(StrictModel):
     """``placement``: search ranges [min, max] of X and the reach range, m and rad."""
 
@@ -181,7 +203,11 @@ class CaseModel(StrictModel):
     name: NonEmptyStr
     robot: NonEmptyStr = "puma560"
     payload: PayloadModel | None = None
-    path: PathModel
+    path: PathModel | None = None
+    paths: Annotated[list[SeamModel], Field(min_length=1)] | None = None
+    sequence: Literal["optimize", "given"] | None = None
+    approach: NonNegative | None = None
+    home: Annotated[list[Coordinate], Field(min_length=1)] | None = None
     task: TaskModel
     placement: PlacementModel = PlacementModel()
     objective: ObjectiveModel = ObjectiveModel()
@@ -282,14 +308,27 @@ def load_case_data(
     """
     base = Path(base_dir)
     model = validate_model(CaseModel, data, file)
+    raise_first(_seam_key_problems(model), data, file)
     robot = load_robot_spec(model.robot, base, case_file=file, assume_limits=assume_limits)
-    start = _array(model.path.start)
-    segments = tuple(
-        _segment(segment, base, file, ("path", "segments", k))
-        for k, segment in enumerate(model.path.segments)
-    )
+    seams = _seam_models(model)
+    paths = [
+        (
+            _array(seam.start),
+            tuple(
+                _segment(segment, base, file, (*loc, "segments", k))
+                for k, segment in enumerate(seam.segments)
+            ),
+        )
+        for loc, seam in seams
+    ]
+    start, segments = paths[0]
     problems = [
-        *_path_problems(start, segments, model, base),
+        *(
+            problem
+            for (loc, _), (seam_start, seam_segments) in zip(seams, paths, strict=True)
+            for problem in _path_problems(seam_start, seam_segments, model, base, loc)
+        ),
+        *_home_problems(model.home, robot),
         *_placement_problems(
             model.placement, _ranges(model.placement, robot), _reach(model.placement, robot)
         ),
@@ -298,22 +337,42 @@ def load_case_data(
         *_objective_kind_problems(model.objective, robot),
         *_payload_problems(model.payload, robot),
     ]
-    nominal = None if problems else NominalPath.from_specs(start, segments)
-    problems += tool_problems(model.task.tool, model.task.tool_rpy, nominal)
+    for (loc, seam), (seam_start, seam_segments) in zip(seams, paths, strict=True):
+        nominal = None if problems else NominalPath.from_specs(seam_start, seam_segments)
+        own = seam.task if isinstance(seam, SeamModel) else None
+        if own is not None and (own.tool is not None or own.tool_rpy is not None):
+            problems += [
+                ((*loc, *where), message)
+                for where, message in tool_problems(own.tool, own.tool_rpy, nominal)
+            ]
+        else:
+            problems += tool_problems(model.task.tool, model.task.tool_rpy, nominal)
     raise_first(problems, data, file)
-    sizes = size_problems(
-        start,
-        segments,
-        n_dof=robot.n_dof,
-        rated_speed=model.task.rated_speed,
-        sample_time=model.task.sample_time,
-        population=model.optimizer.population,
-    )
-    raise_first(sizes, data, file)
+    for (loc, seam), (seam_start, seam_segments) in zip(seams, paths, strict=True):
+        own = seam.task if isinstance(seam, SeamModel) else None
+        sizes = size_problems(
+            seam_start,
+            seam_segments,
+            n_dof=robot.n_dof,
+            rated_speed=(
+                own.rated_speed
+                if own is not None and own.rated_speed is not None
+                else model.task.rated_speed
+            ),
+            sample_time=model.task.sample_time,
+            population=model.optimizer.population,
+        )
+        raise_first(
+            [(loc + where[1:] if where[:1] == ("path",) else where, m) for where, m in sizes],
+            data,
+            file,
+        )
     if model.payload is not None and robot.dynamics is not None:
         dynamics = dataclasses.replace(robot.dynamics, payload=as_payload(model.payload))
         robot = dataclasses.replace(robot, dynamics=dynamics)
     case = _case(model, robot, start, segments, file)
+    if model.paths is not None:
+        case = _with_cycle(case, model, paths)
     if model.cell is None:
         return case
     return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
@@ -374,6 +433,117 @@ def _case(
     )
 
 
+def _seam_models(model: CaseModel) -> list[tuple[Loc, PathModel]]:
+    """Every path of the case with its location: ``path``, or each entry of ``paths``."""
+    if model.paths is not None:
+        return [(("paths", k), seam) for k, seam in enumerate(model.paths)]
+    assert model.path is not None  # _seam_key_problems requires one of them
+    return [(("path",), model.path)]
+
+
+def _seam_key_problems(model: CaseModel) -> list[Problem]:
+    """``path`` or ``paths`` (not both, not neither); unique seam names; the cycle keys
+    only with ``paths``."""
+    if model.path is not None and model.paths is not None:
+        return [
+            (
+                ("paths",),
+                "give path (one seam) or paths (several named seams), not both; "
+                "move path into paths as one named entry",
+            )
+        ]
+    if model.path is None and model.paths is None:
+        return [(("path",), "required key is missing")]
+    if model.paths is None:
+        return [
+            ((key,), f"{key} is only used with paths (several seams)")
+            for key in ("sequence", "approach", "home")
+            if getattr(model, key) is not None
+        ]
+    problems: list[Problem] = []
+    first: dict[str, int] = {}
+    for k, seam in enumerate(model.paths):
+        if seam.name in first:
+            problems.append(
+                (
+                    ("paths", k, "name"),
+                    f"seam name {seam.name!r} is used twice (also paths[{first[seam.name]}]"
+                    ".name); give each seam its own name",
+                )
+            )
+        first.setdefault(seam.name, k)
+    return problems
+
+
+def _home_problems(home: list[float] | None, robot: Robot) -> list[Problem]:
+    """``home``: one value per joint, inside the joint limits."""
+    if home is None:
+        return []
+    if len(home) != robot.n_dof:
+        return [
+            (
+                ("home",),
+                f"expected {robot.n_dof} joint values (one per joint of {robot.name}), rad, "
+                f"got {len(home)}: {show(home)}",
+            )
+        ]
+    return [
+        (
+            ("home", i),
+            f"joint {i + 1} at {value:.6g} rad is outside its limits "
+            f"[{robot.q_min[i]:.6g}, {robot.q_max[i]:.6g}] rad",
+        )
+        for i, value in enumerate(home)
+        if not robot.q_min[i] <= value <= robot.q_max[i]
+    ]
+
+
+def _with_cycle(
+    case: Case, model: CaseModel, paths: list[tuple[np.ndarray, tuple[SegmentSpec, ...]]]
+) -> Case:
+    """The case with its seams (``paths``), their tasks and the cycle settings."""
+    assert model.paths is not None
+    seams = []
+    for seam, (start, segments) in zip(model.paths, paths, strict=True):
+        own = seam.task or SeamTaskModel()
+        task = case.task
+        rated = task.rated_speed if own.rated_speed is None else own.rated_speed
+        if own.corner_speed is not None:
+            corner = own.corner_speed
+        elif model.task.corner_speed is not None:
+            corner = model.task.corner_speed
+        else:
+            corner = rated
+        tool = task.tool
+        if own.tool is not None or own.tool_rpy is not None:
+            tool = as_spec(own.tool, own.tool_rpy)
+        seams.append(
+            Seam(
+                name=seam.name,
+                start=start,
+                segments=segments,
+                task=dataclasses.replace(
+                    task,
+                    rated_speed=rated,
+                    corner_speed=corner,
+                    tolerance=task.tolerance if own.tolerance is None else own.tolerance,
+                    tool=tool,
+                ),
+                reversible=seam.reversible,
+            )
+        )
+    cycle = Cycle(
+        seams=tuple(seams),
+        sequence=model.sequence or "optimize",
+        approach=0.0 if model.approach is None else model.approach,
+        home=None if model.home is None else _array(model.home),
+    )
+    first = cycle.seams[0]
+    return dataclasses.replace(
+        case, start=first.start, segments=first.segments, task=first.task, cycle=cycle
+    )
+
+
 def _array(values: Any) -> np.ndarray:
     """A read-only float64 copy."""
     array = np.array(values, dtype=float)
@@ -399,21 +569,31 @@ def _segment(
 
 
 def _path_problems(
-    start: np.ndarray, segments: tuple[SegmentSpec, ...], model: CaseModel, base: Path
+    start: np.ndarray,
+    segments: tuple[SegmentSpec, ...],
+    model: CaseModel,
+    base: Path,
+    at: Loc = ("path",),
 ) -> list[Problem]:
-    """Degenerate geometry (:func:`trackplan.paths.check_segments`), located in the file."""
+    """Degenerate geometry (:func:`trackplan.paths.check_segments`), located in the file
+    (``at``: the path's location, ``path`` or ``paths[k]``)."""
     problems: list[Problem] = []
     for key, message in check_segments(start, segments):
-        loc = parse_key_path(key)
-        csv = _points_file(model, loc)
+        loc = (*at, *parse_key_path(key)[1:])
+        csv = _points_file(model, loc, len(at))
         problems.append((loc, f"{message} (in {base / csv})" if csv else message))
     return problems
 
 
-def _points_file(model: CaseModel, loc: tuple[str | int, ...]) -> str | None:
-    """The CSV file a problem location points into, if any."""
-    if len(loc) > 2 and loc[1] == "segments" and isinstance(loc[2], int):
-        points = model.path.segments[loc[2]].points
+def _points_file(model: CaseModel, loc: Loc, depth: int = 1) -> str | None:
+    """The CSV file a problem location points into, if any (``loc[:depth]`` locates the
+    path)."""
+    rest = loc[depth:]
+    if len(rest) > 1 and rest[0] == "segments" and isinstance(rest[1], int):
+        path = model.path if depth == 1 else model.paths[int(loc[1])] if model.paths else None
+        if path is None:
+            return None
+        points = path.segments[rest[1]].points
         if isinstance(points, PointsFileModel):
             return points.file
     return None

@@ -12,11 +12,12 @@ final re-check reject the best one).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from pymoo.core.problem import Problem
 
-from trackplan.search.fitness import PlacementFitness, Screening
+from trackplan.search.fitness import Screening
 from trackplan.search.space import SearchSpace
 
 ARCHIVE_SIZE = 8
@@ -84,6 +85,17 @@ class Archive:
         return Archive(X[index], fitness[index], objective[index], feasible[index], branch[index])
 
 
+class Fitness(Protocol):
+    """What the problem evaluates: :class:`~trackplan.search.fitness.PlacementFitness`, or
+    the several-seam fitness of :mod:`trackplan.search.cycle_search`."""
+
+    penalty: float
+
+    def evaluate(self, X: np.ndarray, incumbent: float = np.inf) -> Screening:
+        """Fitness of a batch of candidates, shape (B, n_var)."""
+        ...
+
+
 class PlacementProblem(Problem):
     """Bounded variables X = (x, y, z, roll, pitch, yaw, spin...), one objective: Eq. 30.
 
@@ -104,7 +116,7 @@ class PlacementProblem(Problem):
         The screening of the latest batch, or None before the first.
     """
 
-    def __init__(self, space: SearchSpace, fitness: PlacementFitness):
+    def __init__(self, space: SearchSpace, fitness: Fitness):
         super().__init__(n_var=space.n_var, n_obj=1, xl=space.lower, xu=space.upper, vtype=float)
         self.space = space
         self.fitness = fitness

@@ -1,0 +1,446 @@
+"""One placement for every seam of a workpiece: the batched fitness and the search.
+
+The fitness of a batch of B placements screens every seam on its own screening grid with
+the single-path screening (:meth:`trackplan.search.fitness.PlacementFitness.screen_branches`,
+each call batched over the whole population and every IK branch), keeps per seam and
+candidate the branch clear of the cell with the least J, and adds the moves between the
+seams: per candidate the best sequence (:func:`trackplan.planning.sequence.best_sequence`)
+on the estimated air moves between the seams' end configurations on the screening grid
+(:func:`trackplan.timing.airmove.air_time_estimate`; a reversed seam on the same branch
+swaps its ends). A candidate is feasible only if every seam is.
+
+Fitness (minimised)
+-------------------
+- feasible: ``Σ_seams (J + w·T_low) + air``, ``J`` Eq. 8 on each seam's screening grid,
+  ``T_low`` the duration bound of :mod:`trackplan.search.fitness`, ``w`` the time weight,
+  and ``air`` the sequence's estimated moves, each costing ``Σ C_i |Δq_i| + w·T_air``;
+- infeasible: ``M + v`` (graded) or ``M`` (flat), ``v`` the largest graded violation over
+  the seams (the scale of :mod:`trackplan.search.fitness`).
+
+The search runs the case's method on this fitness (:class:`PlacementProblem`, the same
+algorithms, stopping rules and archive as a single path), then plans the archive's
+candidates best first with :func:`trackplan.planning.cycle.plan_cycle` until one passes the
+checker. The spin of a free-spin tool stays in the middle of its range (it is not searched
+for several seams).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from pymoo.core.algorithm import Algorithm
+
+from trackplan.case import Case
+from trackplan.choices import Method, choose
+from trackplan.errors import CaseError
+from trackplan.planning.cycle import CycleResult, SeamGeometries, plan_cycle, seam_geometries
+from trackplan.planning.sequence import best_sequence
+from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm, make_termination
+from trackplan.search.fitness import (
+    REACH_LEVEL,
+    REACH_SCALE,
+    Finding,
+    PlacementFitness,
+    Screening,
+)
+from trackplan.search.optimize import GenerationRecord, SearchHistory, _run, run_seeds
+from trackplan.search.problem import PlacementProblem
+from trackplan.search.space import SearchSpace
+from trackplan.status import Status
+from trackplan.timing import time_law
+from trackplan.timing.airmove import air_time_estimate
+
+FINAL_TRIES = 4
+"""Archive candidates planned in full, best first, before the search gives up on them."""
+POSE_SPACING = 0.005
+"""Screening grid spacing along each seam, m (about that of a single 0.8 m path's 150
+poses); short seams need far fewer poses than :data:`~trackplan.search.fitness.SCREEN_POSES`."""
+MIN_POSES = 20
+"""Fewest poses of a seam's screening grid."""
+
+
+@dataclass(frozen=True, eq=False)
+class SeamScreen:
+    """Every seam of B placements on its chosen branch.
+
+    Attributes
+    ----------
+    ok
+        Shape (m, B), bool: the seam has a feasible branch clear of the cell.
+    objective
+        J of each seam on its branch, shape (m, B) (inf where not ``ok``).
+    bound
+        Duration bound of each seam, shape (m, B), s.
+    branch
+        Chosen branch, shape (m, B), int.
+    violation, finding
+        Graded violation and :class:`Finding` per seam, shape (m, B).
+    q_first, q_last
+        The seam's first and last configuration on the screening grid, shape (m, B, n), rad.
+    """
+
+    ok: np.ndarray
+    objective: np.ndarray
+    bound: np.ndarray
+    branch: np.ndarray
+    violation: np.ndarray
+    finding: np.ndarray
+    q_first: np.ndarray
+    q_last: np.ndarray
+
+
+class CycleFitness:
+    """The batched fitness of one placement for every seam (see the module docstring).
+
+    Parameters
+    ----------
+    case
+        The case (with ``cycle``).
+    space
+        Its search space (six placement variables).
+    geometries
+        The seams' paths (:func:`trackplan.planning.cycle.seam_geometries`).
+    timing
+        The time law.
+
+    Attributes
+    ----------
+    feasible_count
+        How many evaluated candidates reach each seam feasibly, shape (m,), int.
+    """
+
+    def __init__(self, case: Case, space: SearchSpace, geometries: SeamGeometries, timing: str):
+        self.case = case
+        self.space = space
+        self.seams = [
+            PlacementFitness(
+                case.seam_case(i),
+                space,
+                geometries[i, False],
+                timing,
+                n_poses=max(
+                    MIN_POSES,
+                    int(np.ceil(geometries[i, False].planned.length / POSE_SPACING)) + 1,
+                ),
+            )
+            for i in range(len(case.seams))
+        ]
+        self.penalty = float(case.objective.flat_penalty)
+        self.flat = self.seams[0].flat
+        self.time_weight = float(case.objective.time_weight)
+        self.weights = np.asarray(case.objective.weights, dtype=float)
+        self.reversible = np.array([seam.reversible for seam in case.seams])
+        self.home = None if case.cycle is None else case.cycle.home
+        self.feasible_count = np.zeros(len(case.seams), dtype=int)
+
+    def screen_seams(self, X: np.ndarray) -> SeamScreen:
+        """Screen every seam of placements inside the reach interval.
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6), metres and radians.
+
+        Returns
+        -------
+        SeamScreen
+        """
+        rows = np.arange(len(X))
+        parts = []
+        for fitness in self.seams:
+            tool = fitness.case.task.tool
+            variables = np.hstack([X, np.tile(tool.default_variables(), (len(X), 1))])
+            screen = fitness.screen_branches(variables)
+            values = screen.values(fitness.case.objective)
+            violation = screen.violation
+            finding = screen.finding
+            if fitness.cell is not None:
+                values, violation = fitness._screen_cell(X, screen.grid.q, values, violation)
+                blocked = np.isinf(values) & screen.ok
+                finding = np.where(blocked, int(Finding.COLLISION), finding)
+            ok = np.isfinite(values).any(axis=1)
+            choice = np.where(ok, np.argmin(values, axis=1), np.argmin(violation, axis=1))
+            q = screen.grid.q[rows, choice]  # (B, M, n)
+            parts.append(
+                (
+                    ok,
+                    np.where(ok, values[rows, choice], np.inf),
+                    screen.grid.dt[rows, choice].sum(axis=1),
+                    screen.branches[choice],
+                    np.where(ok, 0.0, violation[rows, choice]),
+                    np.where(ok, int(Finding.FEASIBLE), finding[rows, choice]),
+                    q[:, 0],
+                    q[:, -1],
+                )
+            )
+        return SeamScreen(*(np.stack(column) for column in zip(*parts, strict=True)))
+
+    def air_cost(self, seams: SeamScreen, b: int) -> float:
+        """Estimated cost of the moves of candidate ``b`` in its best sequence: per move
+        ``Σ C_i |Δq_i| + w · T``, plus each seam's own cost."""
+        ends = np.stack([seams.q_first[:, b], seams.q_last[:, b]], axis=1)  # (m, 2, n)
+        q_in = ends  # forward starts at the first end, reversed at the last
+        q_out = ends[:, ::-1]
+        air = self._move(q_out[:, :, None, None], q_in[None, None])
+        m = len(self.seams)
+        seam_cost = np.zeros((m, 2))
+        if self.home is None:
+            start = np.zeros((m, 2))
+            end = np.zeros((m, 2))
+        else:
+            start = self._move(self.home, q_in)
+            end = self._move(q_out, self.home)
+        return best_sequence(seam_cost, air, start, end, self.reversible).cost
+
+    def _move(self, q_from: np.ndarray, q_to: np.ndarray) -> np.ndarray:
+        robot = self.case.robot
+        travel = np.sum(self.weights * np.abs(q_to - q_from), axis=-1)
+        if self.time_weight == 0.0:
+            return np.asarray(travel)
+        duration = air_time_estimate(q_from, q_to, robot.v_max, robot.a_max, robot.j_max)
+        return np.asarray(travel + self.time_weight * duration)
+
+    def evaluate(self, X: np.ndarray, incumbent: float = np.inf) -> Screening:
+        """Fitness of a batch of placements.
+
+        Parameters
+        ----------
+        X
+            Placements, shape (B, 6), metres and radians.
+        incumbent
+            Unused (every feasible candidate is ranked by its screening figures).
+
+        Returns
+        -------
+        Screening
+            ``objective`` is Σ J of the seams on their screening grids, ``duration_bound``
+            the sum of their bounds; ``branch`` the first seam's branch.
+        """
+        X = np.atleast_2d(np.asarray(X, dtype=float))[:, :6]
+        n = len(X)
+        fitness = np.full(n, np.nan)
+        objective = np.full(n, np.nan)
+        bound = np.full(n, np.nan)
+        branch = np.zeros(n, dtype=int)
+        excess = self.space.reach_excess(X)
+        violation = REACH_LEVEL + excess / REACH_SCALE
+        finding = np.full(n, int(Finding.REACH))
+        inside = np.flatnonzero(excess == 0.0)
+        if len(inside):
+            seams = self.screen_seams(X[inside])
+            self.feasible_count += seams.ok.sum(axis=1)
+            all_ok = seams.ok.all(axis=0)
+            worst = np.argmax(seams.violation, axis=0)
+            violation[inside] = seams.violation.max(axis=0)
+            finding[inside] = seams.finding[worst, np.arange(len(inside))]
+            branch[inside] = seams.branch[0]
+            for k in np.flatnonzero(all_ok):
+                b = inside[k]
+                air = self.air_cost(seams, int(k))
+                bound[b] = seams.bound[:, k].sum()
+                objective[b] = seams.objective[:, k].sum()
+                fitness[b] = objective[b] + self.time_weight * bound[b] + air
+            finding[inside[all_ok]] = int(Finding.FEASIBLE)
+        feasible = finding == Finding.FEASIBLE
+        violation[feasible] = 0.0
+        fitness[~feasible] = self.penalty + (0.0 if self.flat else violation[~feasible])
+        return Screening(
+            X,
+            fitness,
+            objective,
+            np.full(n, np.nan),
+            bound,
+            feasible,
+            branch,
+            violation,
+            finding,
+        )
+
+    def branches(self, X: np.ndarray) -> tuple[int, ...]:
+        """The branch the screening chooses for each seam at one placement X (6,)."""
+        seams = self.screen_seams(np.asarray(X, dtype=float)[None, :6])
+        return tuple(int(b) for b in seams.branch[:, 0])
+
+    def unreachable_seams(self) -> tuple[str, ...]:
+        """Seams that no evaluated candidate reached feasibly, by name."""
+        names = self.case.seams
+        return tuple(names[i].name for i in np.flatnonzero(self.feasible_count == 0))
+
+
+@dataclass(frozen=True, eq=False)
+class CycleSearchResult:
+    """Outcome of :func:`optimize_cycle`.
+
+    Attributes
+    ----------
+    success, status, message
+        As for :class:`~trackplan.search.optimize.OptimizeResult`; the message names the
+        seam that decides when nothing feasible was found.
+    X
+        Best placement, shape (6,).
+    fitness
+        Its screened fitness.
+    objective
+        J of the final cycle (Eq. 8 over every sample).
+    final
+        The cycle planned at X (:class:`~trackplan.planning.cycle.CycleResult`).
+    history, evaluations, generations, stop_reason, wall_time_s, method, seed, runs
+        As for a single path.
+    unreachable
+        Seams no evaluated placement reached, by name.
+    rejected
+        Candidates screened feasible whose full cycle failed the check, shape (R, 6).
+    """
+
+    success: bool
+    status: Status
+    message: str
+    X: np.ndarray
+    fitness: float
+    objective: float
+    final: CycleResult
+    history: SearchHistory
+    evaluations: int
+    generations: int
+    stop_reason: str
+    wall_time_s: float
+    method: str
+    seed: int
+    runs: int = 1
+    unreachable: tuple[str, ...] = ()
+    rejected: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+
+
+def optimize_cycle(
+    case: Case,
+    *,
+    method: str | Method | None = None,
+    seed: int | None = None,
+    budget: int | None = None,
+    progress: Callable[[GenerationRecord], None] | None = None,
+    timing: str | None = None,
+    restarts: int | None = None,
+) -> CycleSearchResult:
+    """Search one placement X for every seam of the case, with the best sequence.
+
+    Parameters
+    ----------
+    case
+        A case with several seams (``paths:``).
+    method, seed, budget, progress, timing, restarts
+        As for :func:`trackplan.search.optimize.optimize_placement`.
+
+    Returns
+    -------
+    CycleSearchResult
+
+    Raises
+    ------
+    CaseError
+        For an unknown method or timing, a negative budget or seed, or bounds with no
+        placement inside the reach interval.
+    """
+    start = time.perf_counter()
+    method = choose(Method, method or case.optimizer.method, "method")
+    seed = case.optimizer.seed if seed is None else int(seed)
+    budget = case.optimizer.budget if budget is None else int(budget)
+    restarts = case.optimizer.restarts if restarts is None else restarts
+    restarts = int(DEFAULT_RESTARTS[method] if restarts is None else restarts)
+    if seed < 0:
+        raise CaseError(f"seed must be ≥ 0, got {seed}", key="seed")
+    if budget is not None and budget < 1:
+        raise CaseError(f"budget must be ≥ 1 evaluation, got {budget}", key="budget")
+    law = time_law(timing or case.task.timing)
+    space = SearchSpace.from_bounds(case.bounds, case.source)
+    geometries = seam_geometries(case, law.timing)
+    fitness = CycleFitness(case, space, geometries, law.timing)
+    problem = PlacementProblem(space, fitness)
+    records: list[GenerationRecord] = []
+    stop_reason = ""
+    runs = 0
+    for run_seed in run_seeds(seed, restarts):
+        algorithm: Algorithm = make_algorithm(method, space, case.optimizer.population)
+        rules, parts = make_termination(None, method)
+        algorithm.setup(problem, termination=rules, seed=run_seed)
+        stop_reason = _run(algorithm, problem, parts, budget, progress, start, records)
+        runs += 1
+        if stop_reason in ("budget", "interrupted"):
+            break
+    final, rejected, fitness_value = _final_cycle(case, problem, fitness, law.timing, geometries)
+    unreachable = fitness.unreachable_seams()
+    status = Status.INTERRUPTED if stop_reason == "interrupted" else final.status
+    return CycleSearchResult(
+        success=status is Status.FEASIBLE,
+        status=status,
+        message=_message(final, problem.n_evaluations, unreachable, rejected),
+        X=final.placement,
+        fitness=fitness_value,
+        objective=float(final.objective),
+        final=final,
+        history=SearchHistory.from_records(records),
+        evaluations=problem.n_evaluations,
+        generations=len(records),
+        stop_reason=stop_reason,
+        wall_time_s=time.perf_counter() - start,
+        method=str(method),
+        seed=seed,
+        runs=runs,
+        unreachable=unreachable,
+        rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),
+    )
+
+
+def _final_cycle(
+    case: Case,
+    problem: PlacementProblem,
+    fitness: CycleFitness,
+    timing: str,
+    geometries: SeamGeometries,
+) -> tuple[CycleResult, list[np.ndarray], float]:
+    """Plan the archive's candidates best first until a cycle passes the checker (at most
+    :data:`FINAL_TRIES` screened feasible ones); the cycle, the rejected placements and the
+    chosen candidate's screened fitness."""
+    archive = problem.archive
+    if not len(archive.X):
+        raise CaseError("the search evaluated no placement (budget 0?)", key="budget")
+    rejected: list[np.ndarray] = []
+    first: tuple[CycleResult, float] | None = None
+    for X, feasible, value in zip(archive.X, archive.feasible, archive.fitness, strict=True):
+        if first is not None and (not feasible or len(rejected) >= FINAL_TRIES):
+            break
+        cycle = plan_cycle(
+            case, X[:6], timing=timing, geometries=geometries, branches=fitness.branches(X)
+        )
+        if cycle.success:
+            return cycle, rejected, float(value)
+        first = first or (cycle, float(value))
+        if feasible:
+            rejected.append(X[:6])
+    assert first is not None
+    return first[0], rejected, first[1]
+
+
+def _message(
+    final: CycleResult, evaluations: int, unreachable: tuple[str, ...], rejected: list
+) -> str:
+    """One line on the outcome."""
+    if final.success:
+        note = (
+            f" ({len(rejected)} better screened candidates failed the full check)"
+            if rejected
+            else ""
+        )
+        return (
+            f"feasible placement for all {len(final.seams)} seams found in {evaluations} "
+            f"evaluations: cycle time {final.duration:.3f} s (air {final.air_time:.3f} s), "
+            f"J = {final.objective:.4f}{note}"
+        )
+    if unreachable:
+        return (
+            f"seam {unreachable[0]} is feasible at none of the {evaluations} placements "
+            f"evaluated; at the closest: {final.message}"
+        )
+    return f"no feasible placement for every seam in {evaluations} evaluations: {final.message}"
