@@ -64,6 +64,11 @@ def plan(
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
     X = placement(loaded, X_given)
+    if loaded.cycle is not None:  # several seams: docs/seams.md
+        from trackplan.cli.cycle import plan_cycle_command, refuse_options
+
+        refuse_options(branch=branch, reference=reference, spin=spin, spin_profile=spin_profile)
+        return plan_cycle_command(loaded, X, out, timing=timing, report=report)
     if spin is not None and spin_profile is not None:
         raise CaseError("give --spin or --spin-profile, not both", key="--spin")
     given = None
@@ -109,6 +114,10 @@ def check(
     loaded = load_case(case, assume_limits=assume_limits)
     X = placement(loaded, X_given)
     csv = verified_trajectory(run)
+    if loaded.cycle is not None:  # several seams: docs/seams.md
+        from trackplan.cli.cycle import check_cycle_command
+
+        return check_cycle_command(loaded, X, csv)
     t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
     sample_time = float(np.median(np.diff(t)))
     if not sample_time > 0 or not np.allclose(np.diff(t), sample_time, rtol=1e-6, atol=1e-9):

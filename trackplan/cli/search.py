@@ -90,6 +90,20 @@ def optimize(
         from trackplan.planning.objectives import with_objective
 
         loaded = with_objective(loaded, objective)
+    if loaded.cycle is not None:  # several seams: docs/seams.md
+        from trackplan.cli.cycle import optimize_cycle_command, refuse_options
+
+        refuse_options(pareto=pareto)
+        return optimize_cycle_command(
+            loaded,
+            out,
+            report=report,
+            method=method,
+            seed=seed,
+            budget=budget,
+            restarts=restarts,
+            timing=timing,
+        )
     if pareto is not None:
         return _pareto(loaded, pareto, out, seed=seed, timing=timing, report=report)
     return _search_and_write(

@@ -145,7 +145,8 @@ def read_trajectory_table(file: Path) -> TrajectoryTable:
     ------
     CaseError
         Naming the file and what is wrong: missing, unreadable, a header that is not
-        ``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed,spin``, a non-numeric or short
+        ``t,q1..qn,qd1..qdn,qdd1..qddn,qddd1..qdddn,x,y,z,speed,spin`` (and ``segment``
+        for several seams), a non-numeric or short
         row, a non-finite value, no sample, or times that do not increase.
     """
     file = _trajectory_file(Path(file))
@@ -158,6 +159,9 @@ def read_trajectory_table(file: Path) -> TrajectoryTable:
         raise CaseError(f"cannot read the trajectory: {error}", file=where) from None
     header = lines[0].strip().split(",") if lines else []
     body = [line for line in lines[1:] if line.strip()]
+    if header[-1:] == ["segment"]:  # a cycle of several seams: the labels are not exported
+        header = header[:-1]
+        body = [line.rsplit(",", 1)[0] for line in body]
     if not body:
         raise CaseError("the trajectory has no sample", file=where)
     try:

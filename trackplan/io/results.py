@@ -59,7 +59,7 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     """Read the time and joint columns of a ``trajectory.csv``, whoever wrote it.
 
     Columns are found by their header names, in any order: ``t`` and ``q1..qn``; other
-    columns are ignored.
+    columns are ignored (the text column ``segment`` of a cycle too).
 
     Parameters
     ----------
@@ -83,7 +83,9 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     try:
         with file.open(encoding="utf-8") as handle:
             header = [name.strip() for name in handle.readline().strip().split(",")]
-        data = np.loadtxt(file, delimiter=",", skiprows=1, ndmin=2)
+        numeric = [i for i, name in enumerate(header) if name != "segment"]  # several seams
+        data = np.loadtxt(file, delimiter=",", skiprows=1, ndmin=2, usecols=numeric)
+        header = [header[i] for i in numeric]
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or type(error).__name__
         raise CaseError(f"cannot read trajectory: {reason}", file=str(file)) from None

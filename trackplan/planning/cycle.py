@@ -45,7 +45,7 @@ from trackplan.planning.plan import (
     plan_placement,
     tracking_reference,
 )
-from trackplan.planning.result import CheckReport, PlanResult, Trajectory
+from trackplan.planning.result import CheckReport, PlanResult, Trajectory, Violation
 from trackplan.planning.sequence import Sequence, best_sequence, given_sequence
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
@@ -148,7 +148,8 @@ class CycleResult:
         being welded (0 on moves). Empty when some seam could not be planned.
     segment
         Label of every sample, shape (N,), str: the seam's name, or ``approach``,
-        ``retract``, ``air``. A sample shared by two pieces carries the later one's.
+        ``retract``, ``air``. The sample two pieces share (at rest) carries the earlier
+        piece's label.
     pieces
         The pieces in time order.
     seams
@@ -741,6 +742,107 @@ def check_cycle(
     return report, tuple(seam_checks)
 
 
+def pieces_from_segments(
+    case: Case, X: np.ndarray, q: np.ndarray, segment: np.ndarray
+) -> tuple[Piece, ...]:
+    """The pieces of a cycle trajectory from its ``segment`` labels (a trajectory.csv read
+    back): runs of one label; a seam's direction is the one whose start lies nearer the
+    tool point at the run's first sample.
+
+    Parameters
+    ----------
+    case
+        The case.
+    X
+        Placement, shape (6,).
+    q
+        Joint positions, shape (N, n), rad.
+    segment
+        Label per sample, shape (N,), str.
+
+    Raises
+    ------
+    CaseError
+        When a label is neither a seam of the case nor a move kind.
+    """
+    names = [seam.name for seam in case.seams]
+    labels = np.asarray(segment).astype(str)
+    change = np.flatnonzero(labels[1:] != labels[:-1]) + 1
+    starts = np.r_[0, change]
+    ends = np.r_[change - 1, len(labels) - 1]
+    T_base_part = placement_transform(as_placement(X))
+    pieces = []
+    for begin, end in zip(starts, ends, strict=True):
+        label = str(labels[begin])
+        first = max(int(begin) - 1, 0)  # the shared sample carries the earlier label
+        if label in MOVE_KINDS:
+            pieces.append(Piece(kind=label, label=label, first=first, last=int(end)))
+            continue
+        if label not in names:
+            raise CaseError(
+                f"segment {label!r} is neither a seam of the case ({', '.join(names)}) "
+                f"nor one of {', '.join(MOVE_KINDS)}",
+                key="segment",
+            )
+        i = names.index(label)
+        seam = case.seams[i]
+        tool = forward_kinematics(case.robot, q[first])[:3, 3]
+        forward = T_base_part[:3, :3] @ seam.start + T_base_part[:3, 3]
+        backward_start, _ = reversed_segments(seam.start, seam.segments)
+        backward = T_base_part[:3, :3] @ backward_start + T_base_part[:3, 3]
+        reverse = bool(np.linalg.norm(tool - backward) < np.linalg.norm(tool - forward))
+        pieces.append(
+            Piece(kind="seam", label=label, first=first, last=int(end), seam=i, reversed=reverse)
+        )
+    return tuple(pieces)
+
+
+def check_cycle_trajectory(
+    case: Case, X: np.ndarray, q: np.ndarray, sample_time: float, segment: np.ndarray
+) -> CheckReport:
+    """Check any cycle trajectory (``trackplan check`` of a run with several seams).
+
+    Parameters
+    ----------
+    case
+        The case.
+    X
+        Placement, shape (6,), metres and radians.
+    q
+        Joint positions, shape (N, n), rad.
+    sample_time
+        Ts, s.
+    segment
+        The ``segment`` label of every sample, shape (N,).
+
+    Returns
+    -------
+    CheckReport
+        As :func:`check_cycle`; a seam of the case that no sample welds is a ``coverage``
+        violation.
+    """
+    q = np.asarray(q, dtype=float)
+    pieces = pieces_from_segments(case, X, q, segment)
+    report, _ = check_cycle(case, X, q, sample_time, pieces)
+    welded = {piece.seam for piece in pieces if piece.kind == "seam"}
+    missing = [seam.name for i, seam in enumerate(case.seams) if i not in welded]
+    if not missing:
+        return report
+    skipped = tuple(
+        Violation(
+            limit="coverage",
+            joint=None,
+            t_first=0.0,
+            t_last=0.0,
+            worst=float("nan"),
+            bound=0.0,
+            message=f"seam {name} is not welded: no sample carries its name",
+        )
+        for name in missing
+    )
+    return replace(report, success=False, violations=report.violations + skipped)
+
+
 def _cycle_status(check: CheckReport) -> tuple[Status, str]:
     if check.success:
         return Status.FEASIBLE, "feasible: every seam and every move meets every limit"
@@ -813,6 +915,8 @@ __all__ = [
     "SeamPlan",
     "approach_configuration",
     "check_cycle",
+    "check_cycle_trajectory",
+    "pieces_from_segments",
     "plan_cycle",
     "reversed_segments",
 ]
