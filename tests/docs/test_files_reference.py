@@ -42,7 +42,7 @@ def _schema(model: type[BaseModel], prefix: str = "") -> dict[str, object]:
         key = f"{prefix}{field.alias or name}"
         origin = typing.get_origin(field.annotation)
         inner = _nested_model(field.annotation)
-        if inner is not None and key != "path.segments":
+        if inner is not None and key not in ("path.segments", "paths[i].segments"):
             keys[key] = PARENT
             is_list = origin is list or "list[" in str(field.annotation)
             keys.update(_schema(inner, f"{key}[i]." if is_list else f"{key}."))

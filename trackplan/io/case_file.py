@@ -215,6 +215,12 @@ class CaseModel(StrictModel):
     cell: CellModel | None = None
 
 
+class SinglePathCaseModel(CaseModel):
+    """A case file without ``paths``: its ``path`` is required (reported like any missing key)."""
+
+    path: PathModel
+
+
 # --------------------------------------------------------------------------- loading
 
 
@@ -307,7 +313,8 @@ def load_case_data(
         See :func:`load_case`.
     """
     base = Path(base_dir)
-    model = validate_model(CaseModel, data, file)
+    several = isinstance(data, dict) and "paths" in data
+    model = validate_model(CaseModel if several else SinglePathCaseModel, data, file)
     raise_first(_seam_key_problems(model), data, file)
     robot = load_robot_spec(model.robot, base, case_file=file, assume_limits=assume_limits)
     seams = _seam_models(model)

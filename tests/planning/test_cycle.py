@@ -1,0 +1,210 @@
+"""The cycle of several seams: reversed paths, approach poses, air moves that land exactly,
+directions of travel, segment labels, and the checker on the joined trajectory."""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from trackplan.io.case_file import load_case_text
+from trackplan.io.cycle_results import read_segments, write_cycle_trajectory_csv
+from trackplan.io.results import read_trajectory_csv
+from trackplan.paths import NominalPath
+from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec
+from trackplan.planning.cycle import (
+    AIR,
+    APPROACH,
+    RETRACT,
+    check_cycle_trajectory,
+    plan_cycle,
+    reversed_segments,
+)
+from trackplan.planning.sequence import Sequence, Visit
+from trackplan.robots.kinematics import forward_kinematics
+
+X = np.array([0.2223, -0.5, -0.2999, 0.05, 0.0499, -2.7271])
+"""A placement where the shipped bracket's seams are feasible (found by its search)."""
+APPROACH_DISTANCE = 0.03
+
+CASE = {
+    "name": "three-seams",
+    "robot": "puma560",
+    "paths": [
+        {"name": "left", "start": [0.05, 0.08, 0], "segments": [{"line": {"to": [0.15, 0.08, 0]}}]},
+        {
+            "name": "right",
+            "start": [0.05, 0.10, 0],
+            "segments": [{"line": {"to": [0.15, 0.10, 0]}}],
+            "reversible": False,
+        },
+        {
+            "name": "corner",
+            "start": [0.05, 0.20, 0],
+            "segments": [{"line": {"to": [0.20, 0.20, 0]}}, {"line": {"to": [0.20, 0.15, 0]}}],
+        },
+    ],
+    "approach": APPROACH_DISTANCE,
+    "home": [-1.2, -1.0, -0.2, 0.0, -1.8, -1.5],
+    "task": {
+        "rated_speed": 0.02,
+        "corner_speed": 0.015,
+        "tolerance": 0.0005,
+        "sample_time": 0.004,
+        "tool_rpy": [3.141592653589793, 0, 0],
+    },
+}
+FORCED = Sequence(visits=(Visit(2, True), Visit(0, False), Visit(1, False)), cost=0.0, exact=False)
+
+
+@pytest.fixture(scope="module")
+def case():
+    return load_case_text(yaml.safe_dump(CASE, sort_keys=False))
+
+
+@pytest.fixture(scope="module")
+def cycle(case):
+    return plan_cycle(case, X, sequence=FORCED)
+
+
+def _placed(point: np.ndarray) -> np.ndarray:
+    from trackplan.frames import placement_transform
+
+    T = placement_transform(X)
+    return T[:3, :3] @ point + T[:3, 3]
+
+
+@pytest.mark.parametrize(
+    "segments",
+    [
+        (LineSpec(np.array([0.1, 0, 0])), LineSpec(np.array([0.1, 0.1, 0]))),
+        (
+            LineSpec(np.array([0.1, 0, 0])),
+            ArcSpec(np.array([0.1, 0.05, 0]), np.array([0, 0, 1.0]), np.pi / 2),
+            PointsSpec(np.array([[0.12, 0.06, 0], [0.13, 0.08, 0.01], [0.13, 0.1, 0.02]])),
+        ),
+        (ArcSpec(np.array([0.0, 0.05, 0]), np.array([0, 0, 1.0]), 2 * np.pi),),
+    ],
+)
+def test_reversed_segments_trace_the_same_path_backwards(segments) -> None:
+    start = np.zeros(3)
+    forward = NominalPath.from_specs(start, segments)
+    back_start, back_segments = reversed_segments(start, segments)
+    backward = NominalPath.from_specs(back_start, back_segments)
+    assert backward.length == pytest.approx(forward.length, rel=1e-9)
+    points = backward.polyline(0.004)
+    assert np.allclose(points[0], forward.polyline(0.004)[-1], atol=1e-12)
+    s_back, own = backward.project(points)
+    s_forward, distance = forward.project(points)
+    assert np.max(own) < 1e-9 and np.max(distance) < 1e-9  # the same curve
+    inside = (s_back > 1e-6) & (s_back < backward.length - 1e-6)
+    assert np.max(np.abs(s_forward[inside] + s_back[inside] - forward.length)) < 1e-9
+
+
+def test_the_cycle_is_feasible_and_labelled(cycle, case) -> None:
+    assert cycle.success, cycle.message
+    kinds = [piece.kind for piece in cycle.pieces]
+    # home → (air, approach, seam, retract) per seam → home
+    assert kinds == [AIR, APPROACH, "seam", RETRACT] * 3 + [AIR]
+    for piece in cycle.pieces:
+        labels = set(cycle.segment[piece.first + 1 : piece.last + 1])
+        assert labels == {piece.label}
+    assert [s.name for s in cycle.seams] == ["corner", "left", "right"]
+    assert cycle.duration == pytest.approx(cycle.seam_time + cycle.air_time)
+    assert cycle.seam_time == pytest.approx(sum(s.plan.duration for s in cycle.seams))
+    # the first and last samples are home
+    assert np.array_equal(cycle.trajectory.q[0], case.cycle.home)
+    assert np.array_equal(cycle.trajectory.q[-1], case.cycle.home)
+
+
+def test_each_air_move_ends_exactly_at_the_next_approach_pose(cycle, case) -> None:
+    q = cycle.trajectory.q
+    pieces = cycle.pieces
+    seams = iter(cycle.seams)
+    for before, after in itertools.pairwise(pieces):
+        if before.kind != AIR:
+            continue
+        seam = next(seams)
+        assert after.kind == APPROACH
+        assert np.array_equal(q[before.last], seam.q_approach)
+        start = seam.plan.trajectory.q[0]
+        T_approach = forward_kinematics(case.robot, q[before.last])
+        T_start = forward_kinematics(case.robot, start)
+        expected = T_start[:3, 3] - APPROACH_DISTANCE * T_start[:3, 2]
+        assert np.max(np.abs(T_approach[:3, 3] - expected)) < 1e-9
+        assert np.max(np.abs(T_approach[:3, :3] - T_start[:3, :3])) < 1e-9
+        assert np.array_equal(q[after.last], start)  # the approach lands on the seam start
+
+
+def test_every_sample_is_within_every_joint_limit(cycle, case) -> None:
+    robot = case.robot
+    trajectory = cycle.trajectory
+    for kind, bound in (("qd", robot.v_max), ("qdd", robot.a_max), ("qddd", robot.j_max)):
+        assert np.all(np.abs(getattr(trajectory, kind)) <= bound * (1 + 1e-9)), kind
+    assert cycle.approach_deviation < 1e-3  # joint-space approach stays near the tool axis
+
+
+def test_reversing_a_seam_reverses_its_travel_in_the_output(cycle, case) -> None:
+    position = cycle.trajectory.tool_position
+    corner = next(p for p in cycle.pieces if p.label == "corner")
+    left = next(p for p in cycle.pieces if p.label == "left")
+    assert corner.reversed and not left.reversed
+    # reversed: the corner seam starts at its written end and ends at its written start
+    assert np.linalg.norm(position[corner.first] - _placed(np.array([0.20, 0.15, 0]))) < 1e-6
+    assert np.linalg.norm(position[corner.last] - _placed(np.array([0.05, 0.20, 0]))) < 1e-6
+    assert np.linalg.norm(position[left.first] - _placed(np.array([0.05, 0.08, 0]))) < 1e-6
+    # the same seam forward: the travel direction flips
+    again = plan_cycle(
+        case, X, sequence=replace(FORCED, visits=(Visit(2, False), Visit(0, True), Visit(1, False)))
+    )
+    forward = next(p for p in again.pieces if p.label == "corner")
+    assert not forward.reversed
+    travel = (
+        again.trajectory.tool_position[forward.last] - again.trajectory.tool_position[forward.first]
+    )
+    back = position[corner.last] - position[corner.first]
+    assert np.allclose(travel, -back, atol=1e-6)
+
+
+def test_the_written_cycle_rechecks_from_its_segment_column(cycle, case, tmp_path: Path) -> None:
+    file = tmp_path / "trajectory.csv"
+    write_cycle_trajectory_csv(cycle, file)
+    t, q = read_trajectory_csv(file, case.robot.n_dof)
+    segment = read_segments(file)
+    assert np.array_equal(q, cycle.trajectory.q)
+    assert list(segment) == list(cycle.segment)
+    report = check_cycle_trajectory(case, X, q, float(t[1] - t[0]), segment)
+    assert report.success
+    assert report.max_tracking_error == pytest.approx(cycle.check.max_tracking_error)
+    # a seam missing from the labels is a coverage violation naming it
+    relabelled = np.where(segment == "left", "air", segment)
+    report = check_cycle_trajectory(case, X, q, float(t[1] - t[0]), relabelled)
+    assert not report.success
+    assert any("seam left is not welded" in v.message for v in report.violations)
+
+
+def test_the_checker_names_the_seam_whose_tracking_fails(cycle, case) -> None:
+    q = cycle.trajectory.q.copy()
+    left = next(p for p in cycle.pieces if p.label == "left")
+    middle = (left.first + left.last) // 2
+    q[middle - 2 : middle + 3, 1] += 2e-3  # about 1 mm off the seam, vertically
+    report = check_cycle_trajectory(case, X, q, cycle.trajectory.sample_time, cycle.segment)
+    tracking = [v for v in report.violations if v.limit == "tracking"]
+    assert tracking and tracking[0].message.startswith("seam left: ")
+    assert left.first * cycle.trajectory.sample_time <= tracking[0].t_first
+
+
+def test_optimize_never_reverses_a_seam_that_may_not_be_reversed(case) -> None:
+    cycle = plan_cycle(case, X)
+    assert cycle.success, cycle.message
+    assert cycle.sequence.exact
+    right = next(v for v in cycle.sequence.visits if v.seam == 1)
+    assert not right.reversed
+    given = plan_cycle(
+        case, X, sequence=Sequence(tuple(Visit(i, False) for i in range(3)), 0.0, False)
+    )
+    assert cycle.duration <= given.duration + 1e-9
