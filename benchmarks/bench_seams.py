@@ -12,7 +12,12 @@ Run with ``python -m benchmarks seams``. Prints, in one run:
   instances (seams as segments in a square, air cost the distance between seam ends):
   compute time for m = 4, 6, 8 (dynamic programming) and 12, 20 (heuristic), the cost
   against the order as written; and the heuristic's gap to the optimum at m = 8, on such
-  instances and on independent random costs.
+  instances and on independent random costs;
+- the shipped case ``cases/bracket-4-fillets.yaml`` (four fillets, one placement): the
+  placement search (:func:`trackplan.search.cycle_search.optimize_cycle`, CPU time), then
+  at its placement the cycle time with the optimised sequence against the order and
+  directions as written (:func:`trackplan.planning.cycle.plan_cycle`), and the air time of
+  each.
 
 Compute times are the least CPU time of several repeats (one thread).
 """
@@ -21,11 +26,15 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
+from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_robot
+from trackplan.planning.cycle import plan_cycle, seam_geometries
 from trackplan.planning.sequence import best_sequence, given_sequence, sequence_cost
+from trackplan.search.cycle_search import optimize_cycle
 from trackplan.timing.airmove import air_time_estimate, plan_air_move, trapezoid_time
 
 ROBOT = "kuka_kr10_r1420"
@@ -34,6 +43,7 @@ N_PAIRS = 200
 SEQUENCE_SIZES = (4, 6, 8, 12, 20)
 N_INSTANCES = 10
 N_GAP_INSTANCES = 40
+SHIPPED_CASE = Path(__file__).resolve().parents[1] / "cases" / "bracket-4-fillets.yaml"
 
 
 def best_time(function: Callable[[], object], repeats: int = 3) -> float:
@@ -148,9 +158,40 @@ def sequencing() -> None:
         )
 
 
+def cycle() -> None:
+    """The shipped four-fillet case: search, then the optimised sequence against the given."""
+    case = load_case(SHIPPED_CASE)
+    assert case.cycle is not None
+    start = time.process_time()
+    search = optimize_cycle(case)
+    search_cpu = time.process_time() - start
+    X = search.X
+    geometries = seam_geometries(case)
+    optimised = search.final
+    given = plan_cycle(case, X, sequence=given_sequence(len(case.seams)), geometries=geometries)
+    order = ", ".join(f"{s.name}{' (reversed)' if s.reversed else ''}" for s in optimised.seams)
+    print(f"cycle: {SHIPPED_CASE.name}, {len(case.seams)} seams, approach {case.cycle.approach} m")
+    print(
+        f"  search: {search.evaluations} evaluations, {search_cpu:.1f} s CPU, "
+        f"{search.status.value}; X = ({', '.join(f'{v:.4f}' for v in X)})"
+    )
+    print(f"  optimised sequence: {order}")
+    for name, result in (("optimised", optimised), ("as written", given)):
+        print(
+            f"  {name:10s}: cycle {result.duration:.3f} s, welding {result.seam_time:.3f} s, "
+            f"approach/retract/air {result.air_time:.3f} s, J = {result.objective:.4f}, "
+            f"{'feasible' if result.success else result.status.value}"
+        )
+    print(
+        f"  optimised / as written: cycle time {optimised.duration / given.duration:.3f}, "
+        f"air time {optimised.air_time / given.air_time:.3f}"
+    )
+
+
 def main() -> None:
     air_moves()
     sequencing()
+    cycle()
 
 
 if __name__ == "__main__":

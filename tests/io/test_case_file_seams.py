@@ -102,6 +102,11 @@ def test_the_shipped_case_has_four_seams_and_a_closed_loop() -> None:
             "paths[0].segments[0].line.to: ",
         ),
         ({"paths.1.task.speed": 0.1}, "paths[1].task.speed: unknown key"),
+        (
+            {"objective": {"kind": "time"}},
+            "objective.kind: kind time is not supported with several seams (paths): they "
+            "minimise travel (Eq. 8) with objective.time_weight on the cycle time",
+        ),
     ],
 )
 def test_bad_input_is_one_line(

@@ -3,6 +3,7 @@ directions of travel, segment labels, and the checker on the joined trajectory."
 
 from __future__ import annotations
 
+import copy
 import itertools
 from dataclasses import replace
 from pathlib import Path
@@ -11,6 +12,9 @@ import numpy as np
 import pytest
 import yaml
 
+from trackplan.cell.check import check_cell
+from trackplan.cell.screening import CellGeometry
+from trackplan.frames import placement_transform
 from trackplan.io.case_file import load_case_text
 from trackplan.io.cycle_results import read_segments, write_cycle_trajectory_csv
 from trackplan.io.results import read_trajectory_csv
@@ -20,12 +24,14 @@ from trackplan.planning.cycle import (
     AIR,
     APPROACH,
     RETRACT,
+    VIA_LIFT,
     check_cycle_trajectory,
     plan_cycle,
     reversed_segments,
 )
 from trackplan.planning.sequence import Sequence, Visit
 from trackplan.robots.kinematics import forward_kinematics
+from trackplan.timing.airmove import plan_air_move
 
 X = np.array([0.2223, -0.5, -0.2999, 0.05, 0.0499, -2.7271])
 """A placement where the shipped bracket's seams are feasible (found by its search)."""
@@ -72,8 +78,6 @@ def cycle(case):
 
 
 def _placed(point: np.ndarray) -> np.ndarray:
-    from trackplan.frames import placement_transform
-
     T = placement_transform(X)
     return T[:3, :3] @ point + T[:3, 3]
 
@@ -208,3 +212,33 @@ def test_optimize_never_reverses_a_seam_that_may_not_be_reversed(case) -> None:
         case, X, sequence=Sequence(tuple(Visit(i, False) for i in range(3)), 0.0, False)
     )
     assert cycle.duration <= given.duration + 1e-9
+
+
+def test_a_colliding_air_move_goes_through_a_via_above_the_seam_it_leaves() -> None:
+    data = copy.deepcopy(CASE)
+    data["paths"] = [
+        {"name": "near", "start": [0.05, 0.05, 0], "segments": [{"line": {"to": [0.15, 0.05, 0]}}]},
+        {"name": "far", "start": [0.15, 0.25, 0], "segments": [{"line": {"to": [0.05, 0.25, 0]}}]},
+    ]
+    fence = {"size": [0.4, 0.01, 0.06], "pose": [0.1, 0.15, -0.05, 0, 0, 0]}
+    data["cell"] = {"clearance": 0.005, "workpiece": [{"name": "fence", "box": fence}]}
+    fenced = load_case_text(yaml.safe_dump(data, sort_keys=False))
+    given = Sequence((Visit(0, False), Visit(1, False)), 0.0, False)
+    cycle = plan_cycle(fenced, X, sequence=given)
+    robot = fenced.robot
+    between = cycle.pieces[4]
+    assert between.kind == AIR and between.via is not None
+    # the direct move would have gone through the fence
+    near = cycle.seams[0]
+    direct = plan_air_move(
+        near.q_retract, cycle.seams[1].q_approach, robot.v_max, robot.a_max, robot.j_max, 0.004
+    )
+    geometry = CellGeometry.from_cell(fenced.cell, robot)
+    assert check_cell(geometry, robot, direct.q, 0.004, placement_transform(X)).violations
+    # the via is a sample, VIA_LIFT beyond the retract pose along the tool axis
+    q = cycle.trajectory.q[between.first : between.last + 1]
+    assert np.any(np.all(q == between.via, axis=1))
+    T_end = forward_kinematics(robot, near.plan.trajectory.q[-1])
+    T_via = forward_kinematics(robot, between.via)
+    lifted = T_end[:3, 3] - (APPROACH_DISTANCE + VIA_LIFT) * T_end[:3, 2]
+    assert np.max(np.abs(T_via[:3, 3] - lifted)) < 1e-9

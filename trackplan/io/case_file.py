@@ -468,6 +468,14 @@ def _seam_key_problems(model: CaseModel) -> list[Problem]:
             if getattr(model, key) is not None
         ]
     problems: list[Problem] = []
+    if model.objective.kind != "travel":
+        problems.append(
+            (
+                ("objective", "kind"),
+                f"kind {model.objective.kind} is not supported with several seams (paths): "
+                "they minimise travel (Eq. 8) with objective.time_weight on the cycle time",
+            )
+        )
     first: dict[str, int] = {}
     for k, seam in enumerate(model.paths):
         if seam.name in first:

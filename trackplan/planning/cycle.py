@@ -11,7 +11,8 @@ by ``approach`` metres along the tool axis, solved on the seam's own IK branch a
 straight line, so that the seam and its approach share a branch. The moves between
 configurations (home → approach, approach → seam start, seam end → retract, retract →
 next approach, last retract → home) are jerk-limited, time-optimal, rest-to-rest joint
-moves (:func:`trackplan.timing.airmove.plan_air_move`, ruckig): the approach and retract
+moves (:func:`trackplan.timing.airmove.plan_air_move`, ruckig, slowed down where a torque
+limit asks for it): the approach and retract
 are joint-space moves between two configurations on the tool axis, not straight Cartesian
 lines; their largest distance from the straight line is reported
 (:attr:`CycleResult.approach_deviation`). The pieces are joined rest to rest into one
@@ -53,6 +54,7 @@ from trackplan.robots.path_ik import solve_path_ik
 from trackplan.status import Status
 from trackplan.timing import time_law
 from trackplan.timing.airmove import AirMove, air_time_estimate, plan_air_move
+from trackplan.timing.sample_checks import robot_checks
 
 APPROACH = "approach"
 RETRACT = "retract"
@@ -64,6 +66,9 @@ APPROACH_POSES = 21
 """Poses along the approach line on which its IK is solved (continuity on the seam's branch)."""
 APPROACH_MATCH = 1e-6
 """Largest joint difference, rad, between the seam end and the approach line's IK there."""
+VIA_LIFT = 0.1
+"""How far beyond the retract pose, along the tool axis, the via of a colliding air move
+lies, m."""
 UNPLANNED_COST = 1e12
 """Sequencing cost of a seam direction that could not be planned (never chosen)."""
 
@@ -430,7 +435,7 @@ def plan_cycle(
             _choose_sequence(case, plans, ends, home) if mode == "optimize" else given_sequence(m)
         )
     geometries = {key: plans[key].joint_path.geometry for key in plans}
-    return _assemble(case, X, plans, ends, sequence, home, geometries)
+    return _assemble(case, X, plans, ends, sequence, home, geometries, approach)
 
 
 def _check_sequence(case: Case, sequence: Sequence) -> None:
@@ -529,34 +534,66 @@ def _assemble(
     sequence: Sequence,
     home: np.ndarray | None,
     geometries: SeamGeometries,
+    approach: float,
 ) -> CycleResult:
-    """Join the planned seams in the sequence's order with exact moves, then check."""
+    """Join the planned seams in the sequence's order with exact moves, then check.
+
+    With a cell, an air move whose direct path breaks the clearance is planned again
+    through a via configuration above the seam it leaves (the tool :data:`VIA_LIFT` beyond
+    the retract pose along the tool axis: up, then across); its piece records the via.
+    """
     robot = case.robot
     seams = case.seams
     sample_time = case.task.sample_time
     parts: list[_Part] = []
+    checks = robot_checks(robot)  # the torque limits too, when the robot has dynamics
 
-    def move(kind: str, q_from: np.ndarray, q_to: np.ndarray, seam: int | None) -> None:
+    cell = cell_geometry(case)
+    T_base_part = placement_transform(X)
+
+    def move(
+        kind: str,
+        q_from: np.ndarray,
+        q_to: np.ndarray,
+        seam: int | None,
+        lift: tuple[np.ndarray, int] | None = None,
+    ) -> None:
         air: AirMove = plan_air_move(
-            q_from, q_to, robot.v_max, robot.a_max, robot.j_max, sample_time
+            q_from, q_to, robot.v_max, robot.a_max, robot.j_max, sample_time, checks=checks
         )
+        if cell is not None and lift is not None:
+            collides = check_cell(cell, robot, air.q, sample_time, T_base_part).violations
+            via = approach_configuration(robot, lift[0], approach + VIA_LIFT, lift[1])[0]
+            if collides and via is not None:
+                air = plan_air_move(
+                    q_from,
+                    q_to,
+                    robot.v_max,
+                    robot.a_max,
+                    robot.j_max,
+                    sample_time,
+                    via=via,
+                    checks=checks,
+                )
         rest = np.zeros(len(air.q))
         parts.append(_Part(kind, kind, air.q, rest, rest, seam, False, air.via))
 
     chosen: list[SeamPlan] = []
     q_here = home
+    lift: tuple[np.ndarray, int] | None = None
     for visit in sequence.visits:
         i, reverse = visit.seam, visit.reversed
         plan = plans[i, reverse]
         q_in, q_out = ends[i, reverse]
         welded = plan.trajectory
         if q_here is not None:
-            move(AIR, q_here, q_in, None)
+            move(AIR, q_here, q_in, None, lift or (welded.q[0], plan.branch))
         move(APPROACH, q_in, welded.q[0], i)
         spin = welded.spin if len(welded.spin) == welded.n_samples else np.zeros(welded.n_samples)
         parts.append(_Part("seam", seams[i].name, welded.q, welded.s, spin, i, reverse, None))
         move(RETRACT, welded.q[-1], q_out, i)
         q_here = q_out
+        lift = (welded.q[-1], plan.branch)
         chosen.append(
             SeamPlan(
                 index=i,
@@ -568,7 +605,7 @@ def _assemble(
             )
         )
     if home is not None and q_here is not None:
-        move(AIR, q_here, home, None)
+        move(AIR, q_here, home, None, lift)
 
     # pieces meet at rest on a shared sample: keep it once
     q_all = [parts[0].q[:1]] + [part.q[1:] for part in parts]
