@@ -2,7 +2,7 @@
 its timeline.
 
 ``cycle.png``: left, the tool point's path in the robot base frame seen from above, every
-seam in its own colour (an arrow at its start shows the welding direction) and the
+seam in its own colour (an arrow half-way shows the welding direction) and the
 approach, retract and air moves dashed; right, a Gantt-like timeline of the cycle, one row
 per seam plus one for the moves. ``report.html`` embeds it with the per-seam figures.
 """
@@ -57,12 +57,13 @@ def cycle_figure(result: CycleResult, case: Case) -> Figure:
             color = colors[piece.label]
             direction = " (reversed)" if piece.reversed else ""
             top.plot(*xy.T, color=color, lw=2.0, label=piece.label + direction, gid="seam")
-            k = min(len(xy) - 1, max(1, len(xy) // 20))
+            middle = len(xy) // 2
+            ahead = min(len(xy) - 1, middle + max(1, len(xy) // 50))
             top.annotate(
                 "",
-                xy=tuple(xy[k]),
-                xytext=tuple(xy[0]),
-                arrowprops={"arrowstyle": "->", "color": color, "lw": 1.5},
+                xy=tuple(xy[ahead]),
+                xytext=tuple(xy[middle]),
+                arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.5, "mutation_scale": 18},
             )
             row = names.index(piece.label)
         else:
@@ -121,8 +122,8 @@ def write_cycle_report(
         plot = (
             f'<figure id="plot-cycle"><img alt="the cycle" src="data:image/png;base64,{data}">'
             "<figcaption>Left: the tool point from above, each seam in its colour (the arrow "
-            "shows the welding direction), approach, retract and air moves dashed. Right: the "
-            f"cycle's timeline. (file: {CYCLE_PLOT})</figcaption></figure>"
+            "half-way shows the welding direction), approach, retract and air moves dashed. "
+            f"Right: the cycle's timeline. (file: {CYCLE_PLOT})</figcaption></figure>"
         )
     info = info or {}
     seams = [
