@@ -112,6 +112,7 @@ def print_cycle(text: Console, result: CycleResult, out: Path) -> None:
             f"approach, retract and air {result.air_time:.3f} s)  J = {result.objective:.4f}"
         )
         text.print(f"  sequence: {order}")
+        text.print(f"  placement X = ({', '.join(f'{v:.4f}' for v in result.placement)})")
         for seam, own in zip(result.seams, result.seam_checks, strict=True):
             text.print(
                 f"  {escape(seam.name)}: {seam.plan.duration:.3f} s, "

@@ -23,6 +23,20 @@ def describe_case(case: Case, file: Path | str) -> list[str]:
         f"{angle:.1f}° between segments[{segment - 1}] and segments[{segment}]"
         for segment, angle in segment_corners(path)
     )
+    if case.cycle is not None:
+        seams = ", ".join(
+            f"{seam.name} ({NominalPath.from_specs(seam.start, seam.segments).length:.4f} m"
+            f"{'' if seam.reversible else ', not reversible'})"
+            for seam in case.seams
+        )
+        return [
+            f"{file}: ok",
+            f"  name      {case.name}",
+            f"  robot     {case.robot.name} ({case.robot.n_dof} joints)",
+            f"  seams     {len(case.seams)}: {seams}",
+            f"  cycle     sequence {case.cycle.sequence}, approach {case.cycle.approach:g} m, "
+            f"home {'none' if case.cycle.home is None else 'given'}",
+        ]
     return [
         f"{file}: ok",
         f"  name      {case.name}",
