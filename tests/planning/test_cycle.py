@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 import yaml
 
+from tests.conftest import CASES
 from trackplan.cell.check import check_cell
 from trackplan.cell.screening import CellGeometry
 from trackplan.frames import placement_transform
-from trackplan.io.case_file import load_case_text
+from trackplan.io.case_file import load_case, load_case_text
 from trackplan.io.cycle_results import read_segments, write_cycle_trajectory_csv
 from trackplan.io.results import read_trajectory_csv
 from trackplan.paths import NominalPath
@@ -29,6 +30,7 @@ from trackplan.planning.cycle import (
     plan_cycle,
     reversed_segments,
 )
+from trackplan.planning.plan import plan_placement
 from trackplan.planning.sequence import Sequence, Visit
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.timing.airmove import plan_air_move
@@ -242,3 +244,15 @@ def test_a_colliding_air_move_goes_through_a_via_above_the_seam_it_leaves() -> N
     T_via = forward_kinematics(robot, between.via)
     lifted = T_end[:3, 3] - (APPROACH_DISTANCE + VIA_LIFT) * T_end[:3, 2]
     assert np.max(np.abs(T_via[:3, 3] - lifted)) < 1e-9
+
+
+def test_a_single_path_case_is_the_one_seam_cycle_of_its_plan() -> None:
+    single = load_case(CASES / "bracket-weld.yaml")
+    X_single = single.bounds.example
+    plan = plan_placement(single, X_single)
+    cycle = plan_cycle(single, X_single)
+    assert plan.success and cycle.success
+    assert np.array_equal(cycle.trajectory.q, plan.trajectory.q)
+    assert cycle.duration == plan.duration and cycle.air_time == 0.0
+    assert [p.kind for p in cycle.pieces] == [APPROACH, "seam", RETRACT]
+    assert set(cycle.segment[1:]) == {"bracket-weld"}

@@ -66,14 +66,20 @@ def optimize_cycle_command(case: Case, out: Path, *, report: bool, **options: ob
             **options,  # type: ignore[arg-type]
         )
         signals.deferring = False
-        write_cycle_run(out, result.final, case, report=report, search=result)
+        interrupted = result.stop_reason == "interrupted" or signals.first is not None
+        marks = (
+            {"status": "interrupted", "plan_status": result.final.status.value}
+            if interrupted
+            else None
+        )
+        write_cycle_run(out, result.final, case, report=report, search=result, extra=marks)
     text = console()
     text.print(
         f"{escape(result.message)} ({result.evaluations} evaluations, "
         f"{result.wall_time_s:.2f} s, seed {result.seed})"
     )
     print_cycle(text, result.final, out)
-    if result.stop_reason == "interrupted" or signals.first is not None:
+    if interrupted:
         return ExitCode(signals.exit_code)
     return ExitCode.OK if result.success else ExitCode.INFEASIBLE
 

@@ -387,14 +387,7 @@ def plan_cycle(
     home = None if cycle is None else cycle.home
     if sequence is not None:
         _check_sequence(case, sequence)
-    directions = [
-        (False, True)
-        if sequence is None and mode == "optimize" and seam.reversible
-        else (False,)
-        if sequence is None
-        else (next(v.reversed for v in sequence.visits if v.seam == i),)
-        for i, seam in enumerate(seams)
-    ]
+    directions = _directions(case, mode, sequence)
     plans: dict[tuple[int, bool], PlanResult] = {}
     ends: dict[tuple[int, bool], tuple[np.ndarray, np.ndarray]] = {}
     failed: dict[str, PlanResult] = {}
@@ -436,6 +429,17 @@ def plan_cycle(
         )
     geometries = {key: plans[key].joint_path.geometry for key in plans}
     return _assemble(case, X, plans, ends, sequence, home, geometries, approach)
+
+
+def _directions(case: Case, mode: str, sequence: Sequence | None) -> list[tuple[bool, ...]]:
+    """The directions to plan each seam in (``reversed`` flags): both for a reversible seam
+    whose direction is to be chosen, else the forced or written one."""
+    if sequence is not None:
+        forced = {visit.seam: visit.reversed for visit in sequence.visits}
+        return [(forced[i],) for i in range(len(case.seams))]
+    if mode == "optimize":
+        return [(False, True) if seam.reversible else (False,) for seam in case.seams]
+    return [(False,)] * len(case.seams)
 
 
 def _check_sequence(case: Case, sequence: Sequence) -> None:
