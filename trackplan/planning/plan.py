@@ -12,6 +12,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.cell.screening import CellGeometry
 from trackplan.derivatives import backward_derivatives
+from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform
 from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
@@ -124,8 +125,15 @@ def plan_placement(
     Raises
     ------
     CaseError
-        When X is not 6 finite numbers or the timing names no law.
+        When X is not 6 finite numbers or the timing names no law, or the case has
+        several seams (:func:`trackplan.planning.cycle.plan_cycle` plans those).
     """
+    if case.cycle is not None:
+        raise CaseError(
+            f"case {case.name} has several seams (paths): plan it with "
+            "trackplan.planning.cycle.plan_cycle (docs/seams.md)",
+            key="paths",
+        )
     X = as_placement(X)
     law = time_law(timing or case.task.timing)
     if geometry is None or geometry.mode != law.path_mode:
@@ -302,6 +310,12 @@ def check_case_trajectory(
     -------
     CheckReport
     """
+    if case.cycle is not None:
+        raise CaseError(
+            f"case {case.name} has several seams (paths): check it with "
+            "trackplan.planning.cycle.check_cycle_trajectory (docs/seams.md)",
+            key="paths",
+        )
     law = time_law(timing or case.task.timing)
     geometry = PathGeometry.from_case(case, law.path_mode)
     reference = tracking_reference(case, geometry, as_placement(X))

@@ -239,9 +239,16 @@ def optimize_placement(
     Raises
     ------
     CaseError
-        For an unknown method or timing, a negative budget, or bounds with no placement
-        inside the reach interval.
+        For an unknown method or timing, a negative budget, bounds with no placement
+        inside the reach interval, or a case with several seams
+        (:func:`trackplan.search.cycle_search.optimize_cycle` searches those).
     """
+    if case.cycle is not None:
+        raise CaseError(
+            f"case {case.name} has several seams (paths): search it with "
+            "trackplan.search.cycle_search.optimize_cycle (docs/seams.md)",
+            key="paths",
+        )
     start = time.perf_counter()
     if not isinstance(method, Algorithm):
         method = choose(Method, method or case.optimizer.method, "method")
