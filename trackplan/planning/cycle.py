@@ -396,7 +396,7 @@ def plan_cycle(
         problems: list[PlanResult] = []
         for reverse in directions[i]:
             plan = plan_placement(
-                seam_direction_case(case, i, reverse),
+                replace(seam_direction_case(case, i, reverse), cell=None),
                 X,
                 timing=timing,
                 branch=None if branches is None else branches[i],
@@ -638,7 +638,11 @@ def _assemble(
         robot, q_cycle, np.concatenate(s_all), sample_time, np.concatenate(spin_all)
     )
     segment = np.asarray(labels, dtype=object)
-    check, seam_checks = check_cycle(case, X, trajectory.q, sample_time, pieces, geometries)
+    seam_pieces = [k for k, piece in enumerate(pieces) if piece.kind == "seam"]
+    known = {k: seam.plan.check for k, seam in zip(seam_pieces, chosen, strict=True)}
+    check, seam_checks = check_cycle(
+        case, X, trajectory.q, sample_time, pieces, geometries, seam_reports=known
+    )
     seam_time = sum((p.last - p.first) * sample_time for p in pieces if p.kind == "seam")
     status, message = _cycle_status(check)
     return CycleResult(
@@ -704,6 +708,7 @@ def check_cycle(
     sample_time: float,
     pieces: list[Piece] | tuple[Piece, ...],
     geometries: SeamGeometries | None = None,
+    seam_reports: dict[int, CheckReport] | None = None,
 ) -> tuple[CheckReport, tuple[CheckReport, ...]]:
     """Check a cycle trajectory: every sample's joint limits and clearance, every seam's task.
 
@@ -721,6 +726,9 @@ def check_cycle(
         Where each seam lies in ``q`` (and in which direction).
     geometries
         The seams' paths when already built (:func:`seam_geometries`).
+    seam_reports
+        Each seam's own report by piece index, when already made on exactly its samples
+        (a seam plan's check: the same call on the same samples).
 
     Returns
     -------
@@ -743,16 +751,14 @@ def check_cycle(
     seam_checks: list[CheckReport] = []
     tracking = 0.0
     orientation = 0.0
-    for piece in pieces:
+    for k, piece in enumerate(pieces):
         if piece.kind != "seam" or piece.seam is None:
             continue
-        seam_case = seam_direction_case(case, piece.seam, piece.reversed)
-        geometry = (geometries or {}).get((piece.seam, piece.reversed))
-        if geometry is None:
-            mode = time_law(seam_case.task.timing).path_mode
-            geometry = PathGeometry.from_case(seam_case, mode)
-        reference = tracking_reference(seam_case, geometry, X)
-        own = check_trajectory(case.robot, q[piece.first : piece.last + 1], sample_time, reference)
+        known = (seam_reports or {}).get(k)
+        if known is not None:
+            own = known
+        else:
+            own = _seam_report(case, X, q, sample_time, piece, geometries)
         seam_checks.append(own)
         tracking = max(tracking, own.max_tracking_error)
         orientation = max(orientation, own.max_orientation_error)
@@ -882,6 +888,24 @@ def check_cycle_trajectory(
         for name in missing
     )
     return replace(report, success=False, violations=report.violations + skipped)
+
+
+def _seam_report(
+    case: Case,
+    X: np.ndarray,
+    q: np.ndarray,
+    sample_time: float,
+    piece: Piece,
+    geometries: SeamGeometries | None,
+) -> CheckReport:
+    """One seam's samples checked against its task (tracking, orientation, speed, coverage)."""
+    assert piece.seam is not None
+    seam_case = seam_direction_case(case, piece.seam, piece.reversed)
+    geometry = (geometries or {}).get((piece.seam, piece.reversed))
+    if geometry is None:
+        geometry = PathGeometry.from_case(seam_case, time_law(seam_case.task.timing).path_mode)
+    reference = tracking_reference(seam_case, geometry, X)
+    return check_trajectory(case.robot, q[piece.first : piece.last + 1], sample_time, reference)
 
 
 def _cycle_status(check: CheckReport) -> tuple[Status, str]:
