@@ -115,8 +115,9 @@ def check(
     X = placement(loaded, X_given)
     csv = verified_trajectory(run)
     if loaded.cycle is not None:  # several seams: docs/seams.md
-        from trackplan.cli.cycle import check_cycle_command
+        from trackplan.cli.cycle import check_cycle_command, refuse_options
 
+        refuse_options(timing=timing)
         return check_cycle_command(loaded, X, csv)
     t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
     sample_time = float(np.median(np.diff(t)))
