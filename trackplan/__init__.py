@@ -43,6 +43,9 @@ TIME_LAWS, time_law(name)
     The time laws by name (``smooth``, ``paper``).
 plan_air_move(q_start, q_end, ...) -> AirMove, air_time_estimate, trapezoid_time
     Jerk-limited rest-to-rest joint moves through the air (ruckig), and their time estimates.
+plan_cycle(case, X) -> CycleResult, optimize_cycle(case, ...) -> CycleSearchResult
+    A case with several seams (``paths:``): one placement, approach, retract and air moves,
+    the sequence; ``check_cycle_trajectory`` re-checks its trajectory (``docs/seams.md``).
 best_sequence(...) -> Sequence, given_sequence, sequence_cost, Visit
     The order and direction of several seams (``docs/seams.md``).
 Status, Timing, Method, Penalty
@@ -79,6 +82,7 @@ if TYPE_CHECKING:
     from trackplan.io.robot_file import BUILTIN_ROBOTS, builtin_names, builtin_robot, load_robot
     from trackplan.jointpath import JointPath
     from trackplan.planning.checker import check_trajectory
+    from trackplan.planning.cycle import CycleResult, check_cycle_trajectory, plan_cycle
     from trackplan.planning.energy import EnergyFigures, energy_figures
     from trackplan.planning.objectives import OBJECTIVES
     from trackplan.planning.plan import check_case_trajectory, plan_placement
@@ -95,6 +99,7 @@ if TYPE_CHECKING:
     from trackplan.robots.kinematics import forward_kinematics, jacobian
     from trackplan.robots.model import Robot
     from trackplan.search import OptimizeResult, optimize_placement
+    from trackplan.search.cycle_search import CycleSearchResult, optimize_cycle
     from trackplan.search.pareto import ParetoResult, pareto_front
     from trackplan.status import Status
     from trackplan.study.runner import run_study
@@ -159,6 +164,11 @@ _EXPORTS = {
     "best_sequence": "trackplan.planning.sequence",
     "given_sequence": "trackplan.planning.sequence",
     "sequence_cost": "trackplan.planning.sequence",
+    "plan_cycle": "trackplan.planning.cycle",
+    "CycleResult": "trackplan.planning.cycle",
+    "check_cycle_trajectory": "trackplan.planning.cycle",
+    "optimize_cycle": "trackplan.search.cycle_search",
+    "CycleSearchResult": "trackplan.search.cycle_search",
 }
 
 __all__ = [
@@ -169,6 +179,8 @@ __all__ = [
     "Case",
     "CaseError",
     "CheckReport",
+    "CycleResult",
+    "CycleSearchResult",
     "EnergyFigures",
     "JointPath",
     "Method",
@@ -192,6 +204,7 @@ __all__ = [
     "builtin_names",
     "builtin_robot",
     "check_case_trajectory",
+    "check_cycle_trajectory",
     "check_trajectory",
     "energy_figures",
     "forward_kinematics",
@@ -201,9 +214,11 @@ __all__ = [
     "jacobian",
     "load_case",
     "load_robot",
+    "optimize_cycle",
     "optimize_placement",
     "pareto_front",
     "plan_air_move",
+    "plan_cycle",
     "plan_placement",
     "run_study",
     "sequence_cost",
