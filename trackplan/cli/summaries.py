@@ -60,10 +60,10 @@ def segment_corners(path: NominalPath) -> list[tuple[int, float]]:
         between the points of one ``points`` segment are left out: they sample a curve.
     """
     owner = path.segment_index
+    junctions = path.corner_junctions
+    junctions = junctions[owner[junctions] != owner[junctions + 1]]
     return [
-        (int(owner[corner.junction + 1]), float(np.degrees(np.pi - corner.angle)))
-        for corner in path.corners
-        if owner[corner.junction] != owner[corner.junction + 1]
+        (int(owner[k + 1]), float(np.degrees(np.pi - path.junction_angles[k]))) for k in junctions
     ]
 
 

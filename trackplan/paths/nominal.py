@@ -8,29 +8,17 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from itertools import pairwise
 from typing import cast
 
 import numpy as np
 
 from trackplan.errors import CaseError
-from trackplan.paths.geometry import (
-    COLLINEAR_ANGLE,
-    Arc,
-    Line,
-    Primitive,
-    end_jet,
-    project_onto_arcs,
-    project_onto_lines,
-    start_jet,
-    turning_angle,
-)
-from trackplan.paths.pieces import Piece, chain, evaluate_pieces
+from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, CurveJet, Line, Primitive
+from trackplan.paths.piece_table import PieceTable
+from trackplan.paths.pieces import Piece
+from trackplan.paths.projection import PieceIndex
 from trackplan.paths.specs import ArcSpec, LineSpec, SegmentSpec
 from trackplan.paths.validation import check_segments
-
-# Largest number of (point, piece) pairs projected at once: bounds the scratch memory.
-_PAIRS_PER_BLOCK = 1 << 20
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,13 +47,17 @@ class Corner:
 class NominalPath:
     """The user's path: exact lines and arcs; a sampled curve is the polyline through its points.
 
+    The pieces are held as arrays (:class:`~trackplan.paths.piece_table.PieceTable`): a
+    sampled curve of a million points is a million lines, built and projected onto without a
+    Python object each (``docs/paths.md``).
+
     Attributes
     ----------
     start
         Start point, shape (3,), m, in the definition frame.
     segments
         The segments it was built from.
-    pieces
+    table
         Lines and arcs end to end on the arc length s.
     segment_index
         Index into ``segments`` of each piece, shape (n_pieces,).
@@ -73,7 +65,7 @@ class NominalPath:
 
     start: np.ndarray
     segments: tuple[SegmentSpec, ...]
-    pieces: tuple[Piece, ...]
+    table: PieceTable
     segment_index: np.ndarray
 
     @classmethod
@@ -98,27 +90,43 @@ class NominalPath:
             key, message = problems[0]
             raise CaseError(message, key=key)
         current = np.asarray(start, dtype=float)
-        curves: list[Primitive] = []
-        owner: list[int] = []
+        tables: list[PieceTable] = []
+        owner: list[np.ndarray] = []
         for i, spec in enumerate(segments):
-            new: list[Primitive]
             if isinstance(spec, LineSpec):
-                new = [Line.between(current, np.asarray(spec.to, dtype=float))]
+                line = Line.between(current, np.asarray(spec.to, dtype=float))
+                table, current = PieceTable.from_curves([line]), line.end
             elif isinstance(spec, ArcSpec):
                 arc = Arc.from_rotation(current, spec.center, spec.normal, float(spec.angle))
-                new = [arc]
+                table, current = PieceTable.from_curves([arc]), arc.end
             else:
                 vertices = np.vstack([current[None], np.asarray(spec.points, dtype=float)])
-                new = [Line.between(a, b) for a, b in pairwise(vertices)]
-            curves.extend(new)
-            owner.extend([i] * len(new))
-            current = new[-1].end
-        return cls(np.asarray(start, dtype=float), tuple(segments), chain(curves), np.array(owner))
+                table = PieceTable.from_polyline(vertices)
+                current = table.start[-1] + table.length[-1] * table.direction[-1]
+            tables.append(table)
+            owner.append(np.full(table.n_pieces, i))
+        return cls(
+            np.asarray(start, dtype=float),
+            tuple(segments),
+            PieceTable.concatenate(tables),
+            np.concatenate(owner),
+        )
 
     @property
     def length(self) -> float:
         """Total arc length, m."""
-        return self.pieces[-1].s_end
+        return self.table.total_length
+
+    @property
+    def n_pieces(self) -> int:
+        """Number of lines and arcs."""
+        return self.table.n_pieces
+
+    @cached_property
+    def pieces(self) -> tuple[Piece, ...]:
+        """The lines and arcs end to end, one object each (built on first use)."""
+        table = self.table
+        return tuple(Piece(table.curve(k), float(table.s_start[k])) for k in range(table.n_pieces))
 
     @property
     def curves(self) -> tuple[Primitive, ...]:
@@ -127,43 +135,51 @@ class NominalPath:
 
     def segment_curves(self, segment: int) -> list[Primitive]:
         """The lines and arcs made from ``segments[segment]``, in order."""
-        return [self.curves[k] for k in np.flatnonzero(self.segment_index == segment)]
+        return [self.table.curve(int(k)) for k in np.flatnonzero(self.segment_index == segment)]
 
     def vertices(self, segment: int) -> np.ndarray:
         """The polyline of a ``points`` segment, current point first, shape (K + 1, 3), m."""
-        owned = self.segment_curves(segment)
-        return np.vstack([curve.start for curve in owned] + [owned[-1].end])
+        owned = np.flatnonzero(self.segment_index == segment)
+        table, last = self.table, owned[-1]
+        end = table.start[last] + table.length[last] * table.direction[last]
+        return np.vstack([table.start[owned], end[None]])
+
+    @cached_property
+    def junction_angles(self) -> np.ndarray:
+        """Turning angle of the tangent at each junction, shape (P − 1,), rad, in [0, π]:
+        entry k joins pieces k and k + 1."""
+        t_in = self.table.end_tangents()[:-1]
+        t_out = self.table.start_tangents()[1:]
+        across = np.linalg.norm(np.cross(t_in, t_out), axis=1)
+        angles = np.arctan2(across, np.einsum("ij,ij->i", t_in, t_out))
+        angles.flags.writeable = False
+        return angles
+
+    @cached_property
+    def corner_junctions(self) -> np.ndarray:
+        """Junctions where the tangent turns by more than
+        :data:`~trackplan.paths.geometry.COLLINEAR_ANGLE`, shape (C,): entry ``k`` joins
+        pieces k and k + 1 (polyline vertices included)."""
+        return np.flatnonzero(self.junction_angles > COLLINEAR_ANGLE)
 
     @cached_property
     def corners(self) -> tuple[Corner, ...]:
-        """Junctions where the tangent turns by more than
-        :data:`~trackplan.paths.geometry.COLLINEAR_ANGLE`, in order (polyline vertices included)."""
-        found = []
-        for k, (a, b) in enumerate(pairwise(self.pieces)):
-            angle = turning_angle(end_jet(a.curve).tangent[0], start_jet(b.curve).tangent[0])
-            if angle > COLLINEAR_ANGLE:
-                found.append(Corner(k, b.s_start, angle, b.curve.start))
-        return tuple(found)
+        """The corners (:attr:`corner_junctions`) as objects, in order."""
+        table = self.table
+        return tuple(
+            Corner(
+                int(k),
+                float(table.s_start[k + 1]),
+                float(self.junction_angles[k]),
+                table.start[k + 1],
+            )
+            for k in self.corner_junctions
+        )
 
     @cached_property
-    def _stacked(self) -> dict[str, np.ndarray]:
-        lines = [k for k, curve in enumerate(self.curves) if isinstance(curve, Line)]
-        arcs = [k for k, curve in enumerate(self.curves) if isinstance(curve, Arc)]
-        line_curves = [cast(Line, self.curves[k]) for k in lines]
-        arc_curves = [cast(Arc, self.curves[k]) for k in arcs]
-        return {
-            "lines": np.array(lines, dtype=int),
-            "line_start": np.array([c.start for c in line_curves]).reshape(-1, 3),
-            "line_direction": np.array([c.direction for c in line_curves]).reshape(-1, 3),
-            "line_length": np.array([c.length for c in line_curves]),
-            "arcs": np.array(arcs, dtype=int),
-            "arc_center": np.array([c.center for c in arc_curves]).reshape(-1, 3),
-            "arc_radius": np.array([c.radius for c in arc_curves]),
-            "arc_e1": np.array([c.e1 for c in arc_curves]).reshape(-1, 3),
-            "arc_axis": np.array([c.axis for c in arc_curves]).reshape(-1, 3),
-            "arc_angle": np.array([c.angle for c in arc_curves]),
-            "s_start": np.array([piece.s_start for piece in self.pieces]),
-        }
+    def index(self) -> PieceIndex:
+        """The spatial index of the pieces (built on first use)."""
+        return PieceIndex(self.table)
 
     def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Nearest points on the nominal path.
@@ -180,35 +196,20 @@ class NominalPath:
         distance
             Distance to it, shape (N,), m: the tracking error.
         """
-        points = np.asarray(points, dtype=float).reshape(-1, 3)
-        st = self._stacked
-        s = np.empty(len(points))
-        distance = np.empty(len(points))
-        block = max(1, _PAIRS_PER_BLOCK // len(self.pieces))
-        for first in range(0, len(points), block):
-            chunk = points[first : first + block]
-            sigma_l, dist_l = project_onto_lines(
-                chunk, st["line_start"], st["line_direction"], st["line_length"]
-            )
-            sigma_a, dist_a = project_onto_arcs(
-                chunk,
-                st["arc_center"],
-                st["arc_radius"],
-                st["arc_axis"],
-                st["arc_e1"],
-                st["arc_angle"],
-            )
-            sigma = np.hstack([sigma_l, sigma_a])
-            dist = np.hstack([dist_l, dist_a])
-            owner = np.concatenate([st["lines"], st["arcs"]])
-            # Order columns by piece so that ties resolve to the earliest piece.
-            order = np.argsort(owner, kind="stable")
-            sigma, dist, owner = sigma[:, order], dist[:, order], owner[order]
-            best = np.argmin(dist, axis=1)
-            rows = np.arange(len(chunk))
-            s[first : first + block] = st["s_start"][owner[best]] + sigma[rows, best]
-            distance[first : first + block] = dist[rows, best]
+        s, distance, _ = self.index.project(np.asarray(points, dtype=float).reshape(-1, 3))
         return s, distance
+
+    def evaluate(self, s: np.ndarray) -> tuple[CurveJet, np.ndarray]:
+        """Position and arc-length derivatives at arc lengths ``s`` (M,), m, and the piece of
+        each, shape (M,) (a junction belongs to the later piece)."""
+        return self.table.evaluate(s)
+
+    def tangents(self, s: np.ndarray, piece: np.ndarray) -> np.ndarray:
+        """Unit tangents at arc lengths ``s`` (N,), m, on the given pieces (N,), shape (N, 3)."""
+        table = self.table
+        piece = np.asarray(piece, dtype=int)
+        sigma = np.clip(np.asarray(s, dtype=float) - table.s_start[piece], 0.0, table.length[piece])
+        return table.evaluate_on(piece, sigma).tangent
 
     def polyline(self, ds: float) -> np.ndarray:
         """Points along the path for drawing, at most ``ds`` (m) apart, ends included.
@@ -218,9 +219,10 @@ class NominalPath:
         numpy.ndarray
             Shape (K, 3), m.
         """
-        s = [np.zeros(1)]
-        for piece in self.pieces:
-            n = max(1, int(np.ceil(piece.length / ds)))
-            s.append(piece.s_start + piece.length * np.arange(1, n + 1) / n)
-        jet, _ = evaluate_pieces(self.pieces, np.concatenate(s))
-        return jet.position
+        table = self.table
+        counts = np.maximum(1, np.ceil(table.length / ds)).astype(int)
+        piece = np.repeat(np.arange(table.n_pieces), counts)
+        j = np.arange(len(piece)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+        sigma = table.length[piece] * j / counts[piece]
+        ends = table.evaluate_on(piece, sigma).position
+        return np.vstack([self.start[None], ends])

@@ -29,13 +29,7 @@ def nominal_tangents(nominal: NominalPath, s: np.ndarray, piece: np.ndarray) -> 
     numpy.ndarray
         Shape (N, 3).
     """
-    tangent = np.empty((len(s), 3))
-    for p in np.unique(piece):
-        rows = piece == p
-        segment = nominal.pieces[p]
-        sigma = np.clip(s[rows] - segment.s_start, 0.0, segment.length)
-        tangent[rows] = segment.curve.evaluate(sigma).tangent
-    return tangent
+    return nominal.tangents(s, piece)
 
 
 def transition_zones(spec: ToolSpec, geometry: PathGeometry, tolerance: float) -> np.ndarray:

@@ -11,15 +11,21 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.paths.geometry import unwrap_closed_arc
+from trackplan.paths.nominal import NominalPath
+from trackplan.planning._kernels import monotone_assignment
 
 DIRECTION_SLACK = 0.2
 """A piece agrees with the motion when tangent · velocity ≥ −slack · |velocity|."""
 
 
 def locate_on_nominal(
-    nominal, points: np.ndarray, velocity: np.ndarray, tolerance: float
+    nominal: NominalPath, points: np.ndarray, velocity: np.ndarray, tolerance: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Arc length along the nominal path of each sample, its distance, and its piece.
+
+    Only the pieces within ρ of the nearest one are candidates, found through the path's
+    spatial index (:class:`~trackplan.paths.projection.PieceIndex`): time and memory grow
+    with the samples and the pieces, not with their product.
 
     Parameters
     ----------
@@ -41,64 +47,31 @@ def locate_on_nominal(
     piece
         Index of the nominal piece each sample is assigned to, shape (N,).
     """
-    pieces = nominal.pieces
-    n = len(points)
-    sigma = np.empty((n, len(pieces)))
-    dist = np.empty((n, len(pieces)))
-    agrees = np.empty((n, len(pieces)), dtype=bool)
+    points = np.asarray(points, dtype=float)
+    table = nominal.table
+    found = nominal.index.candidates(points, max(tolerance, 1e-12))
+    row, piece, sigma = found.row, found.piece, found.sigma
     speed = np.linalg.norm(velocity, axis=1)
-    for p, piece in enumerate(pieces):  # loop over pieces, vectorised over samples
-        sigma[:, p], dist[:, p] = piece.curve.project(points)
-        tangent = piece.curve.evaluate(sigma[:, p]).tangent
-        agrees[:, p] = np.einsum("nk,nk->n", tangent, velocity) >= -DIRECTION_SLACK * speed
-    nearest = dist.min(axis=1)
-    close = dist <= nearest[:, None] + max(tolerance, 1e-12)
-    candidates = close & agrees
-    candidates[~candidates.any(axis=1)] = close[~candidates.any(axis=1)]
-    assigned = _monotone_assignment(candidates)
-    rows = np.arange(n)
-    local = sigma[rows, assigned]
-    for p, piece in enumerate(pieces):
+    tangent = table.evaluate_on(piece, sigma).tangent
+    agrees = np.einsum("nk,nk->n", tangent, velocity[row]) >= -DIRECTION_SLACK * speed[row]
+    # where no close piece agrees with the motion, every close piece is a candidate
+    any_agrees = np.bincount(row[agrees], minlength=len(points)) > 0
+    keep = agrees | ~any_agrees[row]
+    row, piece, sigma = row[keep], piece[keep], sigma[keep]
+    bounds = np.searchsorted(row, np.arange(len(points) + 1))
+    chosen = monotone_assignment(bounds, piece)
+    assigned = piece[chosen]
+    local = sigma[chosen]
+    closed = table.is_arc & (table.angle >= 2 * np.pi - 1e-9)
+    for p in np.unique(assigned[closed[assigned]]):
         on_piece = assigned == p
-        if piece.kind == "arc" and piece.curve.angle >= 2 * np.pi - 1e-9 and on_piece.any():
-            local[on_piece] = unwrap_closed_arc(
-                local[on_piece], 2 * np.pi * piece.curve.radius, piece.length
-            )
-    s_start = np.array([piece.s_start for piece in pieces])
-    return s_start[assigned] + local, nearest, assigned
+        local[on_piece] = unwrap_closed_arc(
+            local[on_piece], 2 * np.pi * table.radius[p], table.length[p]
+        )
+    return table.s_start[assigned] + local, found.nearest, assigned
 
 
-def _monotone_assignment(candidates: np.ndarray) -> np.ndarray:
-    """Pick one candidate piece per sample, staying on a piece while it remains a candidate
-    and otherwise moving to the next candidate ahead (behind only when none is ahead).
-
-    Parameters
-    ----------
-    candidates
-        Shape (N, P) bool, at least one True per row.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (N,), piece indices.
-    """
-    n = len(candidates)
-    assigned = np.empty(n, dtype=int)
-    k = 0
-    piece = int(np.argmax(candidates[0]))
-    while k < n:  # one iteration per change of piece
-        leaving = np.flatnonzero(~candidates[k:, piece])
-        end = n if leaving.size == 0 else k + int(leaving[0])
-        assigned[k:end] = piece
-        k = end
-        if k < n:
-            options = np.flatnonzero(candidates[k])
-            ahead = options[options > piece]
-            piece = int(ahead[0]) if ahead.size else int(options[0])
-    return assigned
-
-
-def jump_allowance(nominal, tolerance: float) -> np.ndarray:
+def jump_allowance(nominal: NominalPath, tolerance: float) -> np.ndarray:
     """How far the nominal arc length may jump when leaving each piece, m.
 
     Near a corner of turning angle θ a point within ρ of both legs projects to feet up to
@@ -110,13 +83,12 @@ def jump_allowance(nominal, tolerance: float) -> np.ndarray:
     numpy.ndarray
         Shape (P,), m; entry p applies to the step from piece p to the next.
     """
-    lengths = np.array([piece.length for piece in nominal.pieces])
+    lengths = nominal.table.length
     allowance = np.zeros(len(lengths))
-    for corner in nominal.corners:
-        p = corner.junction
-        half = min(np.pi / 2 - 1e-6, corner.angle / 2)
-        cap = lengths[p] + (lengths[p + 1] if p + 1 < len(lengths) else 0.0)
-        allowance[p] = min(2.0 * tolerance * np.tan(half), cap)
+    p = nominal.corner_junctions
+    half = np.minimum(np.pi / 2 - 1e-6, nominal.junction_angles[p] / 2)
+    following = np.append(lengths, 0.0)[p + 1]
+    allowance[p] = np.minimum(2.0 * tolerance * np.tan(half), lengths[p] + following)
     return allowance
 
 

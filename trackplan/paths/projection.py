@@ -1,0 +1,213 @@
+"""Projection onto a path of many pieces through a spatial index, exact and O(N log P).
+
+A dense projection measures every point against every piece: N × P pairs, 760 million for
+a 20,000-point seam sampled 38,000 times. :class:`PieceIndex` cuts each piece into chunks
+no longer than a common length and puts the chunk midpoints into a k-d tree
+(:class:`scipy.spatial.cKDTree`). A chunk of arc length 2r lies within r of its midpoint,
+so for a point x whose nearest midpoint is e away, every piece within e + slack of x has a
+midpoint within e + slack + r: one ball query finds all the pieces that can be within
+``slack`` of the nearest, and only those are projected exactly. The result is that of the
+dense projection, not an approximation; points near the path meet a handful of pieces.
+The work is split into blocks of bounded size, so a point far from the path (whose ball
+holds many pieces) costs time, never unbounded memory.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterator
+from dataclasses import dataclass
+from functools import cached_property
+from typing import NamedTuple
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from trackplan.paths.piece_table import PieceTable
+
+_EXTRA_CHUNKS = 1000
+"""The chunk length is 2 × the path length / (P + this): a piece of average length or shorter
+is one chunk, and there are at most 1.5 P + 500 chunks."""
+
+_POINTS_PER_BLOCK = 1 << 14
+"""Most points queried at once."""
+
+_PAIRS_PER_BLOCK = 1 << 20
+"""Most (point, chunk) pairs of a ball query held at once."""
+
+_NEIGHBOURS = 32
+"""Nearest chunk midpoints of each point found in one vectorised query."""
+
+_PAD = 1e-9
+"""Relative padding of the query radii (the tree rounds distances its own way), m/m."""
+
+
+class Candidates(NamedTuple):
+    """(point, piece) pairs, sorted by point then piece, with the exact projection.
+
+    Attributes
+    ----------
+    row, piece
+        Indices of the point and the piece, shape (K,).
+    sigma, distance
+        Arc length along the piece of the nearest point (m) and the distance to it (m),
+        shape (K,).
+    nearest
+        Distance of each point from the whole path, shape (N,), m.
+    """
+
+    row: np.ndarray
+    piece: np.ndarray
+    sigma: np.ndarray
+    distance: np.ndarray
+    nearest: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class PieceIndex:
+    """A k-d tree of piece chunks for exact nearest-piece queries.
+
+    Attributes
+    ----------
+    table
+        The pieces.
+    """
+
+    table: PieceTable
+
+    @cached_property
+    def _chunks(self) -> tuple[cKDTree, np.ndarray, np.ndarray, float]:
+        """The tree of chunk midpoints, their piece (C,), half-lengths (C,) m, and the largest."""
+        table = self.table
+        step = 2.0 * table.total_length / (table.n_pieces + _EXTRA_CHUNKS)
+        counts = np.maximum(1, np.ceil(table.length / step)).astype(int)
+        piece = np.repeat(np.arange(table.n_pieces), counts)
+        first = np.cumsum(counts) - counts
+        j = np.arange(len(piece)) - np.repeat(first, counts)
+        chunk = table.length[piece] / counts[piece]
+        midpoints = table.evaluate_on(piece, (j + 0.5) * chunk).position
+        half = 0.5 * chunk
+        return cKDTree(midpoints), piece, half, float(half.max())
+
+    def candidates(self, points: np.ndarray, slack: float) -> Candidates:
+        """Every piece within ``slack`` of the nearest piece, for each point.
+
+        Parameters
+        ----------
+        points
+            Shape (N, 3), m.
+        slack
+            m, ≥ 0: 0 gives the nearest pieces only (several on a tie).
+
+        Returns
+        -------
+        Candidates
+            The pairs (point, piece) with distance ≤ nearest + ``slack``, each piece once.
+        """
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        finite = np.flatnonzero(np.isfinite(points).all(axis=1))
+        tree, widest = self._chunks[0], self._chunks[3]
+        parts = [(np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
+        for start in range(0, len(finite), _POINTS_PER_BLOCK):
+            block = points[finite[start : start + _POINTS_PER_BLOCK]]
+            first, _ = tree.query(block)
+            for rows, chunk in self._near_chunks(block, self._radius(first, slack + widest)):
+                row, piece, sigma, distance = self._pairs(block, first, rows, chunk, slack)
+                parts.append((finite[start + row], piece, sigma, distance))
+        row, piece, sigma, distance = (
+            np.concatenate(values) for values in zip(*parts, strict=True)
+        )
+        if len(finite) < len(points):  # a point that is not finite meets the first piece, at NaN
+            bad = np.setdiff1d(np.arange(len(points)), finite)
+            nan = np.full(len(bad), np.nan)
+            row = np.concatenate([row, bad])
+            piece = np.concatenate([piece, np.zeros(len(bad), dtype=int)])
+            sigma, distance = np.concatenate([sigma, nan]), np.concatenate([distance, nan])
+        order = np.lexsort((piece, row))
+        row, piece, sigma, distance = row[order], piece[order], sigma[order], distance[order]
+        nearest = np.full(len(points), np.nan)
+        nearest[finite] = np.inf
+        measured = ~np.isnan(distance)
+        np.minimum.at(nearest, row[measured], distance[measured])
+        return Candidates(row, piece, sigma, distance, nearest)
+
+    def _radius(self, first_distance: np.ndarray, extra: float) -> np.ndarray:
+        return (first_distance + extra) * (1.0 + _PAD) + _PAD * extra + 1e-15
+
+    def _near_chunks(
+        self, block: np.ndarray, radius: np.ndarray
+    ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """Pairs (row of ``block``, chunk) with the chunk midpoint within ``radius`` (B,), in parts.
+
+        The :data:`_NEIGHBOURS` nearest midpoints of every point come in one vectorised query;
+        the points whose ball holds more are queried ball by ball, in parts of at most
+        :data:`_PAIRS_PER_BLOCK` pairs.
+        """
+        tree = self._chunks[0]
+        k = min(_NEIGHBOURS, tree.n)
+        distance, index = tree.query(block, k=k)
+        distance, index = distance.reshape(len(block), k), index.reshape(len(block), k)
+        inside = distance <= radius[:, None]
+        more = np.flatnonzero(inside[:, -1]) if k < tree.n else np.zeros(0, dtype=int)
+        inside[more] = False
+        rows, column = np.nonzero(inside)
+        yield rows, index[rows, column]
+        start = 0
+        while start < len(more):
+            stop = min(len(more), start + _PAIRS_PER_BLOCK // k)
+            counts = tree.query_ball_point(
+                block[more[start:stop]], radius[more[start:stop]], return_length=True
+            )
+            stop = start + max(
+                1, int(np.searchsorted(np.cumsum(counts), _PAIRS_PER_BLOCK, side="right"))
+            )
+            found = tree.query_ball_point(block[more[start:stop]], radius[more[start:stop]])
+            counts = np.fromiter(map(len, found), dtype=int, count=len(found))
+            chunk = np.fromiter(itertools.chain.from_iterable(found), dtype=int, count=counts.sum())
+            yield np.repeat(more[start:stop], counts), chunk
+            start = stop
+
+    def _pairs(
+        self, block: np.ndarray, first: np.ndarray, row: np.ndarray, chunk: np.ndarray, slack: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The pieces of the chunks found for points of ``block``, projected, and those within
+        ``slack`` of the nearest kept; rows are those of ``block``."""
+        tree, chunk_piece, half, _ = self._chunks
+        # A chunk whose own half-length rules it out is dropped before projecting.
+        gap = np.linalg.norm(block[row] - tree.data[chunk], axis=1)
+        keep = gap <= self._radius(first[row], slack + half[chunk])
+        n_pieces = self.table.n_pieces
+        pair = np.sort(row[keep] * n_pieces + chunk_piece[chunk[keep]])
+        first_of_pair = np.ones(len(pair), dtype=bool)
+        first_of_pair[1:] = pair[1:] != pair[:-1]
+        pair = pair[first_of_pair]
+        row, piece = pair // n_pieces, pair % n_pieces
+        sigma, distance = self.table.project_on(block[row], piece)
+        nearest = np.full(len(block), np.inf)
+        np.minimum.at(nearest, row, distance)
+        close = distance <= nearest[row] + slack
+        return row[close], piece[close], sigma[close], distance[close]
+
+    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Nearest point of the path for each point.
+
+        Parameters
+        ----------
+        points
+            Shape (N, 3), m.
+
+        Returns
+        -------
+        s
+            Path arc length of the nearest point, shape (N,), m (the earliest piece on ties).
+        distance
+            Distance to it, shape (N,), m.
+        piece
+            Its piece, shape (N,).
+        """
+        found = self.candidates(points, 0.0)
+        order = np.lexsort((found.piece, found.distance, found.row))
+        row = found.row[order]
+        best = order[np.flatnonzero(np.diff(np.concatenate([[-1], row])))]
+        piece = found.piece[best]
+        return self.table.s_start[piece] + found.sigma[best], found.distance[best], piece
