@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import math
 from pathlib import Path
 
@@ -42,6 +43,9 @@ def load_points_csv(
         (reported against the CSV file, with its line number as the key).
     """
     text = read_text(file, what="points file", referrer=case_file, key=key)
+    fast = _parse_fast(text)
+    if fast is not None:
+        return fast
     points: list[list[float]] = []
     for number, line in enumerate(text.splitlines(), start=1):
         row = line.strip()
@@ -66,6 +70,37 @@ def load_points_csv(
             f"expected at least {MIN_POINTS} rows x,y,z, got {len(points)}", file=str(file)
         )
     return np.array(points, dtype=float)
+
+
+def _parse_fast(text: str) -> np.ndarray | None:
+    """The points of a well-formed file, parsed in C (a million rows in about a second).
+
+    Returns None when the rows after the header are anything but three finite numbers each
+    (a comment or a blank line among them included), or fewer than :data:`MIN_POINTS`: the
+    line-by-line reader then takes the file, and names the row at fault.
+    """
+    start = 0
+    while True:  # skip blank and comment lines, and a header row, before the first point
+        end = text.find("\n", start)
+        end = len(text) if end < 0 else end
+        row = text[start:end].strip()
+        if row and not row.startswith("#"):
+            if not any(_is_number(field) for field in row.split(",")):
+                start = end + 1
+            break
+        if end >= len(text):
+            return None
+        start = end + 1
+    body = text[start:]
+    if "#" in body:
+        return None
+    try:
+        points = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2)
+    except ValueError:
+        return None
+    if points.shape[1:] != (3,) or len(points) < MIN_POINTS or not np.all(np.isfinite(points)):
+        return None
+    return points
 
 
 def _is_number(text: str) -> bool:

@@ -23,6 +23,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial import cKDTree
 
+from trackplan.paths._kernels import near_pieces
 from trackplan.paths.piece_table import PieceTable
 
 _EXTRA_CHUNKS = 1000
@@ -36,7 +37,11 @@ _PAIRS_PER_BLOCK = 1 << 20
 """Most (point, chunk) pairs of a ball query held at once."""
 
 _NEIGHBOURS = 32
-"""Nearest chunk midpoints of each point found in one vectorised query."""
+"""Nearest chunk midpoints of each point found in one vectorised query; the points whose
+query ball holds more are queried ball by ball."""
+
+_NEIGHBOURS_NEAREST = 8
+"""The same for the nearest piece only (no slack)."""
 
 _PAD = 1e-9
 """Relative padding of the query radii (the tree rounds distances its own way), m/m."""
@@ -108,12 +113,22 @@ class PieceIndex:
         finite = np.flatnonzero(np.isfinite(points).all(axis=1))
         tree, widest = self._chunks[0], self._chunks[3]
         parts = [(np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
+        k = min(_NEIGHBOURS if slack > 0.0 else _NEIGHBOURS_NEAREST, tree.n)
         for start in range(0, len(finite), _POINTS_PER_BLOCK):
             block = points[finite[start : start + _POINTS_PER_BLOCK]]
-            first, _ = tree.query(block)
-            for rows, chunk in self._near_chunks(block, self._radius(first, slack + widest)):
-                row, piece, sigma, distance = self._pairs(block, first, rows, chunk, slack)
-                parts.append((finite[start + row], piece, sigma, distance))
+            distance, index = tree.query(block, k=k)
+            distance, index = distance.reshape(len(block), k), index.reshape(len(block), k)
+            first = distance[:, 0]
+            radius = self._radius(first, slack + widest)
+            more = (distance[:, -1] <= radius) & (k < tree.n)  # the ball holds more than k
+            bounds, piece, sigma, gap = self._near_pieces(
+                block, distance, index, radius, more, slack
+            )
+            row = np.repeat(np.arange(len(block)), np.diff(bounds))
+            parts.append((finite[start + row], piece, sigma, gap))
+            for rows, chunk in self._ball_chunks(block, np.flatnonzero(more), radius):
+                row, piece, sigma, gap = self._pairs(block, first, rows, chunk, slack)
+                parts.append((finite[start + row], piece, sigma, gap))
         row, piece, sigma, distance = (
             np.concatenate(values) for values in zip(*parts, strict=True)
         )
@@ -123,49 +138,71 @@ class PieceIndex:
             row = np.concatenate([row, bad])
             piece = np.concatenate([piece, np.zeros(len(bad), dtype=int)])
             sigma, distance = np.concatenate([sigma, nan]), np.concatenate([distance, nan])
-        order = np.lexsort((piece, row))
-        row, piece, sigma, distance = row[order], piece[order], sigma[order], distance[order]
-        nearest = np.full(len(points), np.nan)
-        nearest[finite] = np.inf
-        measured = ~np.isnan(distance)
-        np.minimum.at(nearest, row[measured], distance[measured])
+        if np.any(np.diff(row) < 0):
+            order = np.lexsort((piece, row))
+            row, piece, sigma, distance = row[order], piece[order], sigma[order], distance[order]
+        nearest = np.full(len(points), np.inf)
+        firsts = _firsts(row)
+        nearest[row[firsts]] = np.minimum.reduceat(distance, firsts) if len(row) else []
         return Candidates(row, piece, sigma, distance, nearest)
 
     def _radius(self, first_distance: np.ndarray, extra: float) -> np.ndarray:
         return (first_distance + extra) * (1.0 + _PAD) + _PAD * extra + 1e-15
 
-    def _near_chunks(
-        self, block: np.ndarray, radius: np.ndarray
-    ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-        """Pairs (row of ``block``, chunk) with the chunk midpoint within ``radius`` (B,), in parts.
+    def _near_pieces(
+        self,
+        block: np.ndarray,
+        distance: np.ndarray,
+        index: np.ndarray,
+        radius: np.ndarray,
+        skip: np.ndarray,
+        slack: float,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The kept pairs of the points of ``block`` whose ball holds at most k chunks
+        (:func:`trackplan.paths._kernels.near_pieces`)."""
+        _, chunk_piece, half, _ = self._chunks
+        t = self.table
+        return near_pieces(
+            block,
+            distance,
+            index,
+            radius,
+            skip,
+            slack,
+            _PAD,
+            chunk_piece,
+            half,
+            t.is_arc,
+            t.start,
+            t.direction,
+            t.length,
+            t.center,
+            t.axis,
+            t.e1,
+            t.e2,
+            t.radius,
+            t.angle,
+        )
 
-        The :data:`_NEIGHBOURS` nearest midpoints of every point come in one vectorised query;
-        the points whose ball holds more are queried ball by ball, in parts of at most
-        :data:`_PAIRS_PER_BLOCK` pairs.
+    def _ball_chunks(
+        self, block: np.ndarray, more: np.ndarray, radius: np.ndarray
+    ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """Pairs (row of ``block``, chunk) for the points ``more`` whose ball holds many chunks.
+
+        Ball by ball, in parts of at most :data:`_PAIRS_PER_BLOCK` pairs.
         """
         tree = self._chunks[0]
-        k = min(_NEIGHBOURS, tree.n)
-        distance, index = tree.query(block, k=k)
-        distance, index = distance.reshape(len(block), k), index.reshape(len(block), k)
-        inside = distance <= radius[:, None]
-        more = np.flatnonzero(inside[:, -1]) if k < tree.n else np.zeros(0, dtype=int)
-        inside[more] = False
-        rows, column = np.nonzero(inside)
-        yield rows, index[rows, column]
         start = 0
         while start < len(more):
-            stop = min(len(more), start + _PAIRS_PER_BLOCK // k)
-            counts = tree.query_ball_point(
-                block[more[start:stop]], radius[more[start:stop]], return_length=True
-            )
-            stop = start + max(
-                1, int(np.searchsorted(np.cumsum(counts), _PAIRS_PER_BLOCK, side="right"))
-            )
-            found = tree.query_ball_point(block[more[start:stop]], radius[more[start:stop]])
+            rows = more[start : start + _POINTS_PER_BLOCK]
+            counts = tree.query_ball_point(block[rows], radius[rows], return_length=True)
+            fits = np.searchsorted(np.cumsum(counts), _PAIRS_PER_BLOCK, side="right")
+            rows = rows[: max(1, int(fits))]
+            found = tree.query_ball_point(block[rows], radius[rows])
             counts = np.fromiter(map(len, found), dtype=int, count=len(found))
             chunk = np.fromiter(itertools.chain.from_iterable(found), dtype=int, count=counts.sum())
-            yield np.repeat(more[start:stop], counts), chunk
-            start = stop
+            yield np.repeat(rows, counts), chunk
+            start += len(rows)
 
     def _pairs(
         self, block: np.ndarray, first: np.ndarray, row: np.ndarray, chunk: np.ndarray, slack: float
@@ -184,7 +221,8 @@ class PieceIndex:
         row, piece = pair // n_pieces, pair % n_pieces
         sigma, distance = self.table.project_on(block[row], piece)
         nearest = np.full(len(block), np.inf)
-        np.minimum.at(nearest, row, distance)
+        firsts = _firsts(row)
+        nearest[row[firsts]] = np.minimum.reduceat(distance, firsts) if len(row) else []
         close = distance <= nearest[row] + slack
         return row[close], piece[close], sigma[close], distance[close]
 
@@ -206,8 +244,15 @@ class PieceIndex:
             Its piece, shape (N,).
         """
         found = self.candidates(points, 0.0)
-        order = np.lexsort((found.piece, found.distance, found.row))
-        row = found.row[order]
-        best = order[np.flatnonzero(np.diff(np.concatenate([[-1], row])))]
+        # the first (earliest) piece of each point at its nearest distance
+        at_nearest = np.flatnonzero(found.distance == found.nearest[found.row])
+        best = at_nearest[_firsts(found.row[at_nearest])]
         piece = found.piece[best]
         return self.table.s_start[piece] + found.sigma[best], found.distance[best], piece
+
+
+def _firsts(row: np.ndarray) -> np.ndarray:
+    """Index of the first entry of each run of equal values in ``row`` (K,), shape (R,)."""
+    starts = np.ones(len(row), dtype=bool)
+    starts[1:] = row[1:] != row[:-1]
+    return np.flatnonzero(starts)
