@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 from tests.paths.random_paths import paths, random_nominal
 from trackplan.paths import LineSpec, NominalPath, PointsSpec
 from trackplan.paths.geometry import unwrap_closed_arc
+from trackplan.planning import tracking
 from trackplan.planning.tracking import DIRECTION_SLACK, jump_allowance, locate_on_nominal
 
 PROPERTY = settings(max_examples=30, deadline=None, derandomize=True)
@@ -112,3 +113,13 @@ def test_jump_allowance_at_corners():
     )
     allowance = jump_allowance(nominal, 1e-3)
     np.testing.assert_allclose(allowance, [2e-3, 0.0], rtol=1e-12)
+
+
+def test_locate_in_blocks_equals_locate_at_once(monkeypatch):
+    nominal = random_nominal(11, 6)
+    points, velocity = _trajectory(nominal, 3, "pauses", 2e-4)
+    whole = locate_on_nominal(nominal, points, velocity, 1e-3)
+    monkeypatch.setattr(tracking, "LOCATE_BLOCK", 37)
+    blocks = locate_on_nominal(nominal, points, velocity, 1e-3)
+    for a, b in zip(whole, blocks, strict=True):
+        np.testing.assert_array_equal(a, b)

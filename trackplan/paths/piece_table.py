@@ -154,6 +154,17 @@ class PieceTable:
             derivative[arc] = -along / radius**2
         return CurveJet(position, tangent, curvature, derivative)
 
+    def tangent_on(self, piece: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+        """Unit tangents (M, 3) on pieces ``piece`` (M,) at their arc lengths ``sigma`` (M,), m."""
+        piece = np.asarray(piece, dtype=int)
+        tangent = self.direction[piece]
+        arc = self.is_arc[piece]
+        if arc.any():
+            k = piece[arc]
+            phi = np.asarray(sigma, dtype=float)[arc][:, None] / self.radius[k][:, None]
+            tangent[arc] = np.cos(phi) * self.e2[k] - np.sin(phi) * self.e1[k]
+        return tangent
+
     def evaluate(self, s: np.ndarray) -> tuple[CurveJet, np.ndarray]:
         """Position and derivatives at path arc lengths ``s`` (M,), m, and the piece of each (M,).
 

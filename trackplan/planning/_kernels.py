@@ -10,7 +10,9 @@ from numba import njit
 
 
 @njit(cache=True)
-def monotone_assignment(bounds: np.ndarray, piece: np.ndarray) -> np.ndarray:  # pragma: no cover
+def monotone_assignment(
+    bounds: np.ndarray, piece: np.ndarray, current: int
+) -> np.ndarray:  # pragma: no cover
     """Pick one candidate piece per sample, in time order.
 
     Stays on a piece while it remains a candidate, otherwise moves to the nearest candidate
@@ -23,6 +25,9 @@ def monotone_assignment(bounds: np.ndarray, piece: np.ndarray) -> np.ndarray:  #
         sample has at least one.
     piece
         Candidate pieces, ascending within each sample, shape (K,).
+    current
+        The piece of the sample before the first, or −1 to start on the first sample's
+        first candidate.
 
     Returns
     -------
@@ -31,7 +36,8 @@ def monotone_assignment(bounds: np.ndarray, piece: np.ndarray) -> np.ndarray:  #
     """
     n = len(bounds) - 1
     chosen = np.empty(n, dtype=np.int64)
-    current = piece[bounds[0]] if n > 0 else 0
+    if current < 0 and n > 0:
+        current = piece[bounds[0]]
     for k in range(n):
         first, last = bounds[k], bounds[k + 1]
         pick = -1

@@ -17,6 +17,9 @@ from trackplan.planning._kernels import monotone_assignment
 DIRECTION_SLACK = 0.2
 """A piece agrees with the motion when tangent · velocity ≥ −slack · |velocity|."""
 
+LOCATE_BLOCK = 1 << 13
+"""Samples located at once (their candidate pieces are held together)."""
+
 
 def locate_on_nominal(
     nominal: NominalPath, points: np.ndarray, velocity: np.ndarray, tolerance: float
@@ -49,26 +52,34 @@ def locate_on_nominal(
     """
     points = np.asarray(points, dtype=float)
     table = nominal.table
-    found = nominal.index.candidates(points, max(tolerance, 1e-12))
-    row, piece, sigma = found.row, found.piece, found.sigma
     speed = np.linalg.norm(velocity, axis=1)
-    tangent = table.evaluate_on(piece, sigma).tangent
-    agrees = np.einsum("nk,nk->n", tangent, velocity[row]) >= -DIRECTION_SLACK * speed[row]
-    # where no close piece agrees with the motion, every close piece is a candidate
-    any_agrees = np.bincount(row[agrees], minlength=len(points)) > 0
-    keep = agrees | ~any_agrees[row]
-    row, piece, sigma = row[keep], piece[keep], sigma[keep]
-    bounds = np.searchsorted(row, np.arange(len(points) + 1))
-    chosen = monotone_assignment(bounds, piece)
-    assigned = piece[chosen]
-    local = sigma[chosen]
+    nearest = np.empty(len(points))
+    assigned = np.empty(len(points), dtype=int)
+    local = np.empty(len(points))
+    current = -1
+    for first in range(0, len(points), LOCATE_BLOCK):  # blocks bound the memory of the pairs
+        block = slice(first, first + LOCATE_BLOCK)
+        found = nominal.index.candidates(points[block], max(tolerance, 1e-12))
+        nearest[block] = found.nearest
+        row, piece, sigma = found.row, found.piece, found.sigma
+        tangent = table.tangent_on(piece, sigma)
+        along = np.einsum("nk,nk->n", tangent, velocity[block][row])
+        agrees = along >= -DIRECTION_SLACK * speed[block][row]
+        # where no close piece agrees with the motion, every close piece is a candidate
+        any_agrees = np.bincount(row[agrees], minlength=len(found.nearest)) > 0
+        keep = agrees | ~any_agrees[row]
+        row, piece, sigma = row[keep], piece[keep], sigma[keep]
+        bounds = np.searchsorted(row, np.arange(len(found.nearest) + 1))
+        chosen = monotone_assignment(bounds, piece, current)
+        assigned[block], local[block] = piece[chosen], sigma[chosen]
+        current = int(assigned[block][-1])
     closed = table.is_arc & (table.angle >= 2 * np.pi - 1e-9)
     for p in np.unique(assigned[closed[assigned]]):
         on_piece = assigned == p
         local[on_piece] = unwrap_closed_arc(
             local[on_piece], 2 * np.pi * table.radius[p], table.length[p]
         )
-    return table.s_start[assigned] + local, found.nearest, assigned
+    return table.s_start[assigned] + local, nearest, assigned
 
 
 def jump_allowance(nominal: NominalPath, tolerance: float) -> np.ndarray:
