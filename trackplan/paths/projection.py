@@ -40,6 +40,9 @@ _NEIGHBOURS = 32
 """Nearest chunk midpoints of each point found in one vectorised query; the points whose
 query ball holds more are queried ball by ball."""
 
+_DENSE_PIECES = 32
+"""A path of at most this many pieces is projected onto every piece, without the tree."""
+
 _NEIGHBOURS_NEAREST = 8
 """The same for the nearest piece only (no slack)."""
 
@@ -111,8 +114,27 @@ class PieceIndex:
         """
         points = np.asarray(points, dtype=float).reshape(-1, 3)
         finite = np.flatnonzero(np.isfinite(points).all(axis=1))
-        tree, widest = self._chunks[0], self._chunks[3]
         parts = [(np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
+        n_pieces = self.table.n_pieces
+        if n_pieces <= _DENSE_PIECES:  # every piece for every point: cheaper than a tree
+            every = np.arange(n_pieces)
+            for start in range(0, len(finite), _POINTS_PER_BLOCK):
+                block = points[finite[start : start + _POINTS_PER_BLOCK]]
+                zeros = np.zeros((len(block), n_pieces))
+                bounds, piece, sigma, gap = self._near_pieces(
+                    block,
+                    zeros,
+                    np.tile(every, (len(block), 1)),
+                    np.full(len(block), np.inf),
+                    np.zeros(len(block), dtype=bool),
+                    slack,
+                    every,
+                    np.zeros(n_pieces),
+                )
+                row = np.repeat(np.arange(len(block)), np.diff(bounds))
+                parts.append((finite[start + row], piece, sigma, gap))
+            return self._gathered(points, finite, parts)
+        tree, chunk_piece, half, widest = self._chunks
         k = min(_NEIGHBOURS if slack > 0.0 else _NEIGHBOURS_NEAREST, tree.n)
         for start in range(0, len(finite), _POINTS_PER_BLOCK):
             block = points[finite[start : start + _POINTS_PER_BLOCK]]
@@ -122,13 +144,22 @@ class PieceIndex:
             radius = self._radius(first, slack + widest)
             more = (distance[:, -1] <= radius) & (k < tree.n)  # the ball holds more than k
             bounds, piece, sigma, gap = self._near_pieces(
-                block, distance, index, radius, more, slack
+                block, distance, index, radius, more, slack, chunk_piece, half
             )
             row = np.repeat(np.arange(len(block)), np.diff(bounds))
             parts.append((finite[start + row], piece, sigma, gap))
             for rows, chunk in self._ball_chunks(block, np.flatnonzero(more), radius):
                 row, piece, sigma, gap = self._pairs(block, first, rows, chunk, slack)
                 parts.append((finite[start + row], piece, sigma, gap))
+        return self._gathered(points, finite, parts)
+
+    def _gathered(
+        self,
+        points: np.ndarray,
+        finite: np.ndarray,
+        parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
+    ) -> Candidates:
+        """The pairs of all blocks together, in order, with the points that are not finite."""
         row, piece, sigma, distance = (
             np.concatenate(values) for values in zip(*parts, strict=True)
         )
@@ -157,10 +188,11 @@ class PieceIndex:
         radius: np.ndarray,
         skip: np.ndarray,
         slack: float,
+        chunk_piece: np.ndarray,
+        half: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The kept pairs of the points of ``block`` whose ball holds at most k chunks
         (:func:`trackplan.paths._kernels.near_pieces`)."""
-        _, chunk_piece, half, _ = self._chunks
         t = self.table
         return near_pieces(
             block,
