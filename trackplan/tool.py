@@ -33,7 +33,6 @@ from trackplan.errors import CaseError
 from trackplan.frames import rpy_matrix
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.paths.pieces import evaluate_pieces
 
 SPIN_COEFFICIENTS = 6
 """B-spline coefficients of a ``free-varying`` spin profile (clamped cubic, uniform knots)."""
@@ -535,14 +534,18 @@ def seam_problems(spec: ToolSpec, nominal: NominalPath) -> list[str]:
     if norm == 0.0:
         return []
     n = spec.normal / norm
+    table = nominal.table
     s = np.unique(
         np.concatenate(
-            [np.linspace(0.0, nominal.length, max(2, int(nominal.length / ZONE_STEP)))]
-            + [[p.s_start, p.s_end - 1e-12] for p in nominal.pieces]
+            [
+                np.linspace(0.0, nominal.length, max(2, int(nominal.length / ZONE_STEP))),
+                table.s_start,
+                table.s_start + table.length - 1e-12,
+            ]
         )
     )
     s = np.clip(s, 0.0, nominal.length)
-    tangent = evaluate_pieces(nominal.pieces, s)[0].tangent
+    tangent = nominal.evaluate(s)[0].tangent
     across = np.linalg.norm(n - np.outer(tangent @ n, np.ones(3)) * tangent, axis=1)
     bad = np.flatnonzero(across < PARALLEL_SINE)
     if not len(bad):
