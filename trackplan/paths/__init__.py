@@ -13,8 +13,10 @@ from trackplan.paths.blending import (
 from trackplan.paths.fitting import PolylineFit, fit_polyline
 from trackplan.paths.geometry import Arc, Line, QuinticBlend
 from trackplan.paths.nominal import Corner, NominalPath
+from trackplan.paths.piece_table import PieceTable
 from trackplan.paths.pieces import Piece
 from trackplan.paths.planned import Path, PathSample, build_path
+from trackplan.paths.projection import PieceIndex
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.paths.validation import check_segments
 
@@ -28,6 +30,8 @@ __all__ = [
     "Path",
     "PathSample",
     "Piece",
+    "PieceIndex",
+    "PieceTable",
     "PointsSpec",
     "PolylineFit",
     "QuinticBlend",
