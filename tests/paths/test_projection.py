@@ -90,6 +90,9 @@ def test_points_that_are_not_finite_meet_the_first_piece_at_nan():
     np.testing.assert_array_equal(found.row, [0, 1, 2])
     assert np.isnan(found.nearest[1])
     np.testing.assert_allclose(found.nearest[[0, 2]], [0.1, 0.0])
+    s, distance = nominal.project(points)
+    np.testing.assert_allclose(s, [0.5, np.nan, 0.2])
+    np.testing.assert_allclose(distance, [0.1, np.nan, 0.0])
 
 
 def test_piece_table_evaluates_like_the_curves():

@@ -277,7 +277,10 @@ class PieceIndex:
         """
         found = self.candidates(points, 0.0)
         # the first (earliest) piece of each point at its nearest distance
-        at_nearest = np.flatnonzero(found.distance == found.nearest[found.row])
+        nearest = found.nearest[found.row]
+        at_nearest = np.flatnonzero(
+            (found.distance == nearest) | (np.isnan(found.distance) & np.isnan(nearest))
+        )
         best = at_nearest[_firsts(found.row[at_nearest])]
         piece = found.piece[best]
         return self.table.s_start[piece] + found.sigma[best], found.distance[best], piece
