@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.derivatives import backward_derivatives
+from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning.result import CheckReport, Violation
 from trackplan.planning.tool_zones import nominal_tangents
@@ -120,9 +120,31 @@ def check_trajectory(
     CheckReport
         Margins, violations and the worst tracking and orientation errors.
     """
-    q = np.asarray(q, dtype=float)
+    return check_motion(SampledMotion(robot, q, sample_time), reference, cell)
+
+
+def check_motion(
+    motion: SampledMotion,
+    reference: TrackingReference | None = None,
+    cell: CellGeometry | None = None,
+) -> CheckReport:
+    """:func:`check_trajectory` of sampled joints whose derivatives, torques and tool poses
+    other readers share (:class:`~trackplan.motion.SampledMotion`: each computed once).
+
+    Parameters
+    ----------
+    motion
+        The joint samples at Ts, shape (N, n), rad, and the robot.
+    reference, cell
+        As :func:`check_trajectory`.
+
+    Returns
+    -------
+    CheckReport
+    """
+    robot, q, sample_time = motion.robot, motion.q, motion.sample_time
     t = np.arange(len(q) + 3) * sample_time
-    qd, qdd, qddd = backward_derivatives(q, sample_time, pad_end=True)
+    qd, qdd, qddd = motion.qd, motion.qdd, motion.qddd
     violations: list[Violation] = []
     margins: dict[str, np.ndarray] = {}
     binding: dict[str, tuple[int, float]] = {}
@@ -138,9 +160,8 @@ def check_trajectory(
         "acceleration": (qdd, np.abs(qdd) / robot.a_max),
         "jerk": (qddd, np.abs(qddd) / robot.j_max),
     }
-    if robot.dynamics is not None:
-        q_held = np.concatenate([q, np.repeat(q[-1:], len(qd) - len(q), axis=0)])
-        torque = inverse_dynamics(robot, q_held, qd, qdd)
+    if robot.dynamics is not None and motion.torque is not None:
+        torque = motion.torque
         bounds["torque"] = robot.dynamics.torque_max
         signals["torque"] = (torque, np.abs(torque) / robot.dynamics.torque_max)
     for kind, (values, use) in signals.items():
@@ -158,13 +179,13 @@ def check_trajectory(
                 _violation(kind, int(j) + 1, t, values[:, j], use[:, j], float(limit))
             )
     if robot.dynamics is not None:
-        violations = [_at_any_speed(robot, q_held, t, v) for v in violations]
+        violations = [_at_any_speed(robot, motion.q_held, t, v) for v in violations]
 
     task_margins: dict[str, float] = {}
     max_tracking = 0.0
     max_orientation = 0.0
     if reference is not None:
-        task, max_tracking, max_orientation = _check_task(robot, q, sample_time, reference)
+        task, max_tracking, max_orientation = _check_task(motion, reference)
         task_margins, task_violations = task
         violations.extend(task_violations)
 
@@ -241,10 +262,11 @@ def _violation(
 
 
 def _check_task(
-    robot: Robot, q: np.ndarray, sample_time: float, ref: TrackingReference
+    motion: SampledMotion, ref: TrackingReference
 ) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
     """Tracking, orientation, Cartesian speed and coverage checks."""
-    T_base_tool = forward_kinematics(robot, q)
+    robot, q, sample_time = motion.robot, motion.q, motion.sample_time
+    T_base_tool = motion.T_base_tool
     R_part_base = ref.T_base_part[:3, :3].T
     p_part = (T_base_tool[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
     t = np.arange(len(q)) * sample_time

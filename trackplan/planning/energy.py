@@ -11,8 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.derivatives import backward_derivatives
-from trackplan.robots.dynamics.rne import inverse_dynamics
+from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
 
 
@@ -60,10 +59,10 @@ def joint_torques(robot: Robot, q: np.ndarray, sample_time: float) -> tuple[np.n
     tuple of numpy.ndarray
         ``(tau, qd)``, each shape (N + 3, n), N·m and rad/s.
     """
-    q = np.asarray(q, dtype=float)
-    qd, qdd, _ = backward_derivatives(q, sample_time, pad_end=True)
-    q_held = np.concatenate([q, np.repeat(q[-1:], len(qd) - len(q), axis=0)])
-    return inverse_dynamics(robot, q_held, qd, qdd), qd
+    motion = SampledMotion(robot, q, sample_time)
+    if motion.torque is None:
+        raise ValueError(f"robot {robot.name!r} has no dynamic parameters")
+    return motion.torque, motion.qd
 
 
 def energy_figures(robot: Robot, q: np.ndarray, sample_time: float) -> EnergyFigures:
@@ -82,10 +81,27 @@ def energy_figures(robot: Robot, q: np.ndarray, sample_time: float) -> EnergyFig
     -------
     EnergyFigures
     """
+    return motion_energy(SampledMotion(robot, q, sample_time))
+
+
+def motion_energy(motion: SampledMotion) -> EnergyFigures:
+    """:func:`energy_figures` from the torques of a :class:`~trackplan.motion.SampledMotion`
+    (computed once for every reader).
+
+    Parameters
+    ----------
+    motion
+        Joint samples at Ts of a robot with dynamics.
+
+    Returns
+    -------
+    EnergyFigures
+    """
+    robot, sample_time = motion.robot, motion.sample_time
     dynamics = robot.dynamics
-    if dynamics is None:
+    if dynamics is None or motion.torque is None:
         raise ValueError(f"robot {robot.name!r} has no dynamic parameters")
-    tau, qd = joint_torques(robot, q, sample_time)
+    tau, qd = motion.torque, motion.qd
     k_m = np.ones(robot.n_dof) if dynamics.motor_constant is None else dynamics.motor_constant
     motor_torque = tau / (np.asarray(dynamics.gear_ratio) * k_m)
     use = np.abs(tau) / dynamics.torque_max

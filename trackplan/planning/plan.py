@@ -7,21 +7,22 @@ depends on which law runs.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from trackplan.case import Case
 from trackplan.cell.screening import CellGeometry
-from trackplan.derivatives import backward_derivatives
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform
 from trackplan.jointpath import JointPath
-from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.checker import TrackingReference, check_trajectory
-from trackplan.planning.energy import energy_figures
+from trackplan.motion import SampledMotion
+from trackplan.paths.path_geometry import PathGeometry, PathMode
+from trackplan.planning.checker import TrackingReference, check_motion, check_trajectory
+from trackplan.planning.energy import motion_energy
 from trackplan.planning.objective import joint_travel
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.planning.tool_zones import transition_zones
-from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.timing import TimeLaw, time_law
@@ -29,11 +30,46 @@ from trackplan.tool import (
     SpinMode,
     SpinProfile,
     ToolOrientation,
+    ToolSpec,
     tool_axis_twist,
 )
 
 CELL_KINDS = ("collision", "clearance")
 """Violation kinds of the cell check."""
+
+
+_GEOMETRIES: weakref.WeakKeyDictionary[Case, dict[str, PathGeometry]] = weakref.WeakKeyDictionary()
+"""The paths of the cases alive, per path mode: placement-independent, built once."""
+
+_TOOL_ZONES: weakref.WeakKeyDictionary[PathGeometry, list[tuple[ToolSpec, float, np.ndarray]]] = (
+    weakref.WeakKeyDictionary()
+)
+"""Transition zones per geometry, tool spec and tolerance: placement-independent."""
+
+
+def case_geometry(case: Case, mode: PathMode = "g2") -> PathGeometry:
+    """The case's paths in a path mode (:meth:`PathGeometry.from_case`), built once per case.
+
+    The case is immutable: every plan of it shares one geometry (and the planning grid
+    cached on it).
+    """
+    built = _GEOMETRIES.setdefault(case, {})
+    if mode not in built:
+        built[mode] = PathGeometry.from_case(case, mode)
+    return built[mode]
+
+
+def _transition_zones(spec: ToolSpec, geometry: PathGeometry, tolerance: float) -> np.ndarray:
+    """:func:`~trackplan.planning.tool_zones.transition_zones`, computed once per geometry,
+    tool spec and tolerance (read-only)."""
+    known = _TOOL_ZONES.setdefault(geometry, [])
+    for known_spec, known_tolerance, zones in known:
+        if known_spec is spec and known_tolerance == tolerance:
+            return zones
+    zones = transition_zones(spec, geometry, tolerance)
+    zones.flags.writeable = False
+    known.append((spec, tolerance, zones))
+    return zones
 
 
 def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> TrackingReference:
@@ -46,7 +82,7 @@ def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> Tra
         rated_speed=case.task.rated_speed,
         corner_speed=case.task.corner_speed,
         corner_intervals=geometry.corner_intervals(),
-        tool_zones=transition_zones(case.task.tool, geometry, case.task.tolerance),
+        tool_zones=_transition_zones(case.task.tool, geometry, case.task.tolerance),
     )
 
 
@@ -68,20 +104,38 @@ def make_trajectory(
     spin
         Spin about the tool axis per sample, shape (N,), rad; default 0.
     """
-    qd, qdd, qddd = backward_derivatives(q, sample_time)
-    position = forward_kinematics(robot, q)[:, :3, 3]
+    return motion_trajectory(SampledMotion(robot, q, sample_time), s, spin)
+
+
+def motion_trajectory(
+    motion: SampledMotion, s: np.ndarray, spin: np.ndarray | None = None
+) -> Trajectory:
+    """:func:`make_trajectory` reading the derivatives and tool poses of a
+    :class:`~trackplan.motion.SampledMotion` (shared with the checker).
+
+    Parameters
+    ----------
+    motion
+        Joint samples at Ts, shape (N, n), rad, and the robot.
+    s
+        Arc length on the planned path per sample, shape (N,), m.
+    spin
+        Spin about the tool axis per sample, shape (N,), rad; default 0.
+    """
+    q, sample_time, n = motion.q, motion.sample_time, motion.n_samples
+    position = motion.T_base_tool[:, :3, 3]
     speed = np.linalg.norm(np.diff(position, axis=0, prepend=position[:1]), axis=1) / sample_time
     return Trajectory(
         sample_time=sample_time,
-        t=np.arange(len(q)) * sample_time,
+        t=np.arange(n) * sample_time,
         s=s,
         q=q,
-        qd=qd,
-        qdd=qdd,
-        qddd=qddd,
+        qd=motion.qd[:n],
+        qdd=motion.qdd[:n],
+        qddd=motion.qddd[:n],
         tool_position=position,
         speed=speed,
-        spin=np.zeros(len(q)) if spin is None else np.asarray(spin, dtype=float),
+        spin=np.zeros(n) if spin is None else np.asarray(spin, dtype=float),
     )
 
 
@@ -137,7 +191,7 @@ def plan_placement(
     X = as_placement(X)
     law = time_law(timing or case.task.timing)
     if geometry is None or geometry.mode != law.path_mode:
-        geometry = PathGeometry.from_case(case, law.path_mode)
+        geometry = case_geometry(case, law.path_mode)
     tool = ToolOrientation.choose(case.task.tool, geometry, spin)
     joint_path = JointPath.solve(case.robot, geometry, X, tool, branch)
     if not joint_path.success:
@@ -215,13 +269,12 @@ def _checked(case: Case, joint_path: JointPath, timed: TimeLaw) -> PlanResult:
     """Check the sampled trajectory and assemble the result."""
     geometry = joint_path.geometry
     spin = joint_path.tool.spin.value(timed.s)
-    trajectory = make_trajectory(case.robot, timed.q, timed.s, timed.sample_time, spin)
-    check = check_trajectory(
-        case.robot,
-        timed.q,
-        timed.sample_time,
-        tracking_reference(case, geometry, joint_path.placement),
-        cell_geometry(case),
+    motion = timed.motion
+    if motion is None or motion.q is not timed.q or motion.robot is not case.robot:
+        motion = SampledMotion(case.robot, timed.q, timed.sample_time)
+    trajectory = motion_trajectory(motion, timed.s, spin)
+    check = check_motion(
+        motion, tracking_reference(case, geometry, joint_path.placement), cell_geometry(case)
     )
     if not check.success:
         status = Status.LIMITS_VIOLATED
@@ -251,11 +304,7 @@ def _checked(case: Case, joint_path: JointPath, timed: TimeLaw) -> PlanResult:
         slowdowns=timed.slowdowns,
         references={},
         joint_path=joint_path,
-        energy=(
-            None
-            if case.robot.dynamics is None
-            else energy_figures(case.robot, timed.q, timed.sample_time)
-        ),
+        energy=None if case.robot.dynamics is None else motion_energy(motion),
     )
 
 
@@ -317,7 +366,7 @@ def check_case_trajectory(
             key="paths",
         )
     law = time_law(timing or case.task.timing)
-    geometry = PathGeometry.from_case(case, law.path_mode)
+    geometry = case_geometry(case, law.path_mode)
     reference = tracking_reference(case, geometry, as_placement(X))
     q = np.asarray(q, dtype=float)
     return check_trajectory(case.robot, q, sample_time, reference, cell_geometry(case))

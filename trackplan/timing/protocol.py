@@ -16,6 +16,7 @@ import numpy as np
 from trackplan.case import Task
 from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
+from trackplan.motion import SampledMotion
 from trackplan.paths.path_geometry import PathMode
 from trackplan.status import Status
 
@@ -71,6 +72,10 @@ class TimeLaw:
         Lowest speed planned on arcs and blends, m/s (nan when the law does not say).
     iterations
         Rebuilds the law needed (1 for a law that builds once).
+    motion
+        The samples ``q`` with the derivatives and torques the law's sample checks computed
+        (:class:`~trackplan.motion.SampledMotion`), for the checker to read again; None
+        when the law checked nothing.
     """
 
     timing: Timing
@@ -83,6 +88,7 @@ class TimeLaw:
     slowdowns: tuple[SlowDown, ...] = ()
     corner_speed: float = float("nan")
     iterations: int = 1
+    motion: SampledMotion | None = None
 
     @property
     def duration(self) -> float:

@@ -12,17 +12,20 @@ A sample check is any callable ``check(q, sample_time) -> (sample, order, ratio)
 
 :class:`RateLimits` is the joint velocity, acceleration and jerk check; :class:`TorqueLimits`
 the joint torque check of a robot with dynamics (``docs/dynamics.md``). :func:`robot_checks`
-is what a law checks by default: both, the second when the robot has dynamics.
+is what a law checks by default: both, the second when the robot has dynamics. Both also
+read a :class:`~trackplan.motion.SampledMotion` (:class:`MotionCheck`), so that the torques
+they compute are those the checker and the energy figures then read.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from trackplan.derivatives import backward_derivatives
+from trackplan.motion import SampledMotion
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.model import Robot
 from trackplan.timing import _kernels
@@ -39,6 +42,18 @@ ask for a near-standstill at once; the next round asks again if needed)."""
 
 SampleCheck = Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, np.ndarray]]
 """``check(q (N, n), Ts) -> (sample (V,), order (V,), ratio (V,))`` (see the module)."""
+
+Found = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""``(sample (V,), order (V,), ratio (V,))`` of a check (see the module)."""
+
+
+@runtime_checkable
+class MotionCheck(Protocol):
+    """A sample check that also reads a :class:`~trackplan.motion.SampledMotion`."""
+
+    def check_motion(self, motion: SampledMotion) -> Found:
+        """The check of ``motion.q`` at ``motion.sample_time`` (see the module)."""
+        ...
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,10 +73,13 @@ class RateLimits:
     robot: Robot
     margin: float = LIMIT_MARGIN
 
-    def __call__(
-        self, q: np.ndarray, sample_time: float
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def __call__(self, q: np.ndarray, sample_time: float) -> Found:
         """Samples where a rate limit (less the margin) is exceeded; see the module."""
+        return self.check_motion(SampledMotion(self.robot, q, sample_time))
+
+    def check_motion(self, motion: SampledMotion) -> Found:
+        """:meth:`__call__` of the motion's samples."""
+        q, sample_time = motion.q, motion.sample_time
         scale = 1.0 - self.margin
         limits = np.stack(
             [scale * self.robot.v_max, scale * self.robot.a_max, scale * self.robot.j_max]
@@ -101,9 +119,7 @@ class TorqueLimits:
     robot: Robot
     margin: float = LIMIT_MARGIN
 
-    def __call__(
-        self, q: np.ndarray, sample_time: float
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def __call__(self, q: np.ndarray, sample_time: float) -> Found:
         """Samples where a torque limit (less the margin) is exceeded and a slower speed helps.
 
         Parameters
@@ -118,14 +134,15 @@ class TorqueLimits:
         tuple of numpy.ndarray
             ``sample (V,)`` (clipped to ``N - 1``), ``order (V,)`` (2) and ``ratio (V,)`` (> 1).
         """
+        return self.check_motion(SampledMotion(self.robot, q, sample_time))
+
+    def check_motion(self, motion: SampledMotion) -> Found:
+        """:meth:`__call__` of the motion's samples, reading its torques."""
         dynamics = self.robot.dynamics
-        if dynamics is None:
+        if dynamics is None or motion.torque is None:
             empty = np.zeros(0)
             return empty.astype(int), empty.astype(int), empty
-        q = np.asarray(q, dtype=float)
-        qd, qdd, _ = backward_derivatives(q, sample_time, pad_end=True)
-        q_held = np.concatenate([q, np.repeat(q[-1:], len(qd) - len(q), axis=0)])
-        tau = inverse_dynamics(self.robot, q_held, qd, qdd)
+        q, qd, q_held, tau = motion.q, motion.qd, motion.q_held, motion.torque
         cap = (1.0 - self.margin) * dynamics.torque_max
         rows = np.flatnonzero((np.abs(tau) > cap).any(axis=1))
         if not rows.size:
@@ -171,11 +188,15 @@ def robot_checks(robot: Robot) -> tuple[SampleCheck, ...]:
     return (RateLimits(robot), TorqueLimits(robot))
 
 
-def run_checks(
-    checks: tuple[SampleCheck, ...], q: np.ndarray, sample_time: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every check's violations, concatenated (``sample``, ``order``, ``ratio``)."""
-    found = [check(q, sample_time) for check in checks]
+def run_checks(checks: tuple[SampleCheck, ...], motion: SampledMotion) -> Found:
+    """Every check's violations on the motion's samples, concatenated (``sample``,
+    ``order``, ``ratio``); a :class:`MotionCheck` reads the motion itself."""
+    found = [
+        check.check_motion(motion)
+        if isinstance(check, MotionCheck)
+        else check(motion.q, motion.sample_time)
+        for check in checks
+    ]
     return (
         np.concatenate([f[0] for f in found]).astype(int),
         np.concatenate([f[1] for f in found]).astype(int),

@@ -34,6 +34,7 @@ import numpy as np
 from trackplan.case import Task
 from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
+from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.timing import _kernels
@@ -139,19 +140,19 @@ def plan_smooth_time_law(
         t = np.arange(n_steps + 1) * sample_time
         s = profile.evaluate(t / time_scale)[0]
         s[-1] = length
-        q = joint_path.joints(s)
-        worst = run_checks(checks, q, sample_time)
+        motion = SampledMotion(robot, joint_path.joints(s), sample_time)
+        worst = run_checks(checks, motion)
         if not worst[0].size:
-            return _sampled(plans, task, s, q, iteration, converged=True)
+            return _sampled(plans, task, s, motion, iteration, converged=True)
         planner.tighten(worst, s, t / time_scale, profile)
-    return _sampled(plans, task, s, q, MAX_ITERATIONS, converged=False)
+    return _sampled(plans, task, s, motion, MAX_ITERATIONS, converged=False)
 
 
 def _sampled(
     plans: list[ZonePlan],
     task: Task,
     s: np.ndarray,
-    q: np.ndarray,
+    motion: SampledMotion,
     iterations: int,
     converged: bool,
 ) -> TimeLaw:
@@ -171,10 +172,11 @@ def _sampled(
         message=message,
         sample_time=task.sample_time,
         s=s,
-        q=q,
+        q=motion.q,
         slowdowns=slowdowns,
         corner_speed=min(plateaus) if plateaus else rated,
         iterations=iterations,
+        motion=motion,
     )
 
 
