@@ -111,6 +111,30 @@ def pose_matrix(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     return T
 
 
+def rotate_each(R: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """``R @ rotations[m]`` for every m, as one (3, 3) × (3, 3M) product per ``R``.
+
+    The same values as the stacked ``R[:, None] @ rotations`` (up to round-off), without
+    one small product per matrix.
+
+    Parameters
+    ----------
+    R
+        Shape (B, 3, 3), or (3, 3).
+    rotations
+        Shape (M, 3, 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (B, M, 3, 3), or (M, 3, 3) for one ``R``; a strided view.
+    """
+    R = np.asarray(R, dtype=float)
+    columns = np.asarray(rotations, dtype=float).transpose(1, 0, 2).reshape(3, -1)  # [j, 3m+k]
+    rotated = (R @ columns).reshape(*R.shape[:-2], 3, -1, 3)  # [..., i, m, k]
+    return np.swapaxes(rotated, -3, -2)
+
+
 def tool_poses(X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray) -> np.ndarray:
     """``T_base_tool = T_X · [R_part_tool  p; 0 1]`` for every placement and path point.
 
@@ -137,7 +161,10 @@ def tool_poses(X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray) ->
     if R_part_tool.ndim < 4:
         R_part_tool = R_part_tool.reshape(1, -1, 3, 3)  # (1, 1 or M, 3, 3)
     poses = np.empty((len(R), len(positions), 4, 4))
-    poses[..., :3, :3] = R[:, None] @ R_part_tool
+    if R_part_tool.shape[0] == 1:
+        poses[..., :3, :3] = rotate_each(R, R_part_tool[0])
+    else:
+        poses[..., :3, :3] = R[:, None] @ R_part_tool
     poses[..., :3, 3] = np.asarray(positions, dtype=float) @ R.transpose(0, 2, 1)
     poses[..., :3, 3] += T_base_part[:, None, :3, 3]
     poses[..., 3, :3] = 0.0

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from trackplan.frames import rotate_each
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning.result import CheckReport, Violation
@@ -299,7 +300,7 @@ def _check_task(
             violations.append(replace(found, message=message))
     margins["tracking"] = float(_met(1.0 - worst / ref.tolerance, RELATIVE_SLACK))
 
-    R_part_tool = np.einsum("ji,njk->nik", ref.T_base_part[:3, :3], T_base_tool[:, :3, :3])
+    R_part_tool = rotate_each(R_part_base, T_base_tool[:, :3, :3])
     orientation_error, tool_found = _check_tool(ref, R_part_tool, s_nominal, piece, t, margins)
     violations.extend(tool_found)
 
