@@ -1,6 +1,12 @@
-"""Compiled kernels of the planning package: the in-order assignment of samples to pieces.
+"""Compiled kernels of the planning package.
 
-The Python API is :func:`trackplan.planning.tracking.locate_on_nominal`.
+- :func:`monotone_assignment`: the in-order assignment of samples to pieces; the Python API
+  is :func:`trackplan.planning.tracking.locate_on_nominal`.
+- :func:`peak_use`: the checker's joint-limit peaks (:mod:`trackplan.planning.checker`).
+  The joint limits are read from a handful of (N, n) arrays per plan; numpy would make a
+  temporary array and a separate reduction per step. The kernel reads each array once, in
+  the same order of operations as the numpy expressions it replaces, so the results are
+  the same to the bit.
 """
 
 from __future__ import annotations
@@ -54,3 +60,46 @@ def monotone_assignment(
             current = piece[pick]
         chosen[k] = pick
     return chosen
+
+
+@njit(cache=True)
+def peak_use(
+    values: np.ndarray, centre: np.ndarray, scale: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Largest ``|values - centre| / scale`` per column, and the first row where it occurs.
+
+    ``np.abs(values - centre) / scale`` reduced by ``max`` and ``argmax`` along the rows,
+    NaN included as numpy treats it (the first NaN is the peak).
+
+    Parameters
+    ----------
+    values
+        Shape (M, n).
+    centre, scale
+        Shape (n,) each.
+
+    Returns
+    -------
+    peak
+        Shape (n,).
+    row
+        Shape (n,), int: the first row of each column's peak.
+    """
+    n_rows, n_cols = values.shape
+    peak = np.full(n_cols, -np.inf)
+    row = np.zeros(n_cols, dtype=np.int64)
+    for j in range(n_cols):
+        best = -np.inf
+        where = 0
+        for r in range(n_rows):
+            use = abs(values[r, j] - centre[j]) / scale[j]
+            if use != use:  # NaN: numpy's max and argmax stop at the first one
+                best = use
+                where = r
+                break
+            if use > best:
+                best = use
+                where = r
+        peak[j] = best
+        row[j] = where
+    return peak, row

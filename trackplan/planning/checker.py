@@ -16,6 +16,7 @@ import numpy as np
 from trackplan.frames import rotate_each
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
+from trackplan.planning import _kernels
 from trackplan.planning.result import CheckReport, Violation
 from trackplan.planning.tool_zones import nominal_tangents
 from trackplan.planning.tracking import between_samples, jump_allowance, locate_on_nominal
@@ -150,35 +151,33 @@ def check_motion(
     margins: dict[str, np.ndarray] = {}
     binding: dict[str, tuple[int, float]] = {}
 
-    # position: distance to the nearer bound as a fraction of the half range
+    # position: distance to the nearer bound as a fraction of the half range; the rates
+    # and torques: their magnitude as a fraction of the limit
     half_range = 0.5 * (robot.q_max - robot.q_min)
     centre = 0.5 * (robot.q_max + robot.q_min)
-    position_use = np.abs(q - centre) / half_range
-    bounds = {"velocity": robot.v_max, "acceleration": robot.a_max, "jerk": robot.j_max}
+    zero = np.zeros(robot.n_dof)
     signals = {
-        "position": (q, position_use),
-        "velocity": (qd, np.abs(qd) / robot.v_max),
-        "acceleration": (qdd, np.abs(qdd) / robot.a_max),
-        "jerk": (qddd, np.abs(qddd) / robot.j_max),
+        "position": (q, centre, half_range),
+        "velocity": (qd, zero, robot.v_max),
+        "acceleration": (qdd, zero, robot.a_max),
+        "jerk": (qddd, zero, robot.j_max),
     }
     if robot.dynamics is not None and motion.torque is not None:
-        torque = motion.torque
-        bounds["torque"] = robot.dynamics.torque_max
-        signals["torque"] = (torque, np.abs(torque) / robot.dynamics.torque_max)
-    for kind, (values, use) in signals.items():
-        peak = use.max(axis=0)
+        signals["torque"] = (motion.torque, zero, robot.dynamics.torque_max)
+    for kind, (values, middle, scale) in signals.items():
+        peak, peak_row = _kernels.peak_use(
+            np.ascontiguousarray(values), np.asarray(middle, dtype=float), np.asarray(scale)
+        )
         margins[kind] = _met(1.0 - peak, RELATIVE_SLACK)
         worst_joint = int(np.argmax(peak))
-        binding[kind] = (worst_joint + 1, float(t[int(np.argmax(use[:, worst_joint]))]))
+        binding[kind] = (worst_joint + 1, float(t[peak_row[worst_joint]]))
         for j in np.flatnonzero(peak > 1.0 + RELATIVE_SLACK):
+            limit = scale[j]
             if kind == "position":
-                above = values[np.argmax(use[:, j]), j] > centre[j]
+                above = values[peak_row[j], j] > centre[j]
                 limit = robot.q_max[j] if above else robot.q_min[j]
-            else:
-                limit = bounds[kind][j]
-            violations.append(
-                _violation(kind, int(j) + 1, t, values[:, j], use[:, j], float(limit))
-            )
+            use = np.abs(values[:, j] - middle[j]) / scale[j]
+            violations.append(_violation(kind, int(j) + 1, t, values[:, j], use, float(limit)))
     if robot.dynamics is not None:
         violations = [_at_any_speed(robot, motion.q_held, t, v) for v in violations]
 
