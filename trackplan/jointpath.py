@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -171,11 +172,19 @@ class JointPath:
 
     def interpolate(self, s: np.ndarray) -> np.ndarray:
         """q at ``s`` (M,) by linear interpolation of the grid, shape (M, n), rad."""
-        grid, first = np.unique(self.s, return_index=True)
+        grid, q_grid = self._distinct_grid
         s = np.asarray(s, dtype=float)
-        return np.stack(
-            [np.interp(s, grid, self.q[first, j]) for j in range(self.robot.n_dof)], axis=-1
-        )
+        out = np.empty((len(s), self.robot.n_dof))
+        for j in range(self.robot.n_dof):
+            out[:, j] = np.interp(s, grid, q_grid[:, j])
+        return out
+
+    @cached_property
+    def _distinct_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """The grid with each zone boundary once, shape (G',), m, and q there, shape
+        (G', n), rad, column-major (each joint contiguous for :meth:`interpolate`)."""
+        grid, first = np.unique(self.s, return_index=True)
+        return grid, np.asfortranarray(self.q[first])
 
     def derivatives(
         self, s: np.ndarray, lo: np.ndarray, hi: np.ndarray, h: np.ndarray | float
