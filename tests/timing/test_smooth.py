@@ -9,7 +9,6 @@ import pytest
 
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
-from trackplan.motion import SampledMotion
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import check_case_trajectory, plan_placement
 from trackplan.robots.dynamics.rne import holding_torque_ratio
@@ -190,9 +189,7 @@ def test_a_sample_check_handed_to_the_law_is_met():
     assert law.success and law.iterations > 1
     assert joint_1_speed(law.q, case.task.sample_time)[0].size == 0
     assert law.duration > free.duration
-    assert not run_checks(
-        (RateLimits(case.robot),), SampledMotion(case.robot, law.q, case.task.sample_time)
-    )[0].size
+    assert not run_checks((RateLimits(case.robot),), law.q, case.task.sample_time)[0].size
 
 
 def test_rate_limits_keep_a_relative_margin(puma):

@@ -188,15 +188,26 @@ def robot_checks(robot: Robot) -> tuple[SampleCheck, ...]:
     return (RateLimits(robot), TorqueLimits(robot))
 
 
-def run_checks(checks: tuple[SampleCheck, ...], motion: SampledMotion) -> Found:
-    """Every check's violations on the motion's samples, concatenated (``sample``,
-    ``order``, ``ratio``); a :class:`MotionCheck` reads the motion itself."""
-    found = [
-        check.check_motion(motion)
-        if isinstance(check, MotionCheck)
-        else check(motion.q, motion.sample_time)
-        for check in checks
-    ]
+def run_checks(checks: tuple[SampleCheck, ...], q: np.ndarray, sample_time: float) -> Found:
+    """Every check's violations, concatenated (``sample``, ``order``, ``ratio``)."""
+    return _concatenated([check(q, sample_time) for check in checks])
+
+
+def run_motion_checks(checks: tuple[SampleCheck, ...], motion: SampledMotion) -> Found:
+    """:func:`run_checks` on a motion's samples: a :class:`MotionCheck` reads the motion
+    itself (its torques are then those the checker reads again)."""
+    return _concatenated(
+        [
+            check.check_motion(motion)
+            if isinstance(check, MotionCheck)
+            else check(motion.q, motion.sample_time)
+            for check in checks
+        ]
+    )
+
+
+def _concatenated(found: list[Found]) -> Found:
+    """The checks' violations as one ``(sample, order, ratio)``."""
     return (
         np.concatenate([f[0] for f in found]).astype(int),
         np.concatenate([f[1] for f in found]).astype(int),

@@ -52,7 +52,12 @@ from trackplan.timing.profile import (
     speed_change_time,
 )
 from trackplan.timing.protocol import SlowDown, TimeLaw, TimeLawSpec, unsampled
-from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, robot_checks, run_checks
+from trackplan.timing.sample_checks import (
+    LIMIT_MARGIN,
+    SampleCheck,
+    robot_checks,
+    run_motion_checks,
+)
 
 LIMIT_SHARE = 0.97
 """Share of each joint limit the planner aims at; the rest absorbs sampling effects."""
@@ -141,7 +146,7 @@ def plan_smooth_time_law(
         s = profile.evaluate(t / time_scale)[0]
         s[-1] = length
         motion = SampledMotion(robot, joint_path.joints(s), sample_time)
-        worst = run_checks(checks, motion)
+        worst = run_motion_checks(checks, motion)
         if not worst[0].size:
             return _sampled(plans, task, s, motion, iteration, converged=True)
         planner.tighten(worst, s, t / time_scale, profile)
