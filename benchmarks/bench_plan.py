@@ -185,7 +185,7 @@ def _breakdown(case, X: np.ndarray) -> list[tuple[str, float]]:  # type: ignore[
         ("FK of the samples (the plan's one pass)", cpu["fk"]),
         ("checker: joint limits, tracking, tool, speed, coverage", cpu["check"]),
         (
-            "rest: trajectory, energy, summaries",
+            "difference: trajectory, energy, summaries, timing noise",
             cpu["plan"] - cpu["grid"] - cpu["law"] - cpu["fk"] - cpu["check"],
         ),
     ]

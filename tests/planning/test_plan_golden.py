@@ -1,6 +1,7 @@
 """Golden values: plans of every shipped case at fixed placements, recorded before the
 planning speed-up (one pose, IK, FK, derivative and RNE pass per plan), must not change
-beyond round-off (the tool axis error, an arccos near 1, only to its resolution).
+beyond round-off: to 1e-9, except the tool axis error (an arccos near 1) and the jerk
+margins (third differences over Ts³), each to the resolution that round-off leaves them.
 
 The placements are each case's ``placement.example``, or for a case without one a
 placement drawn once with a seeded generator inside its bounds (the corner cell at the
@@ -42,6 +43,9 @@ PLACEMENTS: dict[str, list[float] | None] = {
 ORIENTATION_RESOLUTION = 1e-7
 """The tool axis error is an arccos of a cosine near 1, resolved to about sqrt(2 eps) ≈ 2e-8
 rad: below this a change of its last bits is round-off, rad."""
+JERK_RESOLUTION = 1e-6
+"""A jerk is a third difference of q over Ts³ (1e-9 s³ at 1 ms): the last bits of q, which
+an IK kernel's round-off moves, move a jerk margin by up to about 1e-7."""
 SLOW = {"bracket-weld", "kuka-weld", "seam-weld-fixed", "seam-weld-free", "ur5-bead"}
 """Cases whose plan takes about a second or more."""
 TOLERANCE = 1e-9
@@ -78,9 +82,12 @@ def figures(name: str) -> dict[str, Any]:
 
 def _close(actual: Any, expected: Any, where: str) -> None:
     """Equal strings, or numbers equal to :data:`TOLERANCE` (relative or absolute); the
-    tool axis error and its margin to :data:`ORIENTATION_RESOLUTION`."""
+    tool axis error and its margin to :data:`ORIENTATION_RESOLUTION`, jerk margins to
+    :data:`JERK_RESOLUTION`."""
     if where.endswith("orientation_error"):
         assert actual == pytest.approx(expected, abs=ORIENTATION_RESOLUTION, nan_ok=True), where
+    elif ".joint_margins.jerk[" in where:
+        assert actual == pytest.approx(expected, abs=JERK_RESOLUTION), where
     elif where.endswith("task_margins.orientation"):
         resolution = ORIENTATION_RESOLUTION / ORIENTATION_TOLERANCE
         assert actual == pytest.approx(expected, abs=resolution), where
