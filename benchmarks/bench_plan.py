@@ -14,7 +14,8 @@ Run with ``python -m benchmarks plan``. Prints three tables:
    (velocity and acceleration only: a lower bound) and copp-py's TOPP3 (the jerk-limited
    optimum), both on the same joint path, task speed caps and joint limits
    (:mod:`trackplan.timing.references`).
-3. :data:`RANDOM_PER_CASE` random feasible placements of every shipped case (``cases/*.yaml``),
+3. :data:`RANDOM_PER_CASE` random feasible placements of every shipped case (``cases/*.yaml``;
+   each seam of a case with several seams counts as a case),
    drawn uniformly in the case's placement bounds and reach with seed :data:`SEED`: the
    same ratios, their median and worst, every output re-checked by
    :func:`trackplan.check_case_trajectory`.
@@ -50,7 +51,7 @@ PAPER_CASES = ("paper-line", "paper-corner", "paper-circle")
 PLAN_RUNS = 7
 """Warm planning runs whose median is reported."""
 RANDOM_PER_CASE = 6
-"""Random feasible placements drawn per shipped case (5 cases: 30 placements)."""
+"""Random feasible placements drawn per shipped case (and per seam of a multi-seam case)."""
 SEED = 0
 """Seed of the random placements."""
 MAX_DRAWS = 4000
@@ -301,8 +302,10 @@ def _random_table() -> None:
     rng = np.random.default_rng(SEED)
     to_topp3, to_toppra = [], []
     unconverged = rechecked_bad = 0
-    for file in sorted(CASES.glob("*.yaml")):
-        case = _load(file.stem)
+    shipped = [_load(file.stem) for file in sorted(CASES.glob("*.yaml"))]
+    # a case with several seams contributes each seam as a path of its own
+    paths = [whole.seam_case(i) for whole in shipped for i in range(len(whole.seams))]
+    for case in paths:
         for X, result in _random_placements(case, RANDOM_PER_CASE, rng):
             report = trackplan.check_case_trajectory(
                 case, X, result.trajectory.q, result.trajectory.sample_time

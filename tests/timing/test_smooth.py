@@ -19,9 +19,13 @@ WRIST_TURN_CASES = {"paper-circle-seam-fixed", "paper-circle-seam-free"}
 """Their seam frame turns the tool once about its axis: at a constant spin no placement has a
 joint path on the PUMA560; tests/search/test_spin.py plans and checks them with the spin
 chosen."""
-SHIPPED_CASES = sorted(
-    file.stem for file in CASES.glob("*.yaml") if file.stem not in WRIST_TURN_CASES
-)
+SHIPPED_PATHS = [
+    (file.stem, seam)
+    for file in sorted(CASES.glob("*.yaml"))
+    if file.stem not in WRIST_TURN_CASES
+    for seam in range(len(load_case(file).seams))
+]
+"""(case, seam index) of every shipped path: each seam of a case with several seams."""
 PLACEMENTS_PER_CASE = 3
 
 
@@ -120,13 +124,13 @@ CELL_LIMITS = ("collision", "clearance")
 """Violations of the work cell, which the geometry decides and no time law changes."""
 
 
-@pytest.mark.parametrize("name", SHIPPED_CASES)
-def test_random_placements_of_every_case_pass_the_checker(name):
+@pytest.mark.parametrize(("name", "seam"), SHIPPED_PATHS)
+def test_random_placements_of_every_case_pass_the_checker(name, seam):
     """Wherever the path has a joint path the robot can hold against gravity, the smooth
     law's samples pass every check."""
-    case = load_case(CASES / f"{name}.yaml")
+    case = load_case(CASES / f"{name}.yaml").seam_case(seam)
     geometry = PathGeometry.from_case(case)
-    rng = np.random.default_rng(sum(map(ord, name)))
+    rng = np.random.default_rng(sum(map(ord, name)) + seam)
     lower, upper = case.bounds.lower, case.bounds.upper
     reach_min, reach_max = case.bounds.reach
     planned = 0
