@@ -25,6 +25,12 @@ def _descend(run: LocalRun, centre: np.ndarray) -> list[np.ndarray]:
     return asked
 
 
+def test_the_cma_class_is_cmaes_own() -> None:
+    import cmaes
+
+    assert algorithms.cmaes_cma() is cmaes.CMA
+
+
 def test_local_run_descends_a_sphere_inside_the_unit_box() -> None:
     centre = np.array([0.55, 0.45, 0.5, 0.6, 0.4, 0.5])
     run = LocalRun(np.full(6, 0.35), seed=3)
@@ -72,9 +78,9 @@ def test_the_race_stops_the_runs_that_fell_behind() -> None:
 
 
 @pytest.mark.slow
-def test_the_search_imports_neither_cma_nor_matplotlib() -> None:
-    """cma imports matplotlib.pyplot and scipy.stats (2 s on an idle machine): the default
-    search must not need it."""
+def test_the_search_imports_neither_cma_nor_matplotlib_nor_scipy_stats() -> None:
+    """cma imports matplotlib.pyplot and scipy.stats (2 s on an idle machine), the cmaes
+    package's __init__ scipy.stats: the default search needs none of them."""
     code = (
         "import sys; import trackplan.cli.app; "
         "from trackplan.io.case_file import load_case; "
@@ -82,7 +88,7 @@ def test_the_search_imports_neither_cma_nor_matplotlib() -> None:
         f"case = load_case({str(CASES / 'paper-line.yaml')!r}); "
         "r = optimize_placement(case, budget=algorithms.MULTISTART_SAMPLES + 30); "
         "assert r.history.evaluations[-1] > algorithms.MULTISTART_SAMPLES; "
-        "print(sorted(m for m in ('cma', 'matplotlib') if m in sys.modules))"
+        "print(sorted(m for m in ('cma', 'matplotlib', 'scipy.stats') if m in sys.modules))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
