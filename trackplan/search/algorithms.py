@@ -1,11 +1,13 @@
 """The placement optimisers: a pymoo Algorithm and a Termination per method.
 
-- ``multistart`` (the default): uniform admissible samples, then local CMA-ES runs from
-  the best mutually distant ones (a multi-start local search). The fitness has a few
-  valleys (IK branches, placements mirrored about the base); sampling finds them all and
-  short local runs descend each, which reaches the best known J on every shipped case
+- ``multistart`` (the default): uniform admissible samples, then local CMA-ES runs (the
+  ``cmaes`` package) from the best mutually distant ones, side by side in one batch per
+  generation, the runs that fall behind the leader stopped early (a race). The fitness has
+  a few valleys (IK branches, placements mirrored about the base); sampling finds them all
+  and short local runs descend each, which reaches the best known J on every shipped case
   and seed where a single global run stops in whichever valley it first entered
-  (``docs/search.md``);
+  (``docs/search.md``). It imports neither ``cma`` nor matplotlib (``import cma`` alone
+  takes about 2 s);
 - ``ga``: the paper's MATLAB GA configuration through pymoo's GeneticAlgorithm with the
   operators of :mod:`trackplan.search.operators`;
 - ``cmaes``: CMA-ES of the ``cma`` package (Hansen's reference implementation) behind
@@ -22,7 +24,12 @@ budget (the driver); CMA-ES also stops when cma's own criteria say it has conver
 
 from __future__ import annotations
 
+import functools
+import importlib.util
 import math
+import sys
+from collections import deque
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -78,8 +85,14 @@ LOCAL_POPULATION = 12
 """λ of a local CMA-ES run."""
 LOCAL_EVALUATIONS = 600
 """Evaluations a local run may use at most."""
+RACE_GENERATIONS = 5
+"""Generations every local run makes before the race may stop it."""
+RACE_MARGIN = 0.03
+"""A local run stops when its best fitness lies more than this share above the best of all
+runs: it is descending a worse valley (the paper cases' valleys differ by 1 % to 12 %)."""
 LOCAL_TOLERANCE = 1e-7
-"""cma's ``tolfun`` of a local run: it has converged when J changes less than this."""
+"""A local run has converged when its fitness spans less than this over cma's ``tolfun``
+window of generations (:class:`LocalRun`)."""
 DEFAULT_RESTARTS = {
     Method.MULTISTART: 1,
     Method.GA: 6,
@@ -240,16 +253,101 @@ class CMAESearch(Algorithm):
         self.converged = dict(self.es.stop())
 
 
+@functools.cache
+def cmaes_cma() -> type:
+    """The ``cmaes`` package's ``CMA`` class, loaded without the package's ``__init__``.
+
+    That ``__init__`` also imports the package's mixed-integer and multi-objective variants,
+    and through them scipy.stats: 0.6 s of CPU under load, a tenth of a whole ``trackplan
+    optimize``. ``CMA`` lives in a module of its own that needs numpy only, so that module
+    is loaded by itself (under its own name, so a later ``import cmaes`` reuses it); when
+    the package is already imported, or its layout differs, the package is imported.
+    """
+    found = None if "cmaes" in sys.modules else importlib.util.find_spec("cmaes")
+    if found is not None and found.submodule_search_locations:
+        file = Path(found.submodule_search_locations[0]) / "_cma.py"
+        spec = importlib.util.spec_from_file_location("cmaes._cma", file)
+        if file.is_file() and spec is not None and spec.loader is not None:
+            module = importlib.util.module_from_spec(spec)
+            try:
+                spec.loader.exec_module(module)
+            except ImportError:  # a later cmaes whose module needs the package after all
+                pass
+            else:
+                sys.modules.setdefault("cmaes._cma", module)
+                return module.CMA
+    from cmaes import CMA
+
+    return CMA
+
+
+class LocalRun:
+    """One local CMA-ES run of :class:`MultiStartSearch` (the ``cmaes`` package), on [0, 1]ⁿ.
+
+    It stops when cmaes' own criteria fire, after :data:`LOCAL_EVALUATIONS`, or when the
+    fitness has flattened: the best and worst values of each of its last ``10 + ⌈30 n/λ⌉``
+    generations (cma's ``tolfun`` window) span less than :data:`LOCAL_TOLERANCE`.
+
+    Parameters
+    ----------
+    start
+        The start, scaled to [0, 1], shape (n,).
+    seed
+        Seeds the run's normal samples.
+    """
+
+    def __init__(self, start: np.ndarray, seed: int):
+        n = len(start)
+        self.es = cmaes_cma()(
+            mean=np.asarray(start, dtype=float),
+            sigma=LOCAL_SIGMA,
+            bounds=np.tile([0.0, 1.0], (n, 1)),
+            seed=seed,
+            population_size=LOCAL_POPULATION,
+        )
+        self.evaluations = 0
+        self.generations = 0
+        self.best = math.inf
+        self.dropped = False
+        self.window: deque[float] = deque(maxlen=2 * (10 + math.ceil(30 * n / LOCAL_POPULATION)))
+        self.asked = np.zeros((0, n))
+
+    @property
+    def stopped(self) -> bool:
+        """Whether the run has stopped."""
+        flat = (
+            len(self.window) == self.window.maxlen
+            and max(self.window) - min(self.window) < LOCAL_TOLERANCE
+        )
+        return (
+            self.dropped or flat or self.evaluations >= LOCAL_EVALUATIONS or self.es.should_stop()
+        )
+
+    def ask(self) -> np.ndarray:
+        """The next generation, shape (λ, n), in [0, 1]."""
+        self.asked = np.array([self.es.ask() for _ in range(LOCAL_POPULATION)])
+        return self.asked
+
+    def tell(self, fitness: np.ndarray) -> None:
+        """Tell the fitness (λ,) of the generation last asked."""
+        self.es.tell(list(zip(self.asked, fitness.tolist(), strict=True)))
+        self.evaluations += len(fitness)
+        self.generations += 1
+        self.best = min(self.best, float(fitness.min()))
+        self.window.extend((float(fitness.min()), float(fitness.max())))
+
+
 class MultiStartSearch(Algorithm):
     """Multi-start local search: uniform samples, then local CMA-ES runs, behind ask/tell.
 
     Phase 1 evaluates :data:`MULTISTART_SAMPLES` uniform admissible placements in batches
     of :data:`MULTISTART_BATCH`. Phase 2 takes the best of them that lie at least
     :data:`MULTISTART_DISTANCE` apart (scaled max norm) as starts, at most
-    :data:`MULTISTART_STARTS`, and runs a local CMA-ES (step :data:`LOCAL_SIGMA`,
-    λ = :data:`LOCAL_POPULATION`, at most :data:`LOCAL_EVALUATIONS` evaluations, cma's
-    ``tolfun`` :data:`LOCAL_TOLERANCE`) from each in turn, best start first. Every random
-    draw comes from the algorithm's seeded generator.
+    :data:`MULTISTART_STARTS`, and runs a local CMA-ES (:class:`LocalRun`: step
+    :data:`LOCAL_SIGMA`, λ = :data:`LOCAL_POPULATION`) from each. The local runs advance
+    side by side: one generation asks λ placements of every run still going, so that one
+    batched screening call serves them all. Every run draws from its own generator,
+    seeded from the algorithm's, so a seed reproduces the search exactly.
 
     Parameters
     ----------
@@ -268,9 +366,8 @@ class MultiStartSearch(Algorithm):
         self.converged: dict = {}
         self.samples: list[np.ndarray] = []
         self.sample_fitness: list[np.ndarray] = []
-        self.starts: list[np.ndarray] | None = None
-        self.es: Any = None
-        self._asked: list[np.ndarray] = []
+        self.runs: list[LocalRun] | None = None
+        self._asking: list[LocalRun] = []
 
     def _initialize_infill(self) -> Population:
         return self._infill()
@@ -283,48 +380,43 @@ class MultiStartSearch(Algorithm):
         if done < MULTISTART_SAMPLES:
             n = min(MULTISTART_BATCH, MULTISTART_SAMPLES - done)
             return Population.new("X", self.space.sample(self.random_state, n))
-        while True:
-            if self.es is None or self.es.stop():
-                if not self._next_local_run():
-                    self.converged = {"local runs": MULTISTART_STARTS}
-                    return None
-            self._asked = self.es.ask()
-            Z = np.clip(np.asarray(self._asked), 0.0, 1.0)
-            return Population.new("X", self.space.lower + Z * self.space.span)
+        if self.runs is None:
+            starts = self._distinct_starts()
+            seeds = self.random_state.integers(2**31, size=len(starts))
+            self.runs = [LocalRun(z, int(s)) for z, s in zip(starts, seeds, strict=True)]
+        self._asking = [run for run in self.runs if not run.stopped]
+        if not self._asking:
+            self.converged = {"local runs": len(self.runs)}
+            return None
+        Z = np.concatenate([run.ask() for run in self._asking])
+        return Population.new("X", self.space.lower + Z * self.space.span)
 
     def _advance(self, infills: Population | None = None, **kwargs: object) -> None:
         if infills is None:
             raise ValueError("MultiStartSearch follows ask/tell: tell it the evaluated infills")
         fitness = infills.get("F")[:, 0]
-        if self.es is None:
+        if self.runs is None:
             self.samples.append(infills.get("X"))
             self.sample_fitness.append(fitness)
         else:
-            self.es.tell(self._asked, fitness.tolist())
+            for i, run in enumerate(self._asking):
+                run.tell(fitness[i * LOCAL_POPULATION : (i + 1) * LOCAL_POPULATION])
+            self._race()
         self.pop = infills
 
-    def _next_local_run(self) -> bool:
-        """Start the next local CMA-ES run; False when every start has had its run."""
-        import cma
+    def _race(self) -> None:
+        """Stop the local runs that have fallen behind: after :data:`RACE_GENERATIONS`, a run
+        whose best lies more than :data:`RACE_MARGIN` (relative) above the best of all runs."""
+        assert self.runs is not None
+        leader = min(run.best for run in self.runs)
+        for run in self._asking:
+            behind = run.best - leader > RACE_MARGIN * abs(leader)
+            run.dropped |= run.generations >= RACE_GENERATIONS and behind
 
-        if self.starts is None:
-            self.starts = self._distinct_starts()
-        if not self.starts:
-            return False
-        rng = self.random_state
-        options = {
-            "bounds": [0.0, 1.0],
-            "popsize": LOCAL_POPULATION,
-            "randn": lambda *shape: rng.standard_normal(shape),
-            "seed": math.nan,
-            "verbose": -9,
-            "verb_log": 0,
-            "verb_disp": 0,
-            "tolfun": LOCAL_TOLERANCE,
-            "maxfevals": LOCAL_EVALUATIONS,
-        }
-        self.es = cma.CMAEvolutionStrategy(self.starts.pop(0), LOCAL_SIGMA, options)
-        return True
+    def _set_optimum(self) -> None:
+        """The best of the latest generation (the search's own best is the problem's
+        archive); cheaper than pymoo's filter over the whole population."""
+        self.opt = self.pop[[int(np.argmin(self.pop.get("F")[:, 0]))]]
 
     def _distinct_starts(self) -> list[np.ndarray]:
         """The best samples at least MULTISTART_DISTANCE apart, best first, scaled to [0, 1]."""
