@@ -214,3 +214,30 @@ def test_a_pymoo_algorithm_and_termination_can_be_passed_in(
     )
     assert result.method == "GA" and result.runs == 1 and result.stop_reason == "custom"
     assert result.evaluations == 80 and result.generations == 4
+
+
+@pytest.mark.parametrize(("method", "budget"), [("multistart", 2300), ("cmaes", 120), ("ga", 60)])
+def test_a_fixed_coordinate_stays_fixed(
+    case: Case, geometry: PathGeometry, method: str, budget: int
+) -> None:
+    """``min = max`` fixes a coordinate: scaled searches (CMA-ES) must not divide by its
+    zero span; the multistart budget reaches its local runs."""
+    lower, upper = case.bounds.lower.copy(), case.bounds.upper.copy()
+    lower[0] = upper[0] = 0.25  # x fixed
+    fixed = replace(case, bounds=replace(case.bounds, lower=lower, upper=upper))
+    result = optimize_placement(fixed, method=method, budget=budget, geometry=geometry)
+    assert result.X[0] == 0.25
+    assert result.evaluations == budget
+
+
+def test_scaling_maps_a_fixed_coordinate_to_the_middle() -> None:
+    space = SearchSpace(
+        lower=np.array([0.2, -1, -1, 0, 0, 0]),
+        upper=np.array([0.2, 1, 1, 1, 1, 1]),
+        reach=(0.0, 10.0),
+        anchor=np.array([0.2, 0, 0, 0, 0, 0]),
+    )
+    X = np.array([[0.2, 0.5, -1, 0.25, 1, 0]])
+    Z = space.to_unit(X)
+    np.testing.assert_array_equal(Z, [[0.5, 0.75, 0, 0.25, 1, 0]])
+    np.testing.assert_array_equal(space.from_unit(Z), X)

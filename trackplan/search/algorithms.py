@@ -221,7 +221,7 @@ class CMAESearch(Algorithm):
         import cma
 
         rng = self.random_state
-        x0 = (self.space.sample(rng, 1)[0] - self.space.lower) / self.space.span
+        x0 = self.space.to_unit(self.space.sample(rng, 1)[0])
         options = {
             "bounds": [0.0, 1.0],
             "popsize": self.population,
@@ -239,8 +239,7 @@ class CMAESearch(Algorithm):
 
     def _infill(self) -> Population:
         self._asked = self.es.ask()
-        Z = np.clip(np.asarray(self._asked), 0.0, 1.0)
-        return Population.new("X", self.space.lower + Z * self.space.span)
+        return Population.new("X", self.space.from_unit(np.asarray(self._asked)))
 
     def _initialize_advance(self, infills: Population | None = None, **kwargs: object) -> None:
         self._advance(infills)
@@ -389,7 +388,7 @@ class MultiStartSearch(Algorithm):
             self.converged = {"local runs": len(self.runs)}
             return None
         Z = np.concatenate([run.ask() for run in self._asking])
-        return Population.new("X", self.space.lower + Z * self.space.span)
+        return Population.new("X", self.space.from_unit(Z))
 
     def _advance(self, infills: Population | None = None, **kwargs: object) -> None:
         if infills is None:
@@ -422,7 +421,7 @@ class MultiStartSearch(Algorithm):
         """The best samples at least MULTISTART_DISTANCE apart, best first, scaled to [0, 1]."""
         X = np.concatenate(self.samples)
         fitness = np.concatenate(self.sample_fitness)
-        Z = (X - self.space.lower) / self.space.span
+        Z = self.space.to_unit(X)
         starts: list[np.ndarray] = []
         for i in np.argsort(fitness, kind="stable"):
             if all(np.max(np.abs(Z[i] - z)) >= MULTISTART_DISTANCE for z in starts):

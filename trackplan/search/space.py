@@ -131,6 +131,21 @@ class SearchSpace:
         """``upper - lower``, shape (6,)."""
         return self.upper - self.lower
 
+    def to_unit(self, X: np.ndarray) -> np.ndarray:
+        """Placements scaled to [0, 1] per variable, shape (..., n_var).
+
+        A fixed coordinate (``min = max``) maps to 0.5, so scaled searches never divide by
+        its zero span.
+        """
+        span = self.span
+        fixed = span == 0.0
+        Z = (np.asarray(X, dtype=float) - self.lower) / np.where(fixed, 1.0, span)
+        return np.where(fixed, 0.5, Z)
+
+    def from_unit(self, Z: np.ndarray) -> np.ndarray:
+        """The placements of scaled points ``Z`` (shape (..., n_var), clipped to [0, 1])."""
+        return self.lower + np.clip(Z, 0.0, 1.0) * self.span
+
     def reach_excess(self, X: np.ndarray) -> np.ndarray:
         """Distance of each translation outside the reach interval (0 inside).
 
