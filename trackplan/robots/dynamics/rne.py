@@ -6,6 +6,8 @@ inertia and friction, as roboticstoolbox computes it for its DH robots (``rne``)
 
 from __future__ import annotations
 
+from weakref import WeakKeyDictionary
+
 import numpy as np
 
 from trackplan.robots.dynamics import _kernels as kernels
@@ -130,7 +132,14 @@ def chain_inverse_dynamics(
     """
     T_tool = np.eye(4) if T_flange_tcp is None else np.asarray(T_flange_tcp, dtype=float)
     K = kernel_constants(chain, dynamics, chain.T_last_flange @ T_tool, friction)
-    g = np.array(dynamics.gravity if gravity is None else gravity, dtype=float)
+    return _torques(K, dynamics.gravity if gravity is None else gravity, q, qd, qdd)
+
+
+def _torques(
+    K: np.ndarray, gravity: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
+) -> np.ndarray:
+    """Run the kernel over states of any leading shape."""
+    g = np.array(gravity, dtype=float)
     q, qd, qdd = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (q, qd, qdd)))
     shape = q.shape
     q_flat, qd_flat, qdd_flat = (
@@ -174,16 +183,29 @@ def inverse_dynamics(
     ValueError
         When the robot has no dynamic parameters.
     """
-    return chain_inverse_dynamics(
-        robot_chain(robot),
-        _require(robot),
+    dynamics = _require(robot)
+    return _torques(
+        _robot_constants(robot, friction),
+        dynamics.gravity if gravity is None else gravity,
         q,
         qd,
         qdd,
-        T_flange_tcp=robot.T_flange_tool,
-        friction=friction,
-        gravity=gravity,
     )
+
+
+_CONSTANTS: WeakKeyDictionary[Robot, dict[bool, np.ndarray]] = WeakKeyDictionary()
+"""Kernel constants of each robot object (robots are immutable), with and without friction."""
+
+
+def _robot_constants(robot: Robot, friction: bool) -> np.ndarray:
+    """The kernel constants of a robot with dynamics, computed once per robot object."""
+    per_robot = _CONSTANTS.setdefault(robot, {})
+    if friction not in per_robot:
+        chain = robot_chain(robot)
+        per_robot[friction] = kernel_constants(
+            chain, _require(robot), chain.T_last_flange @ robot.T_flange_tool, friction
+        )
+    return per_robot[friction]
 
 
 def gravity_load(robot: Robot, q: np.ndarray) -> np.ndarray:
