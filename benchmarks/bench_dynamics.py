@@ -5,8 +5,8 @@ their throughput is measured in process CPU time (``time.process_time``), which 
 on the machine hardly changes; each figure is the best of several repeats. The Pareto run
 is wall time.
 roboticstoolbox is measured two ways on the same robot and states: ``rne`` called once per
-sample (how a planner loop calls it), and ``rne`` on the whole (N, 6) batch (its C code
-loops over the rows).
+sample (how a planner loop calls it; the issue's ≥ 100× target is stated against this one),
+and ``rne`` on the whole (N, 6) batch (its C code loops over the rows).
 """
 
 from __future__ import annotations
@@ -77,7 +77,11 @@ def main() -> None:
     print(
         f"  roboticstoolbox rne on the batch {batch:12.3e} samples/s   ratio {ours / batch:7.1f}x"
     )
-    print(f"  target >= {TARGET_RATIO:.0f}x the per-sample call")
+    verdict = "met" if ours / single >= TARGET_RATIO else "NOT met"
+    print(
+        f"  target >= {TARGET_RATIO:.0f}x roboticstoolbox's rne called per sample: {verdict} "
+        f"({ours / single:.0f}x); against its batch call {ours / batch:.1f}x"
+    )
 
     case = load_case(CORNER)
     start = time.perf_counter()

@@ -277,3 +277,28 @@ def test_inertia_checks():
         Payload(1.0, inertia=inertia_matrix([-0.1, 0.1, 0.1, 0, 0, 0]))
     with pytest.raises(CaseError, match=r"payload\.mass"):
         Payload(-1.0)
+
+
+def test_kernel_sine_and_cosine_within_one_ulp_of_libm(rng):
+    """The vectorised sin/cos of the RNE kernel against numpy's, including the libm fallback."""
+    from trackplan.robots.dynamics import _kernels as kernels
+
+    block = kernels.BLOCK
+    row = {"q": kernels._Q * block, "cos": kernels._COS * block, "sin": kernels._SIN * block}
+    samples = [
+        rng.uniform(-np.pi, np.pi, block),
+        rng.uniform(-1e5, 1e5, block),
+        np.arange(block) * (np.pi / 4) - 4 * np.pi,  # quadrant boundaries
+        np.where(np.arange(block) == 3, 2e5, rng.uniform(-10, 10, block)),  # libm for the block
+        np.where(np.arange(block) == 5, np.nan, 0.5),
+    ]
+    for x in samples:
+        seg = np.zeros(kernels.SEGMENT)
+        seg[row["q"] : row["q"] + block] = x
+        kernels._sincos(seg)
+        for name, exact in (("cos", np.cos(x)), ("sin", np.sin(x))):
+            got = seg[row[name] : row[name] + block]
+            ulp = np.spacing(np.maximum(np.abs(exact), np.finfo(float).tiny))
+            finite = np.isfinite(x)
+            assert np.all(np.abs(got - exact)[finite] <= np.maximum(ulp[finite], 1.2e-16)), name
+            assert np.all(np.isnan(got[~finite]))

@@ -37,6 +37,12 @@ A robot file for a URDF (paths relative to the file; see ``docs/robots.md``)::
     continuous_range: 6.283185307179586          # optional: continuous joints' half range
     source: "where the numbers come from"        # optional
     assumptions: ["acceleration and jerk assumed: …"]   # optional
+    dynamics:                     # optional, per joint in chain order (docs/dynamics.md)
+      torque: [150, 150, 150, 28, 28, 28]        # N·m, replaces the URDF's effort limits
+      gear_ratio: [101, 101, 101, 101, 101, 101]  # and motor_inertia, viscous, coulomb,
+                                                  # motor_constant, mass, com, inertia
+    gravity: [0, 0, -9.81]        # optional, m/s², base frame
+    payload: {mass: 2.0, com: [0, 0, 0.05]}      # optional, TCP frame
     collision:                    # optional: replaces the URDF's <collision> elements
       - {link: link_2, from: [0, 0, 0], to: [0, 0, 0.705], radius: 0.12}
 
@@ -65,6 +71,7 @@ from pydantic import Field
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_from_matrix, rpy_matrix
 from trackplan.io.urdf import DEFAULT_CONTINUOUS_RANGE, read_urdf_chain, read_urdf_link_geometry
+from trackplan.io.urdf_inertials import read_urdf_inertials
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -168,6 +175,29 @@ class LimitsModel(StrictModel):
     velocity: list[Positive] | None = None
 
 
+Coulomb = Annotated[list[float], Field(min_length=2, max_length=2)]
+"""``[Tc+, Tc−]``, N·m, motor side."""
+
+
+class URDFDynamicsModel(StrictModel):
+    """Dynamics of a URDF robot that add to or replace the URDF's, one entry per joint.
+
+    ``mass``, ``com`` and ``inertia`` (about the centre of mass) are in the joints' child
+    frames, which are the URDF frames of the links the joints move; given, they replace
+    every ``<inertial>`` of the chain. ``torque`` replaces the ``<limit effort>`` values.
+    """
+
+    mass: list[float] | None = None
+    com: list[Vec3] | None = None
+    inertia: list[Inertia6] | None = None
+    torque: list[float] | None = None
+    motor_inertia: list[NonNegative] | None = None
+    gear_ratio: list[float] | None = None
+    viscous: list[NonNegative] | None = None
+    coulomb: list[Coulomb] | None = None
+    motor_constant: list[Positive] | None = None
+
+
 class URDFRobotFileModel(StrictModel):
     """Schema of a robot file that points at a URDF."""
 
@@ -179,6 +209,9 @@ class URDFRobotFileModel(StrictModel):
     tool: ToolModel | None = None
     limits: LimitsModel = Field(default_factory=LimitsModel)
     continuous_range: Positive = DEFAULT_CONTINUOUS_RANGE
+    dynamics: URDFDynamicsModel | None = None
+    gravity: Vec3 = list_default(*STANDARD_GRAVITY)
+    payload: PayloadModel | None = None
     assumptions: list[str] = Field(default_factory=list)
     collision: Collision | None = None
 
@@ -235,6 +268,7 @@ def robot_from_urdf_file(file: str | Path, *, assume_limits: bool = False) -> Ro
         chain, chain.name, LimitsModel(), np.eye(4), "", [], assume_limits, str(file)
     )
     capsules = read_urdf_link_geometry(file, chain.joint_names).capsules
+    robot = replace(robot, dynamics=urdf_dynamics(file, chain, None, None, str(file)))
     return replace(robot, collision=capsules) if len(capsules) else robot
 
 
@@ -421,7 +455,9 @@ def _load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> R
         assume_limits,
         file,
     )
-    return replace(robot, collision=_urdf_collision(model, base / model.urdf, chain, data, file))
+    dynamics = urdf_dynamics(base / model.urdf, chain, model, data, file)
+    collision = _urdf_collision(model, base / model.urdf, chain, data, file)
+    return replace(robot, dynamics=dynamics, collision=collision)
 
 
 def collision_problems(
@@ -491,6 +527,132 @@ def _urdf_collision(
     n_dof = len(chain.joint_names)
     raise_first(collision_problems(model.collision, n_dof, geometry.link_frames), data, file)
     return link_capsules(model.collision, geometry.link_frames)
+
+
+def urdf_dynamics(
+    urdf: str | Path,
+    chain: Any,
+    model: URDFRobotFileModel | None,
+    data: Any,
+    file: str | None,
+) -> RobotDynamics | None:
+    """The dynamics of a URDF robot: the URDF's inertials and efforts, then the robot file's.
+
+    The robot has dynamics when the chain has inertials (``<inertial>`` or
+    ``dynamics.mass``) and every joint a torque limit (``effort`` > 0 or
+    ``dynamics.torque``). A bare URDF short of either has none (no torque check); a robot
+    file that gives ``dynamics``, ``payload`` or ``gravity`` and is short of either is an
+    error.
+
+    Parameters
+    ----------
+    urdf
+        The URDF file.
+    chain
+        Its chain (:class:`~trackplan.io.urdf.URDFChain`).
+    model
+        The validated robot file pointing at the URDF, or None for a bare URDF.
+    data, file
+        The robot file's data and path, for error messages.
+
+    Returns
+    -------
+    RobotDynamics or None
+
+    Raises
+    ------
+    CaseError
+        On a bad value in the URDF's inertials or the robot file's dynamics.
+    """
+    names = chain.joint_names
+    inertials = read_urdf_inertials(urdf, names, None if model is None else model.base_link)
+    extra = model.dynamics if model is not None else None
+    dyn = extra or URDFDynamicsModel()
+    raise_first(_urdf_dynamics_problems(dyn, model, names), data, file)
+    if dyn.mass is not None and dyn.com is not None and dyn.inertia is not None:
+        mass, com = np.array(dyn.mass), np.array(dyn.com)
+        inertia = inertia_matrix(np.array(dyn.inertia))
+    elif inertials.has_inertials:
+        mass, com, inertia = inertials.mass, inertials.com, inertials.inertia
+    else:
+        mass = None
+    torque = np.array(dyn.torque) if dyn.torque is not None else inertials.effort
+    explicit = model is not None and (
+        extra is not None or model.payload is not None or "gravity" in model.model_fields_set
+    )
+    if mass is None or np.any(np.isnan(torque)):
+        if not explicit:
+            return None
+        if mass is None:
+            why = (
+                "the URDF has no <inertial> on the chain's links: add them or give "
+                "dynamics.mass, dynamics.com and dynamics.inertia"
+            )
+        else:
+            missing = ", ".join(names[i] for i in np.flatnonzero(np.isnan(torque)))
+            why = (
+                f"no torque limit for joints {missing}: give effort > 0 in their <limit> "
+                "in the URDF or dynamics.torque"
+            )
+        raise CaseError(why, file=file, key="dynamics")
+    return RobotDynamics(
+        mass=mass,
+        com=com,
+        inertia=inertia,
+        torque_max=torque,
+        motor_inertia=None if dyn.motor_inertia is None else np.array(dyn.motor_inertia),
+        gear_ratio=None if dyn.gear_ratio is None else np.array(dyn.gear_ratio),
+        viscous=None if dyn.viscous is None else np.array(dyn.viscous),
+        coulomb=None if dyn.coulomb is None else np.array(dyn.coulomb),
+        motor_constant=None if dyn.motor_constant is None else np.array(dyn.motor_constant),
+        gravity=np.array(STANDARD_GRAVITY if model is None else model.gravity),
+        payload=None if model is None or model.payload is None else as_payload(model.payload),
+        source="" if model is None else model.source,
+    )
+
+
+def _urdf_dynamics_problems(
+    dyn: URDFDynamicsModel, model: URDFRobotFileModel | None, names: tuple[str, ...]
+) -> list[Problem]:
+    """Wrong list lengths, negative masses, unphysical inertias, torque limits <= 0."""
+    n = len(names)
+    problems: list[Problem] = []
+    for key in URDFDynamicsModel.model_fields:
+        values = getattr(dyn, key)
+        if values is not None and len(values) != n:
+            problems.append(
+                (
+                    ("dynamics", key),
+                    f"expected {n} entries, one per joint of the chain ({', '.join(names)}), "
+                    f"got {len(values)}",
+                )
+            )
+    if problems:
+        return problems
+    inertial = [getattr(dyn, key) is not None for key in ("mass", "com", "inertia")]
+    if any(inertial) and not all(inertial):
+        problems.append(
+            (("dynamics",), "give mass, com and inertia together (they replace the URDF's)")
+        )
+    for i in range(n):
+        if dyn.mass is not None and dyn.mass[i] < 0:
+            problems.append((("dynamics", "mass", i), f"mass must be >= 0 kg, got {dyn.mass[i]:g}"))
+        if dyn.torque is not None and dyn.torque[i] <= 0:
+            problems.append(
+                (
+                    ("dynamics", "torque", i),
+                    f"torque limit must be > 0 N·m, got {dyn.torque[i]:g}",
+                )
+            )
+        if dyn.inertia is not None:
+            problem = inertia_problem(inertia_matrix(dyn.inertia[i]))
+            if problem:
+                problems.append((("dynamics", "inertia", i), f"inertia {problem}"))
+        if dyn.gear_ratio is not None and dyn.gear_ratio[i] == 0:
+            problems.append((("dynamics", "gear_ratio", i), "gear ratio must not be 0"))
+    if model is not None and model.payload is not None:
+        problems += payload_problems(model.payload, ("payload",))
+    return problems
 
 
 def _urdf_robot(

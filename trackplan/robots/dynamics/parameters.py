@@ -364,15 +364,42 @@ def combine_payload(
     R = T_link_tcp[:3, :3]
     com_p = R @ payload.com + T_link_tcp[:3, 3]
     inertia_p = R @ payload.inertia @ R.T
-    total = mass + payload.mass
+    return combine_bodies(
+        np.array([mass, payload.mass]),
+        np.array([com, com_p]),
+        np.array([inertia, inertia_p]),
+    )
+
+
+def combine_bodies(
+    mass: np.ndarray, com: np.ndarray, inertia: np.ndarray
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """The inertial of rigidly joined bodies (parallel-axis theorem), all in one frame.
+
+    Parameters
+    ----------
+    mass
+        Shape (k,), kg.
+    com
+        Centres of mass, shape (k, 3), m.
+    inertia
+        Inertias about the centres of mass, shape (k, 3, 3), kg·m².
+
+    Returns
+    -------
+    tuple
+        ``(mass, com (3,), inertia (3, 3))`` of the whole, about its centre of mass (zero
+        mass: the origin and a zero inertia).
+    """
+    mass = np.asarray(mass, dtype=float)
+    com = np.asarray(com, dtype=float).reshape(-1, 3)
+    inertia = np.asarray(inertia, dtype=float).reshape(-1, 3, 3)
+    total = float(mass.sum())
     if total == 0.0:
         return 0.0, np.zeros(3), np.zeros((3, 3))
-    com_c = (mass * np.asarray(com) + payload.mass * com_p) / total
-
-    def shifted(m: float, inertia_at_com: np.ndarray, r: np.ndarray) -> np.ndarray:
-        return inertia_at_com + m * (float(r @ r) * np.eye(3) - np.outer(r, r))
-
-    inertia_c = shifted(mass, np.asarray(inertia), np.asarray(com) - com_c) + shifted(
-        payload.mass, inertia_p, com_p - com_c
+    com_c = mass @ com / total
+    r = com - com_c
+    shift = np.einsum("k,ki,ki->k", mass, r, r)[:, None, None] * np.eye(3) - mass[:, None, None] * (
+        r[:, :, None] * r[:, None, :]
     )
-    return total, com_c, inertia_c
+    return total, com_c, (inertia + shift).sum(axis=0)

@@ -6,11 +6,11 @@ inertia and friction, as roboticstoolbox computes it for its DH robots (``rne``)
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from weakref import WeakKeyDictionary
 
 import numpy as np
 
-from trackplan.robots.dynamics._kernels import rne_kernel
+from trackplan.robots.dynamics import _kernels as kernels
 from trackplan.robots.dynamics.parameters import (
     JointChain,
     RobotDynamics,
@@ -34,26 +34,31 @@ def robot_chain(robot: Robot) -> JointChain:
     return JointChain(T_parent_joint=robot.origins, axis=robot.axes, T_last_flange=robot.T_tip)
 
 
-@dataclass(frozen=True, eq=False)
-class _KernelArrays:
-    """The chain and inertials as the kernel takes them (payload merged into the last link)."""
-
-    T_parent_joint: np.ndarray
-    axis: np.ndarray
-    mass: np.ndarray
-    com: np.ndarray
-    inertia: np.ndarray
-    gravity: np.ndarray
-    armature: np.ndarray
-    viscous: np.ndarray
-    coulomb_pos: np.ndarray
-    coulomb_neg: np.ndarray
-
-
-def _kernel_arrays(
+def kernel_constants(
     chain: JointChain, dynamics: RobotDynamics, T_last_tcp: np.ndarray, friction: bool
-) -> _KernelArrays:
-    """Arrays for :func:`rne_kernel`."""
+) -> np.ndarray:
+    """The per-joint constant table of :func:`~trackplan.robots.dynamics._kernels.rne_kernel`.
+
+    The payload is merged into the last link; each joint's rotation is split as
+    ``R_fixed · Rot(u, q) = R_fixed u uᵀ + cos q · R_fixed (I − u uᵀ) + sin q · R_fixed [u]×``;
+    inertias are moved to the joint origins (parallel-axis theorem).
+
+    Parameters
+    ----------
+    chain
+        Joint frames and axes.
+    dynamics
+        Inertials in the chain's child frames, actuators, friction.
+    T_last_tcp
+        The TCP in the last joint's child frame, shape (4, 4) (where the payload sits).
+    friction
+        Include viscous and Coulomb friction.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, ``N_CONSTANTS``).
+    """
     mass = np.array(dynamics.mass)
     com = np.array(dynamics.com)
     inertia = np.array(dynamics.inertia)
@@ -61,21 +66,35 @@ def _kernel_arrays(
         mass[-1], com[-1], inertia[-1] = combine_payload(
             mass[-1], com[-1], inertia[-1], dynamics.payload, T_last_tcp
         )
+    n = len(mass)
+    u = np.asarray(chain.axis, dtype=float)
+    R_fixed = np.asarray(chain.T_parent_joint, dtype=float)[:, :3, :3]
+    uu = u[:, :, None] * u[:, None, :]
+    skew = np.zeros((n, 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
+    skew -= np.swapaxes(skew, -1, -2)
+    inertia_origin = inertia + mass[:, None, None] * (
+        np.einsum("ni,ni->n", com, com)[:, None, None] * np.eye(3)
+        - com[:, :, None] * com[:, None, :]
+    )
     G = np.asarray(dynamics.gear_ratio)
     coulomb = np.asarray(dynamics.coulomb) * np.abs(G)[:, None]
     scale = 1.0 if friction else 0.0
-    return _KernelArrays(
-        T_parent_joint=np.ascontiguousarray(chain.T_parent_joint, dtype=float),
-        axis=np.ascontiguousarray(chain.axis, dtype=float),
-        mass=mass,
-        com=np.ascontiguousarray(com),
-        inertia=np.ascontiguousarray(inertia),
-        gravity=np.array(dynamics.gravity),
-        armature=G**2 * np.asarray(dynamics.motor_inertia),
-        viscous=scale * G**2 * np.asarray(dynamics.viscous),
-        coulomb_pos=scale * np.ascontiguousarray(coulomb[:, 0]),
-        coulomb_neg=scale * np.ascontiguousarray(coulomb[:, 1]),
-    )
+    K = np.zeros((n, kernels.N_CONSTANTS))
+    K[:, kernels.ROT_FIXED : kernels.ROT_FIXED + 9] = (R_fixed @ uu).reshape(n, 9)
+    K[:, kernels.ROT_COS : kernels.ROT_COS + 9] = (R_fixed @ (np.eye(3) - uu)).reshape(n, 9)
+    K[:, kernels.ROT_SIN : kernels.ROT_SIN + 9] = (R_fixed @ skew).reshape(n, 9)
+    K[:, kernels.ORIGIN : kernels.ORIGIN + 3] = np.asarray(chain.T_parent_joint)[:, :3, 3]
+    K[:, kernels.AXIS : kernels.AXIS + 3] = u
+    K[:, kernels.MASS] = mass
+    K[:, kernels.MOMENT : kernels.MOMENT + 3] = mass[:, None] * com
+    rows, cols = (0, 1, 2, 0, 1, 0), (0, 1, 2, 1, 2, 2)
+    K[:, kernels.INERTIA : kernels.INERTIA + 6] = inertia_origin[:, rows, cols]
+    K[:, kernels.ARMATURE] = G**2 * np.asarray(dynamics.motor_inertia)
+    K[:, kernels.VISCOUS] = scale * G**2 * np.asarray(dynamics.viscous)
+    K[:, kernels.COULOMB_POS] = scale * coulomb[:, 0]
+    K[:, kernels.COULOMB_NEG] = scale * coulomb[:, 1]
+    return K
 
 
 def chain_inverse_dynamics(
@@ -112,30 +131,22 @@ def chain_inverse_dynamics(
         τ, shape (..., n), N·m.
     """
     T_tool = np.eye(4) if T_flange_tcp is None else np.asarray(T_flange_tcp, dtype=float)
-    arrays = _kernel_arrays(chain, dynamics, chain.T_last_flange @ T_tool, friction)
-    g = arrays.gravity if gravity is None else np.asarray(gravity, dtype=float)
+    K = kernel_constants(chain, dynamics, chain.T_last_flange @ T_tool, friction)
+    return _torques(K, dynamics.gravity if gravity is None else gravity, q, qd, qdd)
+
+
+def _torques(
+    K: np.ndarray, gravity: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
+) -> np.ndarray:
+    """Run the kernel over states of any leading shape."""
+    g = np.array(gravity, dtype=float)
     q, qd, qdd = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (q, qd, qdd)))
     shape = q.shape
     q_flat, qd_flat, qdd_flat = (
         np.ascontiguousarray(x.reshape(-1, shape[-1])) for x in (q, qd, qdd)
     )
     tau = np.empty_like(q_flat)
-    rne_kernel(
-        arrays.T_parent_joint,
-        arrays.axis,
-        arrays.mass,
-        arrays.com,
-        arrays.inertia,
-        g,
-        arrays.armature,
-        arrays.viscous,
-        arrays.coulomb_pos,
-        arrays.coulomb_neg,
-        q_flat,
-        qd_flat,
-        qdd_flat,
-        tau,
-    )
+    kernels.rne_kernel(K, g, q_flat, qd_flat, qdd_flat, tau)
     return tau.reshape(shape)
 
 
@@ -172,16 +183,29 @@ def inverse_dynamics(
     ValueError
         When the robot has no dynamic parameters.
     """
-    return chain_inverse_dynamics(
-        robot_chain(robot),
-        _require(robot),
+    dynamics = _require(robot)
+    return _torques(
+        _robot_constants(robot, friction),
+        dynamics.gravity if gravity is None else gravity,
         q,
         qd,
         qdd,
-        T_flange_tcp=robot.T_flange_tool,
-        friction=friction,
-        gravity=gravity,
     )
+
+
+_CONSTANTS: WeakKeyDictionary[Robot, dict[bool, np.ndarray]] = WeakKeyDictionary()
+"""Kernel constants of each robot object (robots are immutable), with and without friction."""
+
+
+def _robot_constants(robot: Robot, friction: bool) -> np.ndarray:
+    """The kernel constants of a robot with dynamics, computed once per robot object."""
+    per_robot = _CONSTANTS.setdefault(robot, {})
+    if friction not in per_robot:
+        chain = robot_chain(robot)
+        per_robot[friction] = kernel_constants(
+            chain, _require(robot), chain.T_last_flange @ robot.T_flange_tool, friction
+        )
+    return per_robot[friction]
 
 
 def gravity_load(robot: Robot, q: np.ndarray) -> np.ndarray:
