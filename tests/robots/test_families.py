@@ -7,11 +7,13 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from numba import njit
 
 from tests.conftest import replace_dh
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_file import builtin_names, builtin_robot
+from trackplan.robots.families import _kernels as kern
 from trackplan.robots.families import ik_family, solve_ik
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
@@ -283,3 +285,29 @@ def test_stretched_arm_and_shoulder_cylinder_are_reachable(puma, rng):
     assert ik.valid.all()
     assert np.abs(forward_kinematics(puma, ik.q) - T[:, None]).max() < 1e-9
     assert np.abs(wrapped(ik.q[:, :4, 0] - ik.q[:, 4:, 0])).max() < 1e-6  # shoulders meet
+
+
+@njit(cache=True)
+def _compiled_atan2(y, x, out):  # pragma: no cover - compiled
+    for i in range(y.size):
+        out[i] = kern.atan2(y[i], x[i])
+
+
+def test_compiled_atan2_is_libm_atan2_to_two_ulp(rng):
+    """The kernels' arctangent against numpy's (libm's) on random and edge arguments."""
+    n = 200_000
+    scale = np.exp(rng.uniform(-40.0, 40.0, (2, n)))
+    y, x = rng.normal(size=(2, n)) * np.where(rng.random((2, n)) < 0.5, 1.0, scale)
+    got = np.empty(n)
+    _compiled_atan2(y, x, got)
+    expected = np.arctan2(y, x)
+    assert (np.abs(got - expected) <= 2 * np.spacing(np.abs(expected))).all()
+    assert np.mean(got == expected) > 0.9
+    edges = np.array([0.0, -0.0, 1.0, -1.0, 1e-300, -1e-300, 1e300, -1e300, np.nan])
+    y, x = (a.ravel().copy() for a in np.meshgrid(edges, edges))
+    got = np.empty(y.size)
+    _compiled_atan2(y, x, got)
+    expected = np.arctan2(y, x)
+    np.testing.assert_array_equal(got, expected)  # NaN where NaN
+    same = ~np.isnan(expected)
+    np.testing.assert_array_equal(np.signbit(got[same]), np.signbit(expected[same]))

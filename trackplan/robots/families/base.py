@@ -100,34 +100,23 @@ class IKFamily(Protocol):
         ...
 
 
-CHUNK = 2048
-"""Poses per pass of a closed-form solver: its scratch stays in the L2 cache."""
-
-
-def solve_in_chunks(
-    arguments: Callable[..., None],
-    assemble: Callable[..., None],
-    n_angles: int,
+def solve_fused(
+    kernel: Callable[..., None],
     geometry: np.ndarray,
     tail_inv: np.ndarray,
     T_base_tool: np.ndarray,
     with_aux: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Run a closed-form family's compiled kernels over poses, :data:`CHUNK` at a time.
-
-    A family's solver is two kernels around one vectorised ``arctan2``: ``arguments``
-    writes the sine and cosine arguments of every angle of every branch (and the validity
-    flags and branch quantities), ``assemble`` turns the angles into joint values.
+    """Run a closed-form family's fused compiled kernel over a flat batch of poses.
 
     Parameters
     ----------
-    arguments, assemble
-        The family's kernels (``opw_*`` or ``ur_*`` of ``families/_kernels.py``).
-    n_angles
-        Angles the arguments kernel writes per pose.
+    kernel
+        The family's kernel (``opw_solve`` or ``ur_solve`` of ``families/_kernels.py``):
+        pose in, eight branches out, one pose at a time.
     geometry, tail_inv
         The family's parameter array and the inverse of its tool transform, as the
-        kernels take them.
+        kernel takes them.
     T_base_tool
         Tool poses, shape (N, 4, 4), m.
     with_aux
@@ -143,22 +132,5 @@ def solve_in_chunks(
     q = np.empty((n_poses, N_BRANCHES, 6))
     valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
     aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
-    size = min(CHUNK, n_poses)
-    Y = np.zeros((size, n_angles))  # slots a pose leaves unset stay finite
-    X = np.ones((size, n_angles))
-    angles = np.empty((size, n_angles))
-    for start in range(0, n_poses, CHUNK):
-        stop = min(start + CHUNK, n_poses)
-        m = stop - start
-        arguments(
-            geometry,
-            tail_inv,
-            T[start:stop],
-            Y[:m],
-            X[:m],
-            valid[start:stop],
-            aux[start:stop] if with_aux else aux,
-        )
-        np.arctan2(Y[:m], X[:m], out=angles[:m])
-        assemble(geometry, angles[:m], valid[start:stop], q[start:stop])
+    kernel(geometry, tail_inv, T, q, valid, aux)
     return q, valid, aux

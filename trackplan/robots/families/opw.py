@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.robots.families import _kernels as kern
-from trackplan.robots.families.base import describe_bits, solve_in_chunks
+from trackplan.robots.families.base import describe_bits, solve_fused
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
 
@@ -301,12 +301,4 @@ class OPWFamily:
 
         ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
         """
-        return solve_in_chunks(
-            kern.opw_arguments,
-            kern.opw_assemble,
-            kern.O_N_ANGLES,
-            self._geometry,
-            self._tail_inv,
-            T_base_tool,
-            with_aux,
-        )
+        return solve_fused(kern.opw_solve, self._geometry, self._tail_inv, T_base_tool, with_aux)

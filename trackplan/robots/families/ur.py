@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from trackplan.robots.families import _kernels as kern
-from trackplan.robots.families.base import branch_bits, solve_in_chunks
+from trackplan.robots.families.base import branch_bits, solve_fused
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
@@ -263,12 +263,4 @@ class URFamily:
 
         ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
         """
-        return solve_in_chunks(
-            kern.ur_arguments,
-            kern.ur_assemble,
-            kern.U_N_ANGLES,
-            self._geometry,
-            self._tail_inv,
-            T_base_tool,
-            with_aux,
-        )
+        return solve_fused(kern.ur_solve, self._geometry, self._tail_inv, T_base_tool, with_aux)
