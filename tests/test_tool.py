@@ -169,3 +169,147 @@ def test_part_frame_has_no_transition_bound(corner_geometry):
     R = spec.base_rotations(np.eye(3))
     assert rotation_angle(R, np.broadcast_to(rpy_matrix([-np.pi / 2, 0, 0]), R.shape)).max() < 1e-12
     assert replace(spec, spin=SpinMode.FREE).n_spin == 1
+
+
+# Per-segment normals (task.tool.normals).
+
+TWO_FACES = CASES / "bracket-two-faces.yaml"
+
+
+def _segment_seam_axis(normals, nominal, s_nominal, piece, tangent_of):
+    """The spec's tool axis at zero spin, built here from first principles: each sample's
+    segment normal made perpendicular to the nominal tangent (z_s = −n), then the work and
+    travel rotations applied with scipy."""
+    t = tangent_of(nominal, s_nominal, piece)
+    n = np.asarray(normals, dtype=float)[nominal.segment_index[piece]]
+    n = n - np.einsum("mk,mk->m", n, t)[:, None] * t
+    z = -n / np.linalg.norm(n, axis=1, keepdims=True)
+    return np.stack([t, np.cross(z, t), z], axis=-1)
+
+
+def _collinear_geometry():
+    from trackplan.io.case_file import load_case_text
+
+    text = """
+name: collinear
+path:
+  start: [0, 0, 0]
+  segments:
+    - line: {to: [0.1, 0, 0]}
+    - line: {to: [0.2, 0, 0]}
+    - line: {to: [0.2, 0.1, 0]}
+task:
+  rated_speed: 0.02
+  tolerance: 0.0005
+"""
+    return PathGeometry.from_case(load_case_text(text, file="collinear.yaml"))
+
+
+@pytest.fixture(scope="module")
+def two_faces_geometry():
+    return PathGeometry.from_case(load_case(TWO_FACES))
+
+
+@pytest.fixture(scope="module")
+def collinear_geometry():
+    return _collinear_geometry()
+
+
+def _unit_across(rng, tangent):
+    """A random unit vector at least 20° away from ±tangent."""
+    while True:
+        n = rng.normal(size=3)
+        n /= np.linalg.norm(n)
+        if abs(n @ tangent) < np.cos(np.radians(20)):
+            return n
+
+
+@settings(max_examples=8, deadline=None, derandomize=True)
+@given(
+    seed=st.integers(0, 10_000),
+    which=st.sampled_from(["corner", "two faces", "collinear"]),
+    work=st.floats(-0.8, 0.8),
+    travel=st.floats(-0.5, 0.5),
+)
+def test_segment_normals_are_exact_outside_transition_zones_and_bounded_inside(
+    corner_geometry, two_faces_geometry, collinear_geometry, seed, which, work, travel
+):
+    geometry = {
+        "corner": corner_geometry,
+        "two faces": two_faces_geometry,
+        "collinear": collinear_geometry,
+    }[which]
+    planned, nominal = geometry.planned, geometry.nominal
+    rng = np.random.default_rng(seed)
+    normals = []
+    for segment in range(len(nominal.segments)):
+        first = np.flatnonzero(nominal.segment_index == segment)[0]
+        tangent = nominal.pieces[first].curve.evaluate(np.zeros(1)).tangent[0]
+        normals.append(_unit_across(rng, tangent) * rng.uniform(0.5, 2.0))
+    spec = ToolSpec(
+        frame=ToolFrame.SEAM, normals=np.array(normals), work_angle=work, travel_angle=travel
+    )
+    s = np.sort(rng.uniform(0.0, planned.length, 4000))
+    sample = planned.sample(s)
+    R = ToolOrientation.choose(spec, geometry).base_rotations(s, sample.tangent)
+    s_nominal, _, piece = locate_on_nominal(nominal, sample.position, sample.tangent, 1e-3)
+    R_seam = _segment_seam_axis(normals, nominal, s_nominal, piece, nominal_tangents)
+    R_spec = R_seam @ Rotation.from_euler("XY", [work, travel]).as_matrix()  # Rx(work)·Ry(travel)
+    error = np.arccos(np.clip(np.einsum("ni,ni->n", R[:, :, 2], R_spec[:, :, 2]), -1, 1))
+    zones = transition_zones(spec, geometry, 1e-3)
+    inside = np.zeros(len(s), dtype=bool)
+    for s0, s1, bound in zones:
+        zone = (s_nominal >= s0) & (s_nominal <= s1)
+        assert error[zone].max(initial=0.0) <= bound
+        inside |= zone
+    assert error[~inside].max() <= AXIS_EXACT
+    # a zone per junction, each within 2 cm of it
+    junctions = [nominal.pieces[k].s_start for k in range(1, len(nominal.pieces))]
+    assert len(zones) <= len(junctions)
+    for s0, s1, _ in zones:
+        assert any(s0 - 0.02 < j < s1 + 0.02 for j in junctions) and s1 - s0 < 0.04
+
+
+@pytest.mark.parametrize("name", ["two faces", "collinear"])
+def test_a_normal_jump_is_blended_smoothly(two_faces_geometry, collinear_geometry, name):
+    """Across a junction where the normal jumps the tool turns continuously: on a 10 µm
+    grid the tool axis never steps by more than the smooth step's peak rate allows."""
+    geometry = two_faces_geometry if name == "two faces" else collinear_geometry
+    normals = [[0, 0, 1], [-1, 0, 0]] if name == "two faces" else [[0, 0, 1], [0, -1, 1], [0, 0, 1]]
+    spec = ToolSpec(frame=ToolFrame.SEAM, normals=np.array(normals, dtype=float))
+    tool = ToolOrientation.choose(spec, geometry)
+    assert tool.normals is not None and len(tool.normals.windows) == len(normals) - 1
+    planned = geometry.planned
+    s = np.arange(0.0, planned.length, 1e-5)
+    axis = tool.base_rotations(s, planned.sample(s).tangent)[:, :, 2]
+    step = np.arccos(np.clip(np.einsum("mi,mi->m", axis[1:], axis[:-1]), -1, 1))
+    assert step.max() < 0.02  # no jump anywhere (a sharp 90° corner blend turns it fastest)
+    normal = tool.normals(s)
+    step = np.arccos(np.clip(np.einsum("mi,mi->m", normal[1:], normal[:-1]), -1, 1))
+    jump = np.pi / 2 if name == "two faces" else np.pi / 4
+    for s0, s1, *_ in tool.normals.windows:
+        # the smooth step's slope peaks at 15/8: the jump spread over the window
+        inside = (s[1:] > s0) & (s[:-1] < s1)
+        assert step[inside].max() < 2 * 15 / 8 * jump * 1e-5 / (s1 - s0)
+        assert step[inside].sum() == pytest.approx(jump, rel=1e-3)
+        assert 1e-3 < s1 - s0 < 0.03
+    assert step.sum() == pytest.approx(jump * len(tool.normals.windows), rel=1e-3)
+    # away from the junctions the tool points into each segment's face (normals ⊥ tangents)
+    middle = np.array([0.5 * (p.s_start + p.s_end) for p in geometry.nominal.pieces])
+    unit = np.array(normals, dtype=float) / np.linalg.norm(normals, axis=1, keepdims=True)
+    axis = tool.base_rotations(middle, planned.sample(middle).tangent)[:, :, 2]
+    np.testing.assert_allclose(axis, -unit[geometry.nominal.segment_index], atol=1e-12)
+
+
+def test_two_faces_case_plans_feasibly_and_checks():
+    from trackplan.planning.plan import check_case_trajectory, plan_placement
+
+    case = load_case(TWO_FACES)
+    assert case.task.tool.normals is not None and len(case.task.tool.normals) == 2
+    X = case.bounds.example
+    result = plan_placement(case, X, spin=np.array([-2.3905]))
+    assert result.success, result.message
+    check = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
+    assert check.success
+    # the tool turns from one face's normal to the other's: about 90° across the bend
+    assert 1.0 < check.max_orientation_error < 1.5

@@ -11,10 +11,13 @@ Conventions (``docs/tool.md``):
   perpendicular to t): ``x_s = t``, ``z_s = −n``, ``y_s = z_s × x_s``;
 - ``frame: seam``: ``R = [x_s y_s z_s] · Rx(work_angle) · Ry(travel_angle) · Rz(spin)``;
 - ``frame: part``: ``R = RPY(rpy) · Rz(spin)``;
-- the tool axis is the tool's z axis.
+- the tool axis is the tool's z axis;
+- one ``normal`` for the whole path, or ``normals``: one per path segment.
 
 The tangent is the planned path's, so through a blend the orientation turns with the
-blend's tangent, which is continuous with its curvature (G2 blends). The checker holds
+blend's tangent, which is continuous with its curvature (G2 blends). Per-segment normals
+change the same way, across the same windows: where the normal jumps at a junction it is
+blended with the smooth step that rounds the tangent (:class:`SeamNormal`). The checker holds
 the tool axis to the spec on the nominal path; inside a *transition zone* (a blend, a
 corner arc or a fitted curve: a piece of the planned path that is not on the nominal path)
 it allows the deviation bound of :func:`trackplan.planning.tool_zones.transition_zones`.
@@ -33,6 +36,7 @@ from trackplan.errors import CaseError
 from trackplan.frames import rpy_matrix
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.path_geometry import PathGeometry
+from trackplan.paths.pieces import Piece
 
 SPIN_COEFFICIENTS = 6
 """B-spline coefficients of a ``free-varying`` spin profile (clamped cubic, uniform knots)."""
@@ -202,6 +206,8 @@ class ToolSpec:
         Roll, pitch, yaw for ``frame: part``, shape (3,), rad.
     normal
         Surface normal in the part frame for ``frame: seam``, shape (3,) (any length > 0).
+    normals
+        Instead of ``normal``: one surface normal per path segment, shape (S, 3).
     work_angle, travel_angle
         Rotations about the seam's x and y axes, rad (``frame: seam``).
     spin
@@ -218,6 +224,7 @@ class ToolSpec:
     frame: ToolFrame = ToolFrame.PART
     rpy: np.ndarray = field(default_factory=lambda: np.zeros(3))
     normal: np.ndarray | None = None
+    normals: np.ndarray | None = None
     work_angle: float = 0.0
     travel_angle: float = 0.0
     spin: SpinMode = SpinMode.FIXED
@@ -231,6 +238,9 @@ class ToolSpec:
         object.__setattr__(self, "rpy", np.asarray(self.rpy, dtype=float))
         if self.normal is not None:
             object.__setattr__(self, "normal", np.asarray(self.normal, dtype=float))
+        if self.normals is not None:
+            normals = np.asarray(self.normals, dtype=float).reshape(-1, 3)
+            object.__setattr__(self, "normals", normals)
 
     @classmethod
     def part(cls, rpy: np.ndarray) -> ToolSpec:
@@ -303,14 +313,34 @@ class ToolSpec:
             return np.full(self.n_spin, middle)
         return np.concatenate([[middle], np.zeros(self.n_spin - 1)])
 
-    def base_rotations(self, tangent: np.ndarray) -> np.ndarray:
-        """``R_part_tool`` at zero spin for unit path tangents (M, 3), shape (M, 3, 3)."""
+    def segment_normals(self, segment: np.ndarray) -> np.ndarray:
+        """Unit surface normals of path segments ``segment`` (M,) (ints), shape (M, 3).
+
+        With one ``normal``, that normal for every segment.
+        """
+        segment = np.asarray(segment, dtype=int)
+        given = self.normals if self.normals is not None else self.normal
+        assert given is not None  # frame: seam, checked by the case loader
+        unit = np.atleast_2d(given)
+        unit = unit / np.linalg.norm(unit, axis=1, keepdims=True)
+        return unit[segment] if self.normals is not None else np.repeat(unit, segment.size, 0)
+
+    def base_rotations(self, tangent: np.ndarray, normal: np.ndarray | None = None) -> np.ndarray:
+        """``R_part_tool`` at zero spin for unit path tangents (M, 3), shape (M, 3, 3).
+
+        ``normal`` (M, 3): the surface normal at each point (any length > 0); None: the
+        spec's one ``normal`` (a spec with per-segment ``normals`` needs them given, see
+        :meth:`segment_normals`).
+        """
         tangent = np.asarray(tangent, dtype=float)
         if self.frame is ToolFrame.PART:
             return np.broadcast_to(rpy_matrix(self.rpy), (len(tangent), 3, 3)).copy()
-        assert self.normal is not None  # checked by the case loader
-        n = self.normal / np.linalg.norm(self.normal)
-        n_perp = n - np.einsum("mk,k->m", tangent, n)[:, None] * tangent
+        if normal is None:
+            if self.normal is None:
+                raise ValueError("per-segment normals: give the normal at each point")
+            normal = np.broadcast_to(self.normal, tangent.shape)
+        n = normal / np.linalg.norm(normal, axis=-1, keepdims=True)
+        n_perp = n - np.einsum("mk,mk->m", tangent, n)[:, None] * tangent
         z = -n_perp / np.linalg.norm(n_perp, axis=1, keepdims=True)
         y = np.cross(z, tangent)
         R_seam = np.stack([tangent, y, z], axis=-1)
@@ -322,7 +352,10 @@ class ToolSpec:
         if self.frame is ToolFrame.PART:
             data["rpy"] = self.rpy.tolist()
         else:
-            data["normal"] = None if self.normal is None else self.normal.tolist()
+            if self.normals is not None:
+                data["normals"] = self.normals.tolist()
+            else:
+                data["normal"] = None if self.normal is None else self.normal.tolist()
             data["work_angle"] = self.work_angle
             data["travel_angle"] = self.travel_angle
         data["spin"] = str(self.spin)
@@ -355,11 +388,16 @@ class ToolOrientation:
         The case's tool spec.
     spin
         The chosen spin profile over the planned path.
+    seam
+        The rounded seam tangent (``frame: seam``).
+    normals
+        The surface normal along the planned path (per-segment ``normals``).
     """
 
     spec: ToolSpec
     spin: SpinProfile
     seam: SeamTangent | None = None
+    normals: SeamNormal | None = None
 
     @classmethod
     def choose(
@@ -388,8 +426,11 @@ class ToolOrientation:
         """
         length = geometry.planned.length
         seam = SeamTangent.from_geometry(geometry) if spec.frame is ToolFrame.SEAM else None
+        normals = None
+        if spec.frame is ToolFrame.SEAM and spec.normals is not None:
+            normals = SeamNormal.from_geometry(spec, geometry)
         if not isinstance(spin, SpinProfile):
-            return cls(spec, spec.profile(spin, length), seam)
+            return cls(spec, spec.profile(spin, length), seam, normals)
         profile = SpinProfile(np.asarray(spin.coefficients, dtype=float), length)
         lo, hi = spec.spin_range
         if spec.spin is SpinMode.FIXED:
@@ -412,17 +453,19 @@ class ToolOrientation:
                 f"a profile needs 1 or at least {SPIN_DEGREE + 1} coefficients",
                 key="--spin-profile",
             )
-        return cls(spec, profile, seam)
+        return cls(spec, profile, seam, normals)
 
     def base_rotations(self, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:
         """``R_part_tool`` at zero spin at arc lengths ``s`` (M,), shape (M, 3, 3).
 
         ``tangent`` (M, 3) is the planned path's; the seam frame rounds it at the
-        junctions (:class:`SeamTangent`).
+        junctions (:class:`SeamTangent`) and blends per-segment normals across the same
+        windows (:class:`SeamNormal`).
         """
         if self.seam is not None:
             tangent = self.seam(s, tangent)
-        return self.spec.base_rotations(tangent)
+        normal = None if self.normals is None else self.normals(s)
+        return self.spec.base_rotations(tangent, normal)
 
     def rotations(self, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:
         """``R_part_tool`` at arc lengths ``s`` (M,) with planned tangents (M, 3), (M, 3, 3)."""
@@ -462,7 +505,7 @@ class SeamTangent:
         pieces = geometry.planned.pieces
         rows = []
         for a, b in itertools.pairwise(pieces):
-            h = min(SEAM_SMOOTHING, 0.5 * a.length, 0.5 * b.length)
+            h = junction_window(a, b)
             if h <= 0.0:
                 continue
             end = a.curve.evaluate(np.array([a.length]))
@@ -490,12 +533,119 @@ class SeamTangent:
             before = d < 0.0
             T_a = np.where(before, exact[near], t_a + k_a * d + 0.5 * dk_a * d**2)
             T_b = np.where(before, t_b + k_b * d + 0.5 * dk_b * d**2, exact[near])
-            u = (d + h) / (2 * h)
-            w = u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
+            w = smooth_step((d + h) / (2 * h))
             mixed = (1.0 - w) * T_a + w * T_b
             norm = np.linalg.norm(mixed, axis=1, keepdims=True)
             result[near] = np.where(norm > 1e-9, mixed / np.maximum(norm, 1e-300), exact[near])
         return result
+
+
+def junction_window(a: Piece, b: Piece) -> float:
+    """Half-width h of the window in which the seam frame is rounded at the junction of
+    planned pieces a and b: :data:`SEAM_SMOOTHING`, at most half of either piece, m."""
+    return min(SEAM_SMOOTHING, 0.5 * a.length, 0.5 * b.length)
+
+
+def smooth_step(u: np.ndarray) -> np.ndarray:
+    """The quintic step ``6u⁵ − 15u⁴ + 10u³`` from 0 to 1 for u in [0, 1] (zero first and
+    second derivatives at both ends), shape of u."""
+    return u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
+
+
+@dataclass(frozen=True, eq=False)
+class SeamNormal:
+    """The surface normal along the planned path for per-segment normals, C2 in s.
+
+    Each planned piece gets the segment of the nominal path its ends lie on (the nearest
+    segment whose tangent agrees, never going back along the path). Where the segment
+    changes, the normal changes from the one segment's ``n_a`` to the next one's ``n_b``
+    as ``(1 − w) n_a + w n_b`` normalised, ``w`` the :func:`smooth_step` across a window:
+    the blend piece that joins the two segments widened by the seam tangent's windows at
+    its ends (:func:`junction_window`), or ``± h`` around a junction of two pieces. These
+    are the windows in which :class:`SeamTangent` rounds the tangent, so a normal jump is
+    blended where a tangent jump is, and the normal is exact everywhere else.
+
+    Attributes
+    ----------
+    starts
+        s of each planned piece's start, shape (P,), m.
+    piece_normals
+        Unit normal of each planned piece outside the windows, shape (P, 3).
+    windows
+        Per change of the normal: s0, s1 (m), then n_a and n_b, shape (K, 8).
+    """
+
+    starts: np.ndarray
+    piece_normals: np.ndarray
+    windows: np.ndarray
+
+    @classmethod
+    def from_geometry(cls, spec: ToolSpec, geometry: PathGeometry) -> SeamNormal:
+        """The segments of the planned pieces and the windows where the normal changes."""
+        pieces = geometry.planned.pieces
+        segment = _piece_segments(geometry)
+        unit = spec.segment_normals(segment.ravel()).reshape(-1, 2, 3)
+        h = [junction_window(a, b) for a, b in itertools.pairwise(pieces)] + [0.0]
+        windows = []
+        for k, piece in enumerate(pieces):
+            before = h[k - 1] if k > 0 else 0.0
+            if segment[k, 0] != segment[k, 1]:  # a blend from one segment into the next
+                s0, s1 = piece.s_start - before, piece.s_end + h[k]
+                windows.append([s0, s1, *unit[k, 0], *unit[k, 1]])
+            if k + 1 < len(pieces) and segment[k, 1] != segment[k + 1, 0]:
+                s0, s1 = piece.s_end - h[k], piece.s_end + h[k]
+                windows.append([s0, s1, *unit[k, 1], *unit[k + 1, 0]])
+        windows = [row for row in windows if row[1] > row[0] and row[2:5] != row[5:8]]
+        starts = np.array([piece.s_start for piece in pieces])
+        return cls(starts, unit[:, 0].copy(), np.array(windows, dtype=float).reshape(-1, 8))
+
+    def __call__(self, s: np.ndarray) -> np.ndarray:
+        """Unit surface normals at arc lengths ``s`` (M,) of the planned path, shape (M, 3)."""
+        s = np.asarray(s, dtype=float)
+        piece = np.clip(np.searchsorted(self.starts, s, side="right") - 1, 0, len(self.starts) - 1)
+        result = self.piece_normals[piece]
+        for s0, s1, *ends in self.windows:
+            inside = (s > s0) & (s < s1)
+            if not inside.any():
+                continue
+            w = smooth_step((s[inside] - s0) / (s1 - s0))[:, None]
+            n_a, n_b = np.reshape(ends, (2, 3))
+            mixed = (1.0 - w) * n_a + w * n_b
+            result[inside] = mixed / np.linalg.norm(mixed, axis=1, keepdims=True)
+        return result
+
+
+def _piece_segments(geometry: PathGeometry) -> np.ndarray:
+    """The nominal segment at the start and at the end of each planned piece, (P, 2) ints.
+
+    A point just inside each end (1 µm, or a quarter of a shorter piece) is assigned the
+    nearest nominal piece (within 1e-9 m of the nearest) whose tangent agrees with the
+    planned one, and the first such piece at or after the previous assignment, so that a
+    path that doubles back on itself keeps its order.
+    """
+    pieces, nominal = geometry.planned.pieces, geometry.nominal
+    inset = np.array(
+        [[min(1e-6, 0.25 * p.length), p.length - min(1e-6, 0.25 * p.length)] for p in pieces]
+    )
+    jets = [piece.curve.evaluate(sigma) for piece, sigma in zip(pieces, inset, strict=True)]
+    points = np.concatenate([jet.position for jet in jets])
+    tangents = np.concatenate([jet.tangent for jet in jets])
+    distance = np.empty((len(points), len(nominal.pieces)))
+    agrees = np.empty(distance.shape, dtype=bool)
+    for j, curve in enumerate(nominal.curves):
+        sigma, distance[:, j] = curve.project(points)
+        agrees[:, j] = np.einsum("nk,nk->n", curve.evaluate(sigma).tangent, tangents) > 0.0
+    near = distance <= distance.min(axis=1, keepdims=True) + 1e-9
+    candidate = near & agrees
+    none = ~candidate.any(axis=1)
+    candidate[none] = near[none]
+    assigned = np.empty(len(points), dtype=int)
+    previous = 0
+    for i, row in enumerate(candidate):
+        later = np.flatnonzero(row[previous:])
+        previous = previous + int(later[0]) if later.size else int(np.flatnonzero(row)[0])
+        assigned[i] = previous
+    return nominal.segment_index[assigned].reshape(-1, 2)
 
 
 def spin_rotations(base: np.ndarray, spins: np.ndarray) -> np.ndarray:
@@ -522,18 +672,24 @@ def tool_axis_twist(rotations: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(step)])
 
 
-def seam_problems(spec: ToolSpec, nominal: NominalPath) -> list[str]:
+def seam_problems(spec: ToolSpec, nominal: NominalPath) -> list[tuple[int | None, str]]:
     """Why the seam frame is undefined on this path (empty when it is defined).
 
-    The normal must have a component across the tangent everywhere; checked on every
-    piece at its ends and on a 1 mm grid.
+    Each segment's normal must have a component across the tangent everywhere on the
+    segment; checked on every piece at its ends and on a 1 mm grid. Per-segment normals of
+    neighbouring segments must not be opposite (their blend would pass through zero).
+
+    Returns
+    -------
+    list of (int or None, str)
+        The index into ``normals`` the problem is about (None for the one ``normal``) and
+        the message.
     """
-    if spec.frame is not ToolFrame.SEAM or spec.normal is None:
+    if spec.frame is not ToolFrame.SEAM:
         return []
-    norm = float(np.linalg.norm(spec.normal))
-    if norm == 0.0:
+    given = spec.normals if spec.normals is not None else spec.normal
+    if given is None or not np.all(np.linalg.norm(np.atleast_2d(given), axis=1) > 0.0):
         return []
-    n = spec.normal / norm
     table = nominal.table
     s = np.unique(
         np.concatenate(
@@ -545,13 +701,34 @@ def seam_problems(spec: ToolSpec, nominal: NominalPath) -> list[str]:
         )
     )
     s = np.clip(s, 0.0, nominal.length)
-    tangent = nominal.evaluate(s)[0].tangent
-    across = np.linalg.norm(n - np.outer(tangent @ n, np.ones(3)) * tangent, axis=1)
+    jet, piece = nominal.evaluate(s)
+    segment = nominal.segment_index[piece]
+    n = spec.segment_normals(segment)
+    tangent = jet.tangent
+    across = np.linalg.norm(n - np.einsum("mk,mk->m", tangent, n)[:, None] * tangent, axis=1)
     bad = np.flatnonzero(across < PARALLEL_SINE)
-    if not len(bad):
-        return []
-    return [
-        f"the normal {np.round(n, 6).tolist()} is parallel to the path tangent at "
-        f"s = {s[bad[0]]:.4g} m: the seam frame is undefined there; give a normal across "
-        "the path (the surface normal)"
-    ]
+    if len(bad):
+        at = bad[0]
+        index = None if spec.normals is None else int(segment[at])
+        whose = "" if index is None else f" of path.segments[{index}]"
+        return [
+            (
+                index,
+                f"the normal {np.round(n[at], 6).tolist()}{whose} is parallel to the path "
+                f"tangent at s = {s[at]:.4g} m: the seam frame is undefined there; give a "
+                "normal across the path (the surface normal)",
+            )
+        ]
+    if spec.normals is not None:
+        unit = spec.segment_normals(np.arange(len(spec.normals)))
+        opposite = np.flatnonzero(np.einsum("mk,mk->m", unit[:-1], unit[1:]) < -1.0 + 1e-9)
+        if len(opposite):
+            i = int(opposite[0])
+            return [
+                (
+                    i + 1,
+                    f"the normals of path.segments[{i}] and [{i + 1}] are opposite: the normal "
+                    "cannot turn smoothly between them; give the surface normal of each side",
+                )
+            ]
+    return []

@@ -35,6 +35,14 @@ def test_tool_rpy_is_the_part_frame_alias():
     assert old.spin is SpinMode.FIXED and old.n_spin == 0
 
 
+def test_seam_spec_takes_one_normal_per_segment():
+    tool = _case("  tool: {frame: seam, normals: [[0, 0, 2], [0, 0, 1]]}").task.tool
+    assert tool.normal is None
+    np.testing.assert_array_equal(tool.normals, [[0, 0, 2], [0, 0, 1]])
+    np.testing.assert_array_equal(tool.segment_normals(np.array([1, 0])), [[0, 0, 1], [0, 0, 1]])
+    assert tool.describe()["normals"] == [[0, 0, 2], [0, 0, 1]]
+
+
 def test_seam_spec_keys():
     tool = _case(
         "  tool: {frame: seam, normal: [0, 0, 2], work_angle: 0.5, travel_angle: -0.2,"
@@ -66,6 +74,33 @@ BAD = {
     "spin rate not positive": (
         "  tool: {spin: free-varying, spin_rate: 0}",
         "seam.yaml: task.tool.spin_rate: expected a rate > 0, rad/m of path, got 0.0",
+    ),
+    "normal and normals": (
+        "  tool: {frame: seam, normal: [0, 0, 1], normals: [[0, 0, 1], [0, 0, 1]]}",
+        "seam.yaml: task.tool.normals: give the surface normal once: normal (the whole path) "
+        "or normals (one per path segment); remove one of the two",
+    ),
+    "normals count": (
+        "  tool: {frame: seam, normals: [[0, 0, 1], [0, 0, 1], [0, 0, 1]]}",
+        "seam.yaml: task.tool.normals: expected 2 normals, one per path segment (2 segments), "
+        "got 3",
+    ),
+    "zero normal among normals": (
+        "  tool: {frame: seam, normals: [[0, 0, 1], [0, 0, 0]]}",
+        "seam.yaml: task.tool.normals[1]: expected a nonzero surface normal, got [0.0, 0.0, 0.0]",
+    ),
+    "normal along its segment's tangent": (
+        "  tool: {frame: seam, normals: [[0, 0, 1], [0, 1, 0]]}",
+        "seam.yaml: task.tool.normals[1]: the normal [0.0, 1.0, 0.0] of path.segments[1] is "
+        "parallel to the path tangent at s = 0.2 m",
+    ),
+    "opposite neighbouring normals": (
+        "  tool: {frame: seam, normals: [[0, 0, 1], [0, 0, -1]]}",
+        "seam.yaml: task.tool.normals[1]: the normals of path.segments[0] and [1] are opposite",
+    ),
+    "normals with the part frame": (
+        "  tool: {frame: part, normals: [[0, 0, 1], [0, 0, 1]]}",
+        "seam.yaml: task.tool.normals: normals applies to frame: seam",
     ),
     "tool and tool_rpy": (
         "  tool_rpy: [0, 0, 0]\n  tool: {frame: part}",

@@ -41,6 +41,7 @@ class ToolModel(StrictModel):
     frame: Literal["part", "seam"] = "part"
     rpy: Vec3 | None = None
     normal: Vec3 | None = None
+    normals: list[Vec3] | None = None
     work_angle: float = 0.0
     travel_angle: float = 0.0
     spin: Literal["fixed", "free", "free-varying"] = "fixed"
@@ -74,18 +75,13 @@ def tool_problems(
         return []
     problems: list[Problem] = []
     if tool.frame == "seam":
-        if tool.normal is None:
-            problems.append(((*at, "frame"), "frame: seam needs task.tool.normal [x, y, z]"))
-        elif math.hypot(*tool.normal) == 0.0:
-            problems.append(
-                ((*at, "normal"), f"expected a nonzero surface normal, got {show(tool.normal)}")
-            )
-        elif nominal is not None:
-            problems += [((*at, "normal"), text) for text in seam_problems(as_spec(tool), nominal)]
+        problems += _normal_problems(tool, nominal)
         if tool.rpy is not None:
             problems.append(((*at, "rpy"), "rpy applies to frame: part; remove it or the frame"))
-    elif tool.normal is not None:
-        problems.append(((*at, "normal"), "normal applies to frame: seam; remove it or set it"))
+    else:
+        for key in ("normal", "normals"):
+            if getattr(tool, key) is not None:
+                problems.append(((*at, key), f"{key} applies to frame: seam; remove it or set it"))
     low, high = tool.spin_range
     if low > high:
         problems.append(
@@ -101,6 +97,53 @@ def tool_problems(
     return problems
 
 
+def _normal_problems(tool: ToolModel, nominal: NominalPath | None) -> list[Problem]:
+    """Bad ``normal`` / ``normals`` of ``frame: seam``: absent, both, count, zero, parallel."""
+    at: Loc = ("task", "tool")
+    if tool.normal is not None and tool.normals is not None:
+        return [
+            (
+                (*at, "normals"),
+                "give the surface normal once: normal (the whole path) or normals (one per "
+                "path segment); remove one of the two",
+            )
+        ]
+    if tool.normal is None and tool.normals is None:
+        return [
+            (
+                (*at, "frame"),
+                "frame: seam needs task.tool.normal [x, y, z] or task.tool.normals "
+                "[[x, y, z], ...] (one per path segment)",
+            )
+        ]
+    if tool.normal is not None and math.hypot(*tool.normal) == 0.0:
+        return [((*at, "normal"), f"expected a nonzero surface normal, got {show(tool.normal)}")]
+    if tool.normals is not None:
+        if nominal is not None and len(tool.normals) != len(nominal.segments):
+            n = len(nominal.segments)
+            return [
+                (
+                    (*at, "normals"),
+                    f"expected {n} normals, one per path segment ({n} segments), "
+                    f"got {len(tool.normals)}",
+                )
+            ]
+        for i, normal in enumerate(tool.normals):
+            if math.hypot(*normal) == 0.0:
+                return [
+                    (
+                        (*at, "normals", i),
+                        f"expected a nonzero surface normal, got {show(normal)}",
+                    )
+                ]
+    if nominal is None:
+        return []
+    return [
+        ((*at, "normal") if index is None else (*at, "normals", index), text)
+        for index, text in seam_problems(as_spec(tool), nominal)
+    ]
+
+
 def as_spec(tool: ToolModel | None, tool_rpy: list[float] | None = None) -> ToolSpec:
     """The :class:`ToolSpec` of checked keys (the paper's tool when neither is given)."""
     if tool is None:
@@ -109,6 +152,7 @@ def as_spec(tool: ToolModel | None, tool_rpy: list[float] | None = None) -> Tool
         frame=ToolFrame(tool.frame),
         rpy=np.array(tool.rpy if tool.rpy is not None else [0.0, 0.0, 0.0], dtype=float),
         normal=None if tool.normal is None else np.array(tool.normal, dtype=float),
+        normals=None if tool.normals is None else np.array(tool.normals, dtype=float),
         work_angle=tool.work_angle,
         travel_angle=tool.travel_angle,
         spin=SpinMode(tool.spin),

@@ -18,7 +18,7 @@ from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
 from trackplan.planning.result import CheckReport, Violation
-from trackplan.planning.tool_zones import nominal_tangents
+from trackplan.planning.tool_zones import nominal_rotations
 from trackplan.planning.tracking import between_samples, jump_allowance, locate_on_nominal
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.kinematics import forward_kinematics
@@ -350,7 +350,7 @@ def _check_tool(
         The tool axis error per sample (N,), rad, and the violations found.
     """
     nominal, spec, tol = ref.nominal, ref.tool, ref.orientation_tolerance
-    R_spec = spec.base_rotations(nominal_tangents(nominal, s_nominal, piece))
+    R_spec = nominal_rotations(spec, nominal, s_nominal, piece)
     axis_cos = np.einsum("ni,ni->n", R_spec[:, :, 2], R_part_tool[:, :, 2])
     axis_error = np.arccos(np.clip(axis_cos, -1.0, 1.0))
     allowed = np.full(len(t), tol)

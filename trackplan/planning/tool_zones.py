@@ -32,13 +32,29 @@ def nominal_tangents(nominal: NominalPath, s: np.ndarray, piece: np.ndarray) -> 
     return nominal.tangents(s, piece)
 
 
+def nominal_rotations(
+    spec: ToolSpec, nominal: NominalPath, s: np.ndarray, piece: np.ndarray
+) -> np.ndarray:
+    """The spec's ``R_part_tool`` at zero spin on the nominal path, shape (N, 3, 3).
+
+    At arc lengths ``s`` (N,) on pieces ``piece`` (N,): the nominal tangent there and the
+    normal of the segment the piece belongs to (per-segment ``normals``), so the spec's
+    normal jumps exactly at the segment junctions.
+    """
+    tangent = nominal_tangents(nominal, s, piece)
+    if spec.normals is None:
+        return spec.base_rotations(tangent)
+    return spec.base_rotations(tangent, spec.segment_normals(nominal.segment_index[piece]))
+
+
 def transition_zones(spec: ToolSpec, geometry: PathGeometry, tolerance: float) -> np.ndarray:
     """Where the planned tool axis may leave the spec on the nominal path, and how far.
 
     The planned orientation follows the spec on the planned path with the smoothed seam
-    tangent (:class:`trackplan.tool.SeamTangent`); it leaves the spec taken on the nominal
-    path in blends, corner arcs and fitted curves (pieces of the planned path off the
-    nominal path) and where the smoothing rounds a junction. On a grid of
+    tangent (:class:`trackplan.tool.SeamTangent`) and normal
+    (:class:`trackplan.tool.SeamNormal`); it leaves the spec taken on the nominal path in
+    blends, corner arcs and fitted curves (pieces of the planned path off the nominal path)
+    and where the smoothing rounds a junction or blends a normal jump. On a grid of
     ``ZONE_STEP / 4`` along the planned path the deviation of the tool axis is measured;
     every run of grid points deviating more than ``EXACT_AXIS`` (padded by ten points) is
     a transition zone. Its bound is the largest deviation measured in it plus the largest
@@ -66,7 +82,7 @@ def transition_zones(spec: ToolSpec, geometry: PathGeometry, tolerance: float) -
     sample = planned.sample(s)
     axis = ToolOrientation.choose(spec, geometry).base_rotations(s, sample.tangent)[:, :, 2]
     s_nominal, _, piece = locate_on_nominal(nominal, sample.position, sample.tangent, tolerance)
-    expected = spec.base_rotations(nominal_tangents(nominal, s_nominal, piece))[:, :, 2]
+    expected = nominal_rotations(spec, nominal, s_nominal, piece)[:, :, 2]
     deviation = np.arccos(np.clip(np.einsum("mi,mi->m", axis, expected), -1.0, 1.0))
     off = deviation > EXACT_AXIS
     off = np.convolve(off.astype(float), np.ones(21), mode="same") > 0  # pad: 10 points

@@ -565,8 +565,13 @@ def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]
     if str(tool.frame) == "part":
         where = f"part frame, roll/pitch/yaw {_vector(tool.rpy)} rad"
     else:
+        normal = (
+            f"normal {_vector(tool.normal)}"
+            if tool.normals is None
+            else "normals " + " ".join(_vector(n) for n in tool.normals)
+        )
         where = (
-            f"seam frame, normal {_vector(tool.normal)}, work {tool.work_angle:.4g} rad, "
+            f"seam frame, {normal}, work {tool.work_angle:.4g} rad, "
             f"travel {tool.travel_angle:.4g} rad"
         )
     return f"{where}; spin {tool.spin}"
