@@ -3,7 +3,8 @@ path IK, against roboticstoolbox-python (``ikine_LM``, ``fkine``) and py-opw-kin
 same robots, in the same run.
 
 Run with ``.venv/bin/python -m benchmarks kinematics``. Every kernel is serial (one core);
-each figure is the best of several repeats, so other load on the machine only lowers it.
+each figure is the best of several repeats of the process's CPU time, which other load on the
+machine inflates far less than wall time (it still lowers the rates: shared caches and cores).
 """
 
 from __future__ import annotations
@@ -43,13 +44,13 @@ OPW_PARAMETERS = {  # py-opw-kinematics' description of the KR6 R700 sixx (opw_k
 
 
 def best_time(function: Callable[[], object], repeats: int = 5) -> float:
-    """Shortest wall time of ``repeats`` calls after one warm-up call, s."""
+    """Shortest process CPU time of ``repeats`` calls after one warm-up call, s."""
     function()
     times = []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start = time.process_time()
         function()
-        times.append(time.perf_counter() - start)
+        times.append(time.process_time() - start)
     return min(times)
 
 
