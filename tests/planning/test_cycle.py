@@ -16,9 +16,9 @@ import yaml
 from tests.conftest import CASES
 from trackplan.cell.check import check_cell
 from trackplan.cell.screening import CellGeometry
+from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.io.case_file import load_case, load_case_text
-from trackplan.errors import CaseError
 from trackplan.io.cycle_results import (
     read_segments,
     write_cycle_files,
@@ -33,6 +33,7 @@ from trackplan.planning.cycle import (
     RETRACT,
     VIA_LIFT,
     check_cycle_trajectory,
+    pieces_from_segments,
     plan_cycle,
     reversed_segments,
 )
@@ -264,7 +265,7 @@ def test_a_single_path_case_is_the_one_seam_cycle_of_its_plan() -> None:
     assert set(cycle.segment[1:]) == {"bracket-weld"}
 
 
-def _spun_case(left: dict, corner: dict):
+def spun_case(left: dict, corner: dict):
     """The left and corner seams of CASE, each with its own tool (frame part, CASE's rpy)."""
     data = copy.deepcopy(CASE)
     rpy = data["task"]["tool_rpy"]
@@ -291,7 +292,7 @@ LEFT_FIRST = Sequence(visits=(Visit(0, False), Visit(1, False)), cost=0.0, exact
 
 @pytest.mark.parametrize("reverse", [False, True])
 def test_a_chosen_constant_spin_reaches_the_trajectory_and_result(reverse, tmp_path: Path) -> None:
-    case = _spun_case({"spin": "free", "spin_range": [-0.4, 0.4]}, {"spin_value": -0.1})
+    case = spun_case({"spin": "free", "spin_range": [-0.4, 0.4]}, {"spin_value": -0.1})
     order = Sequence(visits=(Visit(0, reverse), Visit(1, False)), cost=0.0, exact=False)
     cycle = plan_cycle(case, X, sequence=order, spins=(np.array([0.25]), None))
     assert cycle.success, cycle.message
@@ -309,7 +310,7 @@ def test_a_chosen_constant_spin_reaches_the_trajectory_and_result(reverse, tmp_p
 
 
 def test_a_spin_profile_is_reversed_with_its_seam() -> None:
-    case = _spun_case({}, {"spin": "free-varying", "spin_range": [-0.5, 0.5], "spin_rate": 5.0})
+    case = spun_case({}, {"spin": "free-varying", "spin_range": [-0.5, 0.5], "spin_rate": 5.0})
     tool = case.seams[1].task.tool
     variables = np.r_[-0.3, np.linspace(1.0, -0.2, tool.n_spin - 1)]  # rises, then falls a bit
     runs = {}
@@ -331,6 +332,28 @@ def test_a_spin_profile_is_reversed_with_its_seam() -> None:
 
 
 def test_one_spin_per_seam_or_a_clear_error() -> None:
-    case = _spun_case({"spin": "free"}, {})
+    case = spun_case({"spin": "free"}, {})
     with pytest.raises(CaseError, match="one spin per seam"):
         plan_cycle(case, X, spins=(np.array([0.1]),))
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_a_closed_seam_rechecks_in_the_direction_it_was_welded(reverse, tmp_path: Path) -> None:
+    data = copy.deepcopy(CASE)
+    loop = {
+        "name": "loop",
+        "start": [0.13, 0.15, 0],
+        "segments": [{"arc": {"center": [0.1, 0.15, 0], "normal": [0, 0, 1], "angle": 2 * np.pi}}],
+    }
+    data["paths"] = [data["paths"][0], loop]
+    case = load_case_text(yaml.safe_dump(data, sort_keys=False))
+    order = Sequence(visits=(Visit(0, False), Visit(1, reverse)), cost=0.0, exact=False)
+    cycle = plan_cycle(case, X, sequence=order)
+    assert cycle.success, cycle.message
+    file = tmp_path / "trajectory.csv"
+    write_cycle_trajectory_csv(cycle, file)
+    _, q = read_trajectory_csv(file, case.robot.n_dof)
+    segment = read_segments(file)
+    pieces = pieces_from_segments(case, X, q, segment)
+    assert [p.reversed for p in pieces if p.kind == "seam"] == [False, reverse]
+    assert check_cycle_trajectory(case, X, q, case.task.sample_time, segment).success

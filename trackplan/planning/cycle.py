@@ -41,6 +41,7 @@ from trackplan.case import Case
 from trackplan.cell.check import check_cell
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform
+from trackplan.paths.nominal import NominalPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.checker import check_trajectory
@@ -861,7 +862,7 @@ def pieces_from_segments(
 ) -> tuple[Piece, ...]:
     """The pieces of a cycle trajectory from its ``segment`` labels (a trajectory.csv read
     back): runs of one label; a seam's direction is the one whose start lies nearer the
-    tool point at the run's first sample.
+    tool point at the run's first sample (for a closed seam, the way the tool runs along it).
 
     Parameters
     ----------
@@ -904,11 +905,25 @@ def pieces_from_segments(
         forward = T_base_part[:3, :3] @ seam.start + T_base_part[:3, 3]
         backward_start, _ = reversed_segments(seam.start, seam.segments)
         backward = T_base_part[:3, :3] @ backward_start + T_base_part[:3, 3]
-        reverse = bool(np.linalg.norm(tool - backward) < np.linalg.norm(tool - forward))
+        if np.linalg.norm(forward - backward) > seam.task.tolerance:
+            reverse = bool(np.linalg.norm(tool - backward) < np.linalg.norm(tool - forward))
+        else:  # a closed seam: the way it runs
+            reverse = _runs_backwards(case, i, q[first : int(end) + 1], T_base_part)
         pieces.append(
             Piece(kind="seam", label=label, first=first, last=int(end), seam=i, reversed=reverse)
         )
     return tuple(pieces)
+
+
+def _runs_backwards(case: Case, index: int, q: np.ndarray, T_base_part: np.ndarray) -> bool:
+    """Whether the samples q (K, n) of a closed seam run it end to start: the tool's
+    projections on the seam as written at a quarter and at half of the run go backwards."""
+    seam = case.seams[index]
+    quarter, half = len(q) // 4, len(q) // 2
+    frames = forward_kinematics(case.robot, q[[quarter, half]])
+    points = (frames[:, :3, 3] - T_base_part[:3, 3]) @ T_base_part[:3, :3]  # part frame
+    s, _ = NominalPath.from_specs(seam.start, seam.segments).project(points)
+    return bool(s[1] < s[0])
 
 
 def check_cycle_trajectory(

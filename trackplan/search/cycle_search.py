@@ -3,10 +3,11 @@
 The decision vector holds the 6 placement variables, then each seam's spin variables in the
 order written (:meth:`trackplan.tool.ToolSpec.spin_bounds` of the seam's tool: one for
 ``spin: free``, the profile's for ``free-varying``, none for ``fixed``;
-:func:`cycle_space`). The fitness of a batch of B candidates screens every seam on its own screening grid with
-the single-path screening (:meth:`trackplan.search.fitness.PlacementFitness.screen_branches`,
-each call batched over the whole population and every IK branch, on the placement and the
-seam's own slice of spin variables), keeps per seam and
+:func:`cycle_space`). The fitness of a batch of B candidates screens every seam on its own
+screening grid with the single-path screening
+(:meth:`trackplan.search.fitness.PlacementFitness.screen_branches`, each call batched over
+the whole population and every IK branch, on the placement and the seam's own slice of spin
+variables), keeps per seam and
 candidate the branch clear of the cell with the least J, and adds the moves between the
 seams: per candidate the best sequence (:func:`trackplan.planning.sequence.best_sequence`)
 on the estimated air moves between the seams' end configurations on the screening grid
