@@ -7,10 +7,10 @@ order written (:meth:`trackplan.tool.ToolSpec.spin_bounds` of the seam's tool: o
 screening grid with the single-path screening
 (:meth:`trackplan.search.fitness.PlacementFitness.screen_branches`, each call batched over
 the whole population and every IK branch, on the placement and the seam's own slice of spin
-variables), keeps per seam and
-candidate the branch clear of the cell with the least J, and adds the moves between the
-seams: per candidate the best sequence (:func:`trackplan.planning.sequence.best_sequence`)
-on the estimated air moves between the seams' end configurations on the screening grid
+variables), keeps per seam and candidate the branch clear of the cell with the least J, and
+adds the moves between the seams: per candidate the best sequence
+(:func:`trackplan.planning.sequence.best_sequence`) on the estimated air moves between the
+seams' end configurations on the screening grid
 (:func:`trackplan.timing.airmove.air_time_estimate`; a reversed seam on the same branch
 swaps its ends). A candidate is feasible only if every seam is.
 
