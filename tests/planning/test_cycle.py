@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import json
 from dataclasses import replace
 from pathlib import Path
 
@@ -15,9 +16,14 @@ import yaml
 from tests.conftest import CASES
 from trackplan.cell.check import check_cell
 from trackplan.cell.screening import CellGeometry
+from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.io.case_file import load_case, load_case_text
-from trackplan.io.cycle_results import read_segments, write_cycle_trajectory_csv
+from trackplan.io.cycle_results import (
+    read_segments,
+    write_cycle_files,
+    write_cycle_trajectory_csv,
+)
 from trackplan.io.results import read_trajectory_csv
 from trackplan.paths import NominalPath
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec
@@ -27,6 +33,7 @@ from trackplan.planning.cycle import (
     RETRACT,
     VIA_LIFT,
     check_cycle_trajectory,
+    pieces_from_segments,
     plan_cycle,
     reversed_segments,
 )
@@ -256,3 +263,97 @@ def test_a_single_path_case_is_the_one_seam_cycle_of_its_plan() -> None:
     assert cycle.duration == plan.duration and cycle.air_time == 0.0
     assert [p.kind for p in cycle.pieces] == [APPROACH, "seam", RETRACT]
     assert set(cycle.segment[1:]) == {"bracket-weld"}
+
+
+def spun_case(left: dict, corner: dict):
+    """The left and corner seams of CASE, each with its own tool (frame part, CASE's rpy)."""
+    data = copy.deepcopy(CASE)
+    rpy = data["task"]["tool_rpy"]
+    left_seam, _, corner_seam = data["paths"]
+    left_seam["task"] = {"tool": {"frame": "part", "rpy": rpy, **left}}
+    corner_seam["task"] = {"tool": {"frame": "part", "rpy": rpy, **corner}}
+    data["paths"] = [left_seam, corner_seam]
+    return load_case_text(yaml.safe_dump(data, sort_keys=False))
+
+
+def _written_spins(cycle, case, out: Path) -> tuple[dict, np.ndarray, np.ndarray]:
+    """result.json, the spin column and the segment column of a cycle written to ``out``."""
+    write_cycle_files(cycle, case, out)
+    header = (out / "trajectory.csv").read_text(encoding="utf-8").splitlines()[0].split(",")
+    table = np.loadtxt(
+        out / "trajectory.csv", delimiter=",", skiprows=1, usecols=range(len(header) - 1)
+    )
+    summary = json.loads((out / "result.json").read_text(encoding="utf-8"))
+    return summary, table[:, header.index("spin")], read_segments(out / "trajectory.csv")
+
+
+LEFT_FIRST = Sequence(visits=(Visit(0, False), Visit(1, False)), cost=0.0, exact=False)
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_a_chosen_constant_spin_reaches_the_trajectory_and_result(reverse, tmp_path: Path) -> None:
+    case = spun_case({"spin": "free", "spin_range": [-0.4, 0.4]}, {"spin_value": -0.1})
+    order = Sequence(visits=(Visit(0, reverse), Visit(1, False)), cost=0.0, exact=False)
+    cycle = plan_cycle(case, X, sequence=order, spins=(np.array([0.25]), None))
+    assert cycle.success, cycle.message
+    summary, spin, segment = _written_spins(cycle, case, tmp_path)
+    # a constant spin is the same in both directions; the fixed seam keeps its spin_value
+    assert np.all(spin[segment == "left"] == 0.25)
+    assert np.all(spin[segment == "corner"] == -0.1)
+    assert np.all(spin[np.isin(segment, [AIR, APPROACH, RETRACT])] == 0.0)
+    seams = {seam["name"]: seam for seam in summary["seams"]}
+    assert seams["left"]["spin"] == {"value": 0.25} and seams["left"]["reversed"] is reverse
+    assert seams["corner"]["spin"] == {"value": -0.1}
+    # the middle of the range by default
+    middle = plan_cycle(case, X, sequence=LEFT_FIRST)
+    assert np.all(middle.trajectory.spin[middle.segment == "left"] == 0.0)
+
+
+def test_a_spin_profile_is_reversed_with_its_seam() -> None:
+    case = spun_case({}, {"spin": "free-varying", "spin_range": [-0.5, 0.5], "spin_rate": 5.0})
+    tool = case.seams[1].task.tool
+    variables = np.r_[-0.3, np.linspace(1.0, -0.2, tool.n_spin - 1)]  # rises, then falls a bit
+    runs = {}
+    for reverse in (False, True):
+        order = Sequence(visits=(Visit(0, False), Visit(1, reverse)), cost=0.0, exact=False)
+        cycle = plan_cycle(case, X, sequence=order, spins=(None, variables))
+        assert cycle.success, cycle.message
+        corner = cycle.segment == "corner"  # (its first sample is the approach's last)
+        runs[reverse] = (cycle.trajectory.s[corner], cycle.trajectory.spin[corner])
+        assert cycle.seams[1].reversed is reverse
+    s_forward, spin_forward = runs[False]
+    s_back, spin_back = runs[True]
+    forward = tool.profile(variables, float(s_forward[-1]))
+    assert np.ptp(spin_forward) > 0.2  # the profile varies
+    assert np.allclose(spin_forward, forward.value(s_forward), atol=1e-12)
+    # welded end to start, every point of the seam keeps its spin: spin_back(s) = spin(L - s)
+    assert np.allclose(spin_back, forward.value(s_back[-1] - s_back), atol=1e-9)
+    assert spin_back[-1] == pytest.approx(-0.3, abs=1e-12)  # ends where the forward run starts
+
+
+def test_one_spin_per_seam_or_a_clear_error() -> None:
+    case = spun_case({"spin": "free"}, {})
+    with pytest.raises(CaseError, match="one spin per seam"):
+        plan_cycle(case, X, spins=(np.array([0.1]),))
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_a_closed_seam_rechecks_in_the_direction_it_was_welded(reverse, tmp_path: Path) -> None:
+    data = copy.deepcopy(CASE)
+    loop = {
+        "name": "loop",
+        "start": [0.13, 0.15, 0],
+        "segments": [{"arc": {"center": [0.1, 0.15, 0], "normal": [0, 0, 1], "angle": 2 * np.pi}}],
+    }
+    data["paths"] = [data["paths"][0], loop]
+    case = load_case_text(yaml.safe_dump(data, sort_keys=False))
+    order = Sequence(visits=(Visit(0, False), Visit(1, reverse)), cost=0.0, exact=False)
+    cycle = plan_cycle(case, X, sequence=order)
+    assert cycle.success, cycle.message
+    file = tmp_path / "trajectory.csv"
+    write_cycle_trajectory_csv(cycle, file)
+    _, q = read_trajectory_csv(file, case.robot.n_dof)
+    segment = read_segments(file)
+    pieces = pieces_from_segments(case, X, q, segment)
+    assert [p.reversed for p in pieces if p.kind == "seam"] == [False, reverse]
+    assert check_cycle_trajectory(case, X, q, case.task.sample_time, segment).success

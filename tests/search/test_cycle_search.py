@@ -1,5 +1,6 @@
-"""One placement for several seams: the batched fitness, an unreachable seam named, and the
-shipped bracket optimised end to end, its outputs re-checked and exported."""
+"""One placement for several seams: the batched fitness, each seam's spin in the decision
+vector, an unreachable seam named, a circle that only a spun tool welds, and the shipped
+bracket optimised end to end, its outputs re-checked and exported."""
 
 from __future__ import annotations
 
@@ -12,11 +13,11 @@ import pytest
 import yaml
 
 from tests.conftest import CASES
-from tests.planning.test_cycle import CASE, X
+from tests.planning.test_cycle import CASE, X, spun_case
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case, load_case_text
 from trackplan.planning.cycle import seam_geometries
-from trackplan.search.cycle_search import CycleFitness
+from trackplan.search.cycle_search import CycleFitness, cycle_space
 from trackplan.search.fitness import Finding, PlacementFitness
 from trackplan.search.space import SearchSpace
 
@@ -111,3 +112,99 @@ def test_the_shipped_bracket_optimizes_rechecks_and_exports(
     assert main(["export", str(run), "--format", "ros", "--output", str(ros)]) == ExitCode.OK
     message = yaml.safe_load(ros.read_text(encoding="utf-8"))
     assert len(message["points"]) == result["n_samples"]
+
+
+@pytest.fixture(scope="module")
+def spun() -> CycleFitness:
+    """Seam ``left`` with ``spin: free``, ``corner`` fixed."""
+    case = spun_case({"spin": "free", "spin_range": [-np.pi, np.pi]}, {})
+    return CycleFitness(case, cycle_space(case), seam_geometries(case), "smooth")
+
+
+def test_the_vector_is_the_placement_then_each_free_seams_spin(spun: CycleFitness) -> None:
+    space = spun.space
+    assert space.n_var == 6 + 1
+    assert space.lower[6] == -np.pi and space.upper[6] == np.pi and space.anchor[6] == 0.0
+    assert spun.slices == (slice(6, 7), slice(7, 7))
+    assert cycle_space(load_case_text(yaml.safe_dump(CASE))).n_var == 6  # fixed spins add none
+    candidate = np.r_[X, 0.7]
+    assert spun.seam_spins(candidate)[0].tolist() == [0.7] and spun.seam_spins(candidate)[1] is None
+
+
+def test_each_seam_is_screened_with_its_own_spin(spun: CycleFitness, batch: np.ndarray) -> None:
+    rng = np.random.default_rng(3)
+    spins = np.r_[np.linspace(-np.pi, np.pi, 9), rng.uniform(-np.pi, np.pi, len(batch) - 9)]
+    candidates = np.vstack(
+        [np.column_stack([np.tile(X, (9, 1)), spins[:9]]), np.column_stack([batch[9:], spins[9:]])]
+    )
+    screen = spun.screen_seams(candidates)
+    for i, seam in enumerate(spun.seams):
+        space = SearchSpace.from_case(seam.case)
+        alone = PlacementFitness(
+            seam.case, space, seam.geometry, "smooth", n_poses=len(seam.s_grid)
+        ).evaluate(np.hstack([candidates[:, :6], candidates[:, spun.slices[i]]]))
+        assert np.array_equal(screen.ok[i], alone.feasible)
+        assert np.allclose(screen.objective[i][alone.feasible], alone.objective[alone.feasible])
+    # at one placement the free seam's reach and start follow its spin; the fixed seam's not
+    assert 0 < screen.ok[0, :9].sum() < 9
+    assert np.ptp(screen.q_first[0, :9][screen.ok[0, :9]], axis=0).max() > 1.0
+    assert screen.ok[1, :9].all() and np.ptp(screen.q_first[1, :9], axis=0).max() == 0.0
+    # the placement alone: the spin in the middle of its range
+    middle = spun.evaluate(np.r_[X, 0.0][None])
+    assert spun.evaluate(X[None]).fitness[0] == middle.fitness[0]
+
+
+CIRCLE_TOOL = {"frame": "seam", "normal": [0, -1, 0], "work_angle": 0.0, "travel_angle": 0.0}
+
+
+def circle_and_line(spin: str) -> dict:
+    """The paper's circle with the seam frame (``cases/paper-circle-seam-free.yaml``) beside a
+    short line, the circle's spin ``spin``."""
+    circle = load_case(CASES / "paper-circle-seam-free.yaml")
+    assert circle.task.tool.spin == "free-varying"
+    data = yaml.safe_load((CASES / "paper-circle-seam-free.yaml").read_text(encoding="utf-8"))
+    path, task = data.pop("path"), data.pop("task")
+    task["sample_time"] = 0.004
+    data["name"] = "circle-and-line"
+    data["paths"] = [
+        {"name": "circle", **path, "task": {"tool": {**task["tool"], "spin": spin}}},
+        {"name": "line", "start": [0.05, 0, 0], "segments": [{"line": {"to": [0.1, 0, 0]}}]},
+    ]
+    data["task"] = {**task, "tool": {**CIRCLE_TOOL, "spin": "fixed"}}
+    data["approach"] = 0.02
+    data["placement"].pop("example")
+    return data
+
+
+@pytest.mark.slow
+def test_only_a_spun_circle_beside_a_line_is_feasible(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    runs = {}
+    for spin in ("free-varying", "fixed"):
+        file = tmp_path / f"{spin}.yaml"
+        file.write_text(yaml.safe_dump(circle_and_line(spin), sort_keys=False), encoding="utf-8")
+        run = tmp_path / spin
+        options = ["--budget", "600", "--restarts", "1", "--no-report"]
+        runs[spin] = main(["optimize", str(file), "--out", str(run), *options])
+    out = capsys.readouterr().out
+    assert runs == {"free-varying": ExitCode.OK, "fixed": ExitCode.INFEASIBLE}
+    assert "seam circle is feasible at none of the 600 placements evaluated" in out
+    assert "the tool turns 6.283 rad (1.00 turns) about its own axis" in out
+    run = tmp_path / "free-varying"
+    result = json.loads((run / "result.json").read_text(encoding="utf-8"))
+    seams = {seam["name"]: seam for seam in result["seams"]}
+    coefficients = seams["circle"]["spin"]["coefficients"]
+    assert len(coefficients) == 6 and np.ptp(coefficients) > 1.0  # it counter-rotates
+    assert seams["line"]["spin"] == {"value": 0.0}
+    # the chosen profile is what the circle's samples of trajectory.csv carry: it ends at
+    # its last coefficient (clamped spline)
+    lines = (run / "trajectory.csv").read_text(encoding="utf-8").splitlines()
+    header = lines[0].split(",")
+    rows = [line.split(",") for line in lines[1:]]
+    spin = np.array([float(r[header.index("spin")]) for r in rows if r[-1] == "circle"])
+    assert spin[-1] == pytest.approx(coefficients[-1], abs=1e-9)
+    assert spin.min() >= -np.pi and spin.max() <= np.pi and np.ptp(spin) > 1.0
+    placement = [str(result["placement"][k]) for k in ("x", "y", "z", "roll", "pitch", "yaw")]
+    file = tmp_path / "free-varying.yaml"
+    assert main(["check", str(file), str(run), "--placement", *placement]) == ExitCode.OK

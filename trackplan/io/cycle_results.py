@@ -79,6 +79,7 @@ def cycle_summary(result: CycleResult, case: Case) -> dict:
                 "max_tracking_error": float(own.max_tracking_error),
                 "max_orientation_error": float(own.max_orientation_error),
                 "branch": int(plan.branch),
+                "spin": plan.joint_path.tool.spin.as_dict(),
                 "feasible": bool(own.success),
                 "slowdowns": [
                     {

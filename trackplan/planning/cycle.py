@@ -24,6 +24,11 @@ The order and direction of the seams is chosen by :func:`trackplan.planning.sequ
 move (:func:`trackplan.timing.airmove.air_time_estimate`); then the chosen sequence is
 planned exactly. Each seam keeps its own IK branch (the one of its plan): the branch may
 differ from seam to seam, the air moves connect them.
+
+A seam whose tool spin is ``free`` or ``free-varying`` is planned with its given spin
+(:func:`seam_spin`): spin variables or a profile along the seam as written. A constant
+spin is the same in both directions; a profile along s is reversed with the seam, so that
+every point of the seam keeps its spin whichever way it is welded.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ from trackplan.case import Case
 from trackplan.cell.check import check_cell
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform
+from trackplan.paths.nominal import NominalPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.checker import check_trajectory
@@ -55,6 +61,7 @@ from trackplan.status import Status
 from trackplan.timing import time_law
 from trackplan.timing.airmove import AirMove, air_time_estimate, plan_air_move
 from trackplan.timing.sample_checks import robot_checks
+from trackplan.tool import SpinMode, SpinProfile
 
 APPROACH = "approach"
 RETRACT = "retract"
@@ -289,6 +296,58 @@ def seam_geometries(case: Case, timing: str | None = None) -> SeamGeometries:
     }
 
 
+SeamSpin = np.ndarray | SpinProfile | None
+"""The spin of one seam: its tool's spin variables (n_spin,), a profile along the seam as
+written, or None (the middle of the spin range)."""
+
+
+def seam_spin(
+    case: Case,
+    index: int,
+    reverse: bool,
+    spin: SeamSpin,
+    geometry: PathGeometry | None = None,
+) -> SpinProfile | None:
+    """The spin of seam ``index`` in one direction, for :func:`plan_placement`.
+
+    Parameters
+    ----------
+    case
+        The case.
+    index
+        The seam (as written).
+    reverse
+        Welded end to start.
+    spin
+        Spin variables of the seam's tool (n_spin,), rad (and rad/m steps for
+        ``free-varying``, :meth:`trackplan.tool.ToolSpec.spin_coefficients`), or a profile
+        over the seam as written, or None.
+    geometry
+        The seam's path in this direction, when built (its length lays out the profile).
+
+    Returns
+    -------
+    SpinProfile or None
+        The profile along the direction welded: reversed (``c(L − s)``, the coefficients
+        in reverse order on the clamped uniform knots) for a reversed seam, unchanged
+        otherwise; None for a fixed spin or no spin given.
+    """
+    tool = case.seams[index].task.tool
+    if spin is None or tool.spin is SpinMode.FIXED:
+        return None
+    if isinstance(spin, SpinProfile):
+        profile = spin
+    else:
+        if geometry is None:
+            seam_case = seam_direction_case(case, index, reverse)
+            mode = time_law(seam_case.task.timing).path_mode
+            geometry = PathGeometry.from_case(seam_case, mode)
+        profile = tool.profile(np.asarray(spin, dtype=float), geometry.planned.length)
+    if not reverse:
+        return profile
+    return SpinProfile(np.asarray(profile.coefficients, dtype=float)[::-1].copy(), profile.length)
+
+
 # --------------------------------------------------------------------------- approach
 
 
@@ -347,6 +406,7 @@ def plan_cycle(
     sequence: Sequence | None = None,
     geometries: SeamGeometries | None = None,
     branches: tuple[int, ...] | None = None,
+    spins: tuple[SeamSpin, ...] | None = None,
 ) -> CycleResult:
     """Plan every seam of the case at placement X, sequence them and join them into one cycle.
 
@@ -367,6 +427,9 @@ def plan_cycle(
     branches
         The IK branch of each seam (as written), both directions; default: per seam the
         one with the largest joint-limit margin.
+    spins
+        The spin of each seam (as written, :data:`SeamSpin`; see :func:`seam_spin`);
+        default: each free spin in the middle of its range.
 
     Returns
     -------
@@ -375,8 +438,9 @@ def plan_cycle(
     Raises
     ------
     CaseError
-        When X is not 6 finite numbers, or a forced sequence names a seam twice or
-        reverses a seam that may not be reversed.
+        When X is not 6 finite numbers, a forced sequence names a seam twice or
+        reverses a seam that may not be reversed, ``spins`` does not give one spin per
+        seam, or a given spin leaves its tool's range or rate.
     """
     X = as_placement(X)
     cycle = case.cycle
@@ -388,6 +452,8 @@ def plan_cycle(
     if sequence is not None:
         _check_sequence(case, sequence)
     directions = _directions(case, mode, sequence)
+    if spins is not None and len(spins) != m:
+        raise CaseError(f"give one spin per seam ({m}), got {len(spins)}", key="spin")
     plans: dict[tuple[int, bool], PlanResult] = {}
     ends: dict[tuple[int, bool], tuple[np.ndarray, np.ndarray]] = {}
     failed: dict[str, PlanResult] = {}
@@ -395,12 +461,14 @@ def plan_cycle(
         usable: dict[bool, tuple[PlanResult, np.ndarray, np.ndarray]] = {}
         problems: list[PlanResult] = []
         for reverse in directions[i]:
+            geometry = None if geometries is None else geometries.get((i, reverse))
             plan = plan_placement(
                 replace(seam_direction_case(case, i, reverse), cell=None),
                 X,
                 timing=timing,
                 branch=None if branches is None else branches[i],
-                geometry=None if geometries is None else geometries.get((i, reverse)),
+                geometry=geometry,
+                spin=seam_spin(case, i, reverse, None if spins is None else spins[i], geometry),
             )
             if not plan.trajectory.n_samples:
                 problems.append(plan)
@@ -794,7 +862,7 @@ def pieces_from_segments(
 ) -> tuple[Piece, ...]:
     """The pieces of a cycle trajectory from its ``segment`` labels (a trajectory.csv read
     back): runs of one label; a seam's direction is the one whose start lies nearer the
-    tool point at the run's first sample.
+    tool point at the run's first sample (for a closed seam, the way the tool runs along it).
 
     Parameters
     ----------
@@ -837,11 +905,25 @@ def pieces_from_segments(
         forward = T_base_part[:3, :3] @ seam.start + T_base_part[:3, 3]
         backward_start, _ = reversed_segments(seam.start, seam.segments)
         backward = T_base_part[:3, :3] @ backward_start + T_base_part[:3, 3]
-        reverse = bool(np.linalg.norm(tool - backward) < np.linalg.norm(tool - forward))
+        if np.linalg.norm(forward - backward) > seam.task.tolerance:
+            reverse = bool(np.linalg.norm(tool - backward) < np.linalg.norm(tool - forward))
+        else:  # a closed seam: the way it runs
+            reverse = _runs_backwards(case, i, q[first : int(end) + 1], T_base_part)
         pieces.append(
             Piece(kind="seam", label=label, first=first, last=int(end), seam=i, reversed=reverse)
         )
     return tuple(pieces)
+
+
+def _runs_backwards(case: Case, index: int, q: np.ndarray, T_base_part: np.ndarray) -> bool:
+    """Whether the samples q (K, n) of a closed seam run it end to start: the tool's
+    projections on the seam as written at a quarter and at half of the run go backwards."""
+    seam = case.seams[index]
+    quarter, half = len(q) // 4, len(q) // 2
+    frames = forward_kinematics(case.robot, q[[quarter, half]])
+    points = (frames[:, :3, 3] - T_base_part[:3, 3]) @ T_base_part[:3, :3]  # part frame
+    s, _ = NominalPath.from_specs(seam.start, seam.segments).project(points)
+    return bool(s[1] < s[0])
 
 
 def check_cycle_trajectory(
@@ -984,4 +1066,5 @@ __all__ = [
     "pieces_from_segments",
     "plan_cycle",
     "reversed_segments",
+    "seam_spin",
 ]

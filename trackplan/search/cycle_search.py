@@ -1,11 +1,16 @@
 """One placement for every seam of a workpiece: the batched fitness and the search.
 
-The fitness of a batch of B placements screens every seam on its own screening grid with
-the single-path screening (:meth:`trackplan.search.fitness.PlacementFitness.screen_branches`,
-each call batched over the whole population and every IK branch), keeps per seam and
-candidate the branch clear of the cell with the least J, and adds the moves between the
-seams: per candidate the best sequence (:func:`trackplan.planning.sequence.best_sequence`)
-on the estimated air moves between the seams' end configurations on the screening grid
+The decision vector holds the 6 placement variables, then each seam's spin variables in the
+order written (:meth:`trackplan.tool.ToolSpec.spin_bounds` of the seam's tool: one for
+``spin: free``, the profile's for ``free-varying``, none for ``fixed``;
+:func:`cycle_space`). The fitness of a batch of B candidates screens every seam on its own
+screening grid with the single-path screening
+(:meth:`trackplan.search.fitness.PlacementFitness.screen_branches`, each call batched over
+the whole population and every IK branch, on the placement and the seam's own slice of spin
+variables), keeps per seam and candidate the branch clear of the cell with the least J, and
+adds the moves between the seams: per candidate the best sequence
+(:func:`trackplan.planning.sequence.best_sequence`) on the estimated air moves between the
+seams' end configurations on the screening grid
 (:func:`trackplan.timing.airmove.air_time_estimate`; a reversed seam on the same branch
 swaps its ends). A candidate is feasible only if every seam is.
 
@@ -20,8 +25,8 @@ Fitness (minimised)
 The search runs the case's method on this fitness (:class:`PlacementProblem`, the same
 algorithms, stopping rules and archive as a single path), then plans the archive's
 candidates best first with :func:`trackplan.planning.cycle.plan_cycle` until one passes the
-checker. The spin of a free-spin tool stays in the middle of its range (it is not searched
-for several seams).
+checker, each seam with its screened branch and its chosen spin (a profile reversed with
+the seam when the sequence welds it end to start, :func:`trackplan.planning.cycle.seam_spin`).
 """
 
 from __future__ import annotations
@@ -36,7 +41,13 @@ from pymoo.core.algorithm import Algorithm
 from trackplan.case import Case
 from trackplan.choices import Method, choose
 from trackplan.errors import CaseError
-from trackplan.planning.cycle import CycleResult, SeamGeometries, plan_cycle, seam_geometries
+from trackplan.planning.cycle import (
+    CycleResult,
+    SeamGeometries,
+    SeamSpin,
+    plan_cycle,
+    seam_geometries,
+)
 from trackplan.planning.sequence import best_sequence
 from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm, make_termination
 from trackplan.search.fitness import (
@@ -48,7 +59,7 @@ from trackplan.search.fitness import (
 )
 from trackplan.search.optimize import GenerationRecord, SearchHistory, _run, run_seeds
 from trackplan.search.problem import PlacementProblem
-from trackplan.search.space import SearchSpace
+from trackplan.search.space import N_VAR, SearchSpace
 from trackplan.status import Status
 from trackplan.timing import time_law
 from trackplan.timing.airmove import air_time_estimate
@@ -62,9 +73,36 @@ MIN_POSES = 20
 """Fewest poses of a seam's screening grid."""
 
 
+def spin_slices(case: Case) -> tuple[slice, ...]:
+    """Where each seam's spin variables lie in the decision vector (as written; an empty
+    slice for a fixed spin)."""
+    slices = []
+    first = N_VAR
+    for seam in case.seams:
+        slices.append(slice(first, first + seam.task.tool.n_spin))
+        first += seam.task.tool.n_spin
+    return tuple(slices)
+
+
+def cycle_space(case: Case) -> SearchSpace:
+    """The search space of a case with several seams: the placement (its bounds and reach
+    shell), then each seam's spin variables (their box, :meth:`ToolSpec.spin_bounds`)."""
+    space = SearchSpace.from_bounds(case.bounds, case.source)
+    tools = [seam.task.tool for seam in case.seams if seam.task.tool.n_spin]
+    if not tools:
+        return space
+    bounds = [tool.spin_bounds() for tool in tools]
+    return SearchSpace(
+        np.concatenate([space.lower, *(lower for lower, _ in bounds)]),
+        np.concatenate([space.upper, *(upper for _, upper in bounds)]),
+        space.reach,
+        np.concatenate([space.anchor, *(tool.default_variables() for tool in tools)]),
+    )
+
+
 @dataclass(frozen=True, eq=False)
 class SeamScreen:
-    """Every seam of B placements on its chosen branch.
+    """Every seam of B candidates on its chosen branch.
 
     Attributes
     ----------
@@ -100,7 +138,7 @@ class CycleFitness:
     case
         The case (with ``cycle``).
     space
-        Its search space (six placement variables).
+        Its search space (:func:`cycle_space`: the placement, then each seam's spin).
     geometries
         The seams' paths (:func:`trackplan.planning.cycle.seam_geometries`).
     timing
@@ -110,6 +148,8 @@ class CycleFitness:
     ----------
     feasible_count
         How many evaluated candidates reach each seam feasibly, shape (m,), int.
+    slices
+        Each seam's spin variables in the decision vector (:func:`spin_slices`).
     """
 
     def __init__(self, case: Case, space: SearchSpace, geometries: SeamGeometries, timing: str):
@@ -135,30 +175,51 @@ class CycleFitness:
         self.reversible = np.array([seam.reversible for seam in case.seams])
         self.home = None if case.cycle is None else case.cycle.home
         self.feasible_count = np.zeros(len(case.seams), dtype=int)
+        self.slices = spin_slices(case)
+        if space.n_var != self.slices[-1].stop:
+            raise ValueError(
+                f"the search space has {space.n_var} variables, the seams need "
+                f"{self.slices[-1].stop} (use cycle_space)"
+            )
+
+    def full(self, X: np.ndarray) -> np.ndarray:
+        """Candidates (B, n_var); placements alone (B, 6) get every free spin in the middle
+        of its range."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if X.shape[1] == N_VAR and self.space.n_var > N_VAR:
+            X = np.hstack([X, np.tile(self.space.anchor[N_VAR:], (len(X), 1))])
+        return X
+
+    def seam_spins(self, X: np.ndarray) -> tuple[SeamSpin, ...]:
+        """Each seam's spin variables of one candidate X (n_var,), None for a fixed spin."""
+        X = self.full(X)[0]
+        return tuple(X[part] if part.stop > part.start else None for part in self.slices)
 
     def screen_seams(self, X: np.ndarray) -> SeamScreen:
-        """Screen every seam of placements inside the reach interval.
+        """Screen every seam of candidates inside the reach interval.
 
         Parameters
         ----------
         X
-            Placements, shape (B, 6), metres and radians.
+            Candidates, shape (B, n_var): placements (metres and radians), then the
+            seams' spin variables.
 
         Returns
         -------
         SeamScreen
         """
+        X = self.full(X)
         rows = np.arange(len(X))
         parts = []
-        for fitness in self.seams:
-            tool = fitness.case.task.tool
-            variables = np.hstack([X, np.tile(tool.default_variables(), (len(X), 1))])
-            screen = fitness.screen_branches(variables)
+        for fitness, part in zip(self.seams, self.slices, strict=True):
+            screen = fitness.screen_branches(np.hstack([X[:, :N_VAR], X[:, part]]))
             values = screen.values(fitness.case.objective)
             violation = screen.violation
             finding = screen.finding
             if fitness.cell is not None:
-                values, violation = fitness._screen_cell(X, screen.grid.q, values, violation)
+                values, violation = fitness._screen_cell(
+                    X[:, :N_VAR], screen.grid.q, values, violation
+                )
                 blocked = np.isinf(values) & screen.ok
                 finding = np.where(blocked, int(Finding.COLLISION), finding)
             ok = np.isfinite(values).any(axis=1)
@@ -204,12 +265,13 @@ class CycleFitness:
         return np.asarray(travel + self.time_weight * duration)
 
     def evaluate(self, X: np.ndarray, incumbent: float = np.inf) -> Screening:
-        """Fitness of a batch of placements.
+        """Fitness of a batch of candidates.
 
         Parameters
         ----------
         X
-            Placements, shape (B, 6), metres and radians.
+            Candidates, shape (B, n_var) (placements alone, (B, 6): every free spin in the
+            middle of its range).
         incumbent
             Unused (every feasible candidate is ranked by its screening figures).
 
@@ -219,7 +281,7 @@ class CycleFitness:
             ``objective`` is Σ J of the seams on their screening grids, ``duration_bound``
             the sum of their bounds; ``branch`` the first seam's branch.
         """
-        X = np.atleast_2d(np.asarray(X, dtype=float))[:, :6]
+        X = self.full(X)
         n = len(X)
         fitness = np.full(n, np.nan)
         objective = np.full(n, np.nan)
@@ -260,8 +322,8 @@ class CycleFitness:
         )
 
     def branches(self, X: np.ndarray) -> tuple[int, ...]:
-        """The branch the screening chooses for each seam at one placement X (6,)."""
-        seams = self.screen_seams(np.asarray(X, dtype=float)[None, :6])
+        """The branch the screening chooses for each seam at one candidate X (n_var,)."""
+        seams = self.screen_seams(np.asarray(X, dtype=float)[None])
         return tuple(int(b) for b in seams.branch[:, 0])
 
     def unreachable_seams(self) -> tuple[str, ...]:
@@ -281,6 +343,9 @@ class CycleSearchResult:
         seam that decides when nothing feasible was found.
     X
         Best placement, shape (6,).
+    spins
+        The spin variables chosen for each seam (as written), None for a fixed spin; the
+        final cycle's seam plans hold the profiles.
     fitness
         Its screened fitness.
     objective
@@ -312,6 +377,7 @@ class CycleSearchResult:
     runs: int = 1
     unreachable: tuple[str, ...] = ()
     rejected: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    spins: tuple[SeamSpin, ...] = ()
 
 
 def optimize_cycle(
@@ -354,7 +420,7 @@ def optimize_cycle(
     if budget is not None and budget < 1:
         raise CaseError(f"budget must be ≥ 1 evaluation, got {budget}", key="budget")
     law = time_law(timing or case.task.timing)
-    space = SearchSpace.from_bounds(case.bounds, case.source)
+    space = cycle_space(case)
     geometries = seam_geometries(case, law.timing)
     fitness = CycleFitness(case, space, geometries, law.timing)
     problem = PlacementProblem(space, fitness)
@@ -369,7 +435,9 @@ def optimize_cycle(
         runs += 1
         if stop_reason in ("budget", "interrupted"):
             break
-    final, rejected, fitness_value = _final_cycle(case, problem, fitness, law.timing, geometries)
+    final, chosen, rejected, fitness_value = _final_cycle(
+        case, problem, fitness, law.timing, geometries
+    )
     unreachable = fitness.unreachable_seams()
     status = Status.INTERRUPTED if stop_reason == "interrupted" else final.status
     return CycleSearchResult(
@@ -390,6 +458,7 @@ def optimize_cycle(
         runs=runs,
         unreachable=unreachable,
         rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),
+        spins=fitness.seam_spins(chosen),
     )
 
 
@@ -399,28 +468,33 @@ def _final_cycle(
     fitness: CycleFitness,
     timing: str,
     geometries: SeamGeometries,
-) -> tuple[CycleResult, list[np.ndarray], float]:
+) -> tuple[CycleResult, np.ndarray, list[np.ndarray], float]:
     """Plan the archive's candidates best first until a cycle passes the checker (at most
-    :data:`FINAL_TRIES` screened feasible ones); the cycle, the rejected placements and the
-    chosen candidate's screened fitness."""
+    :data:`FINAL_TRIES` screened feasible ones); the cycle, its candidate (n_var,), the
+    rejected placements and the chosen candidate's screened fitness."""
     archive = problem.archive
     if not len(archive.X):
         raise CaseError("the search evaluated no placement (budget 0?)", key="budget")
     rejected: list[np.ndarray] = []
-    first: tuple[CycleResult, float] | None = None
+    first: tuple[CycleResult, np.ndarray, float] | None = None
     for X, feasible, value in zip(archive.X, archive.feasible, archive.fitness, strict=True):
         if first is not None and (not feasible or len(rejected) >= FINAL_TRIES):
             break
         cycle = plan_cycle(
-            case, X[:6], timing=timing, geometries=geometries, branches=fitness.branches(X)
+            case,
+            X[:N_VAR],
+            timing=timing,
+            geometries=geometries,
+            branches=fitness.branches(X),
+            spins=fitness.seam_spins(X),
         )
         if cycle.success:
-            return cycle, rejected, float(value)
-        first = first or (cycle, float(value))
+            return cycle, X, rejected, float(value)
+        first = first or (cycle, X, float(value))
         if feasible:
-            rejected.append(X[:6])
+            rejected.append(X[:N_VAR])
     assert first is not None
-    return first[0], rejected, first[1]
+    return first[0], first[1], rejected, first[2]
 
 
 def _message(
