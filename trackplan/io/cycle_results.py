@@ -9,7 +9,12 @@ from pathlib import Path
 import numpy as np
 
 from trackplan.case import PLACEMENT_KEYS, Case
-from trackplan.io.results import trajectory_header, write_result_json, write_trajectory_csv
+from trackplan.io.results import (
+    slowdown_record,
+    trajectory_header,
+    write_result_json,
+    write_trajectory_csv,
+)
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.planning.cycle import CycleResult
 from trackplan.planning.result import CheckReport, Violation
@@ -81,17 +86,7 @@ def cycle_summary(result: CycleResult, case: Case) -> dict:
                 "branch": int(plan.branch),
                 "spin": plan.joint_path.tool.spin.as_dict(),
                 "feasible": bool(own.success),
-                "slowdowns": [
-                    {
-                        "s_start": d.s_start,
-                        "s_end": d.s_end,
-                        "speed": d.speed,
-                        "rated_speed": d.rated_speed,
-                        "shortfall": 1.0 - d.speed / d.rated_speed,
-                        "limit": d.limit,
-                    }
-                    for d in plan.slowdowns
-                ],
+                "slowdowns": [slowdown_record(d) for d in plan.slowdowns],
             }
         )
     moves = [

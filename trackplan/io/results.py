@@ -14,6 +14,7 @@ from trackplan.errors import CaseError
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
+from trackplan.timing.protocol import SlowDown
 
 
 def trajectory_header(n_dof: int) -> list[str]:
@@ -22,6 +23,18 @@ def trajectory_header(n_dof: int) -> list[str]:
     for prefix in ("q", "qd", "qdd", "qddd"):
         columns += [f"{prefix}{i + 1}" for i in range(n_dof)]
     return [*columns, "x", "y", "z", "speed", "spin"]
+
+
+def slowdown_record(slowdown: SlowDown) -> dict[str, Any]:
+    """One ``slowdowns`` entry of result.json: where (m), how fast (m/s) and why."""
+    return {
+        "s_start": slowdown.s_start,
+        "s_end": slowdown.s_end,
+        "speed": slowdown.speed,
+        "rated_speed": slowdown.rated_speed,
+        "shortfall": 1.0 - slowdown.speed / slowdown.rated_speed,
+        "limit": slowdown.limit,
+    }
 
 
 def write_trajectory_csv(trajectory: Trajectory, file: Path) -> None:
@@ -189,17 +202,7 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
             }
             for v in check.violations
         ],
-        "slowdowns": [
-            {
-                "s_start": d.s_start,
-                "s_end": d.s_end,
-                "speed": d.speed,
-                "rated_speed": d.rated_speed,
-                "shortfall": 1.0 - d.speed / d.rated_speed,
-                "limit": d.limit,
-            }
-            for d in result.slowdowns
-        ],
+        "slowdowns": [slowdown_record(d) for d in result.slowdowns],
         "timing": result.timing,
         "branch": int(result.branch),
         "joint_names": list(joint_names),

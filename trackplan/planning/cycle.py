@@ -1008,18 +1008,7 @@ def _unplanned_cycle(
 ) -> CycleResult:
     """The result of a placement where some seam cannot be planned."""
     n = case.robot.n_dof
-    nothing = np.zeros((0, n))
-    trajectory = Trajectory(
-        sample_time=case.task.sample_time,
-        t=np.zeros(0),
-        s=np.zeros(0),
-        q=nothing,
-        qd=nothing,
-        qdd=nothing,
-        qddd=nothing,
-        tool_position=np.zeros((0, 3)),
-        speed=np.zeros(0),
-    )
+    trajectory = Trajectory.empty(n, case.task.sample_time)
     name, plan = next(iter(failed.items()))
     status = plan.status if plan.status is not Status.FEASIBLE else Status.UNREACHABLE
     check = CheckReport(

@@ -224,18 +224,7 @@ def _unplanned(
 ) -> PlanResult:
     """The result of a placement that has no trajectory."""
     n_dof = case.robot.n_dof
-    nothing = np.zeros((0, n_dof))
-    trajectory = Trajectory(
-        sample_time=case.task.sample_time,
-        t=np.zeros(0),
-        s=np.zeros(0),
-        q=nothing,
-        qd=nothing,
-        qdd=nothing,
-        qddd=nothing,
-        tool_position=np.zeros((0, 3)),
-        speed=np.zeros(0),
-    )
+    trajectory = Trajectory.empty(n_dof, case.task.sample_time)
     check = CheckReport(
         success=False,
         joint_margins={},

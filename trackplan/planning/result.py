@@ -52,6 +52,22 @@ class Trajectory:
     speed: np.ndarray
     spin: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
+    @classmethod
+    def empty(cls, n_dof: int, sample_time: float) -> Trajectory:
+        """A trajectory with no samples (a placement that could not be planned)."""
+        nothing = np.zeros((0, n_dof))
+        return cls(
+            sample_time=sample_time,
+            t=np.zeros(0),
+            s=np.zeros(0),
+            q=nothing,
+            qd=nothing,
+            qdd=nothing,
+            qddd=nothing,
+            tool_position=np.zeros((0, 3)),
+            speed=np.zeros(0),
+        )
+
     @property
     def n_samples(self) -> int:
         """Number of samples N."""
