@@ -304,12 +304,16 @@ def _run_jobs(
 
 
 def _row(future: Future, job: Job) -> JobRow:
-    """The row a finished task returned, or a failed row when the task itself failed."""
-    if future.status == "finished":
-        return future.result()
+    """The row a finished task returned, or a failed row when the task itself failed.
+
+    A task whose worker died after it finished, before its result was fetched, is pending
+    again when it gets here (Dask recomputes it elsewhere): ``exception`` waits for that.
+    """
     if future.status == "cancelled":
         return failed_row(job.describe(), "cancelled", math.nan, "")
     exc = future.exception()
+    if exc is None:
+        return future.result()
     reason = f"{type(exc).__name__}: {exc}".replace("\n", " ")
     return failed_row(job.describe(), reason, math.nan, "")
 
