@@ -68,6 +68,24 @@ class URDFChain:
     T_tip: np.ndarray
 
 
+def load_urdf_model(path: str) -> Any:
+    """yourdfpy's parsed robot model of a URDF (no meshes, no scene graph), its log quiet.
+
+    Raises whatever yourdfpy raises on a file it cannot parse.
+    """
+    import yourdfpy
+
+    logger = logging.getLogger("yourdfpy")
+    level = logger.level
+    logger.setLevel(logging.CRITICAL)
+    try:
+        return yourdfpy.URDF.load(
+            path, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
+        ).robot
+    finally:
+        logger.setLevel(level)
+
+
 def read_urdf_chain(
     file: str | Path,
     base_link: str | None = None,
@@ -100,27 +118,18 @@ def read_urdf_chain(
         branches and no tip link is named, or the chain holds a mimic, prismatic,
         planar or floating joint.
     """
-    import yourdfpy
 
     path = str(file)
     if not Path(path).is_file():
         raise CaseError("URDF file not found", file=path)
-    logger = logging.getLogger("yourdfpy")
-    level = logger.level
-    logger.setLevel(logging.CRITICAL)
     try:
-        urdf = yourdfpy.URDF.load(
-            path, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
-        )
+        robot = load_urdf_model(path)
     except Exception as exc:  # yourdfpy raises whatever its XML parsing meets
         raise CaseError(
             f"not a valid URDF ({type(exc).__name__}: {exc}): check the XML against the URDF "
             "specification",
             file=path,
         ) from None
-    finally:
-        logger.setLevel(level)
-    robot = urdf.robot
     links = {link.name for link in robot.links}
     by_child = {}
     children: dict[str, list[str]] = {name: [] for name in links}
@@ -280,18 +289,9 @@ def read_urdf_link_geometry(
     CaseError
         When a collision mesh is missing or cannot be read, or a shape has a size ≤ 0.
     """
-    import yourdfpy
 
     path = str(file)
-    logger = logging.getLogger("yourdfpy")
-    level = logger.level
-    logger.setLevel(logging.CRITICAL)
-    try:
-        robot = yourdfpy.URDF.load(
-            path, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
-        ).robot
-    finally:
-        logger.setLevel(level)
+    robot = load_urdf_model(path)
     by_child = {joint.child: joint for joint in robot.joints}
     base = base_link or next(link.name for link in robot.links if link.name not in by_child)
     anchors = {base: 0}

@@ -13,13 +13,13 @@ each moving joint's ``<limit effort=…>``; a missing or zero effort is no limit
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.io.urdf import load_urdf_model
 from trackplan.robots.dynamics.parameters import combine_bodies, inertia_problem
 
 
@@ -73,18 +73,9 @@ def read_urdf_inertials(
         breaks the triangle inequality, or a negative effort; the error names the link or
         joint.
     """
-    import yourdfpy
 
     path = str(file)
-    logger = logging.getLogger("yourdfpy")
-    level = logger.level
-    logger.setLevel(logging.CRITICAL)
-    try:
-        robot = yourdfpy.URDF.load(
-            path, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
-        ).robot
-    finally:
-        logger.setLevel(level)
+    robot = load_urdf_model(path)
     joints = {joint.name: joint for joint in robot.joints}
     by_child = {joint.child: joint for joint in robot.joints}
     base = base_link or next(link.name for link in robot.links if link.name not in by_child)
