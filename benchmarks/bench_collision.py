@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks import best_time
 from trackplan.cell.exact import ExactDistance
 from trackplan.cell.screening import CellGeometry
 from trackplan.frames import placement_transform
@@ -41,21 +42,6 @@ N_POSES = 150
 N_EXACT = 3000
 TARGET_RATE = 5e6
 TARGET_SLOWDOWN = 2.0
-
-
-def best_time(function, repeats: int = 5) -> float:
-    """Shortest CPU time of this process over ``repeats`` calls after a warm-up call, s.
-
-    CPU time, not wall time: on a shared machine the wall time of a serial kernel measures
-    the other load as much as the kernel.
-    """
-    function()
-    times = []
-    for _ in range(repeats):
-        start = time.process_time()
-        function()
-        times.append(time.process_time() - start)
-    return min(times)
 
 
 def screening() -> None:

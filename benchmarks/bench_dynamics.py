@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks import best_time
 from trackplan.io.case_file import load_case
 from trackplan.robots.builtin import puma560
 from trackplan.robots.dynamics.rne import inverse_dynamics
@@ -27,17 +27,6 @@ N_SAMPLES = 200_000
 N_RTB_SINGLE = 2_000
 TARGET_RATIO = 100.0
 CORNER = Path(__file__).resolve().parents[1] / "cases" / "paper-corner.yaml"
-
-
-def best_time(function: Callable[[], object], repeats: int = 5) -> float:
-    """Shortest CPU time of ``repeats`` calls after one warm-up call, s."""
-    function()
-    times = []
-    for _ in range(repeats):
-        start = time.process_time()
-        function()
-        times.append(time.process_time() - start)
-    return min(times)
 
 
 def rtb_puma():

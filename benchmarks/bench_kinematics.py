@@ -9,12 +9,11 @@ machine inflates far less than wall time (it still lowers the rates: shared cach
 
 from __future__ import annotations
 
-import time
 import warnings
-from collections.abc import Callable
 
 import numpy as np
 
+from benchmarks import best_time
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_file import builtin_robot
 from trackplan.robots.builtin import puma560, ur5
@@ -41,17 +40,6 @@ OPW_PARAMETERS = {  # py-opw-kinematics' description of the KR6 R700 sixx (opw_k
     "offsets": (0.0, -np.pi / 2, 0.0, 0.0, 0.0, 0.0),
     "flip_axes": (True, False, False, True, False, True),
 }
-
-
-def best_time(function: Callable[[], object], repeats: int = 5) -> float:
-    """Shortest process CPU time of ``repeats`` calls after one warm-up call, s."""
-    function()
-    times = []
-    for _ in range(repeats):
-        start = time.process_time()
-        function()
-        times.append(time.process_time() - start)
-    return min(times)
 
 
 def rtb_ets(robot: Robot):

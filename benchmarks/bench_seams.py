@@ -25,11 +25,11 @@ Compute times are the least CPU time of several repeats (one thread).
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks import best_time
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_robot
 from trackplan.planning.cycle import plan_cycle, seam_geometries
@@ -44,17 +44,6 @@ SEQUENCE_SIZES = (4, 6, 8, 12, 20)
 N_INSTANCES = 10
 N_GAP_INSTANCES = 40
 SHIPPED_CASE = Path(__file__).resolve().parents[1] / "cases" / "bracket-4-fillets.yaml"
-
-
-def best_time(function: Callable[[], object], repeats: int = 3) -> float:
-    """Shortest CPU time of this process over ``repeats`` calls after a warm-up call, s."""
-    function()
-    times = []
-    for _ in range(repeats):
-        start = time.process_time()
-        function()
-        times.append(time.process_time() - start)
-    return min(times)
 
 
 def air_moves() -> None:
@@ -72,7 +61,7 @@ def air_moves() -> None:
         ]
 
     duration = np.array(plan_all())
-    seconds = best_time(plan_all)
+    seconds = best_time(plan_all, 3)
     trapezoid = trapezoid_time(start, end, robot.v_max, robot.a_max)
     estimate = air_time_estimate(start, end, *limits)
     estimate_seconds = best_time(lambda: air_time_estimate(start, end, *limits), repeats=20)
@@ -133,7 +122,7 @@ def sequencing() -> None:
     print(f"sequencing: {N_INSTANCES} random geometric instances per size")
     for m in SEQUENCE_SIZES:
         instances = [geometric_instance(rng, m) for _ in range(N_INSTANCES)]
-        seconds = [best_time(lambda costs=costs: best_sequence(*costs)) for costs in instances]
+        seconds = [best_time(lambda costs=costs: best_sequence(*costs), 3) for costs in instances]
         found = [best_sequence(*costs) for costs in instances]
         given = [sequence_cost(given_sequence(m).visits, *costs[:4]) for costs in instances]
         ratio = np.array([f.cost for f in found]) / np.array(given)
