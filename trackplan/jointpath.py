@@ -19,7 +19,7 @@ import numpy as np
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.robots.model import Robot
-from trackplan.robots.path_ik import PathIK, solve_path_ik
+from trackplan.robots.path_ik import PathIK, branch_joints, solve_path_ik
 from trackplan.status import Status
 from trackplan.stencils import stencil_derivatives, stencil_points
 from trackplan.tool import ToolOrientation
@@ -166,9 +166,7 @@ class JointPath:
             Shape (M, n), rad.
         """
         s = np.asarray(s, dtype=float)
-        q = solve_path_ik(self.robot, self.poses(s)[None], branch=self.branch).q[0]
-        reference = self.interpolate(s)
-        return q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
+        return branch_joints(self.robot, self.poses(s), self.branch, self.interpolate(s))
 
     def interpolate(self, s: np.ndarray) -> np.ndarray:
         """q at ``s`` (M,) by linear interpolation of the grid, shape (M, n), rad."""

@@ -9,7 +9,12 @@ from trackplan.errors import CaseError
 from trackplan.frames import placement_transform, pose_matrix, rpy_matrix
 from trackplan.robots.families import solve_ik
 from trackplan.robots.kinematics import forward_kinematics
-from trackplan.robots.path_ik import numeric_seeds, solve_path_ik, solve_path_ik_branches
+from trackplan.robots.path_ik import (
+    branch_joints,
+    numeric_seeds,
+    solve_path_ik,
+    solve_path_ik_branches,
+)
 from trackplan.status import Status
 
 # A 1 m line with constant tool orientation that the PUMA follows within its limits.
@@ -282,3 +287,45 @@ def test_windings_of_wide_joints_are_enumerated_and_the_widest_margin_kept(puma)
             assert all(m <= kept for m in fitting)
     branches = solve_path_ik_branches(puma, feasible_line(50)[None])
     assert branches.windings.shape == (1, 8, 6) and branches.windings.max() <= 1
+
+
+def ur_line(ur, n_poses):
+    """Poses along a line the UR5 follows on its branches."""
+    T_mid = forward_kinematics(ur, np.array([0.3, -1.2, 1.4, -1.6, -1.5, 0.2]))
+    return line(T_mid[:3, 3], np.array([0.3, 1.0, -0.2]), T_mid[:3, :3], 0.4, n_poses)
+
+
+@pytest.mark.parametrize("robot_name", ["puma", "ur"])
+def test_branch_joints_are_the_path_ik_wound_to_a_reference(robot_name, request):
+    """branch_joints (one branch solved, no path analysis) gives solve_path_ik's joints on
+    that branch, each wound nearest the reference, with unreachable poses held."""
+    robot = request.getfixturevalue(robot_name)
+    T = feasible_line(400) if robot_name == "puma" else ur_line(robot, 400)
+    T[150:160, :3, 3] *= 4.0  # out of reach: held at the pose before
+    T[0, :3, 3] *= 4.0  # and before the first reachable one: that one
+    shifts = 2 * np.pi * (np.arange(400 * 6).reshape(400, 6) % 5 - 2)
+    solved = 0
+    for branch in range(8):
+        path = solve_path_ik(robot, T[None], branch=branch)
+        if not path.reachable.any():
+            continue
+        solved += 1
+        reference = path.q[0] + shifts + 0.3  # other windings, off by less than π
+        found = branch_joints(robot, T, branch, reference)
+        np.testing.assert_allclose(found, path.q[0] + shifts, rtol=0, atol=1e-12)
+    assert solved >= 4
+
+
+def test_branch_joints_of_a_numeric_robot_are_its_path_ik():
+    from pathlib import Path
+
+    from trackplan.io.robot_file import load_robot
+
+    robot = load_robot(
+        Path(__file__).resolve().parents[1] / "io" / "data" / "tilted7.urdf", assume_limits=True
+    )
+    T_mid = forward_kinematics(robot, np.array([0.3, -0.5, 0.8, 0.4, 0.6, -0.3, 0.2]))
+    T = line(T_mid[:3, 3], np.array([0.2, 1.0, -0.3]), T_mid[:3, :3], 0.1, 50)
+    path = solve_path_ik(robot, T[None], branch=1)
+    found = branch_joints(robot, T, 1, path.q[0] - 2 * np.pi)
+    np.testing.assert_allclose(found, path.q[0] - 2 * np.pi, rtol=0, atol=1e-12)

@@ -331,6 +331,47 @@ def solve_path_ik_branches(
     )
 
 
+def branch_joints(
+    robot: Robot, T_base_tool: np.ndarray, branch: int, reference: np.ndarray
+) -> np.ndarray:
+    """Joint positions of poses on one known branch, each on the winding nearest a reference.
+
+    The joints of ``solve_path_ik(robot, T_base_tool[None], branch=branch).q[0]``, each
+    moved by the multiple of 2π that brings it nearest ``reference``: a pose the branch
+    does not reach repeats the reachable pose before it (the first reachable one before
+    them all). A closed-form family solves only that branch
+    (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch`, the same operations
+    as for all eight), with no path analysis: the poses of a planned trajectory, whose
+    branch the planning grid has chosen and checked.
+
+    Parameters
+    ----------
+    robot
+        The robot.
+    T_base_tool
+        Tool poses in the base frame, shape (M, 4, 4), m.
+    branch
+        The IK branch (closed-form branch or numeric seed), 0 … 7.
+    reference
+        Joint positions each result is wound nearest to, shape (M, n), rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (M, n), rad.
+    """
+    family = ik_family(robot)
+    if family.closed_form:
+        q, valid = family.solve_branch(T_base_tool, branch)
+        if not valid.all() and valid.any():
+            held = np.maximum.accumulate(np.where(valid, np.arange(len(valid)), -1))
+            held[held < 0] = np.argmax(valid)
+            q = q[held]
+    else:
+        q = solve_path_ik(robot, np.asarray(T_base_tool)[None], branch=branch).q[0]
+    return q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
+
+
 def _branch_paths(
     robot: Robot,
     T_base_tool: np.ndarray,

@@ -5,7 +5,10 @@ its eight branches: a per-pose pass writes the arguments (Y, X) of every arctang
 small buffer, :func:`atan2` evaluates the buffer (a compiled, branch-free arctangent that
 LLVM vectorises; libm's scalar ``atan2`` and numpy's ``arctan2`` cost about 25 ns each
 and dominated the former three-pass design), and a per-pose pass assembles the joint
-values. No array of the batch's size is allocated besides the outputs. The Python APIs are
+values. No array of the batch's size is allocated besides the outputs. A one-branch kernel
+per family (:func:`opw_solve_branch`, :func:`ur_solve_branch`) runs the same operations for
+the arm of one branch only (6 arctangents a pose instead of 20): a planned trajectory's
+samples need only the branch chosen on the planning grid. The Python APIs are
 :mod:`trackplan.robots.families.opw` and :mod:`trackplan.robots.families.ur`.
 """
 
@@ -256,10 +259,14 @@ def _opw_arguments(
     X: np.ndarray,
     valid: np.ndarray,
     aux: np.ndarray,
+    shoulders: tuple[int, int],
+    elbows: tuple[int, int],
 ) -> None:  # pragma: no cover - compiled
     """Kernel: one pose's OPW arctangent arguments (20,), reachability (8,), aux (8, 5).
 
-    T is the pose (4, 4).
+    T is the pose (4, 4). Only the arms of shoulders ``range(*shoulders)`` and elbows
+    ``range(*elbows)`` are worked out (all four: ``(0, 2)`` and ``(0, 2)``); the slots,
+    validity and aux of the others are left as they were.
     """
     a1 = g[O_A1]
     b = g[O_B]
@@ -278,7 +285,7 @@ def _opw_arguments(
         _unreachable(valid, aux, 0, N_BRANCHES)
         return
     r = math.sqrt(max(r2, 0.0))
-    for shoulder in range(2):
+    for shoulder in range(shoulders[0], shoulders[1]):
         xr = r if shoulder == 0 else -r
         c1_, s1_ = unit(cx * xr + cy * b, cy * xr - cx * b)
         Y[O_TH1 + shoulder] = s1_
@@ -293,7 +300,7 @@ def _opw_arguments(
         sphi = math.sqrt((1.0 - K) * (1.0 + K))
         Y[O_PHI + shoulder] = sphi
         X[O_PHI + shoulder] = K
-        for elbow in range(2):
+        for elbow in range(elbows[0], elbows[1]):
             arm = 2 * shoulder + elbow
             sg = 1.0 if shoulder == elbow else -1.0
             vx = c2 + kappa * K
@@ -328,43 +335,52 @@ def _opw_arguments(
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _opw_joints(
+    g: np.ndarray, a: np.ndarray, arm: int, flip: int, q: np.ndarray
+) -> None:  # pragma: no cover - compiled
+    """Kernel: the joint angles q (6,) of OPW branch ``2·arm + flip`` from the pose's
+    arctangents a (20,) (the arm reaches the pose)."""
+    psi = g[O_PSI]
+    t0 = g[O_THETA0 : O_THETA0 + 6]
+    sg = g[O_SIGN : O_SIGN + 6]
+    shoulder = arm >> 1
+    th1 = sg[0] * wrap(a[O_TH1 + shoulder] - t0[0])
+    th2 = sg[1] * wrap(a[O_TH2 + arm] - t0[1])
+    phi = a[O_PHI + shoulder]
+    th3 = (phi if shoulder == (arm & 1) else -phi) - psi - t0[2]
+    th3 = sg[2] * wrap(th3)
+    slot = O_WRIST + 3 * arm
+    th4 = a[slot] - t0[3]
+    th5 = a[slot + 1]
+    th6 = a[slot + 2] - t0[5]
+    q[0] = th1
+    q[1] = th2
+    q[2] = th3
+    if flip == 0:
+        q[3] = sg[3] * wrap(th4)
+        q[4] = sg[4] * wrap(th5 - t0[4])
+        q[5] = sg[5] * wrap(th6)
+    else:
+        q[3] = sg[3] * wrap(th4 + math.pi)
+        q[4] = sg[4] * wrap(-th5 - t0[4])
+        q[5] = sg[5] * wrap(th6 + math.pi)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _opw_assemble(
     g: np.ndarray, a: np.ndarray, valid: np.ndarray, q: np.ndarray
 ) -> None:  # pragma: no cover - compiled
     """Kernel: one pose's joint angles q (8, 6) of the eight OPW branches from its
     arctangents a (20,)."""
-    psi = g[O_PSI]
-    t0 = g[O_THETA0 : O_THETA0 + 6]
-    sg = g[O_SIGN : O_SIGN + 6]
     for arm in range(4):
-        shoulder = arm >> 1
         b0 = 2 * arm
         if not valid[b0]:
             for j in range(6):
                 q[b0, j] = np.nan
                 q[b0 + 1, j] = np.nan
             continue
-        th1 = sg[0] * wrap(a[O_TH1 + shoulder] - t0[0])
-        th2 = sg[1] * wrap(a[O_TH2 + arm] - t0[1])
-        phi = a[O_PHI + shoulder]
-        th3 = (phi if shoulder == (arm & 1) else -phi) - psi - t0[2]
-        th3 = sg[2] * wrap(th3)
-        slot = O_WRIST + 3 * arm
-        th4 = a[slot] - t0[3]
-        th5 = a[slot + 1]
-        th6 = a[slot + 2] - t0[5]
-        q[b0, 0] = th1
-        q[b0, 1] = th2
-        q[b0, 2] = th3
-        q[b0, 3] = sg[3] * wrap(th4)
-        q[b0, 4] = sg[4] * wrap(th5 - t0[4])
-        q[b0, 5] = sg[5] * wrap(th6)
-        q[b0 + 1, 0] = th1
-        q[b0 + 1, 1] = th2
-        q[b0 + 1, 2] = th3
-        q[b0 + 1, 3] = sg[3] * wrap(th4 + math.pi)
-        q[b0 + 1, 4] = sg[4] * wrap(-th5 - t0[4])
-        q[b0 + 1, 5] = sg[5] * wrap(th6 + math.pi)
+        _opw_joints(g, a, arm, 0, q[b0])
+        _opw_joints(g, a, arm, 1, q[b0 + 1])
 
 
 @njit(cache=True, error_model="numpy")
@@ -383,9 +399,44 @@ def opw_solve(
     angles = np.empty(O_N_ANGLES)
     for k in range(T.shape[0]):
         ak = aux[k if aux.shape[0] > 1 else 0]
-        _opw_arguments(g, tail_inv, T[k], Y, X, valid[k], ak)
+        _opw_arguments(g, tail_inv, T[k], Y, X, valid[k], ak, (0, 2), (0, 2))
         _atan2_all(Y, X, angles)
         _opw_assemble(g, angles, valid[k], q[k])
+
+
+@njit(cache=True, error_model="numpy")
+def opw_solve_branch(
+    g: np.ndarray,
+    tail_inv: np.ndarray,
+    T: np.ndarray,
+    branch: int,
+    q: np.ndarray,
+    valid: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Kernel: OPW branch ``branch`` of poses T (N, 4, 4): q (N, 6), NaN where not
+    valid (N,); the same operations as :func:`opw_solve` on that branch alone."""
+    Y = np.zeros(O_N_ANGLES)
+    X = np.ones(O_N_ANGLES)
+    angles = np.empty(O_N_ANGLES)
+    reach = np.empty(N_BRANCHES, dtype=np.bool_)
+    aux = np.empty((N_BRANCHES, AUX_SIZE))
+    shoulder = (branch >> 2) & 1
+    elbow = (branch >> 1) & 1
+    arm = 2 * shoulder + elbow
+    wrist = O_WRIST + 3 * arm
+    slots = np.array([O_TH1 + shoulder, O_PHI + shoulder, O_TH2 + arm, wrist, wrist + 1, wrist + 2])
+    for k in range(T.shape[0]):
+        _opw_arguments(
+            g, tail_inv, T[k], Y, X, reach, aux, (shoulder, shoulder + 1), (elbow, elbow + 1)
+        )
+        valid[k] = reach[branch]
+        if not valid[k]:
+            for j in range(6):
+                q[k, j] = np.nan
+            continue
+        for slot in slots:
+            angles[slot] = atan2(Y[slot], X[slot])
+        _opw_joints(g, angles, arm, branch & 1, q[k])
 
 
 # UR geometry vector.
@@ -409,10 +460,15 @@ def _ur_arguments(
     X: np.ndarray,
     valid: np.ndarray,
     aux: np.ndarray,
+    shoulders: tuple[int, int],
+    wrists: tuple[int, int],
+    elbows: tuple[int, int],
 ) -> None:  # pragma: no cover - compiled
     """Kernel: one pose's UR arctangent arguments (20,), reachability (8,), aux (8, 5).
 
-    T is the pose (4, 4).
+    T is the pose (4, 4). Only the branches of shoulders ``range(*shoulders)``, wrists
+    ``range(*wrists)`` and elbows ``range(*elbows)`` are worked out (all eight: ``(0, 2)``
+    each); the slots of the others are left as they were.
     """
     d1 = g[U_D1]
     a2 = g[U_A2]
@@ -429,7 +485,7 @@ def _ur_arguments(
     if rho2 < -REACH_TOL:
         return
     r0 = math.sqrt(max(rho2, 0.0))
-    for shoulder in range(2):
+    for shoulder in range(shoulders[0], shoulders[1]):
         r = r0 if shoulder == 0 else -r0
         c1, s1 = unit(px * r - py * d4, py * r + px * d4)
         Y[U_TH1 + shoulder] = s1
@@ -458,7 +514,7 @@ def _ur_arguments(
         x4z = c5 * (c6 * w20 - s6 * w21) - s5 * w22
         Y[U_TH234 + shoulder] = x4z
         X[U_TH234 + shoulder] = c1 * x4x + s1 * x4y
-        for wrist in range(2):
+        for wrist in range(wrists[0], wrists[1]):
             sgn = 1.0 if wrist == 0 else -1.0
             # z4 = x4 × z1 with z1 = (s1, −c1, 0); O4 = P05 − d5 z4.
             z4x = sgn * (x4z * c1)
@@ -477,7 +533,7 @@ def _ur_arguments(
             pair = 2 * shoulder + wrist
             Y[U_PHI + pair] = s3m
             X[U_PHI + pair] = c3
-            for elbow in range(2):
+            for elbow in range(elbows[0], elbows[1]):
                 s3 = s3m if elbow == 0 else -s3m
                 vx = a2 + a3 * c3
                 vy = a3 * s3
@@ -493,31 +549,40 @@ def _ur_arguments(
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _ur_joints(
+    g: np.ndarray, a: np.ndarray, br: int, q: np.ndarray, theta: np.ndarray
+) -> None:  # pragma: no cover - compiled
+    """Kernel: the joint angles q (6,) of UR branch ``br`` from the pose's arctangents
+    a (20,) (the branch reaches the pose); theta (6,) is scratch."""
+    th0 = g[U_THETA0 : U_THETA0 + 6]
+    sign = g[U_SIGN : U_SIGN + 6]
+    shoulder = (br >> 2) & 1
+    elbow = (br >> 1) & 1
+    wrist = br & 1
+    pair = 2 * shoulder + wrist
+    flip = math.pi if wrist == 1 else 0.0
+    theta[0] = a[U_TH1 + shoulder]
+    theta[1] = a[U_TH2 + 2 * pair + elbow]
+    theta[2] = a[U_PHI + pair] if elbow == 0 else -a[U_PHI + pair]
+    theta[3] = a[U_TH234 + shoulder] + flip - theta[1] - theta[2]
+    theta[4] = a[U_TH5 + shoulder] if wrist == 0 else -a[U_TH5 + shoulder]
+    theta[5] = a[U_TH6 + shoulder] + flip
+    for j in range(6):
+        q[j] = sign[j] * wrap(theta[j] - th0[j])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _ur_assemble(
     g: np.ndarray, a: np.ndarray, valid: np.ndarray, q: np.ndarray, theta: np.ndarray
 ) -> None:  # pragma: no cover - compiled
     """Kernel: one pose's joint angles q (8, 6) of the eight UR branches from its
     arctangents a (20,); theta (6,) is scratch."""
-    th0 = g[U_THETA0 : U_THETA0 + 6]
-    sign = g[U_SIGN : U_SIGN + 6]
     for br in range(N_BRANCHES):
         if not valid[br]:
             for j in range(6):
                 q[br, j] = np.nan
             continue
-        shoulder = (br >> 2) & 1
-        elbow = (br >> 1) & 1
-        wrist = br & 1
-        pair = 2 * shoulder + wrist
-        flip = math.pi if wrist == 1 else 0.0
-        theta[0] = a[U_TH1 + shoulder]
-        theta[1] = a[U_TH2 + 2 * pair + elbow]
-        theta[2] = a[U_PHI + pair] if elbow == 0 else -a[U_PHI + pair]
-        theta[3] = a[U_TH234 + shoulder] + flip - theta[1] - theta[2]
-        theta[4] = a[U_TH5 + shoulder] if wrist == 0 else -a[U_TH5 + shoulder]
-        theta[5] = a[U_TH6 + shoulder] + flip
-        for j in range(6):
-            q[br, j] = sign[j] * wrap(theta[j] - th0[j])
+        _ur_joints(g, a, br, q[br], theta)
 
 
 @njit(cache=True, error_model="numpy")
@@ -537,6 +602,60 @@ def ur_solve(
     angles = np.empty(U_N_ANGLES)
     for k in range(T.shape[0]):
         ak = aux[k if aux.shape[0] > 1 else 0]
-        _ur_arguments(g, tail_inv, T[k], Y, X, valid[k], ak)
+        _ur_arguments(g, tail_inv, T[k], Y, X, valid[k], ak, (0, 2), (0, 2), (0, 2))
         _atan2_all(Y, X, angles)
         _ur_assemble(g, angles, valid[k], q[k], theta)
+
+
+@njit(cache=True, error_model="numpy")
+def ur_solve_branch(
+    g: np.ndarray,
+    tail_inv: np.ndarray,
+    T: np.ndarray,
+    branch: int,
+    q: np.ndarray,
+    valid: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Kernel: UR branch ``branch`` of poses T (N, 4, 4): q (N, 6), NaN where not
+    valid (N,); the same operations as :func:`ur_solve` on that branch alone."""
+    theta = np.empty(6)
+    Y = np.zeros(U_N_ANGLES)
+    X = np.ones(U_N_ANGLES)
+    angles = np.empty(U_N_ANGLES)
+    reach = np.empty(N_BRANCHES, dtype=np.bool_)
+    aux = np.empty((N_BRANCHES, AUX_SIZE))
+    shoulder = (branch >> 2) & 1
+    elbow = (branch >> 1) & 1
+    wrist = branch & 1
+    pair = 2 * shoulder + wrist
+    slots = np.array(
+        [
+            U_TH1 + shoulder,
+            U_TH5 + shoulder,
+            U_TH6 + shoulder,
+            U_TH234 + shoulder,
+            U_PHI + pair,
+            U_TH2 + 2 * pair + elbow,
+        ]
+    )
+    for k in range(T.shape[0]):
+        _ur_arguments(
+            g,
+            tail_inv,
+            T[k],
+            Y,
+            X,
+            reach,
+            aux,
+            (shoulder, shoulder + 1),
+            (wrist, wrist + 1),
+            (elbow, elbow + 1),
+        )
+        valid[k] = reach[branch]
+        if not valid[k]:
+            for j in range(6):
+                q[k, j] = np.nan
+            continue
+        for slot in slots:
+            angles[slot] = atan2(Y[slot], X[slot])
+        _ur_joints(g, angles, branch, q[k], theta)

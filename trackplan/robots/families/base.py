@@ -99,6 +99,19 @@ class IKFamily(Protocol):
         """
         ...
 
+    def solve_branch(self, T_base_tool: np.ndarray, branch: int) -> tuple[np.ndarray, np.ndarray]:
+        """One branch of a flat batch of tool poses (N, 4, 4): what :meth:`solve_flat`
+        gives for that branch, solving that branch only.
+
+        Returns
+        -------
+        q
+            Shape (N, 6), rad in (−π, π], NaN where not valid.
+        valid
+            Shape (N,), bool.
+        """
+        ...
+
 
 def solve_fused(
     kernel: Callable[..., None],
@@ -134,3 +147,35 @@ def solve_fused(
     aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
     kernel(geometry, tail_inv, T, q, valid, aux)
     return q, valid, aux
+
+
+def solve_branch_fused(
+    kernel: Callable[..., None],
+    geometry: np.ndarray,
+    tail_inv: np.ndarray,
+    T_base_tool: np.ndarray,
+    branch: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Run a closed-form family's one-branch compiled kernel over a flat batch of poses.
+
+    Parameters
+    ----------
+    kernel
+        ``opw_solve_branch`` or ``ur_solve_branch`` of ``families/_kernels.py``.
+    geometry, tail_inv
+        As :func:`solve_fused`.
+    T_base_tool
+        Tool poses, shape (N, 4, 4), m.
+    branch
+        The branch, 0 … 7.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        q (N, 6) rad (NaN where not valid), valid (N,) bool.
+    """
+    T = np.ascontiguousarray(T_base_tool, dtype=float)
+    q = np.empty((T.shape[0], 6))
+    valid = np.empty(T.shape[0], dtype=np.bool_)
+    kernel(geometry, tail_inv, T, int(branch), q, valid)
+    return q, valid

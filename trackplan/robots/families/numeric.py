@@ -46,3 +46,7 @@ class NumericFamily:
             "use trackplan.robots.ik_numeric",
             key="robot",
         )
+
+    def solve_branch(self, T_base_tool: np.ndarray, branch: int) -> tuple[np.ndarray, np.ndarray]:
+        """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
+        return self.solve_flat(T_base_tool)[:2]

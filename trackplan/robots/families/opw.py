@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.robots.families import _kernels as kern
-from trackplan.robots.families.base import describe_bits, solve_fused
+from trackplan.robots.families.base import describe_bits, solve_branch_fused, solve_fused
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
 
@@ -302,3 +302,10 @@ class OPWFamily:
         ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
         """
         return solve_fused(kern.opw_solve, self._geometry, self._tail_inv, T_base_tool, with_aux)
+
+    def solve_branch(self, T_base_tool: np.ndarray, branch: int) -> tuple[np.ndarray, np.ndarray]:
+        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), the values
+        :meth:`solve_flat` gives for it."""
+        return solve_branch_fused(
+            kern.opw_solve_branch, self._geometry, self._tail_inv, T_base_tool, branch
+        )
