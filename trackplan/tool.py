@@ -80,6 +80,22 @@ def rotation_z(angle: np.ndarray) -> np.ndarray:
     return R
 
 
+def spun(R: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """``R @ rotation_z(angle)`` for rotations R (..., 3, 3) and angles (...,), rad.
+
+    Elementwise: the columns ``(c x + s y, c y − s x, z)`` of each R = (x, y, z), without
+    a small matrix product per rotation.
+    """
+    angle = np.asarray(angle, dtype=float)
+    c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
+    x, y = R[..., 0], R[..., 1]
+    out = np.empty(np.broadcast_shapes(R.shape, (*angle.shape, 3, 3)))
+    out[..., 0] = x * c + y * s
+    out[..., 1] = y * c - x * s
+    out[..., 2] = R[..., 2]
+    return out
+
+
 def rotation_angle(R_a: np.ndarray, R_b: np.ndarray) -> np.ndarray:
     """Angle of ``R_aᵀ R_b`` for rotations (..., 3, 3), shape (...,), rad."""
     trace = np.einsum("...ji,...ji->...", R_a, R_b)
@@ -469,7 +485,7 @@ class ToolOrientation:
 
     def rotations(self, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:
         """``R_part_tool`` at arc lengths ``s`` (M,) with planned tangents (M, 3), (M, 3, 3)."""
-        return self.base_rotations(s, tangent) @ rotation_z(self.spin.value(s))
+        return spun(self.base_rotations(s, tangent), self.spin.value(s))
 
 
 @dataclass(frozen=True, eq=False)

@@ -114,3 +114,18 @@ def test_polyline_table_is_built_without_objects():
     np.testing.assert_array_equal(table.start, vertices[:-1])
     ends = table.start + table.length[:, None] * table.direction
     np.testing.assert_allclose(ends, vertices[1:], atol=1e-13)
+
+
+@PROPERTY
+@given(paths, st.integers(0, 2**31), st.sampled_from([0.0, 1e-3, 0.1]))
+def test_few_pieces_in_one_pass_equal_the_blocked_pairs(path, seed, slack):
+    """A path of few pieces is projected in one compiled pass; a batch holding a point that
+    is not finite takes the blocked pairs instead: the same candidates, to the bit."""
+    nominal = random_nominal(*path)
+    points = points_near(nominal, seed, 200, 1e-2)
+    fast = nominal.index.candidates(points, slack)
+    blocked = nominal.index.candidates(np.vstack([points, [[np.nan, 0.0, 0.0]]]), slack)
+    kept = blocked.row < len(points)
+    for field in ("row", "piece", "sigma", "distance"):
+        np.testing.assert_array_equal(getattr(fast, field), getattr(blocked, field)[kept])
+    np.testing.assert_array_equal(fast.nearest, blocked.nearest[: len(points)])

@@ -1,4 +1,5 @@
-"""Compiled kernels of the paths package: nearest pieces of points, from their nearest chunks.
+"""Compiled kernels of the paths package: nearest pieces of points, from their nearest chunks
+(or, on a path of few pieces, from every piece).
 
 The Python API is :class:`trackplan.paths.projection.PieceIndex`; the table layout is that
 of :class:`trackplan.paths.piece_table.PieceTable`.
@@ -56,6 +57,73 @@ def project_point(
     if last < first:
         return angle[k] * radius[k], math.sqrt(last)
     return 0.0, math.sqrt(first)
+
+
+@njit(cache=True)
+def dense_pieces(
+    points: np.ndarray,
+    slack: float,
+    is_arc: np.ndarray,
+    start: np.ndarray,
+    direction: np.ndarray,
+    length: np.ndarray,
+    center: np.ndarray,
+    axis: np.ndarray,
+    e1: np.ndarray,
+    e2: np.ndarray,
+    arc_radius: np.ndarray,
+    angle: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover
+    """Kernel: the pieces within ``slack`` of the nearest piece of each point, every piece
+    projected (a path of few pieces: no tree).
+
+    Parameters
+    ----------
+    points
+        Shape (B, 3), m, finite.
+    slack
+        m.
+    is_arc, start, direction, length, center, axis, e1, e2, arc_radius, angle
+        The piece table (P pieces).
+
+    Returns
+    -------
+    bounds
+        Pairs of point b are ``bounds[b]:bounds[b + 1]``, shape (B + 1,).
+    piece, sigma, distance
+        The pairs: piece (ascending within a point), arc length along it and distance, m.
+    nearest
+        Distance of each point from the whole path, shape (B,), m.
+    """
+    n = points.shape[0]
+    n_pieces = length.shape[0]
+    bounds = np.zeros(n + 1, dtype=np.int64)
+    out_piece = np.empty(n * n_pieces, dtype=np.int64)
+    out_sigma = np.empty(n * n_pieces)
+    out_distance = np.empty(n * n_pieces)
+    nearest = np.empty(n)
+    sigmas = np.empty(n_pieces)
+    distances = np.empty(n_pieces)
+    used = 0
+    for b in range(n):
+        bounds[b] = used
+        closest = np.inf
+        for k in range(n_pieces):
+            sigmas[k], distances[k] = project_point(
+                points[b], k, is_arc, start, direction, length, center, axis, e1, e2,
+                arc_radius, angle,
+            )  # fmt: skip
+            closest = min(closest, distances[k])
+        nearest[b] = closest
+        for k in range(n_pieces):
+            if distances[k] > closest + slack:
+                continue
+            out_piece[used] = k
+            out_sigma[used] = sigmas[k]
+            out_distance[used] = distances[k]
+            used += 1
+    bounds[n] = used
+    return bounds, out_piece[:used], out_sigma[:used], out_distance[:used], nearest
 
 
 @njit(cache=True)

@@ -23,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.spatial import cKDTree
 
-from trackplan.paths._kernels import near_pieces
+from trackplan.paths._kernels import dense_pieces, near_pieces
 from trackplan.paths.piece_table import PieceTable
 
 _EXTRA_CHUNKS = 1000
@@ -116,7 +116,16 @@ class PieceIndex:
         finite = np.flatnonzero(np.isfinite(points).all(axis=1))
         parts = [(np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
         n_pieces = self.table.n_pieces
-        if n_pieces <= _DENSE_PIECES:  # every piece for every point: cheaper than a tree
+        if n_pieces <= _DENSE_PIECES and len(finite) == len(points):
+            # every piece for every point, in one compiled pass: cheaper than a tree
+            t = self.table
+            bounds, piece, sigma, gap, nearest = dense_pieces(
+                points, slack, t.is_arc, t.start, t.direction, t.length, t.center, t.axis,
+                t.e1, t.e2, t.radius, t.angle,
+            )  # fmt: skip
+            row = np.repeat(np.arange(len(points)), np.diff(bounds))
+            return Candidates(row, piece, sigma, gap, nearest)
+        if n_pieces <= _DENSE_PIECES:  # the same with points that are not finite
             every = np.arange(n_pieces)
             for start in range(0, len(finite), _POINTS_PER_BLOCK):
                 block = points[finite[start : start + _POINTS_PER_BLOCK]]

@@ -365,16 +365,19 @@ def _check_tool(
     outside = allowed == tol
     if not outside.any():
         return axis_error, found
-    x_actual = R_part_tool[outside, :, 0]
-    spin = np.unwrap(
-        np.arctan2(
-            np.einsum("ni,ni->n", x_actual, R_spec[outside, :, 1]),
-            np.einsum("ni,ni->n", x_actual, R_spec[outside, :, 0]),
-        )
+    x_actual = R_part_tool[:, :, 0]
+    spin = np.arctan2(
+        np.einsum("ni,ni->n", x_actual, R_spec[:, :, 1]),
+        np.einsum("ni,ni->n", x_actual, R_spec[:, :, 0]),
     )
-    t_out, s_out, piece_out = t[outside], s_nominal[outside], piece[outside]
+    everywhere = outside.all()  # no transition zone: no copies
+    spin = np.unwrap(spin if everywhere else spin[outside])
+    t_out, s_out, piece_out = (
+        (t, s_nominal, piece) if everywhere else (t[outside], s_nominal[outside], piece[outside])
+    )
     if spec.spin is SpinMode.FIXED:
-        error = np.abs(np.angle(np.exp(1j * (spin - spec.spin_value))))
+        turn = spin - spec.spin_value
+        error = np.abs(turn - 2 * np.pi * np.round(turn / (2 * np.pi)))
         margins["spin"] = float(_met(1.0 - error.max() / tol, RELATIVE_SLACK))
         if margins["spin"] < 0:
             found.append(_violation("spin", None, t_out, spin, error / tol, spec.spin_value))

@@ -13,7 +13,7 @@ import numpy as np
 from trackplan.paths import NominalPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.tracking import locate_on_nominal
-from trackplan.tool import ToolOrientation, ToolSpec
+from trackplan.tool import ToolFrame, ToolOrientation, ToolSpec
 
 ZONE_STEP = 1e-3
 """Four grid steps of the deviation measurement, m."""
@@ -39,8 +39,11 @@ def nominal_rotations(
 
     At arc lengths ``s`` (N,) on pieces ``piece`` (N,): the nominal tangent there and the
     normal of the segment the piece belongs to (per-segment ``normals``), so the spec's
-    normal jumps exactly at the segment junctions.
+    normal jumps exactly at the segment junctions. A part-frame spec does not depend on
+    the tangent.
     """
+    if spec.frame is ToolFrame.PART:
+        return spec.base_rotations(np.zeros((len(s), 3)))
     tangent = nominal_tangents(nominal, s, piece)
     if spec.normals is None:
         return spec.base_rotations(tangent)
