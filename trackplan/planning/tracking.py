@@ -140,6 +140,9 @@ def between_samples(
     if len(q) < 2:
         return np.zeros((0, q.shape[1] if q.ndim == 2 else 0)), np.zeros(0)
     chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    if chord.max() <= 2 * BETWEEN_STEP * tolerance:  # (NaN: False) every period in halves
+        midpoints = q[:-1] + 0.5 * (q[1:] - q[:-1])  # as below with the fraction 1/2
+        return midpoints, np.arange(len(chord)) + 0.5
     parts = np.ceil(chord / (BETWEEN_STEP * tolerance))
     parts = np.clip(np.nan_to_num(parts, nan=2.0), 2, MAX_BETWEEN_PER_PERIOD).astype(int)
     period = np.repeat(np.arange(len(parts)), parts - 1)  # (K,)
