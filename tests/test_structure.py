@@ -18,6 +18,7 @@ from trackplan.errors import CaseError
 def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
     calls: list[tuple[str, int]] = []
     real_poses, real_ik = jointpath.tool_poses, jointpath.solve_path_ik
+    real_branch = jointpath.branch_joints
 
     def poses(X, positions, R_part_tool):
         calls.append(("poses", len(positions)))
@@ -27,8 +28,13 @@ def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
         calls.append(("ik", T.shape[1]))
         return real_ik(robot, T, *args, **kwargs)
 
+    def branch_ik(robot, T, branch, reference):  # the samples: their branch only
+        calls.append(("ik", len(T)))
+        return real_branch(robot, T, branch, reference)
+
     monkeypatch.setattr(jointpath, "tool_poses", poses)
     monkeypatch.setattr(jointpath, "solve_path_ik", ik)
+    monkeypatch.setattr(jointpath, "branch_joints", branch_ik)
     case = trackplan.load_case(CASES / "paper-corner.yaml")
     result = trackplan.plan_placement(case, case.bounds.example)
     assert result.success, result.message
