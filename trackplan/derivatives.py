@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from trackplan._kernels import backward_differences
+
 REST_PADDING = 3
 """Samples at rest appended after the last one: the robot stays still after the trajectory,
 so the first three backward differences past the end are checked too."""
@@ -33,15 +35,11 @@ def backward_derivatives(
         ``(qd, qdd, qddd)`` in unit/s, unit/s², unit/s³.
     """
     q = np.asarray(q, dtype=float)
-    head = np.repeat(q[:1], REST_PADDING, axis=0)
-    parts = [head, q]
-    if pad_end:
-        parts.append(np.repeat(q[-1:], REST_PADDING, axis=0))
-    padded = np.concatenate(parts, axis=0)
-    first = np.diff(padded, axis=0)
-    second = np.diff(first, axis=0)  # np.diff(padded, 2) exactly
-    third = np.diff(second, axis=0)
-    qd = first / sample_time
-    qdd = second / sample_time**2
-    qddd = third / sample_time**3
-    return qd[REST_PADDING - 1 :], qdd[REST_PADDING - 2 :], qddd
+    if not len(q):
+        return np.zeros(q.shape), np.zeros(q.shape), np.zeros(q.shape)
+    columns = np.ascontiguousarray(q.reshape(len(q), -1))
+    tail = REST_PADDING if pad_end else 0
+    found = backward_differences(
+        columns, REST_PADDING, tail, sample_time, sample_time**2, sample_time**3
+    )
+    return tuple(d.reshape(-1, *q.shape[1:]) for d in found)  # type: ignore[return-value]

@@ -31,3 +31,24 @@ def test_backward_differences_at_rest_before_and_after(rng):
     assert len(qd_end) == len(q) + 3
     np.testing.assert_allclose(qd_end[-3:], 0.0)
     assert np.abs(qddd_end[-3:]).max() > 0  # stopping abruptly shows up after the end
+
+
+@pytest.mark.parametrize("shape", [(1, 6), (2, 3), (40, 6), (40,)])
+@pytest.mark.parametrize("pad_end", [False, True])
+def test_backward_differences_in_one_pass_are_numpys_to_the_bit(rng, shape, pad_end):
+    """The compiled pass does numpy's subtractions and divisions: the same bits."""
+    Ts = 1e-3
+    q = np.cumsum(rng.normal(scale=1e-3, size=shape), axis=0)
+    parts = [q[:1]] * 3 + [q] + ([q[-1:]] * 3 if pad_end else [])
+    padded = np.concatenate(parts, axis=0)
+    first = np.diff(padded, axis=0)
+    second = np.diff(first, axis=0)
+    third = np.diff(second, axis=0)
+    expected = (first[2:] / Ts, second[1:] / Ts**2, third / Ts**3)
+    for found, wanted in zip(backward_derivatives(q, Ts, pad_end), expected, strict=True):
+        assert found.shape == wanted.shape
+        np.testing.assert_array_equal(found, wanted)
+
+
+def test_backward_differences_of_no_samples_are_empty():
+    assert all(d.shape == (0, 6) for d in backward_derivatives(np.zeros((0, 6)), 1e-3, True))
