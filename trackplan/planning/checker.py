@@ -286,7 +286,7 @@ def _check_task(
     if len(q_between):
         T_between = forward_kinematics(robot, q_between)
         p_between = (T_between[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
-        _, d_between = ref.nominal.project(p_between)
+        d_between = ref.nominal.index.candidates(p_between, 0.0).nearest  # distances only
         worst = max(worst, float(d_between.max()))
         if d_between.max() > ref.tolerance * (1 + RELATIVE_SLACK) and not violations_of(
             violations, "tracking"
