@@ -153,7 +153,7 @@ def _breakdown(case, X: np.ndarray) -> list[tuple[str, float]]:  # type: ignore[
     robot, q, s = case.robot, trajectory.q, trajectory.s
     motion = SampledMotion(robot, q, trajectory.sample_time)
     _ = motion.T_base_tool, motion.torque  # computed once, as in a plan
-    poses, reference = joint_path.poses(s), joint_path.interpolate(s)
+    poses, q_reference = joint_path.poses(s), joint_path.interpolate(s)
     reference = tracking_reference(case, joint_path.geometry, joint_path.placement)
     n_grid, n = joint_path.ik.q.shape[1], len(q)
     cpu = _interleaved_cpu(
@@ -164,7 +164,7 @@ def _breakdown(case, X: np.ndarray) -> list[tuple[str, float]]:  # type: ignore[
             ),
             "law": lambda: plan_smooth_time_law(joint_path, case.task),
             "poses": lambda: joint_path.poses(s),
-            "ik": lambda: branch_joints(robot, poses, joint_path.branch, reference),
+            "ik": lambda: branch_joints(robot, poses, joint_path.branch, q_reference),
             "rates": lambda: RateLimits(robot).check_motion(motion),
             "rne": lambda: inverse_dynamics(robot, motion.q_held, motion.qd, motion.qdd),
             "fk": lambda: forward_kinematics(robot, q),
