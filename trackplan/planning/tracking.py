@@ -62,14 +62,21 @@ def locate_on_nominal(
         found = nominal.index.candidates(points[block], max(tolerance, 1e-12))
         nearest[block] = found.nearest
         row, piece, sigma = found.row, found.piece, found.sigma
-        tangent = table.tangent_on(piece, sigma)
-        along = np.einsum("nk,nk->n", tangent, velocity[block][row])
-        agrees = along >= -DIRECTION_SLACK * speed[block][row]
-        # where no close piece agrees with the motion, every close piece is a candidate
-        any_agrees = np.bincount(row[agrees], minlength=len(found.nearest)) > 0
-        keep = agrees | ~any_agrees[row]
-        row, piece, sigma = row[keep], piece[keep], sigma[keep]
-        bounds = np.searchsorted(row, np.arange(len(found.nearest) + 1))
+        n_block = len(found.nearest)
+        # a sample near one piece only keeps it; where several are near, those that agree
+        # with the motion, or every one when none agrees
+        several = np.bincount(row, minlength=n_block)[row] > 1
+        if several.any():
+            pairs = np.flatnonzero(several)
+            tangent = table.tangent_on(piece[pairs], sigma[pairs])
+            moving = velocity[block][row[pairs]]
+            along = np.einsum("nk,nk->n", tangent, moving)
+            agrees = along >= -DIRECTION_SLACK * speed[block][row[pairs]]
+            any_agrees = np.bincount(row[pairs][agrees], minlength=n_block) > 0
+            keep = np.ones(len(row), dtype=bool)
+            keep[pairs] = agrees | ~any_agrees[row[pairs]]
+            row, piece, sigma = row[keep], piece[keep], sigma[keep]
+        bounds = np.searchsorted(row, np.arange(n_block + 1))
         chosen = monotone_assignment(bounds, piece, current)
         assigned[block], local[block] = piece[chosen], sigma[chosen]
         current = int(assigned[block][-1])
