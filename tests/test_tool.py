@@ -25,7 +25,9 @@ from trackplan.tool import (
     ToolOrientation,
     ToolSpec,
     rotation_angle,
+    rotation_z,
     spin_knots,
+    spun,
     tool_axis_twist,
 )
 
@@ -313,3 +315,11 @@ def test_two_faces_case_plans_feasibly_and_checks():
     assert check.success
     # the tool turns from one face's normal to the other's: about 90° across the bend
     assert 1.0 < check.max_orientation_error < 1.5
+
+
+def test_spinning_rotations_elementwise_is_the_matrix_product():
+    rng = np.random.default_rng(7)
+    R = Rotation.random(500, random_state=8).as_matrix()
+    angle = rng.uniform(-4.0, 4.0, 500)
+    np.testing.assert_allclose(spun(R, angle), R @ rotation_z(angle), rtol=0, atol=4e-16)
+    np.testing.assert_allclose(spun(R[0], angle), R[0] @ rotation_z(angle), rtol=0, atol=4e-16)
