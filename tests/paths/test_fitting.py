@@ -6,9 +6,13 @@ from itertools import pairwise
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from trackplan.paths import NominalPath, PointsSpec, build_path, fit_polyline
+from trackplan.paths.fitting import biarc, fit_deviation, vertex_tangents
 from trackplan.paths.geometry import Arc, Line, end_jet, start_jet, turning_angle
+from trackplan.paths.pieces import chain, evaluate_pieces
 from trackplan.paths.planned import FIT_SHARE
 
 RHO = 1e-3
@@ -91,3 +95,85 @@ def test_collinear_samples_are_one_line_and_circle_samples_one_arc():
     assert len(arc.curves) == 1
     assert isinstance(arc.curves[0], Arc)
     assert arc.curves[0].radius == pytest.approx(0.3, rel=1e-12)
+
+
+def _deviation_oracle(curves, vertices: np.ndarray) -> tuple[float, float]:
+    """The bound of fit_deviation in plain numpy, piece by piece (the former implementation)."""
+    pieces = chain(curves)
+    projections = [curve.project(vertices) for curve in curves]
+    distance = np.min([d for _, d in projections], axis=0)
+    nearest = np.argmin([d for _, d in projections], axis=0)
+    sigma = np.choose(
+        nearest, [p.s_start + s for p, (s, _) in zip(pieces, projections, strict=True)]
+    )
+    total = pieces[-1].s_end
+    sigma = np.clip(np.maximum.accumulate(sigma), 0.0, total)
+    sigma[0], sigma[-1] = 0.0, total
+    fraction = np.linspace(0.0, 1.0, 5)
+    grid = sigma[:-1, None] + (sigma[1:] - sigma[:-1])[:, None] * fraction
+    points = evaluate_pieces(pieces, grid.ravel())[0].position.reshape(*grid.shape, 3)
+    starts = vertices[:-1, None, :]
+    chords = (vertices[1:] - vertices[:-1])[:, None, :]
+    along = np.sum((points - starts) * chords, axis=-1) / np.sum(chords * chords, axis=-1)
+    foot = starts + np.clip(along, 0.0, 1.0)[..., None] * chords
+    gap = np.linalg.norm(points - foot, axis=-1)
+    step = (sigma[1:] - sigma[:-1]) / 4
+    kappa = max((1.0 / c.radius for c in curves if isinstance(c, Arc)), default=0.0)
+    sagitta = np.zeros_like(step)
+    if kappa > 0.0:
+        sagitta = (1.0 - np.cos(0.5 * np.minimum(kappa * step, np.pi))) / kappa
+    bound = np.maximum(gap[:, :-1], gap[:, 1:]) + sagitta[:, None]
+    return float(distance.max()), float(bound.max())
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(
+    st.integers(3, 400),
+    st.floats(0.02, 0.5),
+    st.floats(-0.2, 0.2),
+    st.floats(0.0, 2e-4),
+    st.integers(0, 2**32 - 1),
+)
+def test_deviation_kernel_agrees_with_numpy(n, radius, rise, noise, seed):
+    rng = np.random.default_rng(seed)
+    angle = np.linspace(0.0, rng.uniform(0.1, 3.0), n)
+    vertices = np.c_[radius * np.cos(angle), radius * np.sin(angle), rise * angle]
+    vertices += noise * rng.standard_normal(vertices.shape)
+    t0, t1 = vertex_tangents(vertices)[[0, -1]]
+    curves = biarc(vertices[0], t0, vertices[-1], t1)
+    if not curves:
+        curves = [Line.between(vertices[0], vertices[-1])]
+    expected = _deviation_oracle(curves, vertices)
+    np.testing.assert_allclose(fit_deviation(curves, vertices), expected, rtol=1e-9, atol=1e-15)
+    # With a limit, the work may stop early, but only when the limit is exceeded.
+    limit = 0.5 * max(expected)
+    assert max(fit_deviation(curves, vertices, limit)) > limit
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(
+    st.integers(20, 1500),
+    st.floats(0.03, 0.3),
+    st.floats(0.0, 0.1),
+    st.floats(0.5, 12.0),
+    st.floats(0.0, 5e-5),
+    st.integers(0, 2**32 - 1),
+)
+def test_fit_holds_the_tolerance_both_ways(n, radius, rise, turn, noise, seed):
+    """Any sampled helix, noisy or not: the fit stays within the fitting share of ρ."""
+    rng = np.random.default_rng(seed)
+    angle = np.linspace(0.0, turn, n)
+    vertices = np.c_[radius * np.cos(angle), radius * np.sin(angle), rise * angle]
+    vertices += noise * rng.standard_normal(vertices.shape)
+    tolerance = FIT_SHARE * RHO
+    fit = fit_polyline(vertices, tolerance)
+    assert fit.spans[0, 0] == 0 and fit.spans[-1, 1] == n - 1
+    pieces = chain(fit.curves)
+    s = np.linspace(0.0, pieces[-1].s_end, 20 * n)
+    points = evaluate_pieces(pieces, s)[0].position
+    nearest_on_polyline = _polyline_distance(points, vertices) if n <= 600 else None
+    if nearest_on_polyline is not None:
+        assert nearest_on_polyline.max() <= fit.deviation.max() + 1e-12
+    assert np.all(fit.deviation <= tolerance)
+    vertex_distance = np.min([curve.project(vertices)[1] for curve in fit.curves], axis=0)
+    assert vertex_distance.max() <= tolerance

@@ -3,17 +3,17 @@ and result.json with the per-seam figures, the sequence, the air and cycle time.
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
 from trackplan.case import PLACEMENT_KEYS, Case
+from trackplan.io.csv_table import format_table
 from trackplan.io.results import (
     slowdown_record,
     trajectory_header,
+    trajectory_table,
     write_result_json,
-    write_trajectory_csv,
 )
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.planning.cycle import CycleResult
@@ -26,10 +26,8 @@ SEGMENT_COLUMN = "segment"
 
 def write_cycle_trajectory_csv(result: CycleResult, file: Path) -> None:
     """Write one row per sample: the columns of a single path, then ``segment``."""
-    buffer = io.StringIO()
-    write_trajectory_csv(result.trajectory, buffer)  # type: ignore[arg-type]
-    lines = buffer.getvalue().splitlines()
-    rows = [f"{line},{label}" for line, label in zip(lines[1:], result.segment, strict=True)]
+    lines = format_table(trajectory_table(result.trajectory)).decode("ascii").splitlines()
+    rows = [f"{line},{label}" for line, label in zip(lines, result.segment, strict=True)]
     n_dof = result.trajectory.q.shape[1]
     header = ",".join([*trajectory_header(n_dof), SEGMENT_COLUMN])
     Path(file).write_text("\n".join([header, *rows]) + "\n", encoding="utf-8")

@@ -23,6 +23,7 @@ import numpy as np
 import yaml
 
 from trackplan.errors import CaseError
+from trackplan.io.csv_table import write_csv_table
 from trackplan.io.results import trajectory_header
 from trackplan.io.run_folder import verified_trajectory, write_atomically
 from trackplan.planning.result import Trajectory
@@ -246,10 +247,7 @@ def joint_trajectory_msg(table: TrajectoryTable, frame_id: str = "") -> dict:
 
 
 def _write_csv(table: TrajectoryTable, output: Path) -> None:
-    lines = [",".join(["t", *table.joint_names])]
-    # repr of a Python float is the shortest text that reads back to the same float
-    lines += [",".join(map(repr, row)) for row in np.column_stack([table.t, table.q]).tolist()]
-    output.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    write_csv_table(output, np.column_stack([table.t, table.q]), ["t", *table.joint_names])
 
 
 def _write_json(table: TrajectoryTable, output: Path) -> None:

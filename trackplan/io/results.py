@@ -11,6 +11,7 @@ import numpy as np
 
 from trackplan.case import PLACEMENT_KEYS
 from trackplan.errors import CaseError
+from trackplan.io.csv_table import write_csv_table
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
@@ -37,35 +38,37 @@ def slowdown_record(slowdown: SlowDown) -> dict[str, Any]:
     }
 
 
-def write_trajectory_csv(trajectory: Trajectory, file: Path) -> None:
-    """Write one row per sample (full float precision, so the file re-checks identically)."""
+def trajectory_table(trajectory: Trajectory) -> np.ndarray:
+    """The columns of :func:`trajectory_header` as one table, shape (N, 4 n + 6)."""
     n_dof = trajectory.q.shape[1] if trajectory.q.ndim == 2 else 0
-    table = (
-        np.column_stack(
-            [
-                trajectory.t,
-                trajectory.q,
-                trajectory.qd,
-                trajectory.qdd,
-                trajectory.qddd,
-                trajectory.tool_position,
-                trajectory.speed,
-                trajectory.spin
-                if len(trajectory.spin) == trajectory.n_samples
-                else np.zeros(trajectory.n_samples),
-            ]
-        )
-        if trajectory.n_samples
-        else np.zeros((0, 4 * n_dof + 6))
+    if not trajectory.n_samples:
+        return np.zeros((0, 4 * n_dof + 6))
+    spin = (
+        trajectory.spin
+        if len(trajectory.spin) == trajectory.n_samples
+        else np.zeros(trajectory.n_samples)
     )
-    np.savetxt(
-        file,
-        table,
-        delimiter=",",
-        header=",".join(trajectory_header(n_dof)),
-        comments="",
-        fmt="%.17g",
+    return np.column_stack(
+        [
+            trajectory.t,
+            trajectory.q,
+            trajectory.qd,
+            trajectory.qdd,
+            trajectory.qddd,
+            trajectory.tool_position,
+            trajectory.speed,
+            spin,
+        ]
     )
+
+
+def write_trajectory_csv(trajectory: Trajectory, file: Path) -> None:
+    """Write one row per sample, each value the shortest text that reads back exactly.
+
+    So the file re-checks identically (see :mod:`trackplan.io.csv_table`).
+    """
+    n_dof = trajectory.q.shape[1] if trajectory.q.ndim == 2 else 0
+    write_csv_table(file, trajectory_table(trajectory), trajectory_header(n_dof))
 
 
 def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -238,3 +238,124 @@ def near_pieces(
             used += 1
     bounds[n] = used
     return bounds, out_piece[:used], out_sigma[:used], out_distance[:used]
+
+
+@njit(cache=True)
+def fit_deviation(
+    vertices: np.ndarray,
+    n_sub: int,
+    s_start: np.ndarray,
+    is_arc: np.ndarray,
+    start: np.ndarray,
+    direction: np.ndarray,
+    length: np.ndarray,
+    center: np.ndarray,
+    axis: np.ndarray,
+    e1: np.ndarray,
+    e2: np.ndarray,
+    radius: np.ndarray,
+    angle: np.ndarray,
+    limit: float,
+) -> tuple[float, float]:  # pragma: no cover
+    """Kernel: distances between a few curves laid end to end and the polyline ``vertices``.
+
+    The bound of :func:`trackplan.paths.fitting.fit_deviation`: each vertex is projected onto
+    the curves; the curves are cut at those projections (made monotone) and each part is
+    compared with its own polyline segment at ``n_sub`` sub-intervals, plus the sagitta of a
+    sub-interval at the largest curvature.
+
+    Parameters
+    ----------
+    vertices
+        The polyline, shape (n, 3), m, n ≥ 2.
+    n_sub
+        Sub-intervals per polyline segment.
+    s_start, is_arc, start, direction, length, center, axis, e1, e2, radius, angle
+        The curves as a piece table (P rows), ``s_start`` their arc length from 0.
+    limit
+        m: the work stops as soon as a distance exceeds it (the values returned then
+        exceed ``limit`` but are not the largest).
+
+    Returns
+    -------
+    vertex_distance
+        Largest distance of a vertex from the curves, m.
+    curve_distance
+        Upper bound of the largest distance of a curve point from the polyline, m.
+    """
+    n = vertices.shape[0]
+    n_pieces = length.shape[0]
+    total = s_start[n_pieces - 1] + length[n_pieces - 1]
+    sigma = np.empty(n)
+    vertex_distance = 0.0
+    running = -np.inf
+    for v in range(n):
+        nearest = np.inf
+        along = 0.0
+        for k in range(n_pieces):
+            s, d = project_point(
+                vertices[v],
+                k,
+                is_arc,
+                start,
+                direction,
+                length,
+                center,
+                axis,
+                e1,
+                e2,
+                radius,
+                angle,
+            )
+            if d < nearest:
+                nearest, along = d, s_start[k] + s
+        vertex_distance = max(vertex_distance, nearest)
+        running = max(running, along)
+        sigma[v] = min(max(running, 0.0), total)
+    sigma[0], sigma[n - 1] = 0.0, total
+    if vertex_distance > limit:
+        return vertex_distance, 0.0
+    kappa = 0.0
+    for k in range(n_pieces):
+        if is_arc[k]:
+            kappa = max(kappa, 1.0 / radius[k])
+    bound = 0.0
+    point = np.empty(3)
+    for v in range(n - 1):
+        a, b = sigma[v], sigma[v + 1]
+        step = (b - a) / n_sub
+        sagitta = 0.0
+        if kappa > 0.0:
+            sagitta = (1.0 - math.cos(0.5 * min(kappa * step, math.pi))) / kappa
+        c0 = vertices[v + 1, 0] - vertices[v, 0]
+        c1 = vertices[v + 1, 1] - vertices[v, 1]
+        c2 = vertices[v + 1, 2] - vertices[v, 2]
+        chord2 = c0 * c0 + c1 * c1 + c2 * c2
+        previous = 0.0
+        for i in range(n_sub + 1):
+            s = a + (b - a) * (i / n_sub)
+            k = 0
+            for j in range(1, n_pieces):
+                if s >= s_start[j]:
+                    k = j
+            local = min(max(s - s_start[k], 0.0), length[k])
+            if is_arc[k]:
+                phi = local / radius[k]
+                cos_phi, sin_phi = math.cos(phi), math.sin(phi)
+                for m in range(3):
+                    point[m] = center[k, m] + radius[k] * (cos_phi * e1[k, m] + sin_phi * e2[k, m])
+            else:
+                for m in range(3):
+                    point[m] = start[k, m] + local * direction[k, m]
+            r0 = point[0] - vertices[v, 0]
+            r1 = point[1] - vertices[v, 1]
+            r2 = point[2] - vertices[v, 2]
+            t = min(max((r0 * c0 + r1 * c1 + r2 * c2) / chord2, 0.0), 1.0)
+            d0, d1, d2 = r0 - t * c0, r1 - t * c1, r2 - t * c2
+            gap = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            if i > 0:
+                bound = max(bound, max(previous, gap) + sagitta)
+            previous = gap
+        if bound > limit:
+            break
+    return vertex_distance, bound

@@ -28,8 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trackplan.paths import _kernels as kernels
 from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, Line, Primitive, end_jet, unit
-from trackplan.paths.pieces import chain, evaluate_pieces
+from trackplan.paths.piece_table import PieceTable
 
 # Sub-intervals per polyline segment when bounding the distance of a fit from the polyline.
 _SAMPLES_PER_SEGMENT = 4
@@ -125,8 +126,23 @@ def biarc(
     return curves
 
 
-def _deviation(curves: Sequence[Primitive], vertices: np.ndarray) -> tuple[float, float]:
-    """Distances between curves laid end to end and the polyline ``vertices`` (n, 3).
+def fit_deviation(
+    curves: Sequence[Primitive], vertices: np.ndarray, limit: float = np.inf
+) -> tuple[float, float]:
+    """Distances between curves laid end to end and the polyline ``vertices`` (n, 3), m.
+
+    The bound of the module docstring, by the compiled kernel
+    :func:`trackplan.paths._kernels.fit_deviation`: O(n · len(curves)) time, O(n) memory.
+
+    Parameters
+    ----------
+    curves
+        Lines and arcs end to end, from the first vertex to the last.
+    vertices
+        The polyline, shape (n, 3), m, n ≥ 2.
+    limit
+        m: the work stops once a distance exceeds it; one of the values returned then
+        exceeds ``limit``, but they need not be the largest.
 
     Returns
     -------
@@ -135,31 +151,25 @@ def _deviation(curves: Sequence[Primitive], vertices: np.ndarray) -> tuple[float
     curve_distance
         Upper bound of the largest distance of a curve point from the polyline, m.
     """
-    pieces = chain(curves)
-    projections = [curve.project(vertices) for curve in curves]
-    distance = np.min([d for _, d in projections], axis=0)
-    nearest = np.argmin([d for _, d in projections], axis=0)
-    sigma = np.choose(
-        nearest, [p.s_start + s for p, (s, _) in zip(pieces, projections, strict=True)]
+    table = PieceTable.from_curves(curves)
+    s_start = np.concatenate([[0.0], np.cumsum(table.length)])[:-1]
+    vertex_distance, curve_distance = kernels.fit_deviation(
+        np.ascontiguousarray(vertices, dtype=float),
+        _SAMPLES_PER_SEGMENT,
+        s_start,
+        table.is_arc,
+        table.start,
+        table.direction,
+        table.length,
+        table.center,
+        table.axis,
+        table.e1,
+        table.e2,
+        table.radius,
+        table.angle,
+        float(limit),
     )
-    total = pieces[-1].s_end
-    sigma = np.clip(np.maximum.accumulate(sigma), 0.0, total)
-    sigma[0], sigma[-1] = 0.0, total
-    fraction = np.linspace(0.0, 1.0, _SAMPLES_PER_SEGMENT + 1)
-    grid = sigma[:-1, None] + (sigma[1:] - sigma[:-1])[:, None] * fraction
-    points = evaluate_pieces(pieces, grid.ravel())[0].position.reshape(*grid.shape, 3)
-    starts = vertices[:-1, None, :]
-    chords = (vertices[1:] - vertices[:-1])[:, None, :]
-    along = np.sum((points - starts) * chords, axis=-1) / np.sum(chords * chords, axis=-1)
-    foot = starts + np.clip(along, 0.0, 1.0)[..., None] * chords
-    gap = np.linalg.norm(points - foot, axis=-1)
-    step = (sigma[1:] - sigma[:-1]) / _SAMPLES_PER_SEGMENT
-    kappa = max((1.0 / c.radius for c in curves if isinstance(c, Arc)), default=0.0)
-    sagitta = np.zeros_like(step)
-    if kappa > 0.0:
-        sagitta = (1.0 - np.cos(0.5 * np.minimum(kappa * step, np.pi))) / kappa
-    bound = np.maximum(gap[:, :-1], gap[:, 1:]) + sagitta[:, None]
-    return float(distance.max()), float(bound.max())
+    return float(vertex_distance), float(curve_distance)
 
 
 def _longest(
@@ -180,7 +190,9 @@ def _longest(
         curves = make(last)
         if not curves:
             return False
-        vertex_distance, curve_distance = _deviation(curves, vertices[first : last + 1])
+        vertex_distance, curve_distance = fit_deviation(
+            curves, vertices[first : last + 1], tolerance
+        )
         if max(vertex_distance, curve_distance) > tolerance:
             return False
         best = (last, curves, curve_distance)
