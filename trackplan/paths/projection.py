@@ -46,6 +46,9 @@ _DENSE_PIECES = 32
 _NEIGHBOURS_NEAREST = 8
 """The same for the nearest piece only (no slack)."""
 
+_WIDER = 4
+"""The points whose ball holds more are asked again for this many times the neighbours."""
+
 _PAD = 1e-9
 """Relative padding of the query radii (the tree rounds distances its own way), m/m."""
 
@@ -144,22 +147,34 @@ class PieceIndex:
                 parts.append((finite[start + row], piece, sigma, gap))
             return self._gathered(points, finite, parts)
         tree, chunk_piece, half, widest = self._chunks
-        k = min(_NEIGHBOURS if slack > 0.0 else _NEIGHBOURS_NEAREST, tree.n)
+        k_first = _NEIGHBOURS if slack > 0.0 else _NEIGHBOURS_NEAREST
         for start in range(0, len(finite), _POINTS_PER_BLOCK):
             block = points[finite[start : start + _POINTS_PER_BLOCK]]
-            distance, index = tree.query(block, k=k)
-            distance, index = distance.reshape(len(block), k), index.reshape(len(block), k)
-            first = distance[:, 0]
-            radius = self._radius(first, slack + widest)
-            more = (distance[:, -1] <= radius) & (k < tree.n)  # the ball holds more than k
-            bounds, piece, sigma, gap = self._near_pieces(
-                block, distance, index, radius, more, slack, chunk_piece, half
-            )
-            row = np.repeat(np.arange(len(block)), np.diff(bounds))
-            parts.append((finite[start + row], piece, sigma, gap))
-            for rows, chunk in self._ball_chunks(block, np.flatnonzero(more), radius):
-                row, piece, sigma, gap = self._pairs(block, first, rows, chunk, slack)
-                parts.append((finite[start + row], piece, sigma, gap))
+            first, radius = np.zeros(len(block)), np.zeros(len(block))
+            more = np.arange(len(block))
+            found = []  # each point's pairs come from one query only, sorted by piece
+            for k in (min(k_first, tree.n), min(_WIDER * k_first, tree.n)):
+                # a finely sampled path puts more than k chunks in many balls: ask again for
+                # more neighbours, vectorised, before going ball by ball
+                distance, index = tree.query(block[more], k=k)
+                distance, index = distance.reshape(len(more), k), index.reshape(len(more), k)
+                first[more] = distance[:, 0]
+                radius[more] = self._radius(distance[:, 0], slack + widest)
+                full = (distance[:, -1] <= radius[more]) & (k < tree.n)  # more than k chunks
+                bounds, piece, sigma, gap = self._near_pieces(
+                    block[more], distance, index, radius[more], full, slack, chunk_piece, half
+                )
+                found.append(
+                    (more[np.repeat(np.arange(len(more)), np.diff(bounds))], piece, sigma, gap)
+                )
+                more = more[full]
+                if more.size == 0:
+                    break
+            for rows, chunk in self._ball_chunks(block, more, radius):
+                found.append(self._pairs(block, first, rows, chunk, slack))
+            row, piece, sigma, gap = (np.concatenate(values) for values in zip(*found, strict=True))
+            order = np.argsort(row, kind="stable")  # a few sorted runs: merged in linear time
+            parts.append((finite[start + row[order]], piece[order], sigma[order], gap[order]))
         return self._gathered(points, finite, parts)
 
     def _gathered(
