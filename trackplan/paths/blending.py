@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from trackplan.paths._kernels import nearest_distance
 from trackplan.paths.geometry import (
     Arc,
     Line,
@@ -39,6 +40,7 @@ from trackplan.paths.geometry import (
     hermite_offsets,
     start_jet,
 )
+from trackplan.paths.piece_table import PieceTable
 
 # Parameter samples of a blend when measuring its deviation and peak curvature.
 _N_SAMPLES = 513
@@ -161,8 +163,13 @@ def blend_deviation(
 
 
 def _distances(points: np.ndarray, neighbours: tuple[Primitive, ...]) -> np.ndarray:
-    """Distance (N,) of ``points`` (N, 3) from the nearest of ``neighbours``, m."""
-    return np.min([curve.project(points)[1] for curve in neighbours], axis=0)
+    """Distance (N,) of ``points`` (N, 3) from the nearest of ``neighbours``, m (compiled:
+    the blend search measures a few dozen points hundreds of times)."""
+    t = PieceTable.from_curves(neighbours)
+    return nearest_distance(
+        np.ascontiguousarray(points, dtype=float), t.is_arc, t.start, t.direction, t.length,
+        t.center, t.axis, t.e1, t.e2, t.radius, t.angle,
+    )  # fmt: skip
 
 
 def _curvature(offsets: np.ndarray) -> np.ndarray:
