@@ -11,7 +11,8 @@ Run with ``python -m benchmarks robustness``. Three sections:
    validated, and those that validate planned. Prints the exit codes, exit-1s, tracebacks,
    runs over 10 s and exit-2 messages that do not name the key (targets: 0 each).
 3. A 20,000-point smooth helix (a points file): wall time and peak memory of ``validate``,
-   ``plan`` and ``check``, each a fresh process (targets: 10 s and 1 GB each).
+   ``plan`` and ``check``, each a fresh process (targets: 10 s and 1 GB each), and the CPU
+   time of writing the plan's trajectory.csv against ``numpy.savetxt`` (``%.17g``).
 """
 
 from __future__ import annotations
@@ -25,8 +26,10 @@ from pathlib import Path
 import numpy as np
 
 from trackplan.io.case_file import load_case
+from trackplan.io.csv_table import write_csv_table
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
+from trackplan.run_files import TRAJECTORY_FILE
 from trackplan.status import Status
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
@@ -103,6 +106,31 @@ def helix() -> None:
             print(
                 f"  {label:<14}{shown}  CPU {cpu:6.1f} s  peak {peak / 2**30:5.2f} GiB  exit {code}"
             )
+        _csv_writer(folder / "run" / TRAJECTORY_FILE)
+
+
+def _csv_writer(trajectory: Path) -> None:
+    """CPU time of writing the plan's trajectory.csv: the exact writer against numpy.savetxt."""
+    if not trajectory.is_file():
+        print("  no trajectory.csv to time the CSV writer on")
+        return
+    table = np.loadtxt(trajectory, delimiter=",", skiprows=1, ndmin=2)
+    header = [f"c{i}" for i in range(table.shape[1])]
+    out = trajectory.with_name("again.csv")
+    write_csv_table(out, table[:2], header)  # the kernel loaded, as in a plan
+    start = time.process_time()
+    write_csv_table(out, table, header)
+    exact = time.process_time() - start
+    same = np.array_equal(np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2), table)
+    size = out.stat().st_size
+    start = time.process_time()
+    np.savetxt(out, table, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+    reference = time.process_time() - start
+    print(
+        f"  writing its trajectory.csv ({table.size:,} values): {exact:.2f} s CPU, "
+        f"{size / 1e6:.0f} MB, read back bit for bit: {same}; numpy.savetxt %.17g "
+        f"{reference:.2f} s, {out.stat().st_size / 1e6:.0f} MB ({reference / exact:.1f} times)"
+    )
 
 
 def _measure(command: list[str]) -> tuple[float, float, float, int | None]:
