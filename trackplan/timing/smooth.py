@@ -38,6 +38,7 @@ from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.timing import _kernels
+from trackplan.timing.continuous import SpeedCurve, plan_speed_curve
 from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
@@ -148,9 +149,79 @@ def plan_smooth_time_law(
         motion = SampledMotion(robot, joint_path.joints(s), sample_time)
         worst = run_motion_checks(checks, motion)
         if not worst[0].size:
-            return _sampled(plans, task, s, motion, iteration, converged=True)
+            law = _sampled(plans, task, s, motion, iteration, converged=True)
+            return _or_curve(law, plans, profile.duration, joint_path, task, checks)
         planner.tighten(worst, s, t / time_scale, profile)
-    return _sampled(plans, task, s, motion, MAX_ITERATIONS, converged=False)
+    law = _sampled(plans, task, s, motion, MAX_ITERATIONS, converged=False)
+    return _or_curve(law, plans, profile.duration, joint_path, task, checks)
+
+
+CURVE_SHARE = 0.05
+"""Share of the window plan's time spent in windows the joint limits slow down above which
+the law also plans one continuous speed curve (:mod:`trackplan.timing.continuous`) and keeps
+the faster of the two."""
+
+
+def _or_curve(
+    law: TimeLaw,
+    plans: list[ZonePlan],
+    duration: float,
+    joint_path: JointPath,
+    task: Task,
+    checks: tuple[SampleCheck, ...],
+) -> TimeLaw:
+    """The window law, or the continuous speed curve where the joints slow the windows down
+    enough for it to pay (:data:`CURVE_SHARE`) and it is faster (or the windows failed)."""
+    limited = sum(
+        (p.s_end - p.s_start) / p.plateau
+        for p in plans
+        if p.kind != "stop" and p.plateau > 0.0 and p.reason not in ("rated speed", "corner speed")
+    )
+    if law.success and limited < CURVE_SHARE * duration:
+        return law
+    curve = plan_speed_curve(joint_path, task, checks, LIMIT_SHARE)
+    if curve is None or (law.success and curve.duration >= law.duration):
+        return law
+    return TimeLaw(
+        timing=Timing.SMOOTH,
+        success=True,
+        status=Status.FEASIBLE,
+        message="",
+        sample_time=task.sample_time,
+        s=curve.s,
+        q=curve.motion.q,
+        slowdowns=_curve_slowdowns(curve, joint_path, task.rated_speed),
+        iterations=law.iterations + curve.rebuilds,
+        motion=curve.motion,
+    )
+
+
+def _curve_slowdowns(
+    curve: SpeedCurve, joint_path: JointPath, rated: float
+) -> tuple[SlowDown, ...]:
+    """Where a speed curve runs a straight piece below the rated speed because the joints
+    cannot hold it there at a constant speed (as the windows do): each run of such nodes,
+    at the lowest speed planned on it and the limit that sets its lowest cap."""
+    straight = np.zeros(len(curve.s_nodes), dtype=bool)
+    for s0, s1, kind in joint_path.geometry.zones():
+        if kind == "straight":
+            straight |= (curve.s_nodes >= s0) & (curve.s_nodes <= s1)
+    forced = straight & (curve.joint_cap < rated) & (curve.speed < rated * (1 - 1e-9))
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], forced.astype(int), [0]])))
+    out = []
+    for first, stop in zip(edges[::2], edges[1::2], strict=True):
+        rows = slice(first, stop)
+        lowest = first + int(np.argmin(curve.joint_cap[rows]))
+        out.append(
+            SlowDown(
+                float(curve.s_nodes[first]),
+                float(curve.s_nodes[stop - 1]),
+                float(curve.speed[rows].min()),
+                rated,
+                str(curve.reason[lowest]),
+            )
+        )
+    return tuple(out)
 
 
 def _sampled(

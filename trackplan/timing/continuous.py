@@ -1,0 +1,390 @@
+"""A continuous speed curve under the joint limits, for paths whose speed cap varies quickly.
+
+Near a wrist singularity the joints cap the path speed along a stretch whose cap changes
+every few millimetres. The window plan of :mod:`trackplan.timing.smooth` then holds a
+staircase of short plateaus under the lowest constant-speed cap of each window, where the
+jerk-limited optimum follows the cap continuously, and even rises above it where a speed
+change cancels part of the joint demand (``q' s̈`` against ``q'' ṡ²``). This module plans
+the speed as one curve instead.
+
+With ``x(s) = ṡ²`` (so ``s̈ = x'/2`` and ``s⃛ = ṡ x''/2``) the joint velocity, acceleration
+and jerk are
+
+    q̇ = q' √x,    q̈ = q' x'/2 + q'' x,    q⃛ = √x (q' x''/2 + 3 q'' x'/2 + q''' x).
+
+On a uniform grid of nodes (spacing at most :data:`NODE_SPACING`) with central differences
+for ``x'`` and ``x''`` the acceleration is linear in x, and so is the jerk once ``√x`` is
+bounded by a speed ``v̄`` known to lie above it: ``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄``
+with ``x ≤ v̄²`` is a sufficient (conservative) form. Maximising ``Σ x`` under these linear
+bounds, the velocity limits and the task's speed caps is a linear program (HiGHS, through
+:func:`scipy.optimize.linprog`), solved :data:`ROUNDS` times with ``v̄`` lowered towards the
+previous solution. The signed joint-path derivatives enter as they are, so the curve uses
+the cancellations the optimum uses.
+
+Each stretch between stops is planned from rest to rest. The nodes become times by the
+constant-acceleration step ``Δt = 2h / (ṡ_k + ṡ_{k+1})``, and s(t) is a quintic Hermite
+curve through (s, ṡ, s̈) at the nodes, sampled at Ts. The samples go through the law's
+sample checks; where one fails, the limits of the nodes around it are lowered by the
+ratio found and the curve is planned again (:data:`MAX_REBUILDS` times at most).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sparse
+from scipy.interpolate import make_interp_spline
+from scipy.optimize import linprog
+
+from trackplan.case import Task
+from trackplan.jointpath import JointPath
+from trackplan.motion import SampledMotion
+from trackplan.robots.model import Robot
+from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, run_motion_checks
+
+NODE_SPACING = 1e-3
+"""Largest distance between two nodes of the speed curve, m."""
+MIN_NODES = 24
+"""Fewest nodes of a stretch between stops (a short stretch gets a finer spacing)."""
+ROUNDS = 2
+"""Linear programs per plan: the first bounds √x by the speed caps, the second by
+:data:`SPEED_ROOM` times the first solution."""
+SPEED_ROOM = 1.3
+"""How far above the first round's speed the second round may go (its jerk bound assumes
+the speed stays below it)."""
+MAX_REBUILDS = 10
+"""Plans of the curve with lowered limits before the law gives up on it."""
+REST_JERK_SHARE = 0.7
+"""Share of the path jerk the joints allow that a start from rest or a stop plans with."""
+REBUILD_REACH = 3
+"""Nodes on each side of a failing sample whose limits a rebuild lowers."""
+CAP_SHARE = 0.999
+"""Share of the task's speed caps the curve plans against: its spline rings slightly (about
+1e-4) above a cruise it joins."""
+OVER_SPEED_RATIO = 2.0
+"""A sample over the speed cap halves the jerk limits planned around it (the ringing of the
+spline as it joins a cruise grows with the jerk of the approach)."""
+REBUILD_FACTOR = 0.97
+"""A rebuild lowers the failing limit to this share of its value over the ratio found."""
+
+
+@dataclass(frozen=True, eq=False)
+class SpeedCurve:
+    """A sampled continuous speed curve that passed its sample checks.
+
+    Attributes
+    ----------
+    s
+        Arc length at each sample, shape (N,), m; from 0 to the path's length.
+    motion
+        The samples' joints with their backward differences, as the checks read them.
+    s_nodes, speed
+        The nodes (G,), m, and the path speed planned there (G,), m/s.
+    joint_cap
+        Highest constant speed the joint limits allow at each node, shape (G,), m/s.
+    reason
+        What sets it there, e.g. ``"joint 4 jerk"``, shape (G,).
+    rebuilds
+        Plans of the curve it took (1 when the first passed).
+    """
+
+    s: np.ndarray
+    motion: SampledMotion
+    s_nodes: np.ndarray
+    speed: np.ndarray
+    joint_cap: np.ndarray
+    reason: np.ndarray
+    rebuilds: int
+
+    @property
+    def duration(self) -> float:
+        """Time of the last sample, s."""
+        return (len(self.s) - 1) * self.motion.sample_time
+
+
+@dataclass(frozen=True, eq=False)
+class _Stretch:
+    """Nodes of one stretch between stops and the joint demand at them.
+
+    ``d1, d2, d3`` have shape (2, G, n): the derivatives just before and just after each
+    node (they differ only at zone boundaries, where both are checked).
+    """
+
+    s: np.ndarray
+    cap: np.ndarray
+    d1: np.ndarray
+    d2: np.ndarray
+    d3: np.ndarray
+
+
+def plan_speed_curve(
+    joint_path: JointPath,
+    task: Task,
+    checks: tuple[SampleCheck, ...],
+    share: float,
+) -> SpeedCurve | None:
+    """The continuous speed curve of a joint path (see the module), or None.
+
+    Parameters
+    ----------
+    joint_path
+        q(s) with its derivatives on the planning grid.
+    task
+        Rated and corner speeds, m/s, and Ts, s.
+    checks
+        The sample checks the samples must pass.
+    share
+        Share of each joint limit planned against.
+
+    Returns
+    -------
+    SpeedCurve or None
+        None when a linear program fails or the samples still fail a check after
+        :data:`MAX_REBUILDS` plans.
+    """
+    stretches = _stretches(joint_path, task)
+    robot = joint_path.robot
+    scales = [np.ones((3, len(st.s))) for st in stretches]
+    for rebuild in range(1, MAX_REBUILDS + 1):
+        speeds = []
+        for stretch, scale in zip(stretches, scales, strict=True):
+            limits = (
+                share
+                * scale[:, :, None]
+                * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
+            )
+            x = _solve(stretch, limits)
+            if x is None:
+                return None
+            speeds.append(np.sqrt(x))
+        s = _sample(stretches, speeds, task.sample_time)
+        motion = SampledMotion(robot, joint_path.joints(s), task.sample_time)
+        sample, order, ratio = run_motion_checks(checks, motion)
+        fast = _over_speed(s, task, stretches)
+        if not sample.size and not fast.size:
+            s_nodes = np.concatenate([st.s for st in stretches])
+            speed = np.concatenate(speeds)
+            caps = [_joint_caps(st, robot, share) for st in stretches]
+            joint_cap = np.concatenate([c[0] for c in caps])
+            reason = np.concatenate([c[1] for c in caps])
+            return SpeedCurve(s, motion, s_nodes, speed, joint_cap, reason, rebuild)
+        # the spline rings above a speed cap it joins: a gentler approach there
+        sample = np.concatenate([sample, fast])
+        order = np.concatenate([order, np.full(fast.size, 3)])
+        ratio = np.concatenate([ratio, np.full(fast.size, OVER_SPEED_RATIO)])
+        for stretch, scale in zip(stretches, scales, strict=True):
+            _lower(stretch.s, scale, s[sample], order, ratio)
+    return None
+
+
+def _stretches(joint_path: JointPath, task: Task) -> list[_Stretch]:
+    """The stretches between stops, each with its nodes, caps and joint demand."""
+    zones = joint_path.geometry.zones()
+    bounds = [0.0] + [z[0] for z in zones if z[2] == "stop"] + [zones[-1][1]]
+    moving = [(z, zone) for z, zone in enumerate(zones) if zone[2] != "stop"]
+    out = []
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        if b - a <= 1e-12:
+            continue
+        count = max(MIN_NODES, int(np.ceil((b - a) / NODE_SPACING)) + 1)
+        s = np.linspace(a, b, count)
+        h = s[1] - s[0]
+        inside = [(z, zone) for z, zone in moving if zone[0] < b and zone[1] > a]
+        cap = np.full(count, np.inf)
+        for _, (s0, s1, kind) in inside:
+            speed = task.rated_speed
+            if kind != "straight":
+                speed = min(task.rated_speed, task.corner_speed * (1.0 - LIMIT_MARGIN))
+            near = (s >= s0 - h) & (s <= s1 + h)  # a node's neighbourhood touches the zone
+            cap[near] = np.minimum(cap[near], CAP_SHARE * speed)
+        rows = np.isin(joint_path.zone, [z for z, _ in inside])
+        grid = joint_path.s[rows]
+        sides = []
+        for derivative in (joint_path.dq, joint_path.ddq, joint_path.dddq):
+            values = derivative[rows]
+            sides.append(np.stack([_interp(s, grid, values, last) for last in (True, False)]))
+        out.append(_Stretch(s, cap, *sides))
+    return out
+
+
+def _interp(s: np.ndarray, grid: np.ndarray, values: np.ndarray, last: bool) -> np.ndarray:
+    """Linear interpolation of ``values`` (G, n) on a grid with repeated zone boundaries,
+    taking the last (``last``) or first of the repeated rows, shape (M, n)."""
+    if last:
+        distinct, index = np.unique(grid[::-1], return_index=True)
+        index = len(grid) - 1 - index
+    else:
+        distinct, index = np.unique(grid, return_index=True)
+    return np.stack(
+        [np.interp(s, distinct, values[index, j]) for j in range(values.shape[1])], axis=1
+    )
+
+
+def _solve(stretch: _Stretch, limits: np.ndarray) -> np.ndarray | None:
+    """Node values of ``x = ṡ²`` (G,) maximising ``Σ x`` under the limits (see the module).
+
+    Parameters
+    ----------
+    limits
+        Joint velocity, acceleration and jerk limits at each node, shape (3, G, n).
+    """
+    s, d1, d2, d3 = stretch.s, stretch.d1, stretch.d2, stretch.d3
+    count = len(s)
+    h = s[1] - s[0]
+    with np.errstate(divide="ignore"):
+        velocity = np.min(limits[0] / np.abs(d1), axis=(0, 2))
+    top = np.minimum(np.minimum(stretch.cap, velocity) ** 2, _rest_envelope(s, d1, limits[2]))
+    k = np.arange(1, count - 1)
+    # accel:  q' (x[k+1] - x[k-1]) / (4h) + q'' x[k]
+    # jerk:   q' (x[k+1] - 2 x[k] + x[k-1]) / (2h²) + 1.5 q'' (x[k+1] - x[k-1]) / (2h) + q''' x[k]
+    q1, q2, q3 = d1[:, k], d2[:, k], d3[:, k]  # (2, m, n)
+    c1, c2 = q1 / (2 * h * h), 0.75 * q2 / h
+    coefficients = np.stack(
+        [
+            np.stack([-q1 / (4 * h), q2, q1 / (4 * h)], axis=-1),
+            np.stack([c1 - c2, q3 - 2 * c1, c1 + c2], axis=-1),
+        ]
+    )  # (2 kinds, 2 sides, m, n, 3 columns)
+    columns = np.broadcast_to(
+        np.stack([k - 1, k, k + 1], axis=-1)[None, None, :, None, :], coefficients.shape
+    )
+    matrix_coefficients = np.concatenate([coefficients, -coefficients], axis=0).reshape(-1, 3)
+    matrix_columns = np.concatenate([columns, columns], axis=0).reshape(-1, 3)
+    rows = np.repeat(np.arange(len(matrix_columns)), 3)
+    x = top
+    for _ in range(ROUNDS):
+        bound = np.sqrt(x)
+        with np.errstate(divide="ignore"):
+            jerk = limits[2][k] / np.maximum(bound[k], 1e-9)[:, None]
+        rhs = np.stack([np.broadcast_to(limits[1][k], jerk.shape), jerk])[:, None]  # (2,1,m,n)
+        rhs = np.broadcast_to(rhs, coefficients.shape[:-1])
+        matrix = sparse.csr_matrix(
+            (matrix_coefficients.ravel(), (rows, matrix_columns.ravel())),
+            shape=(len(matrix_columns), count),
+        )
+        result = linprog(
+            -np.ones(count),
+            A_ub=matrix,
+            b_ub=np.concatenate([rhs, rhs]).ravel(),
+            bounds=np.stack([np.zeros(count), x], axis=1),
+            method="highs",
+        )
+        if result.status != 0:
+            return None
+        solution = np.clip(result.x, 0.0, x)
+        x = np.minimum(top, SPEED_ROOM**2 * solution)
+    return solution
+
+
+def _rest_envelope(s: np.ndarray, d1: np.ndarray, jerk: np.ndarray) -> np.ndarray:
+    """Bound on ``x = ṡ²`` (G,) near the rests at both ends of a stretch.
+
+    Leaving or reaching a rest at a constant path jerk ``J`` covers ``s = J t³/6`` at
+    ``ṡ = J t²/2``, so ``x = (6^(4/3)/4) J^(2/3) s^(4/3)`` at a distance ``s`` from the rest.
+    ``J`` is :data:`REST_JERK_SHARE` of the lowest path jerk ``q⃛max / |q'|`` between the rest
+    and the node (the rest of the joint jerk is left to the terms in q'' and q'''). The
+    linear program's difference quotients cannot see the first interval, where the
+    acceleration must grow from zero; this bound shapes it.
+
+    Parameters
+    ----------
+    s
+        Nodes, shape (G,), m.
+    d1
+        q' before and after each node, shape (2, G, n), rad/m.
+    jerk
+        Joint jerk limits at each node, shape (G, n), rad/s³.
+    """
+    with np.errstate(divide="ignore"):
+        path_jerk = REST_JERK_SHARE * np.min(jerk / np.abs(d1), axis=(0, 2))
+    forward = np.minimum.accumulate(path_jerk)
+    backward = np.minimum.accumulate(path_jerk[::-1])[::-1]
+    start = 6.0 ** (4.0 / 3.0) / 4.0 * np.cbrt(forward * (s - s[0]) ** 2) ** 2
+    end = 6.0 ** (4.0 / 3.0) / 4.0 * np.cbrt(backward * (s[-1] - s) ** 2) ** 2
+    return np.minimum(start, end)
+
+
+def _sample(stretches: list[_Stretch], speeds: list[np.ndarray], sample_time: float) -> np.ndarray:
+    """Arc length at Ts along the curve, from rest to rest, shape (N,), m.
+
+    Node times from constant acceleration between nodes (constant jerk next to a rest).
+    The fraction of a period left at the end is given to the final stop: the steps after
+    the last stretch's top speed last that much longer, so every speed before it is kept
+    exactly. s(t) of each stretch is the quintic spline through (t, s) at the nodes, at
+    rest (ṡ = s̈ = 0) at both ends, so its jerk is continuous.
+    """
+    steps = []
+    for stretch, v in zip(stretches, speeds, strict=True):
+        step = 2.0 * (stretch.s[1] - stretch.s[0]) / np.maximum(v[1:] + v[:-1], 1e-300)
+        step[[0, -1]] *= 1.5  # from and to rest at constant jerk: s/ṡ = t/3, not t/2
+        steps.append(step)
+    duration = float(sum(step.sum() for step in steps))
+    n_steps = max(1, int(np.ceil(duration / sample_time - 1e-9)))
+    last = speeds[-1]
+    top = len(last) - 1 - int(np.argmax(last[::-1]))  # the last node at the top speed
+    tail = steps[-1][top:].sum()
+    steps[-1][top:] *= (tail + n_steps * sample_time - duration) / tail
+    times = np.arange(n_steps + 1) * sample_time
+    out = np.empty(len(times))
+    start = 0.0
+    rest = [(1, 0.0), (2, 0.0)]
+    for stretch, step in zip(stretches, steps, strict=True):
+        t = start + np.concatenate([[0.0], np.cumsum(step)])
+        spline = make_interp_spline(t, stretch.s, k=5, bc_type=(rest, rest))
+        inside = (times >= t[0] - 1e-9 * sample_time) & (times <= t[-1] + 1e-9 * sample_time)
+        out[inside] = spline(np.clip(times[inside], t[0], t[-1]))
+        start = t[-1]
+    first, end = stretches[0].s[0], stretches[-1].s[-1]
+    out = np.maximum.accumulate(np.clip(out, first, end))
+    out[-1] = end
+    return out
+
+
+def _over_speed(s: np.ndarray, task: Task, stretches: list[_Stretch]) -> np.ndarray:
+    """Samples whose mean speed over the period before them, ``Δs / Ts``, passes the cap of
+    the zone they end in or of the one before, shape (V,), int (the caps of the nodes
+    around them, which lie on the lower side at a zone boundary)."""
+    nodes = np.concatenate([st.s for st in stretches])
+    caps = np.concatenate([st.cap for st in stretches])
+    cap = caps[np.clip(np.searchsorted(nodes, s), 0, len(nodes) - 1)] / CAP_SHARE
+    cap[1:] = np.maximum(cap[1:], cap[:-1])
+    speed = np.diff(s, prepend=s[0]) / task.sample_time
+    return np.flatnonzero(speed > cap * (1.0 + 1e-9))
+
+
+def _lower(
+    s_nodes: np.ndarray, scale: np.ndarray, s_bad: np.ndarray, order: np.ndarray, ratio: np.ndarray
+) -> None:
+    """Lower the limit of each failing order at the nodes around each failing sample."""
+    h = s_nodes[1] - s_nodes[0]
+    reach = REBUILD_REACH * h
+    inside = (s_bad >= s_nodes[0] - reach) & (s_bad <= s_nodes[-1] + reach)
+    factor = np.ones_like(scale)
+    for where, o, r in zip(s_bad[inside], order[inside], ratio[inside], strict=True):
+        # full lowering within the reach, tapering off over as much again beyond it, so
+        # the lowered limit has no step of its own
+        taper = np.clip(2.0 - np.abs(s_nodes - where) / reach, 0.0, 1.0)
+        lowered = 1.0 - taper * (1.0 - REBUILD_FACTOR / r)
+        factor[o - 1] = np.minimum(factor[o - 1], lowered)
+    scale *= factor
+
+
+def _joint_caps(stretch: _Stretch, robot: Robot, share: float) -> tuple[np.ndarray, np.ndarray]:
+    """Highest constant speed the joints allow at each node, shape (G,), m/s, and what sets
+    it (e.g. ``"joint 4 jerk"``), shape (G,)."""
+    q1, q2, q3 = (np.abs(d).max(axis=0) for d in (stretch.d1, stretch.d2, stretch.d3))
+    with np.errstate(divide="ignore"):
+        caps = np.stack(
+            [
+                share * robot.v_max / q1,
+                np.sqrt(share * robot.a_max / q2),
+                np.cbrt(share * robot.j_max / q3),
+            ]
+        )  # (3, G, n)
+    flat = caps.transpose(1, 0, 2).reshape(len(stretch.s), -1)
+    best = np.argmin(flat, axis=1)
+    n = robot.n_dof
+    kinds = ("velocity", "acceleration", "jerk")
+    reasons = np.array([f"joint {b % n + 1} {kinds[b // n]}" for b in best])
+    return flat[np.arange(len(best)), best], reasons
