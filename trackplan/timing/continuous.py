@@ -30,6 +30,7 @@ ratio found and the curve is planned again (:data:`MAX_REBUILDS` times at most).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -184,7 +185,7 @@ def _stretches(joint_path: JointPath, task: Task) -> list[_Stretch]:
     bounds = [0.0] + [z[0] for z in zones if z[2] == "stop"] + [zones[-1][1]]
     moving = [(z, zone) for z, zone in enumerate(zones) if zone[2] != "stop"]
     out = []
-    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+    for a, b in itertools.pairwise(bounds):
         if b - a <= 1e-12:
             continue
         count = max(MIN_NODES, int(np.ceil((b - a) / NODE_SPACING)) + 1)
