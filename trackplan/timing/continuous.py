@@ -54,6 +54,9 @@ ROUNDS = 2
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
+MAX_DURATION = 600.0
+"""Longest curve sampled, s: a curve that would take longer has (almost) stopped inside a
+stretch, and the window law stands."""
 MAX_REBUILDS = 10
 """Plans of the curve with lowered limits before the law gives up on it."""
 REST_JERK_SHARE = 0.7
@@ -63,9 +66,6 @@ REBUILD_REACH = 3
 CAP_SHARE = 0.999
 """Share of the task's speed caps the curve plans against: its spline rings slightly (about
 1e-4) above a cruise it joins."""
-OVER_SPEED_RATIO = 2.0
-"""A sample over the speed cap halves the jerk limits planned around it (the ringing of the
-spline as it joins a cruise grows with the jerk of the approach)."""
 REBUILD_FACTOR = 0.97
 """A rebuild lowers the failing limit to this share of its value over the ratio found."""
 
@@ -146,23 +146,25 @@ def plan_speed_curve(
     """
     stretches = _stretches(joint_path, task)
     robot = joint_path.robot
-    scales = [np.ones((3, len(st.s))) for st in stretches]
+    scales = [np.ones((4, len(st.s))) for st in stretches]  # v, a, j limits; speed cap
     for rebuild in range(1, MAX_REBUILDS + 1):
         speeds = []
         for stretch, scale in zip(stretches, scales, strict=True):
             limits = (
                 share
-                * scale[:, :, None]
+                * scale[:3, :, None]
                 * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
             )
-            x = _solve(stretch, limits)
+            x = _solve(stretch, limits, scale[3])
             if x is None:
                 return None
             speeds.append(np.sqrt(x))
         s = _sample(stretches, speeds, task.sample_time)
+        if s is None:
+            return None
         motion = SampledMotion(robot, joint_path.joints(s), task.sample_time)
         sample, order, ratio = run_motion_checks(checks, motion)
-        fast = _over_speed(s, task, stretches)
+        fast, excess = _over_speed(s, task, stretches)
         if not sample.size and not fast.size:
             s_nodes = np.concatenate([st.s for st in stretches])
             speed = np.concatenate(speeds)
@@ -170,10 +172,10 @@ def plan_speed_curve(
             joint_cap = np.concatenate([c[0] for c in caps])
             reason = np.concatenate([c[1] for c in caps])
             return SpeedCurve(s, motion, s_nodes, speed, joint_cap, reason, rebuild)
-        # the spline rings above a speed cap it joins: a gentler approach there
+        # the spline rings above a speed cap it joins: a lower cap there (order 4)
         sample = np.concatenate([sample, fast])
-        order = np.concatenate([order, np.full(fast.size, 3)])
-        ratio = np.concatenate([ratio, np.full(fast.size, OVER_SPEED_RATIO)])
+        order = np.concatenate([order, np.full(fast.size, 4)])
+        ratio = np.concatenate([ratio, excess])
         for stretch, scale in zip(stretches, scales, strict=True):
             _lower(stretch.s, scale, s[sample], order, ratio)
     return None
@@ -222,20 +224,23 @@ def _interp(s: np.ndarray, grid: np.ndarray, values: np.ndarray, last: bool) -> 
     )
 
 
-def _solve(stretch: _Stretch, limits: np.ndarray) -> np.ndarray | None:
+def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.ndarray | None:
     """Node values of ``x = ṡ²`` (G,) maximising ``Σ x`` under the limits (see the module).
 
     Parameters
     ----------
     limits
         Joint velocity, acceleration and jerk limits at each node, shape (3, G, n).
+    cap_scale
+        Share of the speed cap planned at each node, shape (G,).
     """
     s, d1, d2, d3 = stretch.s, stretch.d1, stretch.d2, stretch.d3
     count = len(s)
     h = s[1] - s[0]
     with np.errstate(divide="ignore"):
         velocity = np.min(limits[0] / np.abs(d1), axis=(0, 2))
-    top = np.minimum(np.minimum(stretch.cap, velocity) ** 2, _rest_envelope(s, d1, limits[2]))
+    cap = stretch.cap * cap_scale
+    top = np.minimum(np.minimum(cap, velocity) ** 2, _rest_envelope(s, d1, limits[2]))
     k = np.arange(1, count - 1)
     # accel:  q' (x[k+1] - x[k-1]) / (4h) + q'' x[k]
     # jerk:   q' (x[k+1] - 2 x[k] + x[k-1]) / (2h²) + 1.5 q'' (x[k+1] - x[k-1]) / (2h) + q''' x[k]
@@ -306,8 +311,11 @@ def _rest_envelope(s: np.ndarray, d1: np.ndarray, jerk: np.ndarray) -> np.ndarra
     return np.minimum(start, end)
 
 
-def _sample(stretches: list[_Stretch], speeds: list[np.ndarray], sample_time: float) -> np.ndarray:
-    """Arc length at Ts along the curve, from rest to rest, shape (N,), m.
+def _sample(
+    stretches: list[_Stretch], speeds: list[np.ndarray], sample_time: float
+) -> np.ndarray | None:
+    """Arc length at Ts along the curve, from rest to rest, shape (N,), m (None when the
+    curve stops inside a stretch or would last :data:`MAX_DURATION` or more).
 
     Node times from constant acceleration between nodes (constant jerk next to a rest).
     The fraction of a period left at the end is given to the final stop: the steps after
@@ -321,6 +329,8 @@ def _sample(stretches: list[_Stretch], speeds: list[np.ndarray], sample_time: fl
         step[[0, -1]] *= 1.5  # from and to rest at constant jerk: s/ṡ = t/3, not t/2
         steps.append(step)
     duration = float(sum(step.sum() for step in steps))
+    if not duration < MAX_DURATION:
+        return None
     n_steps = max(1, int(np.ceil(duration / sample_time - 1e-9)))
     last = speeds[-1]
     top = len(last) - 1 - int(np.argmax(last[::-1]))  # the last node at the top speed
@@ -342,22 +352,26 @@ def _sample(stretches: list[_Stretch], speeds: list[np.ndarray], sample_time: fl
     return out
 
 
-def _over_speed(s: np.ndarray, task: Task, stretches: list[_Stretch]) -> np.ndarray:
+def _over_speed(
+    s: np.ndarray, task: Task, stretches: list[_Stretch]
+) -> tuple[np.ndarray, np.ndarray]:
     """Samples whose mean speed over the period before them, ``Δs / Ts``, passes the cap of
     the zone they end in or of the one before, shape (V,), int (the caps of the nodes
-    around them, which lie on the lower side at a zone boundary)."""
+    around them, which lie on the lower side at a zone boundary), and speed / cap there."""
     nodes = np.concatenate([st.s for st in stretches])
     caps = np.concatenate([st.cap for st in stretches])
     cap = caps[np.clip(np.searchsorted(nodes, s), 0, len(nodes) - 1)] / CAP_SHARE
     cap[1:] = np.maximum(cap[1:], cap[:-1])
     speed = np.diff(s, prepend=s[0]) / task.sample_time
-    return np.flatnonzero(speed > cap * (1.0 + 1e-9))
+    bad = np.flatnonzero(speed > cap * (1.0 + 1e-9))
+    return bad, speed[bad] / cap[bad]
 
 
 def _lower(
     s_nodes: np.ndarray, scale: np.ndarray, s_bad: np.ndarray, order: np.ndarray, ratio: np.ndarray
 ) -> None:
-    """Lower the limit of each failing order at the nodes around each failing sample."""
+    """Lower the limit of each failing order at the nodes around each failing sample
+    (order 4: the speed cap, by the excess found and twice as much again)."""
     h = s_nodes[1] - s_nodes[0]
     reach = REBUILD_REACH * h
     inside = (s_bad >= s_nodes[0] - reach) & (s_bad <= s_nodes[-1] + reach)
@@ -366,7 +380,8 @@ def _lower(
         # full lowering within the reach, tapering off over as much again beyond it, so
         # the lowered limit has no step of its own
         taper = np.clip(2.0 - np.abs(s_nodes - where) / reach, 0.0, 1.0)
-        lowered = 1.0 - taper * (1.0 - REBUILD_FACTOR / r)
+        target = REBUILD_FACTOR / r if o < 4 else (1.0 - 2.0 * (r - 1.0)) / r
+        lowered = 1.0 - taper * (1.0 - target)
         factor[o - 1] = np.minimum(factor[o - 1], lowered)
     scale *= factor
 
