@@ -21,11 +21,14 @@ bounds, the velocity limits and the task's speed caps is a linear program (HiGHS
 previous solution. The signed joint-path derivatives enter as they are, so the curve uses
 the cancellations the optimum uses.
 
-Each stretch between stops is planned from rest to rest. The nodes become times by the
-constant-acceleration step ``Δt = 2h / (ṡ_k + ṡ_{k+1})``, and s(t) is a quintic Hermite
-curve through (s, ṡ, s̈) at the nodes, sampled at Ts. The samples go through the law's
-sample checks; where one fails, the limits of the nodes around it are lowered by the
-ratio found and the curve is planned again (:data:`MAX_REBUILDS` times at most).
+Each stretch between stops is planned from rest to rest; next to a rest, where the
+difference quotients cannot see the acceleration grow from zero, x is also bounded by a
+start at constant path jerk (:func:`_rest_envelope`). The nodes become times by the
+constant-acceleration step ``Δt = 2h / (ṡ_k + ṡ_{k+1})`` (constant jerk next to a rest), and
+s(t) is the quintic spline through (t, s) at the nodes, at rest at both ends, sampled at Ts.
+The samples go through the law's sample checks and the speed caps; where one fails, the
+limits (or the cap) of the nodes around it are lowered by the ratio found and the curve is
+planned again (:data:`MAX_REBUILDS` times at most).
 """
 
 from __future__ import annotations
@@ -54,9 +57,9 @@ ROUNDS = 2
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
-MAX_DURATION = 600.0
-"""Longest curve sampled, s: a curve that would take longer has (almost) stopped inside a
-stretch, and the window law stands."""
+MAX_DURATION = 2000.0
+"""Longest curve sampled, s (the window law's longest, 2 000 000 samples at 1 ms): a curve
+that would take longer has (almost) stopped inside a stretch, and the window law stands."""
 MAX_REBUILDS = 10
 """Plans of the curve with lowered limits before the law gives up on it."""
 REST_JERK_SHARE = 0.7
