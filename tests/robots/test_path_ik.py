@@ -329,3 +329,46 @@ def test_branch_joints_of_a_numeric_robot_are_its_path_ik():
     path = solve_path_ik(robot, T[None], branch=1)
     found = branch_joints(robot, T, 1, path.q[0] - 2 * np.pi)
     np.testing.assert_allclose(found, path.q[0] - 2 * np.pi, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("robot_name", ["puma", "ur"])
+def test_screened_choice_is_the_choice_among_all_eight_branches(robot_name, request, monkeypatch):
+    """solve_path_ik analyses the branch with the most room pose by pose first and keeps
+    it alone only when no other branch can beat it: the same branch, joints, analysis and
+    message as choosing among all eight analysed branches, and the screen's bound is never
+    below a usable branch's analysed margin."""
+    from trackplan.robots import path_ik
+    from trackplan.robots._kernels import room_bounds
+    from trackplan.robots.families import ik_family
+
+    robot = request.getfixturevalue(robot_name)
+    base = feasible_line(300) if robot_name == "puma" else ur_line(robot, 300)
+    rng = np.random.default_rng(8)
+    X = np.column_stack([rng.normal(0.0, 0.08, (24, 3)), rng.normal(0.0, 0.4, (24, 3))])
+    T = placement_transform(X)[:, None] @ base[None]
+    gathered = []
+    real_gather = path_ik.gather_closed_form
+
+    def gather(*args):  # type: ignore[no-untyped-def]
+        gathered.append(args[-1].shape[1])
+        return real_gather(*args)
+
+    monkeypatch.setattr(path_ik, "gather_closed_form", gather)
+    short = 0
+    for c in range(len(X)):
+        gathered.clear()
+        chosen = solve_path_ik(robot, T[c : c + 1])
+        short += gathered == [1]
+        every = solve_path_ik_branches(robot, T[c : c + 1])
+        b = int(path_ik._choose(every.success, every.first_problem, every.margin)[0])
+        assert chosen.branch[0] == b
+        np.testing.assert_array_equal(chosen.q[0], every.q[0, b])
+        for field in ("reachable", "switch", "success", "margin", "first_problem", "winding"):
+            np.testing.assert_array_equal(getattr(chosen, field)[0], getattr(every, field)[0, b])
+        full = solve_path_ik(robot, T[c : c + 1], branch=b)
+        assert chosen.status == full.status and chosen.message == full.message
+        q_all, valid, _ = ik_family(robot).solve_flat(T[c])
+        bound = room_bounds(q_all[None], valid[None], robot.q_min, robot.q_max)[0]
+        usable = every.success[0]
+        assert np.all(bound[usable] >= every.margin[0, usable] - 1e-12)
+    assert 0 < short < len(X)  # both ways are exercised

@@ -2,7 +2,9 @@
 (or, on a path of few pieces, from every piece).
 
 The Python API is :class:`trackplan.paths.projection.PieceIndex`; the table layout is that
-of :class:`trackplan.paths.piece_table.PieceTable`.
+of :class:`trackplan.paths.piece_table.PieceTable`. :func:`blend_parameter` is the curve
+parameter of a quintic blend at arc lengths
+(:meth:`trackplan.paths.geometry.QuinticBlend.parameter`).
 """
 
 from __future__ import annotations
@@ -386,4 +388,80 @@ def nearest_distance(
             )[1]  # fmt: skip
             nearest = min(nearest, d)
         out[b] = nearest
+    return out
+
+
+@njit(cache=True, inline="always")
+def _horner(coefficients: np.ndarray, x: float) -> float:  # pragma: no cover
+    """Kernel: the polynomial with ascending ``coefficients`` at ``x`` (numpy's polyval)."""
+    value = coefficients[-1]
+    for i in range(coefficients.size - 2, -1, -1):
+        value = coefficients[i] + value * x
+    return value
+
+
+@njit(cache=True, inline="always")
+def _blend_arc_length(
+    u: float,
+    breaks: np.ndarray,
+    cumulative: np.ndarray,
+    speed_squared: np.ndarray,
+    nodes: np.ndarray,
+    weights: np.ndarray,
+) -> float:  # pragma: no cover
+    """Kernel: arc length from 0 to ``u``: the panel table, then Gauss–Legendre in the panel."""
+    n_panels = breaks.size - 1
+    panel = min(int(u * n_panels), n_panels - 1)
+    lower = breaks[panel]
+    half = 0.5 * (u - lower)
+    partial = 0.0
+    for i in range(nodes.size):
+        partial += math.sqrt(_horner(speed_squared, lower + half * (nodes[i] + 1.0))) * weights[i]
+    return cumulative[panel] + half * partial
+
+
+@njit(cache=True)
+def blend_parameter(
+    sigma: np.ndarray,
+    breaks: np.ndarray,
+    cumulative: np.ndarray,
+    speed_squared: np.ndarray,
+    nodes: np.ndarray,
+    weights: np.ndarray,
+) -> np.ndarray:  # pragma: no cover
+    """Kernel: the curve parameter u (M,) of a quintic blend at arc lengths ``sigma`` (M,).
+
+    Each point starts from the cubic Hermite interpolant of u(S) on the panel table
+    (``breaks``, ``cumulative``; du/dS = 1 / speed) and takes Newton steps until one is
+    below 1e-9 m, then one more (it lands at rounding level); at most 30.
+    """
+    n_table = breaks.size
+    slope = np.empty(n_table)
+    for k in range(n_table):
+        slope[k] = 1.0 / math.sqrt(_horner(speed_squared, breaks[k]))
+    length = cumulative[-1]
+    out = np.empty(sigma.size)
+    for m in range(sigma.size):
+        target = min(max(sigma[m], 0.0), length)
+        k = np.searchsorted(cumulative, target, side="right") - 1
+        k = min(max(k, 0), n_table - 2)
+        width = cumulative[k + 1] - cumulative[k]
+        x = (target - cumulative[k]) / width
+        x2, x3 = x * x, x * x * x
+        u = (
+            (2 * x3 - 3 * x2 + 1) * breaks[k]
+            + (x3 - 2 * x2 + x) * width * slope[k]
+            + (-2 * x3 + 3 * x2) * breaks[k + 1]
+            + (x3 - x2) * width * slope[k + 1]
+        )
+        for _ in range(30):
+            arc = _blend_arc_length(u, breaks, cumulative, speed_squared, nodes, weights)
+            step = (arc - target) / math.sqrt(_horner(speed_squared, u))
+            u = min(max(u - step, 0.0), 1.0)
+            if abs(step) < 1e-9:
+                arc = _blend_arc_length(u, breaks, cumulative, speed_squared, nodes, weights)
+                step = (arc - target) / math.sqrt(_horner(speed_squared, u))
+                u = min(max(u - step, 0.0), 1.0)
+                break
+        out[m] = u
     return out

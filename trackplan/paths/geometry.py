@@ -16,6 +16,8 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
+from trackplan.paths._kernels import blend_parameter
+
 #: A line is an arc whose turning angle is below this (rad): its sagitta is < 1e-9 of its length.
 STRAIGHT_ANGLE = 8e-9
 
@@ -504,28 +506,17 @@ class QuinticBlend:
         return self._cumulative[panel] + partial
 
     def parameter(self, sigma: np.ndarray) -> np.ndarray:
-        """Curve parameter u (M,) at arc lengths ``sigma`` (M,), m, to machine precision."""
-        sigma = np.clip(np.asarray(sigma, dtype=float), 0.0, self.length)
-        # Start from the cubic Hermite interpolant of u(S) on the panel table (du/dS = 1/speed),
-        # then Newton: once a step is below 1e-9 the next one lands at rounding level.
-        table_u, table_s = self._breaks, self._cumulative
-        slope = 1.0 / self.speed(table_u)
-        k = np.clip(np.searchsorted(table_s, sigma, side="right") - 1, 0, table_s.size - 2)
-        width = table_s[k + 1] - table_s[k]
-        x = (sigma - table_s[k]) / width
-        u = (
-            (2 * x**3 - 3 * x**2 + 1) * table_u[k]
-            + (x**3 - 2 * x**2 + x) * width * slope[k]
-            + (-2 * x**3 + 3 * x**2) * table_u[k + 1]
-            + (x**3 - x**2) * width * slope[k + 1]
+        """Curve parameter u (M,) at arc lengths ``sigma`` (M,), m, to machine precision.
+
+        Each point starts from the cubic Hermite interpolant of u(S) on the panel table
+        (du/dS = 1/speed) and takes Newton steps until one is below 1e-9, the next one
+        landing at rounding level: one compiled pass
+        (:func:`~trackplan.paths._kernels.blend_parameter`).
+        """
+        sigma = np.ascontiguousarray(sigma, dtype=float).ravel()
+        return blend_parameter(
+            sigma, self._breaks, self._cumulative, self._speed_squared, _GAUSS_NODES, _GAUSS_WEIGHTS
         )
-        for _ in range(30):
-            step = (self.arc_length(u) - sigma) / self.speed(u)
-            u = np.clip(u - step, 0.0, 1.0)
-            if np.max(np.abs(step), initial=0.0) < 1e-9:
-                step = (self.arc_length(u) - sigma) / self.speed(u)
-                return np.clip(u - step, 0.0, 1.0)
-        return u
 
     def evaluate(self, sigma: np.ndarray) -> CurveJet:
         """Position and arc-length derivatives at ``sigma`` (M,), m."""

@@ -430,6 +430,50 @@ def gather_closed_form(
 
 
 @njit(cache=True, error_model="numpy")
+def room_bounds(
+    q_all: np.ndarray, valid: np.ndarray, q_min: np.ndarray, q_max: np.ndarray
+) -> np.ndarray:  # pragma: no cover - compiled
+    """Kernel: an upper bound of each branch's path margin from its poses one at a time.
+
+    A joint value θ fits its limits by at most ``max_k min(θ + 2πk − q_min, q_max − θ −
+    2πk)``, reached at the k nearest the centre of the range. The continuous path through
+    a branch's poses, shifted by one multiple of 2π per joint, has no more margin than its
+    worst pose (:func:`analyse_paths`): the smallest of these over the poses and joints
+    bounds the branch's margin from above (up to the round-off of the unwrapping).
+    A branch that misses a pose is not usable: −inf.
+
+    Parameters
+    ----------
+    q_all, valid
+        Closed-form solutions (B, M, 8, n), rad, and their validity (B, M, 8).
+    q_min, q_max
+        Joint limits, shape (n,), rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (B, 8), rad.
+    """
+    n_cand, n_poses, n_branch, n = q_all.shape
+    two_pi = 2.0 * math.pi
+    bound = np.full((n_cand, n_branch), np.inf)
+    for b in range(n_cand):
+        for m in range(n_poses):
+            for k in range(n_branch):
+                if not valid[b, m, k]:
+                    bound[b, k] = -np.inf
+                    continue
+                for j in range(n):
+                    theta = q_all[b, m, k, j]
+                    middle = 0.5 * (q_min[j] + q_max[j])
+                    shift = two_pi * math.floor((middle - theta) / two_pi + 0.5)
+                    room = min(theta + shift - q_min[j], q_max[j] - theta - shift)
+                    if room < bound[b, k]:
+                        bound[b, k] = room
+    return bound
+
+
+@njit(cache=True, error_model="numpy")
 def numeric_paths(
     chain: np.ndarray,
     tool: np.ndarray,

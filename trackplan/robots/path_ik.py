@@ -58,6 +58,7 @@ from trackplan.robots._kernels import (
     analyse_paths,
     gather_closed_form,
     numeric_paths,
+    room_bounds,
 )
 from trackplan.robots.families import AUX_SIZE, N_BRANCHES, ik_family
 from trackplan.robots.ik_numeric import chain_arrays
@@ -74,6 +75,10 @@ counts :data:`ROTATION_LENGTH` metres per radian."""
 
 ROTATION_LENGTH = 0.2
 """Metres of travel one radian of tool rotation counts for when choosing coarse poses."""
+
+_ROOM_SLACK = 1e-9
+"""Margin by which the screened branch must beat every other branch's bound, rad: far
+above the round-off of unwrapping a path (about 1e-12 rad over thousands of poses)."""
 
 _NEWTON_TOL = 1e-10
 _MARCH_MAX_ITER = 100  # first pose from a seed, and the coarse march
@@ -254,7 +259,7 @@ def solve_path_ik(
     CaseError
         When the shapes, the branch, max_step or the method are invalid.
     """
-    paths = _branch_paths(robot, T_base_tool, branch, max_step, method)
+    paths = _branch_paths(robot, T_base_tool, branch, max_step, method, screen=True)
     q, reach, switch, report, values, ok = paths[:6]
     candidates, step, method, windings, winding = paths[6:]
     n_cand, n_poses = reach.shape[0], reach.shape[2]
@@ -378,6 +383,8 @@ def _branch_paths(
     branch: int | np.ndarray | None,
     max_step: float | np.ndarray | None,
     method: str,
+    *,
+    screen: bool = False,
 ) -> tuple[
     np.ndarray,
     np.ndarray,
@@ -393,7 +400,12 @@ def _branch_paths(
 ]:
     """The candidate branches' joint paths, analysed: the shared core of both solvers.
 
-    Parameters are those of :func:`solve_path_ik`.
+    Parameters are those of :func:`solve_path_ik`. With ``screen`` (closed form, no branch
+    given), the branch whose poses leave the most room in the limits one at a time
+    (:func:`~trackplan.robots._kernels.room_bounds`) is analysed first; when its path is
+    usable with a margin above every other branch's bound (by :data:`_ROOM_SLACK`), no
+    other branch can be chosen and it is returned alone (K = 1): the same branch and
+    analysis as from all eight. Otherwise all eight are analysed.
 
     Returns
     -------
@@ -415,13 +427,24 @@ def _branch_paths(
     if method == "closed_form":
         q_all, valid, aux = family.solve_flat(T.reshape(-1, 4, 4))
         shape = (n_cand, n_poses)
-        q, reach, magnitude, crossing = gather_closed_form(
+        solutions = (
             q_all.reshape(*shape, N_BRANCHES, n),
             valid.reshape(*shape, N_BRANCHES),
             aux.reshape(*shape, N_BRANCHES, AUX_SIZE),
-            candidates,
         )
         channel_kind = np.array([SHOULDER, ELBOW, WRIST])
+        if screen and branch is None:
+            bound = room_bounds(*solutions[:2], robot.q_min, robot.q_max)
+            best = np.argmax(bound, axis=1)
+            rival = np.where(np.arange(N_BRANCHES) == best[:, None], -np.inf, bound).max(axis=1)
+            first = np.ascontiguousarray(best[:, None])
+            q, reach, magnitude, crossing = gather_closed_form(*solutions, first)
+            analysed = _analysed(robot, q, reach, magnitude, channel_kind, crossing, step)
+            ok, values = analysed[3], analysed[2]
+            if np.all(ok[:, 0] & (values[:, 0, F_MARGIN] > rival + _ROOM_SLACK)):
+                switch, report, values, ok, windings, winding = analysed
+                return q, reach, switch, report, values, ok, first, step, method, windings, winding
+        q, reach, magnitude, crossing = gather_closed_form(*solutions, candidates)
     elif method == "numeric":
         seeds = np.ascontiguousarray(numeric_seeds(robot)[candidates])
         q, reach, magnitude, crossing = numeric_paths(
@@ -436,12 +459,29 @@ def _branch_paths(
         channel_kind = np.array([SINGULAR])
     else:
         raise CaseError(f"method must be auto, closed_form or numeric, got {method!r}")
+    switch, report, values, ok, windings, winding = _analysed(
+        robot, q, reach, magnitude, channel_kind, crossing, step
+    )
+    return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
+
+
+def _analysed(
+    robot: Robot,
+    q: np.ndarray,
+    reach: np.ndarray,
+    magnitude: np.ndarray,
+    channel_kind: np.ndarray,
+    crossing: np.ndarray,
+    step: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`~trackplan.robots._kernels.analyse_paths` of the gathered paths (q in place)
+    and which are usable: switch, report, values, ok (B, K), windings, winding."""
     switch, report, values, windings, winding = analyse_paths(
         q, reach, magnitude, channel_kind, crossing, robot.q_min.copy(), robot.q_max.copy(), step
     )
     ok = (report[..., I_N_UNREACH] == 0) & (report[..., I_N_SWITCH] == 0)
     ok &= values[..., F_MARGIN] >= 0.0
-    return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
+    return switch, report, values, ok, windings, winding
 
 
 def _candidate_branches(branch: int | np.ndarray | None, n_cand: int) -> np.ndarray:
