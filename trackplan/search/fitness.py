@@ -179,7 +179,7 @@ class BranchScreen:
     ----------
     grid
         Joint paths (B, K, M, n) and least interval times (B, K, M - 1) for the objectives
-        (NaN where not ``ok``).
+        (where not ``ok``, the tool's alone).
     branches
         The branch of each column, shape (K,), int.
     ok
@@ -350,8 +350,9 @@ class PlacementFitness:
             ],
             int(Finding.POSITION_LIMITS),
         )
-        # least interval times of the usable branches only (few of them while sampling)
-        dt = np.full((*ok.shape, n_poses - 1), np.nan)  # (B, K, M - 1), s
+        # the joints' least interval times on the usable branches only (few of them while
+        # sampling); the others keep the tool's
+        dt = np.tile(self.tool_time, (*ok.shape, 1))  # (B, K, M - 1), s
         steps = np.abs(np.diff(paths.q[ok], axis=1))  # (P, M - 1, n), rad
         dt[ok] = np.fmax(self.tool_time, np.max(steps / self.case.robot.v_max, axis=2))
         return BranchScreen(
