@@ -1,4 +1,4 @@
-"""Start-up: each command imports what it uses (docs/search.md, "Whole-process time").
+"""Start-up: each command imports what it uses (docs/benchmarks.md, "Wall time").
 
 Each check runs in a fresh interpreter, the only way to see what an import pulls in.
 """

@@ -4,9 +4,9 @@
 it, and :func:`minimize_bounded` Brent's bounded minimisation as
 ``scipy.optimize.minimize_scalar(method="bounded")`` does: the same steps in the same
 order, so they return the same floats (``tests/paths/test_scalar_search.py`` compares
-them). They live here because importing ``scipy.optimize`` costs about 0.7 s, a quarter
-of a whole ``trackplan optimize`` run (``docs/search.md``), for two loops that each blend
-runs a few dozen times.
+them). They live here because importing ``scipy.optimize`` took 0.8–0.9 s of CPU under
+load on top of everything else ``trackplan optimize`` imports, for two loops that each
+blend runs a few dozen times (``docs/benchmarks.md``, "Wall time").
 """
 
 from __future__ import annotations
