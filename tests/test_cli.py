@@ -13,8 +13,8 @@ import trackplan
 from tests.conftest import CASES, REPO
 from trackplan import cli
 from trackplan.cli import ExitCode, main
-from trackplan.cli import common as cli_common
 from trackplan.cli.common import shipped_cases_dir
+from trackplan.io import case_file
 from trackplan.io.robot_file import load_robot_text
 from trackplan.robots.builtin import ur5
 
@@ -99,7 +99,7 @@ def test_internal_error_is_one_line_without_traceback(
     def broken(file: object) -> None:
         raise RuntimeError("boom\nsecond line")
 
-    monkeypatch.setattr(cli_common, "load_case", broken)
+    monkeypatch.setattr(case_file, "load_case", broken)
     monkeypatch.delenv(cli.DEBUG_ENV, raising=False)
     code, _, err = run(capsys, "validate", "any.yaml")
     assert code == ExitCode.INTERNAL_ERROR
@@ -113,7 +113,7 @@ def test_debug_prints_the_traceback(
     def broken(file: object) -> None:
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(cli_common, "load_case", broken)
+    monkeypatch.setattr(case_file, "load_case", broken)
     if how == "environment":
         monkeypatch.setenv(cli.DEBUG_ENV, "1")
         args: tuple[str, ...] = ("validate", "any.yaml")

@@ -64,14 +64,14 @@ A notebook needs five lines::
     result = trackplan.plan_placement(case, case.bounds.example)
     print(result.status, result.duration)
 
-Names are imported on first use, so ``import trackplan`` stays cheap and the
-computational subpackages can be imported without the file-format dependencies.
+Names (and ``__version__``) are imported on first use, so ``import trackplan`` stays
+cheap and the computational subpackages can be imported without the file-format
+dependencies.
 """
 
 from __future__ import annotations
 
 import importlib
-from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -105,11 +105,6 @@ if TYPE_CHECKING:
     from trackplan.study.runner import run_study
     from trackplan.timing import TIME_LAWS, TimeLaw, time_law
     from trackplan.timing.airmove import AirMove, air_time_estimate, plan_air_move, trapezoid_time
-
-try:
-    __version__ = version("trackplan")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
 
 _EXPORTS = {
     "optimize_spin": "trackplan.search.spin",
@@ -229,6 +224,9 @@ __all__ = [
 
 def __getattr__(name: str) -> Any:
     """Import a public name on first use (PEP 562)."""
+    if name == "__version__":
+        globals()[name] = _version()
+        return globals()[name]
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'trackplan' has no attribute {name!r}")
@@ -237,6 +235,17 @@ def __getattr__(name: str) -> Any:
     return value
 
 
+def _version() -> str:
+    """The installed distribution's version (importlib.metadata costs 0.1 s: read on first
+    use)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("trackplan")
+    except PackageNotFoundError:  # running from a source tree that is not installed
+        return "0+unknown"
+
+
 def __dir__() -> list[str]:
     """Public names, for tab completion."""
-    return sorted({*globals(), *_EXPORTS})
+    return sorted({*globals(), *_EXPORTS, "__version__"})

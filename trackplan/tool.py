@@ -30,7 +30,6 @@ import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from trackplan.errors import CaseError
 from trackplan.frames import rpy_matrix
@@ -152,6 +151,8 @@ class SpinProfile:
         s = np.asarray(s, dtype=float)
         if len(self.coefficients) == 1:
             return np.zeros(s.shape)
+        from scipy.interpolate import BSpline  # only spin profiles need scipy
+
         spline = BSpline(self.knots, self.coefficients, SPIN_DEGREE, extrapolate=False)
         return np.nan_to_num(spline.derivative()(np.clip(s, 0.0, self.length)))
 
@@ -205,6 +206,8 @@ def spin_values(coefficients: np.ndarray, s: np.ndarray, length: float) -> np.nd
     s = np.asarray(s, dtype=float)
     if coefficients.shape[1] == 1:
         return np.broadcast_to(coefficients, (len(coefficients), s.size)).copy()
+    from scipy.interpolate import BSpline  # only spin profiles need scipy
+
     knots = spin_knots(coefficients.shape[1], length)
     basis = BSpline.design_matrix(np.clip(s, 0.0, length), knots, SPIN_DEGREE).toarray()
     return coefficients @ basis.T

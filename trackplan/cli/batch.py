@@ -7,8 +7,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.markup import escape
 
 from trackplan.cli import ExitCode
 from trackplan.cli.common import app, output_folder
@@ -39,6 +37,8 @@ def batch(
     Exit code 0 when every job found a feasible placement, 3 when some did not, 1 when a
     job failed, 130 on Ctrl-C (pending jobs cancelled, the summary of the finished written).
     """
+    from rich.markup import escape
+
     from trackplan.io.study_file import load_study
     from trackplan.study import connect, run_study
 
@@ -71,6 +71,7 @@ def batch(
 @contextmanager
 def _study_progress(total: int):  # type: ignore[no-untyped-def]
     """A progress callback for run_study: a rich bar on a terminal, else one line per job."""
+    from rich.console import Console
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,

@@ -6,10 +6,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.markup import escape
-from rich.table import Table
 
-from trackplan.cell.robot_bodies import link_capsules_line
 from trackplan.cli import ExitCode
 from trackplan.cli.common import (
     AssumeLimitsOption,
@@ -19,9 +16,6 @@ from trackplan.cli.common import (
     load_each,
     shipped_cases_dir,
 )
-from trackplan.cli.summaries import describe_case, robot_table, segment_corners
-from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot_spec, robot_to_yaml
-from trackplan.paths import NominalPath
 
 
 @app.command()
@@ -29,6 +23,8 @@ def validate(
     cases: Annotated[list[Path], typer.Argument(help="Case files to check.", show_default=False)],
 ) -> ExitCode:
     """Check case files and their robots; print a summary of each valid case."""
+    from trackplan.cli.summaries import describe_case
+
     loaded = load_each(cases)
     for file, case in loaded:
         if case is not None:
@@ -57,6 +53,12 @@ def robots(
     assume_limits: AssumeLimitsOption = False,
 ) -> ExitCode:
     """List the built-in robots (family, reach, link capsules, source), or show one robot."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from trackplan.cell.robot_bodies import link_capsules_line
+    from trackplan.cli.summaries import robot_table
+    from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot_spec, robot_to_yaml
     from trackplan.robots.describe import robot_info
 
     if as_yaml is not None:
@@ -106,6 +108,12 @@ def _show_value(value: object) -> str:
 @app.command()
 def cases() -> ExitCode:
     """List the cases shipped in the repository's cases/ folder."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from trackplan.cli.summaries import segment_corners
+    from trackplan.paths import NominalPath
+
     folder = shipped_cases_dir()
     files = sorted(folder.glob("*.yaml")) if folder.is_dir() else []
     if not files:

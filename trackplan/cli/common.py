@@ -11,17 +11,19 @@ import math
 import os
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
-from rich.console import Console
 
 import trackplan
-from trackplan.case import Case
 from trackplan.choices import Method, Timing, choose
 from trackplan.errors import CaseError
-from trackplan.io.case_file import load_case
+
+if TYPE_CHECKING:  # imported where used: --help and usage errors need none of them
+    import numpy as np
+    from rich.console import Console
+
+    from trackplan.case import Case
 
 PIPE_WIDTH = 160
 """Width of tables written to something other than a terminal, characters."""
@@ -57,6 +59,8 @@ def console() -> Console:
     Output that is not a terminal (a pipe, a file, a test) is laid out 160 columns wide
     rather than rich's 80, so that tables keep their numbers whole.
     """
+    from rich.console import Console
+
     return Console(highlight=False, width=None if sys.stdout.isatty() else PIPE_WIDTH)
 
 
@@ -67,6 +71,8 @@ def shipped_cases_dir() -> Path:
 
 def load_each(files: list[Path]) -> list[tuple[Path, Case | None]]:
     """Load case files one by one; a bad one is reported on stderr and comes with None."""
+    from trackplan.io.case_file import load_case
+
     loaded: list[tuple[Path, Case | None]] = []
     for file in files:
         try:
@@ -114,6 +120,8 @@ def placement_option(values: tuple[float, ...] | None) -> np.ndarray | None:
     CaseError
         Naming ``--placement`` and the bad entry.
     """
+    import numpy as np
+
     if values is None:
         return None
     for name, value in zip(("X", "Y", "Z", "ROLL", "PITCH", "YAW"), values, strict=True):
@@ -127,6 +135,8 @@ def placement_option(values: tuple[float, ...] | None) -> np.ndarray | None:
 
 def placement(case: Case, values: np.ndarray | None) -> np.ndarray:
     """The placement given on the command line, else the case's example placement."""
+    import numpy as np
+
     if values is not None:
         return values
     if case.bounds.example is None:

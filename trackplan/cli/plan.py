@@ -6,7 +6,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from trackplan.cli import ExitCode
@@ -21,9 +20,7 @@ from trackplan.cli.common import (
     placement_option,
     timing_option,
 )
-from trackplan.cli.summaries import print_check, print_plan
 from trackplan.errors import CaseError
-from trackplan.io.case_file import load_case
 
 
 @app.command()
@@ -54,6 +51,10 @@ def plan(
     With a free spin and neither --spin nor --spin-profile, the spin is optimised for the
     placement (docs/tool.md).
     """
+    import numpy as np
+
+    from trackplan.cli.summaries import print_plan
+    from trackplan.io.case_file import load_case
     from trackplan.outputs import write_run
     from trackplan.planning.plan import plan_placement
     from trackplan.search.spin import optimize_spin
@@ -105,6 +106,10 @@ def check(
     A run folder must be consistent (its result.json written with its trajectory.csv);
     a CSV file is read as it is, columns t and q1..qn found by their header names.
     """
+    import numpy as np
+
+    from trackplan.cli.summaries import print_check
+    from trackplan.io.case_file import load_case
     from trackplan.io.results import read_trajectory_csv
     from trackplan.io.run_folder import verified_trajectory
     from trackplan.planning.plan import check_case_trajectory

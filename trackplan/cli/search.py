@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
-from rich.console import Console
 
-from trackplan.case import Case
 from trackplan.cli import ExitCode
 from trackplan.cli.common import (
     AssumeLimitsOption,
@@ -23,9 +20,10 @@ from trackplan.cli.common import (
     timing_option,
 )
 from trackplan.cli.signals import SignalLog, stop_on_signals
-from trackplan.cli.summaries import print_search
 from trackplan.errors import CaseError
-from trackplan.io.case_file import load_case
+
+if TYPE_CHECKING:
+    from trackplan.case import Case
 
 
 @app.command()
@@ -82,6 +80,8 @@ def optimize(
     Ctrl-C (SIGINT) or SIGTERM stops the search and still writes everything for the best
     placement found, with ``status: interrupted`` in result.json, and exits 130 or 143.
     """
+    from trackplan.io.case_file import load_case
+
     out = output_folder(out)
     method = method_option(method)
     timing = timing_option(timing)
@@ -123,6 +123,8 @@ def demo(
     out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("runs/demo"),
 ) -> ExitCode:
     """Optimize the paper's corner case (cases/paper-corner.yaml) end to end, with the report."""
+    from trackplan.io.case_file import load_case
+
     out = output_folder(out)
     file = shipped_cases_dir() / "paper-corner.yaml"
     if not file.is_file():
@@ -157,6 +159,9 @@ def map_command(
     Writes map.png, map.csv and map.html. Without --rpy and --z the case's placement
     search runs first and the map keeps its best placement's height and orientation.
     """
+    import numpy as np
+
+    from trackplan.io.case_file import load_case
     from trackplan.io.map_file import write_map_csv
     from trackplan.report.cell_figures import write_map_report
     from trackplan.search.placement_map import placement_map
@@ -216,6 +221,7 @@ def _pareto(
 
 def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> ExitCode:  # type: ignore[no-untyped-def]
     """Search (SIGINT and SIGTERM stop it), write the run, print it; the exit code."""
+    from trackplan.cli.summaries import print_search
     from trackplan.outputs import write_search_run
 
     with stop_on_signals() as signals:  # a second signal while writing stops the writing
@@ -249,6 +255,8 @@ def _interrupted_marks(result, signals: SignalLog) -> dict:  # type: ignore[no-u
 def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyped-def]
     """Run the placement search, with a progress bar when stderr is a terminal; a signal
     recorded in ``signals`` stops it after the current generation."""
+    import numpy as np
+    from rich.console import Console
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from trackplan.search import optimize_placement

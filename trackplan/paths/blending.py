@@ -27,7 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from trackplan.paths._kernels import nearest_distance
 from trackplan.paths.geometry import (
@@ -41,6 +40,7 @@ from trackplan.paths.geometry import (
     start_jet,
 )
 from trackplan.paths.piece_table import PieceTable
+from trackplan.paths.scalar_search import find_root, minimize_bounded
 
 # Parameter samples of a blend when measuring its deviation and peak curvature.
 _N_SAMPLES = 513
@@ -253,14 +253,13 @@ def g2_blend(incoming: Primitive, outgoing: Primitive, budget: float, reach: flo
         upper = min(last[0] + 0.2, high)
         if excess(upper, shape) <= 0.0:
             upper = high
-        last[0] = brentq(excess, low, upper, args=(shape,), xtol=1e-6)
+        last[0] = find_root(lambda log_setback: excess(log_setback, shape), low, upper, 1e-6)
         return float(np.exp(last[0]))
 
     def peak(shape: float) -> float:
         return float(np.max(_curvature(control(largest_setback(shape), shape)[1])))
 
-    found = minimize_scalar(peak, bounds=_SHAPE_BOUNDS, method="bounded", options={"xatol": 1e-2})
-    shape = float(found.x)
+    shape = minimize_bounded(peak, *_SHAPE_BOUNDS, xatol=1e-2)
     setback = largest_setback(shape)
     while True:
         blend = QuinticBlend(*control(setback, shape))

@@ -18,13 +18,15 @@ import itertools
 from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import cached_property
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from trackplan.paths._kernels import dense_pieces, near_pieces
 from trackplan.paths.piece_table import PieceTable
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 _EXTRA_CHUNKS = 1000
 """The chunk length is 2 × the path length / (P + this): a piece of average length or shorter
@@ -89,6 +91,8 @@ class PieceIndex:
     @cached_property
     def _chunks(self) -> tuple[cKDTree, np.ndarray, np.ndarray, float]:
         """The tree of chunk midpoints, their piece (C,), half-lengths (C,) m, and the largest."""
+        from scipy.spatial import cKDTree  # paths of few pieces never build the tree
+
         table = self.table
         step = 2.0 * table.total_length / (table.n_pieces + _EXTRA_CHUNKS)
         counts = np.maximum(1, np.ceil(table.length / step)).astype(int)

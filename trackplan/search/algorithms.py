@@ -33,28 +33,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
-from pymoo.algorithms.soo.nonconvex.de import DE
-from pymoo.algorithms.soo.nonconvex.random_search import RandomSearch
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.population import Population
 from pymoo.core.termination import TerminateIfAny, Termination
-from pymoo.termination import get_termination
 from pymoo.termination.max_gen import MaximumGenerationTermination
 
 from trackplan.choices import Method
 from trackplan.errors import CaseError
-from trackplan.search.operators import (
-    AdaptiveFeasibleMutation,
-    AdmissibleSampling,
-    EliteSurvival,
-    MatlabMating,
-    ReachRepair,
-    ScatteredCrossover,
-    StallTermination,
-    StochasticUniformSelection,
-    elite_count,
-)
 from trackplan.search.space import N_VAR, SearchSpace
 
 CROSSOVER_FRACTION = 0.8
@@ -123,6 +108,26 @@ def make_algorithm(method: str, space: SearchSpace, population: int) -> Algorith
     """
     if population < 2:
         raise CaseError(f"population must be ≥ 2, got {population}", key="optimizer.population")
+    if method == "cmaes":
+        return CMAESearch(space, population)
+    if method == "multistart":
+        return MultiStartSearch(space)
+    # the population methods' operators and pymoo classes, imported for them only
+    from pymoo.algorithms.base.genetic import GeneticAlgorithm
+    from pymoo.algorithms.soo.nonconvex.de import DE
+    from pymoo.algorithms.soo.nonconvex.random_search import RandomSearch
+
+    from trackplan.search.operators import (
+        AdaptiveFeasibleMutation,
+        AdmissibleSampling,
+        EliteSurvival,
+        MatlabMating,
+        ReachRepair,
+        ScatteredCrossover,
+        StochasticUniformSelection,
+        elite_count,
+    )
+
     sampling = AdmissibleSampling(space)
     if method == "ga":
         n_elite = elite_count(population)
@@ -149,12 +154,8 @@ def make_algorithm(method: str, space: SearchSpace, population: int) -> Algorith
             F=DE_F,
             repair=ReachRepair(space),
         )
-    if method == "cmaes":
-        return CMAESearch(space, population)
     if method == "random":
         return RandomSearch(n_points_per_iteration=population, sampling=sampling)
-    if method == "multistart":
-        return MultiStartSearch(space)
     raise CaseError(f"unknown method {method!r}", key="method")
 
 
@@ -179,12 +180,16 @@ def make_termination(
     """
     if termination is not None:
         if isinstance(termination, tuple):
+            from pymoo.termination import get_termination
+
             termination = get_termination(*termination)
         return termination, {"custom": termination}
     parts: dict[str, Termination] = {
         "max_generations": MaximumGenerationTermination(MAX_GENERATIONS),
     }
     if method is not Method.MULTISTART:
+        from trackplan.search.operators import StallTermination
+
         parts["stall"] = StallTermination(STALL_GENERATIONS, FUNCTION_TOLERANCE)
     return TerminateIfAny(*parts.values()), parts
 

@@ -1,0 +1,67 @@
+"""Start-up: each command imports what it uses (docs/benchmarks.md, "Wall time").
+
+Each check runs in a fresh interpreter, the only way to see what an import pulls in.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+from tests.conftest import CASES
+
+REPORT_AND_OPTIONAL = (
+    "scipy.optimize",
+    "scipy.interpolate",
+    "scipy.spatial",
+    "scipy.stats",
+    "matplotlib",
+    "plotly",
+    "dask",
+    "distributed",
+    "trimesh",
+    "yourdfpy",
+    "coal",
+    "cma",
+    "toppra",
+    "ruckig",
+    "pymoo.algorithms",
+    "trackplan.report",
+    "trackplan.search.operators",
+)
+"""Modules a search with the default method and ``--no-report`` does not use."""
+
+
+def _loaded_after(code: str, modules: tuple[str, ...]) -> list[str]:
+    """Which of ``modules`` (or their submodules) are imported after running ``code``."""
+    probe = (
+        f"{code}\nimport json, sys\n"
+        f"print(json.dumps([m for m in {list(modules)!r} "
+        "if any(k == m or k.startswith(m + '.') for k in sys.modules)]))"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+def test_the_command_line_imports_no_planner_before_a_command_runs():
+    """``trackplan --help`` and usage errors need typer only: no numpy, numba or pydantic."""
+    heavy = ("numpy", "numba", "pydantic", "scipy", "pymoo", "trackplan.case", "trackplan.io")
+    assert _loaded_after("import trackplan.cli.app", heavy) == []
+
+
+def test_import_trackplan_is_cheap():
+    assert _loaded_after("import trackplan", ("numpy", "importlib.metadata")) == []
+
+
+def test_optimize_without_report_imports_only_what_it_uses(tmp_path):
+    """A whole ``optimize --no-report`` of the corner case (a blend: the scalar solvers run)
+    imports neither scipy's optimisers and splines nor the report, the cell's exact
+    distances, Dask, the URDF stack or the population methods."""
+    run = (
+        "from trackplan.cli import main\n"
+        f"code = main(['optimize', {str(CASES / 'paper-corner.yaml')!r}, '--no-report', "
+        f"'--budget', '30', '--out', {str(tmp_path / 'out')!r}])\n"
+        "assert code == 0, code"
+    )
+    assert _loaded_after(run, REPORT_AND_OPTIONAL) == []
