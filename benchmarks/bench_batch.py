@@ -155,9 +155,9 @@ def main() -> None:
         f"{n} jobs on {os.cpu_count()} cores, {ROUNDS} rounds taking turns; load average "
         f"{load_start:.1f} at the start, {os.getloadavg()[0]:.1f} at the end{_autogroup()}"
     )
-    print("wall time of each run, s (rounds in order):")
+    print("each round in order: wall time s, and job CPU s per job")
     for kind in kinds:
-        walls = "  ".join(f"{run.wall_s:7.2f}" for run in runs[kind])
+        walls = "  ".join(f"{run.wall_s:7.2f} {run.jobs_cpu_s / n:5.2f}" for run in runs[kind])
         print(f"  {labels[kind]:<17}{walls}")
     print("median over the rounds (spread: max − min over the median):")
     header = ("cluster start s", "batch s", "per job s", "job CPU s/job", "engine CPU s/job")
