@@ -2,7 +2,8 @@
 
 ``dask worker tcp://HOST:8786 --nthreads 1 --preload trackplan.study.preload`` (and every
 local cluster :func:`trackplan.run_study` starts) runs :func:`dask_setup` in each worker
-process when it starts: it leaves Ctrl-C to the client, sets glibc's allocator as the CLI does
+process when it starts: it leaves Ctrl-C to the client, turns off the worker's statistical
+profiler (:func:`stop_profiler`), sets glibc's allocator as the CLI does
 (:func:`trackplan.allocator.keep_freed_memory`) and runs two tiny searches, one per IK
 family (closed form, numeric), so that numba compiles its kernels into its on-disk cache
 (or loads them from it) before any job is timed.
@@ -32,6 +33,9 @@ optimizer: {{population: 4, budget: 8, restarts: 1}}
 WARM_UP_ROBOTS = ("puma560", "ur5")
 """One robot per IK family."""
 
+PROFILER_CALLBACKS = ("profile", "profile-cycle")
+"""The worker's periodic callbacks that sample and collect its statistical profile."""
+
 
 def warm_up() -> None:
     """Run a tiny placement search per IK family (compiles or loads the numba kernels)."""
@@ -40,6 +44,22 @@ def warm_up() -> None:
 
     for robot in WARM_UP_ROBOTS:
         optimize_placement(load_case_text(WARM_UP_CASE.format(robot=robot), file="warm-up"))
+
+
+def stop_profiler(worker: Any) -> None:
+    """Turn off a Dask worker's statistical profiler before it starts.
+
+    Every 10 ms (``distributed.worker.profile.interval``) the worker's event loop takes the
+    GIL from the running task to walk its Python stack. A placement search is one long task
+    with deep stacks (pymoo, numpy): measured 0.4 s of the event loop's CPU time per 4 s
+    search, during which the search waits for the GIL. The profile is only a dashboard
+    page; nothing in a batch reads it. Called from :func:`dask_setup`, which Dask runs
+    before it starts the worker's periodic callbacks.
+    """
+    for name in PROFILER_CALLBACKS:
+        callback = worker.periodic_callbacks.pop(name, None)
+        if callback is not None:
+            callback.stop()
 
 
 def dask_setup(worker: Any) -> None:
@@ -51,5 +71,6 @@ def dask_setup(worker: Any) -> None:
     """
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    stop_profiler(worker)
     keep_freed_memory()
     warm_up()
