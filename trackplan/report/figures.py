@@ -45,12 +45,7 @@ BEFORE_COLOR = "tab:purple"
 AFTER_COLOR = "tab:orange"
 VIOLATION_COLOR = "red"
 SYMLOG_RATIO = 20.0  # data spanning more than this many limit ranges get a symlog axis
-_SYMBOLS = {
-    "position": "$q$",
-    "velocity": r"$\dot{q}$",
-    "acceleration": r"$\ddot{q}$",
-    "jerk": r"$\dddot{q}$",
-}
+_SYMBOLS = {"position": "q", "velocity": "q̇", "acceleration": "q̈", "jerk": "d³q/dt³"}
 
 
 def _new_figure(
@@ -138,6 +133,8 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
     matplotlib.figure.Figure
         4 × n axes.
     """
+    from matplotlib.ticker import MaxNLocator
+
     trajectory = result.trajectory
     robot = case.robot
     n = robot.n_dof
@@ -145,6 +142,10 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
     figure = _new_figure(2.3 * n + 1.0, 9.0, layout=None)
     figure.subplots_adjust(left=0.06, right=0.99, bottom=0.1, top=0.93, wspace=0.35, hspace=0.12)
     axes = figure.subplots(len(LIMIT_KINDS), n, sharex=True, squeeze=False)
+    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
+    if trajectory.n_samples:
+        t_margin = 0.02 * (trajectory.t[-1] - trajectory.t[0])
+        axes[0, 0].set_xlim(trajectory.t[0] - t_margin, trajectory.t[-1] + t_margin)
     half = 0.5 * trajectory.sample_time
     for row, kind in enumerate(LIMIT_KINDS):
         values = joint_series(trajectory, kind)
@@ -153,6 +154,19 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
         for j in range(n):
             ax = axes[row, j]
             series = values[:, j]
+            # limits first: every artist added to an axes with autoscaling on recomputes
+            # the view limits of all the axes sharing its time axis
+            low = float(np.min(series, initial=lower[j]))
+            high = float(np.max(series, initial=upper[j]))
+            limit = max(abs(lower[j]), abs(upper[j]))
+            if high - low > SYMLOG_RATIO * 2 * limit:
+                # linear inside ±limit, logarithmic beyond: the limits stay visible next
+                # to violations that exceed them by orders of magnitude
+                ax.set_yscale("symlog", linthresh=limit)
+                ax.set_ylim(1.5 * low, 1.5 * high)
+            else:
+                pad = 0.08 * (high - low)
+                ax.set_ylim(low - pad, high + pad)
             ax.plot(
                 *envelope(trajectory.t, series), color=f"C{j}", lw=1.0, label=robot.joint_names[j]
             )
@@ -173,17 +187,6 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
                         label="violation window",
                         gid="violation-window",
                     )
-            low = float(np.min(series, initial=lower[j]))
-            high = float(np.max(series, initial=upper[j]))
-            limit = max(abs(lower[j]), abs(upper[j]))
-            if high - low > SYMLOG_RATIO * 2 * limit:
-                # linear inside ±limit, logarithmic beyond: the limits stay visible next
-                # to violations that exceed them by orders of magnitude
-                ax.set_yscale("symlog", linthresh=limit)
-                ax.set_ylim(1.5 * low, 1.5 * high)
-            else:
-                pad = 0.08 * (high - low)
-                ax.set_ylim(low - pad, high + pad)
             if margins is not None and np.isfinite(margins[j]):
                 ax.text(
                     0.98,
@@ -196,15 +199,18 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
                     color=VIOLATION_COLOR if margins[j] < 0 else "0.35",
                     bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0},
                 )
+            ax.yaxis.set_major_locator(MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]))
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3, lw=0.5)
             if row == 0:
-                ax.set_title(f"joint {j + 1}", fontsize=9)
+                ax.set_title(f"joint {j + 1}", fontsize=9, y=1.0)
             if j == 0:
                 name, unit = JOINT_QUANTITIES[kind]
                 ax.set_ylabel(f"{name} {_SYMBOLS[kind]} [{unit}]", fontsize=8)
+                ax.yaxis.set_label_coords(-0.3, 0.5)
             if row == len(LIMIT_KINDS) - 1:
                 ax.set_xlabel("time [s]", fontsize=8)
+                ax.xaxis.set_label_coords(0.5, -0.14)
     note = "" if trajectory.n_samples else f" — no trajectory: {result.message}"
     figure.suptitle(f"{_status_line(result)}: joint trajectories and limits{note}", fontsize=10)
     return figure

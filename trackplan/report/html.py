@@ -19,7 +19,8 @@ from trackplan.case import Case
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.result import LIMIT_KINDS, PlanResult
 from trackplan.report.figures import history_columns
-from trackplan.report.robot_view import VIEW_ID, robot_view_figure
+from trackplan.report.plotly_html import plotly_div
+from trackplan.report.robot_view import VIEW_ID, robot_view_spec
 from trackplan.report.scene import JOINT_QUANTITIES
 from trackplan.robots.families import ik_family
 from trackplan.run_files import REPORT_FILE
@@ -469,12 +470,9 @@ def _view_section(result: PlanResult, case: Case, n_frames: int) -> str:
             '<section id="view"><h2>3D view</h2><p>No trajectory to show: '
             f"{_esc(result.message)}</p></section>"
         )
-    figure = robot_view_figure(result, case, n_frames=n_frames)
-    div = figure.to_html(
-        full_html=False,
-        include_plotlyjs=True,
-        div_id=VIEW_ID,
-        auto_play=False,
+    div = plotly_div(
+        robot_view_spec(result, case, n_frames=n_frames),
+        VIEW_ID,
         config={"displaylogo": False, "responsive": True},
         post_script=_QUIET_INTERRUPTS,
     )
