@@ -260,7 +260,8 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
     trajectory = result.trajectory
     points_part, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
-    figure = _new_figure(13.0, 6.8)
+    figure = _new_figure(13.0, 6.8, layout=None)
+    figure.subplots_adjust(left=0.0, right=0.97, bottom=0.12, top=0.92, wspace=0.08)
     ax_cell = figure.add_subplot(1, 2, 1, projection="3d")
     ax_path = figure.add_subplot(1, 2, 2, projection="3d")
 
@@ -299,7 +300,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         ax_cell.plot(*chain.T, "o-", color="0.2", lw=3.0, ms=4, gid="robot", label="robot at t = 0")
         scene.append(chain)
     _set_equal(ax_cell, np.vstack(scene))
-    ax_cell.set_title("work cell (robot base frame)", fontsize=10)
+    ax_cell.set_title("work cell (robot base frame)", fontsize=10, y=1.0)
 
     ax_path.plot(*points_base.T, color=AFTER_COLOR, lw=2.0, gid="path-zoom")
     ax_path.plot(*points_base[0], "o", color="tab:green", ms=6, label="start", gid="start")
@@ -313,7 +314,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         if bad.any():
             _mark_violations(ax_path, points_base[bad].T, "samples inside a violation window")
     _set_equal(ax_path, points_base)
-    ax_path.set_title("placed path (close-up)", fontsize=10)
+    ax_path.set_title("placed path (close-up)", fontsize=10, y=1.0)
 
     handles, labels = [], []
     for ax in (ax_cell, ax_path):
@@ -321,7 +322,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
             if label not in labels:
                 handles.append(handle)
                 labels.append(label)
-    figure.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+    figure.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     figure.suptitle(
         f"{_status_line(result)}: placement X = {_format_placement(result)}", fontsize=10
     )
@@ -358,7 +359,8 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
     trajectory = result.trajectory
     task = case.task
     t = trajectory.t
-    figure = _new_figure(11.0, 6.5)
+    figure = _new_figure(11.0, 6.5, layout=None)
+    figure.subplots_adjust(left=0.07, right=0.76, bottom=0.08, top=0.94, hspace=0.08)
     ax_speed, ax_error = figure.subplots(2, 1, sharex=True)
 
     ax_speed.plot(
@@ -368,7 +370,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
         1e3 * task.rated_speed,
         ls="--",
         color="tab:green",
-        label=f"rated speed $v_r$ = {1e3 * task.rated_speed:.4g} mm/s",
+        label=f"rated speed vᵣ = {1e3 * task.rated_speed:.4g} mm/s",
         gid="rated-speed",
     )
     ax_speed.axhline(
@@ -376,7 +378,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
         ls=":",
         color="tab:orange",
         lw=1.5,
-        label=rf"corner speed cap $v_t^{{max}}$ = {1e3 * task.corner_speed:.4g} mm/s",
+        label=f"corner speed cap vₜᵐᵃˣ = {1e3 * task.corner_speed:.4g} mm/s",
         gid="corner-speed",
     )
     if trajectory.n_samples:
@@ -389,7 +391,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
                 alpha=0.15,
                 lw=0,
                 gid="slowdown",
-                label="slow-down below $v_r$" if k == 0 else None,
+                label="slow-down below vᵣ" if k == 0 else None,
             )
             ax_speed.annotate(
                 slowdown.limit,
@@ -473,8 +475,11 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
         Three axes (best, mean, feasible share), one line per method in each
         (``gid=method``).
     """
+    from matplotlib.ticker import LogFormatter
+
     columns = history_columns(history)
-    figure = _new_figure(9.0, 8.0)
+    figure = _new_figure(9.0, 8.0, layout=None)
+    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.07, top=0.95, hspace=0.08)
     ax_best, ax_mean, ax_share = figure.subplots(3, 1, sharex=True)
     for k, (method, c) in enumerate(columns.items()):
         color = f"C{k}"
@@ -502,6 +507,10 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
         values = np.concatenate([c[key] for c in columns.values()])
         if values.size and np.all(values > 0):
             ax.set_yscale("log")
+            # plain-text labels: the default ones are mathtext, whose parser costs more
+            # than the rest of the figure
+            ax.yaxis.set_major_formatter(LogFormatter())
+            ax.yaxis.set_minor_formatter(LogFormatter(labelOnlyBase=False))
         ax.set_ylabel(f"{label} [–]")
     ax_share.set_ylabel("feasible share [%]")
     ax_share.set_ylim(-2, 102)
@@ -538,7 +547,8 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
     """
     trajectory = result.trajectory
     tool = case.task.tool
-    figure = _new_figure(13.0, 5.6)
+    figure = _new_figure(13.0, 5.6, layout=None)
+    figure.subplots_adjust(left=0.06, right=0.98, bottom=0.1, top=0.88, wspace=0.12)
     ax_spin = figure.add_subplot(1, 2, 1)
     ax_frames = figure.add_subplot(1, 2, 2, projection="3d")
     if trajectory.n_samples and len(trajectory.spin) == trajectory.n_samples:
@@ -548,7 +558,7 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
             ax_spin.axhline(bound, ls="--", color="0.4", lw=1.0)
     ax_spin.set_xlabel("s along the planned path [m]")
     ax_spin.set_ylabel("spin about the tool axis [rad]")
-    ax_spin.set_title(f"spin: {tool.spin}", fontsize=10)
+    ax_spin.set_title(f"spin: {tool.spin}", fontsize=10, y=1.0)
     ax_spin.grid(alpha=0.3)
     _, points_base = path_points(result, case)
     ax_frames.plot(*points_base.T, color=AFTER_COLOR, lw=1.5, gid="tool-path")
@@ -558,7 +568,7 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
         T_tool = forward_kinematics(case.robot, trajectory.q[idx])
         _plot_triads(ax_frames, triad_lines(T_tool, 0.06 * extent), "tool-frames", "tool frames")
     _set_equal(ax_frames, points_base)
-    ax_frames.set_title(f"tool frames ({tool.frame} frame)", fontsize=10)
+    ax_frames.set_title(f"tool frames ({tool.frame} frame)", fontsize=10, y=1.0)
     figure.suptitle(_status_line(result), fontsize=10)
     return figure
 
