@@ -78,6 +78,16 @@ def _status_line(result: PlanResult) -> str:
     return f"{result.case_name}: {verdict}"
 
 
+PNG_COMPRESSION = 1
+"""zlib level of the PNG files: level 1 encodes several times faster than the default 6,
+for files about a third larger."""
+
+
+def save_png(figure: Figure, path: Path) -> None:
+    """Write ``figure`` as a PNG file at :data:`DPI`."""
+    figure.savefig(path, dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESSION})
+
+
 ENVELOPE_POINTS = 2000
 """Most points drawn per series: longer series are drawn as their min/max envelope."""
 
@@ -118,8 +128,9 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
     shared panel. Limits are dashed lines (``gid="limit"``): ±limit, and q_min/q_max for
     positions. Samples beyond a limit are red markers (``gid="violation"``) and every
     violation window the checker reported is a red band (``gid="violation-window"``).
-    Each panel states its margin (unused fraction of the limit). A panel whose data exceed
-    the limits by more than 20 times gets a symmetric-log axis (linear within ±limit).
+    Each panel states its margin (unused fraction of the limit) above its right corner.
+    A panel whose data exceed the limits by more than 20 times gets a symmetric-log axis
+    (linear within ±limit).
 
     Parameters
     ----------
@@ -188,22 +199,21 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
                         gid="violation-window",
                     )
             if margins is not None and np.isfinite(margins[j]):
-                ax.text(
-                    0.98,
-                    0.04,
+                # above the panel, clear of the data (a boxed label inside cost a tenth
+                # of the figure)
+                ax.set_title(
                     f"margin {100 * margins[j]:.0f} %",
-                    transform=ax.transAxes,
-                    ha="right",
-                    va="bottom",
+                    loc="right",
                     fontsize=7,
                     color=VIOLATION_COLOR if margins[j] < 0 else "0.35",
-                    bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0},
+                    y=1.0,
+                    pad=2.0,
                 )
             ax.yaxis.set_major_locator(MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]))
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3, lw=0.5)
             if row == 0:
-                ax.set_title(f"joint {j + 1}", fontsize=9, y=1.0)
+                ax.set_title(f"joint {j + 1}", loc="left", fontsize=9, y=1.0)
             if j == 0:
                 name, unit = JOINT_QUANTITIES[kind]
                 ax.set_ylabel(f"{name} {_SYMBOLS[kind]} [{unit}]", fontsize=8)
@@ -223,10 +233,14 @@ def _plot_triads(ax: Axes3D, lines: np.ndarray, gid: str, label: str, lw: float 
 
 
 def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
+    from matplotlib.ticker import MaxNLocator
+
     limits = equal_limits(points)
     ax.set_xlim(*limits[0])
     ax.set_ylim(*limits[1])
     ax.set_zlim(*limits[2])
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(nbins=5))
     ax.set_box_aspect((1.0, 1.0, 1.0))
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -624,6 +638,6 @@ def write_plots(
     written = []
     for name, build in plot_figures(result, case, history).items():
         path = out_dir / name
-        build().savefig(path, dpi=DPI)
+        save_png(build(), path)
         written.append(path)
     return written
