@@ -63,10 +63,9 @@ def write_run(
 
     def write(folder: Path) -> None:
         if report:
-            from trackplan.report import write_plots, write_report
+            from trackplan.report.run_report import write_run_report
 
-            plots = write_plots(result, case, folder, history)
-            write_report(result, case, folder, plots, history=history, optimizer_info=extra)
+            write_run_report(result, case, folder, history, extra)
         if search is not None:
             from trackplan.io.history import write_history
 

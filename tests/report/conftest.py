@@ -188,17 +188,19 @@ def history() -> dict[str, dict[str, np.ndarray]]:
 
 
 REPORT_FRAMES = 60  # animation frames of the 3D view in the report tests
+REPORT_INFO = {"method": "ga", "evaluations": 750, "wall_time": 37.5, "best_X": PAPER_PLACEMENT}
+"""The optimizer table of the report tests."""
 
 
 @pytest.fixture(scope="session")
 def report_file(tmp_path_factory, corner: Case, corner_result: PlanResult):
-    """report.html of the corner result with an optimizer history (written once)."""
-    from trackplan.report import write_plots, write_report
+    """report.html of the corner result with an optimizer history (written once, as a run
+    writes it: :func:`~trackplan.report.run_report.write_run_report`)."""
+    from trackplan.report.run_report import write_run_report
 
     history = optimizer_history(np.random.default_rng(7))
-    info = {"method": "ga", "evaluations": 750, "wall_time": 37.5, "best_X": PAPER_PLACEMENT}
     out_dir = tmp_path_factory.mktemp("report")
-    plots = write_plots(corner_result, corner, out_dir, history)
-    return write_report(
-        corner_result, corner, out_dir, plots, history, info, n_frames=REPORT_FRAMES
+    _, report = write_run_report(
+        corner_result, corner, out_dir, history, REPORT_INFO, n_frames=REPORT_FRAMES
     )
+    return report

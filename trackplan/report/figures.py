@@ -45,12 +45,7 @@ BEFORE_COLOR = "tab:purple"
 AFTER_COLOR = "tab:orange"
 VIOLATION_COLOR = "red"
 SYMLOG_RATIO = 20.0  # data spanning more than this many limit ranges get a symlog axis
-_SYMBOLS = {
-    "position": "$q$",
-    "velocity": r"$\dot{q}$",
-    "acceleration": r"$\ddot{q}$",
-    "jerk": r"$\dddot{q}$",
-}
+_SYMBOLS = {"position": "q", "velocity": "q̇", "acceleration": "q̈", "jerk": "d³q/dt³"}
 
 
 def _new_figure(
@@ -81,6 +76,16 @@ def _mark_violations(ax: Axes | Axes3D, coordinates: Sequence[np.ndarray], label
 def _status_line(result: PlanResult) -> str:
     verdict = "feasible" if result.feasible else f"infeasible ({result.status.value})"
     return f"{result.case_name}: {verdict}"
+
+
+PNG_COMPRESSION = 1
+"""zlib level of the PNG files: level 1 encodes several times faster than the default 6,
+for files about a third larger."""
+
+
+def save_png(figure: Figure, path: Path) -> None:
+    """Write ``figure`` as a PNG file at :data:`DPI`."""
+    figure.savefig(path, dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESSION})
 
 
 ENVELOPE_POINTS = 2000
@@ -123,8 +128,9 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
     shared panel. Limits are dashed lines (``gid="limit"``): ±limit, and q_min/q_max for
     positions. Samples beyond a limit are red markers (``gid="violation"``) and every
     violation window the checker reported is a red band (``gid="violation-window"``).
-    Each panel states its margin (unused fraction of the limit). A panel whose data exceed
-    the limits by more than 20 times gets a symmetric-log axis (linear within ±limit).
+    Each panel states its margin (unused fraction of the limit) above its right corner.
+    A panel whose data exceed the limits by more than 20 times gets a symmetric-log axis
+    (linear within ±limit).
 
     Parameters
     ----------
@@ -138,6 +144,8 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
     matplotlib.figure.Figure
         4 × n axes.
     """
+    from matplotlib.ticker import MaxNLocator
+
     trajectory = result.trajectory
     robot = case.robot
     n = robot.n_dof
@@ -145,6 +153,10 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
     figure = _new_figure(2.3 * n + 1.0, 9.0, layout=None)
     figure.subplots_adjust(left=0.06, right=0.99, bottom=0.1, top=0.93, wspace=0.35, hspace=0.12)
     axes = figure.subplots(len(LIMIT_KINDS), n, sharex=True, squeeze=False)
+    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
+    if trajectory.n_samples:
+        t_margin = 0.02 * (trajectory.t[-1] - trajectory.t[0])
+        axes[0, 0].set_xlim(trajectory.t[0] - t_margin, trajectory.t[-1] + t_margin)
     half = 0.5 * trajectory.sample_time
     for row, kind in enumerate(LIMIT_KINDS):
         values = joint_series(trajectory, kind)
@@ -153,6 +165,19 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
         for j in range(n):
             ax = axes[row, j]
             series = values[:, j]
+            # limits first: every artist added to an axes with autoscaling on recomputes
+            # the view limits of all the axes sharing its time axis
+            low = float(np.min(series, initial=lower[j]))
+            high = float(np.max(series, initial=upper[j]))
+            limit = max(abs(lower[j]), abs(upper[j]))
+            if high - low > SYMLOG_RATIO * 2 * limit:
+                # linear inside ±limit, logarithmic beyond: the limits stay visible next
+                # to violations that exceed them by orders of magnitude
+                ax.set_yscale("symlog", linthresh=limit)
+                ax.set_ylim(1.5 * low, 1.5 * high)
+            else:
+                pad = 0.08 * (high - low)
+                ax.set_ylim(low - pad, high + pad)
             ax.plot(
                 *envelope(trajectory.t, series), color=f"C{j}", lw=1.0, label=robot.joint_names[j]
             )
@@ -173,38 +198,29 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
                         label="violation window",
                         gid="violation-window",
                     )
-            low = float(np.min(series, initial=lower[j]))
-            high = float(np.max(series, initial=upper[j]))
-            limit = max(abs(lower[j]), abs(upper[j]))
-            if high - low > SYMLOG_RATIO * 2 * limit:
-                # linear inside ±limit, logarithmic beyond: the limits stay visible next
-                # to violations that exceed them by orders of magnitude
-                ax.set_yscale("symlog", linthresh=limit)
-                ax.set_ylim(1.5 * low, 1.5 * high)
-            else:
-                pad = 0.08 * (high - low)
-                ax.set_ylim(low - pad, high + pad)
             if margins is not None and np.isfinite(margins[j]):
-                ax.text(
-                    0.98,
-                    0.04,
+                # above the panel, clear of the data (a boxed label inside cost a tenth
+                # of the figure)
+                ax.set_title(
                     f"margin {100 * margins[j]:.0f} %",
-                    transform=ax.transAxes,
-                    ha="right",
-                    va="bottom",
+                    loc="right",
                     fontsize=7,
                     color=VIOLATION_COLOR if margins[j] < 0 else "0.35",
-                    bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1.0},
+                    y=1.0,
+                    pad=2.0,
                 )
+            ax.yaxis.set_major_locator(MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]))
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3, lw=0.5)
             if row == 0:
-                ax.set_title(f"joint {j + 1}", fontsize=9)
+                ax.set_title(f"joint {j + 1}", loc="left", fontsize=9, y=1.0)
             if j == 0:
                 name, unit = JOINT_QUANTITIES[kind]
                 ax.set_ylabel(f"{name} {_SYMBOLS[kind]} [{unit}]", fontsize=8)
+                ax.yaxis.set_label_coords(-0.3, 0.5)
             if row == len(LIMIT_KINDS) - 1:
                 ax.set_xlabel("time [s]", fontsize=8)
+                ax.xaxis.set_label_coords(0.5, -0.14)
     note = "" if trajectory.n_samples else f" — no trajectory: {result.message}"
     figure.suptitle(f"{_status_line(result)}: joint trajectories and limits{note}", fontsize=10)
     return figure
@@ -217,10 +233,14 @@ def _plot_triads(ax: Axes3D, lines: np.ndarray, gid: str, label: str, lw: float 
 
 
 def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
+    from matplotlib.ticker import MaxNLocator
+
     limits = equal_limits(points)
     ax.set_xlim(*limits[0])
     ax.set_ylim(*limits[1])
     ax.set_zlim(*limits[2])
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(nbins=5))
     ax.set_box_aspect((1.0, 1.0, 1.0))
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -254,7 +274,8 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
     trajectory = result.trajectory
     points_part, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
-    figure = _new_figure(13.0, 6.8)
+    figure = _new_figure(13.0, 6.8, layout=None)
+    figure.subplots_adjust(left=0.0, right=0.97, bottom=0.12, top=0.92, wspace=0.08)
     ax_cell = figure.add_subplot(1, 2, 1, projection="3d")
     ax_path = figure.add_subplot(1, 2, 2, projection="3d")
 
@@ -293,7 +314,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         ax_cell.plot(*chain.T, "o-", color="0.2", lw=3.0, ms=4, gid="robot", label="robot at t = 0")
         scene.append(chain)
     _set_equal(ax_cell, np.vstack(scene))
-    ax_cell.set_title("work cell (robot base frame)", fontsize=10)
+    ax_cell.set_title("work cell (robot base frame)", fontsize=10, y=1.0)
 
     ax_path.plot(*points_base.T, color=AFTER_COLOR, lw=2.0, gid="path-zoom")
     ax_path.plot(*points_base[0], "o", color="tab:green", ms=6, label="start", gid="start")
@@ -307,7 +328,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         if bad.any():
             _mark_violations(ax_path, points_base[bad].T, "samples inside a violation window")
     _set_equal(ax_path, points_base)
-    ax_path.set_title("placed path (close-up)", fontsize=10)
+    ax_path.set_title("placed path (close-up)", fontsize=10, y=1.0)
 
     handles, labels = [], []
     for ax in (ax_cell, ax_path):
@@ -315,7 +336,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
             if label not in labels:
                 handles.append(handle)
                 labels.append(label)
-    figure.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=8, frameon=False)
+    figure.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     figure.suptitle(
         f"{_status_line(result)}: placement X = {_format_placement(result)}", fontsize=10
     )
@@ -352,7 +373,8 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
     trajectory = result.trajectory
     task = case.task
     t = trajectory.t
-    figure = _new_figure(11.0, 6.5)
+    figure = _new_figure(11.0, 6.5, layout=None)
+    figure.subplots_adjust(left=0.07, right=0.76, bottom=0.08, top=0.94, hspace=0.08)
     ax_speed, ax_error = figure.subplots(2, 1, sharex=True)
 
     ax_speed.plot(
@@ -362,7 +384,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
         1e3 * task.rated_speed,
         ls="--",
         color="tab:green",
-        label=f"rated speed $v_r$ = {1e3 * task.rated_speed:.4g} mm/s",
+        label=f"rated speed vᵣ = {1e3 * task.rated_speed:.4g} mm/s",
         gid="rated-speed",
     )
     ax_speed.axhline(
@@ -370,7 +392,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
         ls=":",
         color="tab:orange",
         lw=1.5,
-        label=rf"corner speed cap $v_t^{{max}}$ = {1e3 * task.corner_speed:.4g} mm/s",
+        label=f"corner speed cap vₜᵐᵃˣ = {1e3 * task.corner_speed:.4g} mm/s",
         gid="corner-speed",
     )
     if trajectory.n_samples:
@@ -383,7 +405,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
                 alpha=0.15,
                 lw=0,
                 gid="slowdown",
-                label="slow-down below $v_r$" if k == 0 else None,
+                label="slow-down below vᵣ" if k == 0 else None,
             )
             ax_speed.annotate(
                 slowdown.limit,
@@ -467,8 +489,11 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
         Three axes (best, mean, feasible share), one line per method in each
         (``gid=method``).
     """
+    from matplotlib.ticker import LogFormatter
+
     columns = history_columns(history)
-    figure = _new_figure(9.0, 8.0)
+    figure = _new_figure(9.0, 8.0, layout=None)
+    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.07, top=0.95, hspace=0.08)
     ax_best, ax_mean, ax_share = figure.subplots(3, 1, sharex=True)
     for k, (method, c) in enumerate(columns.items()):
         color = f"C{k}"
@@ -496,6 +521,10 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
         values = np.concatenate([c[key] for c in columns.values()])
         if values.size and np.all(values > 0):
             ax.set_yscale("log")
+            # plain-text labels: the default ones are mathtext, whose parser costs more
+            # than the rest of the figure
+            ax.yaxis.set_major_formatter(LogFormatter())
+            ax.yaxis.set_minor_formatter(LogFormatter(labelOnlyBase=False))
         ax.set_ylabel(f"{label} [–]")
     ax_share.set_ylabel("feasible share [%]")
     ax_share.set_ylim(-2, 102)
@@ -532,7 +561,8 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
     """
     trajectory = result.trajectory
     tool = case.task.tool
-    figure = _new_figure(13.0, 5.6)
+    figure = _new_figure(13.0, 5.6, layout=None)
+    figure.subplots_adjust(left=0.06, right=0.98, bottom=0.1, top=0.88, wspace=0.12)
     ax_spin = figure.add_subplot(1, 2, 1)
     ax_frames = figure.add_subplot(1, 2, 2, projection="3d")
     if trajectory.n_samples and len(trajectory.spin) == trajectory.n_samples:
@@ -542,7 +572,7 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
             ax_spin.axhline(bound, ls="--", color="0.4", lw=1.0)
     ax_spin.set_xlabel("s along the planned path [m]")
     ax_spin.set_ylabel("spin about the tool axis [rad]")
-    ax_spin.set_title(f"spin: {tool.spin}", fontsize=10)
+    ax_spin.set_title(f"spin: {tool.spin}", fontsize=10, y=1.0)
     ax_spin.grid(alpha=0.3)
     _, points_base = path_points(result, case)
     ax_frames.plot(*points_base.T, color=AFTER_COLOR, lw=1.5, gid="tool-path")
@@ -552,7 +582,7 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
         T_tool = forward_kinematics(case.robot, trajectory.q[idx])
         _plot_triads(ax_frames, triad_lines(T_tool, 0.06 * extent), "tool-frames", "tool frames")
     _set_equal(ax_frames, points_base)
-    ax_frames.set_title(f"tool frames ({tool.frame} frame)", fontsize=10)
+    ax_frames.set_title(f"tool frames ({tool.frame} frame)", fontsize=10, y=1.0)
     figure.suptitle(_status_line(result), fontsize=10)
     return figure
 
@@ -608,6 +638,6 @@ def write_plots(
     written = []
     for name, build in plot_figures(result, case, history).items():
         path = out_dir / name
-        build().savefig(path, dpi=DPI)
+        save_png(build(), path)
         written.append(path)
     return written

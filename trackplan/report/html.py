@@ -19,7 +19,8 @@ from trackplan.case import Case
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.result import LIMIT_KINDS, PlanResult
 from trackplan.report.figures import history_columns
-from trackplan.report.robot_view import VIEW_ID, robot_view_figure
+from trackplan.report.plotly_html import plotly_div
+from trackplan.report.robot_view import VIEW_ID, robot_view_spec
 from trackplan.report.scene import JOINT_QUANTITIES
 from trackplan.robots.families import ik_family
 from trackplan.run_files import REPORT_FILE
@@ -33,7 +34,7 @@ _PLOT_CAPTIONS = {
         "Rows: position, velocity, acceleration and jerk (backward differences at Ts, robot "
         "at rest before the first sample); one column per joint. Dashed lines are the limits; "
         "red markers are samples beyond a limit and red bands the violation windows the "
-        "checker reported. Each panel gives the margin (unused fraction of the limit).",
+        "checker reported. Each panel gives its margin (unused fraction of the limit) above it.",
     ),
     "path.png": (
         "Path and placement",
@@ -463,18 +464,17 @@ def _plots_section(paths: Sequence[Path]) -> str:
     return '<section id="plots"><h2>Plots</h2>' + "".join(items) + "</section>"
 
 
-def _view_section(result: PlanResult, case: Case, n_frames: int) -> str:
+def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
+    """The report's 3D view section: the robot following the path (plotly.js embedded), or
+    a note when there is no trajectory. ``n_frames`` animation frames."""
     if result.trajectory.n_samples == 0:
         return (
             '<section id="view"><h2>3D view</h2><p>No trajectory to show: '
             f"{_esc(result.message)}</p></section>"
         )
-    figure = robot_view_figure(result, case, n_frames=n_frames)
-    div = figure.to_html(
-        full_html=False,
-        include_plotlyjs=True,
-        div_id=VIEW_ID,
-        auto_play=False,
+    div = plotly_div(
+        robot_view_spec(result, case, n_frames=n_frames),
+        VIEW_ID,
         config={"displaylogo": False, "responsive": True},
         post_script=_QUIET_INTERRUPTS,
     )
@@ -526,6 +526,24 @@ def write_report(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    page = report_page(
+        result, case, plots, view_section(result, case, n_frames), history, optimizer_info
+    )
+    path = out_dir / REPORT_FILE
+    path.write_text(page, encoding="utf-8")
+    return path
+
+
+def report_page(
+    result: PlanResult,
+    case: Case,
+    plots: Sequence[Path],
+    view: str,
+    history: Mapping[str, Mapping[str, np.ndarray]] | None = None,
+    optimizer_info: Mapping[str, object] | None = None,
+) -> str:
+    """The HTML of ``report.html`` (see :func:`write_report`) around the 3D view section
+    ``view`` (:func:`view_section`)."""
     verdict = "feasible" if result.feasible else "infeasible"
     body = "".join(
         [
@@ -546,18 +564,15 @@ def write_report(
             _violations_table(result),
             "</section>",
             _plots_section(plots),
-            _view_section(result, case, n_frames),
+            view,
         ]
     )
-    page = (
+    return (
         '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
         f"<title>trackplan report: {_esc(case.name)}</title><style>{_CSS}</style></head>"
         f"<body>{body}</body></html>\n"
     )
-    path = out_dir / REPORT_FILE
-    path.write_text(page, encoding="utf-8")
-    return path
 
 
 def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]

@@ -5,7 +5,12 @@ DH frames 1..n, tool) with a marker at each joint, on a subsampled trajectory. A
 slider and play/pause buttons drive plotly animation frames that update only the robot
 and the tool trail. With a work cell, obstacles and the placed workpiece are drawn as
 solids, the robot's link and tool capsules follow the animation, and the closest approach
-is a red segment between the nearest points. plotly is imported inside the functions.
+is a red segment between the nearest points.
+
+:func:`robot_view_spec` builds the figure as plain JSON-ready data (lists, dicts, numbers),
+which the report serialises directly: building plotly's validated objects for every
+animation frame cost more than the rest of the report's HTML. :func:`robot_view_figure`
+wraps the same data in a :class:`plotly.graph_objects.Figure`; plotly is imported there only.
 """
 
 from __future__ import annotations
@@ -46,13 +51,11 @@ DECIMALS = 5  # 10 µm: keeps the page small, far below anything visible
 _AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")
 
 
-def _xyz(points: np.ndarray) -> dict[str, list[float | None]]:
+def _xyz(points: np.ndarray, decimals: int = DECIMALS) -> dict[str, list[float | None]]:
     """Plotly coordinates from points (M, 3), NaN rows as gaps (None)."""
-    rounded = np.round(points, DECIMALS)
-    return {
-        axis: [None if np.isnan(v) else float(v) for v in rounded[:, i]]
-        for i, axis in enumerate("xyz")
-    }
+    columns = np.round(points, decimals).T.astype(object)
+    columns[np.isnan(points.T.astype(float))] = None
+    return {axis: columns[i].tolist() for i, axis in enumerate("xyz")}
 
 
 def frame_name(k: int) -> str:
@@ -63,8 +66,6 @@ def frame_name(k: int) -> str:
 def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list, Callable]:
     """Static traces of the cell (obstacles, workpiece, closest approach) and the builder of
     the animated link-capsule trace."""
-    import plotly.graph_objects as go
-
     from trackplan.cell.screening import CellGeometry
     from trackplan.report.cell_scene import (
         body_mesh,
@@ -84,20 +85,21 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
         if not bodies:
             continue
         vertices, faces = merge([body_mesh(body, T) for body in bodies])
-        traces.append(_mesh_trace(go, vertices, faces, label, color, opacity))
+        traces.append(_mesh_trace(vertices, faces, label, color, opacity))
     closest = closest_approach(geometry, case.robot, result)
     if closest is not None:
         points, label = closest
         traces.append(
-            go.Scatter3d(
+            {
+                "type": "scatter3d",
                 **_xyz(points),
-                mode="lines+markers",
-                name=CLOSEST_TRACE,
-                line={"color": "red", "width": 6},
-                marker={"size": 4, "color": "red"},
-                hovertext=[label, label],
-                hoverinfo="text",
-            )
+                "mode": "lines+markers",
+                "name": CLOSEST_TRACE,
+                "line": {"color": "red", "width": 6},
+                "marker": {"size": 4, "color": "red"},
+                "hovertext": [label, label],
+                "hoverinfo": "text",
+            }
         )
     frames = joint_frames(case.robot, result.trajectory.q[idx])
 
@@ -111,9 +113,7 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
         )
         return {
             "type": "mesh3d",
-            "x": np.round(vertices[:, 0], 3).tolist(),
-            "y": np.round(vertices[:, 1], 3).tolist(),
-            "z": np.round(vertices[:, 2], 3).tolist(),
+            **_xyz(vertices, 3),
             **triangles,
             "name": CAPSULES_TRACE,
             "showlegend": True,
@@ -125,30 +125,28 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
     return traces, capsules_trace
 
 
-def _mesh_trace(go, vertices: np.ndarray, faces: np.ndarray, name: str, color: str, opacity: float):  # type: ignore[no-untyped-def]
-    return go.Mesh3d(
-        x=vertices[:, 0],
-        y=vertices[:, 1],
-        z=vertices[:, 2],
-        i=faces[:, 0],
-        j=faces[:, 1],
-        k=faces[:, 2],
-        name=name,
-        showlegend=True,
-        color=color,
-        opacity=opacity,
-        flatshading=True,
-        hoverinfo="name",
-    )
+def _mesh_trace(
+    vertices: np.ndarray, faces: np.ndarray, name: str, color: str, opacity: float
+) -> dict:
+    return {
+        "type": "mesh3d",
+        **_xyz(vertices),
+        "i": faces[:, 0].tolist(),
+        "j": faces[:, 1].tolist(),
+        "k": faces[:, 2].tolist(),
+        "name": name,
+        "showlegend": True,
+        "color": color,
+        "opacity": opacity,
+        "flatshading": True,
+        "hoverinfo": "name",
+    }
 
 
 def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go.Figure:
     """The robot following the placed path, as a plotly figure with animation frames.
 
-    Static traces: the nominal path placed in the base frame (dashed), the planned tool
-    path, base and part frame axes, and the outer reach shell of the placement origin.
-    Animated traces: the robot (links and joints, ``name="robot"``) and the tool trail.
-    The axes are fixed with equal scale so the scene does not jump between frames.
+    The figure of :func:`robot_view_spec`, validated by plotly.
 
     Parameters
     ----------
@@ -173,6 +171,40 @@ def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go
     """
     import plotly.graph_objects as go
 
+    return go.Figure(robot_view_spec(result, case, n_frames))
+
+
+def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict:
+    """The robot following the placed path, as plotly figure data (plain JSON-ready values).
+
+    Static traces: the nominal path placed in the base frame (dashed), the planned tool
+    path, base and part frame axes, and the outer reach shell of the placement origin.
+    Animated traces: the robot (links and joints, ``name="robot"``) and the tool trail.
+    The axes are fixed with equal scale so the scene does not jump between frames.
+    Coordinates are rounded to 10 µm; gaps are ``None``.
+
+    Parameters
+    ----------
+    result
+        The planned placement; needs a non-empty trajectory (q in rad, positions in m).
+    case
+        The case (robot, nominal path, reach).
+    n_frames
+        Number of animation frames (evenly spread samples, first and last included);
+        fewer when the trajectory has fewer samples.
+
+    Returns
+    -------
+    dict
+        ``{"data": [trace, ...], "layout": {...}, "frames": [frame, ...]}`` as plotly.js
+        takes them (no template: plotly's default applies), with ``frames`` named
+        :func:`frame_name`, a slider with one step per frame and play/pause buttons.
+
+    Raises
+    ------
+    ValueError
+        When the trajectory is empty.
+    """
     trajectory = result.trajectory
     if trajectory.n_samples == 0:
         raise ValueError("no trajectory to animate")
@@ -190,8 +222,8 @@ def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go
     joint_sizes = [8] + [6] * robot.n_dof + [4]
     joint_colors = ["#444444"] + ["#1f3b73"] * robot.n_dof + ["#ff7f0e"]
 
-    # The animated traces are plain dicts and the figure skips plotly's property validation
-    # (it cost ~2 s for 150 frames); the static traces below are validated go objects.
+    trail = _xyz(tool)
+
     def robot_trace(k: int) -> dict:
         return {
             "type": "scatter3d",
@@ -211,50 +243,54 @@ def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go
     def trail_trace(k: int) -> dict:
         return {
             "type": "scatter3d",
-            **_xyz(tool[: k + 1]),
+            **{axis: values[: k + 1] for axis, values in trail.items()},
             "mode": "lines",
             "name": TRAIL_TRACE,
             "line": {"color": "#ff7f0e", "width": 6},
             "hoverinfo": "skip",
         }
 
-    static = [
-        go.Scatter3d(
+    static: list[dict] = [
+        {
+            "type": "scatter3d",
             **_xyz(shell),
-            mode="lines",
-            name=f"reach shell {reach:.3g} m",
-            line={"color": "rgba(120,120,120,0.25)", "width": 1},
-            hoverinfo="skip",
-            visible="legendonly",
-        ),
-        go.Scatter3d(
+            "mode": "lines",
+            "name": f"reach shell {reach:.3g} m",
+            "line": {"color": "rgba(120,120,120,0.25)", "width": 1},
+            "hoverinfo": "skip",
+            "visible": "legendonly",
+        },
+        {
+            "type": "scatter3d",
             **_xyz(nominal),
-            mode="lines",
-            name=NOMINAL_TRACE,
-            line={"color": "#7f7f7f", "width": 3, "dash": "dash"},
-            hoverinfo="skip",
-        ),
-        go.Scatter3d(
+            "mode": "lines",
+            "name": NOMINAL_TRACE,
+            "line": {"color": "#7f7f7f", "width": 3, "dash": "dash"},
+            "hoverinfo": "skip",
+        },
+        {
+            "type": "scatter3d",
             **_xyz(points_base[:: max(1, len(points_base) // 2000)]),
-            mode="lines",
-            name=PATH_TRACE,
-            line={"color": "#9467bd", "width": 3},
-            hoverinfo="skip",
-        ),
+            "mode": "lines",
+            "name": PATH_TRACE,
+            "line": {"color": "#9467bd", "width": 3},
+            "hoverinfo": "skip",
+        },
     ]
     for label, T in (("base frame", np.eye(4)), ("part frame", T_base_part)):
         lines = triad_lines(T, axis_length if label == "base frame" else 0.6 * axis_length)
         for axis, color in enumerate(_AXIS_COLORS):
             static.append(
-                go.Scatter3d(
+                {
+                    "type": "scatter3d",
                     **_xyz(lines[axis]),
-                    mode="lines",
-                    name=label,
-                    legendgroup=label,
-                    showlegend=axis == 0,
-                    line={"color": color, "width": 5},
-                    hoverinfo="skip",
-                )
+                    "mode": "lines",
+                    "name": label,
+                    "legendgroup": label,
+                    "showlegend": axis == 0,
+                    "line": {"color": color, "width": 5},
+                    "hoverinfo": "skip",
+                }
             )
     builders = [robot_trace, trail_trace]
     if case.cell is not None:
@@ -327,26 +363,29 @@ def robot_view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> go
         np.vstack([chains.reshape(-1, 3), points_base, nominal, [[0.0, 0.0, 0.0]]])
     )
     scene_axes = {
-        f"{axis}axis": {"range": limits[i].tolist(), "title": f"{axis} [m]", "autorange": False}
+        f"{axis}axis": {
+            "range": limits[i].tolist(),
+            "title": {"text": f"{axis} [m]"},
+            "autorange": False,
+        }
         for i, axis in enumerate("xyz")
     }
-    figure = go.Figure(data=[*static, *animated], frames=frames, _validate=False)
-    figure.update_layout(
-        title=(
-            f"{robot.name} following the placed path "
+    layout = {
+        "title": {
+            "text": f"{robot.name} following the placed path "
             f"({len(idx)} frames of {trajectory.n_samples} samples)"
-        ),
-        height=720,
-        margin={"l": 0, "r": 0, "t": 40, "b": 10},
-        scene={
+        },
+        "height": 720,
+        "margin": {"l": 0, "r": 0, "t": 40, "b": 10},
+        "scene": {
             **scene_axes,
             "aspectmode": "cube",
             "domain": {"x": [0.0, 1.0], "y": [0.14, 1.0]},
             "camera": {"eye": {"x": 1.6, "y": -1.6, "z": 1.0}},
         },
-        uirevision="robot-view",
-        legend={"x": 0.0, "y": 1.0},
-        sliders=[slider],
-        updatemenus=[buttons],
-    )
-    return figure
+        "uirevision": "robot-view",
+        "legend": {"x": 0.0, "y": 1.0},
+        "sliders": [slider],
+        "updatemenus": [buttons],
+    }
+    return {"data": [*static, *animated], "layout": layout, "frames": frames}

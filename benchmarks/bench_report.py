@@ -1,0 +1,150 @@
+"""Report writing: the plots and report.html of the corner case against planning it.
+
+Run with ``python -m benchmarks report``. Prints, in one run:
+
+- the reference: planning the corner case at the placement the default search finds
+  (in-process CPU time, warm, best of 5);
+- writing that run's plots and ``report.html`` with its search history, as ``trackplan
+  optimize`` writes them (:func:`~trackplan.report.run_report.write_run_report`), warm, best
+  of 3: with the first plot drawn in a forked process and with every plot drawn in turn;
+  wall time, CPU time of this process and of the forked one, and the busier of the two
+  against the plan;
+- the imports the report adds to a process (matplotlib, plotly), in a fresh process;
+- ``trackplan optimize cases/paper-corner.yaml`` as a whole process with and without the
+  report (median of 3 after one run that fills numba's cache): wall and CPU time, and their
+  difference, the report's cost; issue 8's targets on an idle machine are ≤ 5 s with the
+  report and ≤ 3 s without.
+
+Wall times count the other load of the machine; on a shared machine read the CPU times.
+"""
+
+from __future__ import annotations
+
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from benchmarks import best_time
+from trackplan.io.case_file import load_case
+from trackplan.planning.plan import plan_placement
+from trackplan.report.run_report import can_fork, write_run_report
+from trackplan.search import optimize_placement
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+CASE = "paper-corner"
+REPORT_REPEATS = 3
+"""Reports written per mode after a warm-up one (the best is printed)."""
+PROCESS_RUNS = 3
+"""Whole-process runs per command (the median is printed)."""
+TARGETS = {True: 5.0, False: 3.0}
+"""Whole-process wall time targets of issue 8 on an idle machine, s, with and without the
+report."""
+REPORT_IMPORTS = "import matplotlib.figure, matplotlib.backends.backend_agg, plotly.offline"
+
+
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _report_seconds(write) -> tuple[float, float, float]:  # type: ignore[no-untyped-def]
+    """Best wall time, CPU time of this process and CPU time of its children over
+    :data:`REPORT_REPEATS` calls after a warm-up call, s (the best by wall time)."""
+    write()
+    runs = []
+    for _ in range(REPORT_REPEATS):
+        wall, cpu, children = time.perf_counter(), time.process_time(), _children_cpu()
+        write()
+        runs.append(
+            (
+                time.perf_counter() - wall,
+                time.process_time() - cpu,
+                _children_cpu() - children,
+            )
+        )
+    return min(runs)
+
+
+def _process_seconds(args: list[str], runs: int = PROCESS_RUNS) -> tuple[float, float]:
+    """Median wall time and median CPU time (user + system) of a command run as a fresh
+    process, s."""
+    walls, cpus = [], []
+    for _ in range(runs):
+        before = _children_cpu()
+        start = time.perf_counter()
+        subprocess.run(args, check=False, capture_output=True)
+        walls.append(time.perf_counter() - start)
+        cpus.append(_children_cpu() - before)
+    return statistics.median(walls), statistics.median(cpus)
+
+
+def _in_process() -> None:
+    case = load_case(CASES / f"{CASE}.yaml")
+    search = optimize_placement(case)
+    result = search.final
+    history = {search.method: search.history.as_columns()}
+    plan = best_time(lambda: plan_placement(case, search.X))
+    print(
+        f"{CASE}: {result.trajectory.n_samples} samples at Ts = "
+        f"{1e3 * case.task.sample_time:.3g} ms, found by {search.method}"
+    )
+    print(f"  plan_placement (reference, CPU, warm): {1e3 * plan:.1f} ms")
+    print(f"\n  {'report (plots + report.html), warm':<44}{'wall s':>8}{'CPU s':>8}", end="")
+    print(f"{'forked CPU s':>14}{'longest / plan':>16}")
+    modes = (True, False) if can_fork() else (False,)
+    with tempfile.TemporaryDirectory() as out:
+        for parallel in modes:
+
+            def write(parallel: bool = parallel) -> None:
+                write_run_report(result, case, Path(out), history, parallel=parallel)
+
+            wall, cpu, children = _report_seconds(write)
+            label = "first plot in a forked process" if parallel else "plots in turn"
+            longest = max(cpu, children) / plan
+            print(f"  {label:<44}{wall:>8.2f}{cpu:>8.2f}{children:>14.2f}{longest:>15.0f}×")
+    print("  longest: the CPU time of the busier process, the wall time on an idle 2-core machine")
+    if not can_fork():
+        print("  (no second core or no fork here: the forked mode was not measured)")
+
+
+def _whole_process() -> None:
+    python = sys.executable
+    imports = _process_seconds([python, "-c", "import trackplan.cli.app"])
+    with_report = _process_seconds([python, "-c", f"import trackplan.cli.app; {REPORT_IMPORTS}"])
+    print(f"\nWhole process, median of {PROCESS_RUNS} runs (after one that fills numba's cache)")
+    print(f"  {'command':<58}{'wall s':>8}{'CPU s':>8}  target (idle machine)")
+    print(f"  {'python -c import trackplan.cli.app':<58}{imports[0]:>8.2f}{imports[1]:>8.2f}")
+    print(
+        f"  {'  + the report imports (matplotlib, plotly)':<58}"
+        f"{with_report[0] - imports[0]:>+8.2f}{with_report[1] - imports[1]:>+8.2f}"
+    )
+    seconds = {}
+    for report in (False, True):
+        command = [python, "-m", "trackplan", "optimize", str(CASES / f"{CASE}.yaml")]
+        if not report:
+            command.append("--no-report")
+        with tempfile.TemporaryDirectory() as out:
+            subprocess.run([*command, "--out", out], check=False, capture_output=True)
+            seconds[report] = _process_seconds([*command, "--out", out])
+        wall, cpu = seconds[report]
+        verdict = "MET" if wall <= TARGETS[report] else "MISSED"
+        label = f"trackplan optimize {CASE}" + ("" if report else " --no-report")
+        print(f"  {label:<58}{wall:>8.2f}{cpu:>8.2f}  ≤ {TARGETS[report]:g} s wall: {verdict}")
+    print(
+        f"  {'  the report (difference)':<58}{seconds[True][0] - seconds[False][0]:>+8.2f}"
+        f"{seconds[True][1] - seconds[False][1]:>+8.2f}"
+    )
+    print("  (wall time on a loaded machine exceeds the CPU time; the targets are for an idle one)")
+
+
+def main() -> None:
+    _in_process()
+    _whole_process()
+
+
+if __name__ == "__main__":
+    main()
