@@ -11,11 +11,10 @@ import sys
 
 from tests.conftest import CASES
 
+SCIPY_SOLVERS = ("scipy.optimize", "scipy.interpolate", "scipy.spatial", "scipy.stats")
+"""scipy's optimisers, splines and trees: a plan whose speed stays in windows uses none."""
+
 REPORT_AND_OPTIONAL = (
-    "scipy.optimize",
-    "scipy.interpolate",
-    "scipy.spatial",
-    "scipy.stats",
     "matplotlib",
     "plotly",
     "dask",
@@ -54,10 +53,22 @@ def test_import_trackplan_is_cheap():
     assert _loaded_after("import trackplan", ("numpy", "importlib.metadata")) == []
 
 
+def test_plan_in_windows_imports_no_scipy_solver(tmp_path):
+    """A plan of the corner case at its example placement (a blend: the scalar solvers run;
+    the speed stays in windows) imports none of scipy's optimisers, splines or trees."""
+    run = (
+        "from trackplan.cli import main\n"
+        f"code = main(['plan', {str(CASES / 'paper-corner.yaml')!r}, '--no-report', "
+        f"'--out', {str(tmp_path / 'out')!r}])\n"
+        "assert code == 0, code"
+    )
+    assert _loaded_after(run, SCIPY_SOLVERS) == []
+
+
 def test_optimize_without_report_imports_only_what_it_uses(tmp_path):
-    """A whole ``optimize --no-report`` of the corner case (a blend: the scalar solvers run)
-    imports neither scipy's optimisers and splines nor the report, the cell's exact
-    distances, Dask, the URDF stack or the population methods."""
+    """A whole ``optimize --no-report`` of the corner case imports neither the report, the
+    cell's exact distances, Dask, the URDF stack nor the population methods. (Its plan at
+    the centre of the box runs the continuous speed curve, so scipy's LP solver is used.)"""
     run = (
         "from trackplan.cli import main\n"
         f"code = main(['optimize', {str(CASES / 'paper-corner.yaml')!r}, '--no-report', "

@@ -12,7 +12,6 @@ around the best. The best is planned and checked by
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from trackplan.case import Case
 from trackplan.frames import as_placement
@@ -50,6 +49,8 @@ def spin_seeds(fitness: PlacementFitness) -> np.ndarray:
     middle = 0.5 * sum(tool.spin_range)
     if tool.n_spin == 1:
         return np.array([[middle]])
+    from scipy.interpolate import BSpline  # only free-spin tools need scipy's splines
+
     basis = BSpline.design_matrix(
         fitness.s_grid, spin_knots(tool.n_spin, length), SPIN_DEGREE
     ).toarray()

@@ -37,9 +37,6 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sparse
-from scipy.interpolate import make_interp_spline
-from scipy.optimize import linprog
 
 from trackplan.case import Task
 from trackplan.jointpath import JointPath
@@ -237,6 +234,9 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     cap_scale
         Share of the speed cap planned at each node, shape (G,).
     """
+    import scipy.sparse as sparse  # scipy's LP stack only where a curve is planned
+    from scipy.optimize import linprog
+
     s, d1, d2, d3 = stretch.s, stretch.d1, stretch.d2, stretch.d3
     count = len(s)
     h = s[1] - s[0]
@@ -342,6 +342,8 @@ def _sample(
     times = np.arange(n_steps + 1) * sample_time
     out = np.empty(len(times))
     start = 0.0
+    from scipy.interpolate import make_interp_spline  # only where a curve is sampled
+
     rest = [(1, 0.0), (2, 0.0)]
     for stretch, step in zip(stretches, steps, strict=True):
         t = start + np.concatenate([[0.0], np.cumsum(step)])
