@@ -9,6 +9,7 @@ from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.planning.plan import check_case_trajectory, plan_placement
 from trackplan.timing import continuous
+from trackplan.timing.sample_checks import robot_checks
 from trackplan.timing.smooth import LIMIT_SHARE
 
 WRIST_X = np.array([-0.1891, 0.1807, 0.1739, -0.5075, -1.3612, 1.5486])
@@ -75,3 +76,21 @@ def test_rest_envelope_is_a_start_at_constant_path_jerk():
     assert np.allclose(x[near_start], (J * t[near_start] ** 2 / 2) ** 2, rtol=1e-12)
     assert x[0] == 0.0 and x[-1] == 0.0
     assert np.allclose(x, x[::-1], rtol=1e-12)  # the stop mirrors the start
+
+
+def test_a_curve_that_cannot_beat_the_windows_is_given_up(wrist):
+    """Given the window plan's duration to beat, the curve is planned when it is faster and
+    given up (None) when even the nodes' own timing cannot beat a shorter one."""
+    case, result = wrist
+    checks = robot_checks(case.robot)
+    curve = continuous.plan_speed_curve(
+        result.joint_path, case.task, checks, LIMIT_SHARE, to_beat=WINDOWS_ONLY
+    )
+    assert curve is not None and curve.duration < WINDOWS_ONLY
+    unbeatable = 0.5 * curve.duration
+    assert (
+        continuous.plan_speed_curve(
+            result.joint_path, case.task, checks, LIMIT_SHARE, to_beat=unbeatable
+        )
+        is None
+    )

@@ -124,6 +124,7 @@ def plan_speed_curve(
     task: Task,
     checks: tuple[SampleCheck, ...],
     share: float,
+    to_beat: float = np.inf,
 ) -> SpeedCurve | None:
     """The continuous speed curve of a joint path (see the module), or None.
 
@@ -137,12 +138,17 @@ def plan_speed_curve(
         The sample checks the samples must pass.
     share
         Share of each joint limit planned against.
+    to_beat
+        Duration, s, of a law already found (the window plan's). A rebuild plans with
+        lower limits, which in practice never makes the curve faster; so once the nodes'
+        own timing (before sampling) reaches ``to_beat``, the work stops and None is
+        returned.
 
     Returns
     -------
     SpeedCurve or None
-        None when a linear program fails or the samples still fail a check after
-        :data:`MAX_REBUILDS` plans.
+        None when a linear program fails, the curve cannot beat ``to_beat``, or the samples
+        still fail a check after :data:`MAX_REBUILDS` plans.
     """
     stretches = _stretches(joint_path, task)
     robot = joint_path.robot
@@ -159,6 +165,11 @@ def plan_speed_curve(
             if x is None:
                 return None
             speeds.append(np.sqrt(x))
+        if (
+            sum(_node_steps(st, v).sum() for st, v in zip(stretches, speeds, strict=True))
+            >= to_beat
+        ):
+            return None
         s = _sample(stretches, speeds, task.sample_time)
         if s is None:
             return None
@@ -314,6 +325,14 @@ def _rest_envelope(s: np.ndarray, d1: np.ndarray, jerk: np.ndarray) -> np.ndarra
     return np.minimum(start, end)
 
 
+def _node_steps(stretch: _Stretch, speed: np.ndarray) -> np.ndarray:
+    """Time between consecutive nodes, shape (G - 1,), s, at the node speeds ``speed`` (G,):
+    constant acceleration between nodes, constant jerk next to the rests at both ends."""
+    step = 2.0 * (stretch.s[1] - stretch.s[0]) / np.maximum(speed[1:] + speed[:-1], 1e-300)
+    step[[0, -1]] *= 1.5  # from and to rest at constant jerk: s/ṡ = t/3, not t/2
+    return step
+
+
 def _sample(
     stretches: list[_Stretch], speeds: list[np.ndarray], sample_time: float
 ) -> np.ndarray | None:
@@ -326,11 +345,7 @@ def _sample(
     exactly. s(t) of each stretch is the quintic spline through (t, s) at the nodes, at
     rest (ṡ = s̈ = 0) at both ends, so its jerk is continuous.
     """
-    steps = []
-    for stretch, v in zip(stretches, speeds, strict=True):
-        step = 2.0 * (stretch.s[1] - stretch.s[0]) / np.maximum(v[1:] + v[:-1], 1e-300)
-        step[[0, -1]] *= 1.5  # from and to rest at constant jerk: s/ṡ = t/3, not t/2
-        steps.append(step)
+    steps = [_node_steps(stretch, v) for stretch, v in zip(stretches, speeds, strict=True)]
     duration = float(sum(step.sum() for step in steps))
     if not duration < MAX_DURATION:
         return None

@@ -179,7 +179,9 @@ def _or_curve(
     )
     if law.success and limited < CURVE_SHARE * duration:
         return law
-    curve = plan_speed_curve(joint_path, task, checks, LIMIT_SHARE)
+    curve = plan_speed_curve(
+        joint_path, task, checks, LIMIT_SHARE, to_beat=law.duration if law.success else np.inf
+    )
     if curve is None or (law.success and curve.duration >= law.duration):
         return law
     return TimeLaw(
