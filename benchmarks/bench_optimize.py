@@ -214,14 +214,20 @@ def _corner_seeds() -> None:
 
 def _case_names() -> list[str]:
     """The cases to run: ``TRACKPLAN_BENCH_CASES`` (comma-separated names; ``none``: only the
-    whole-process times) or every shipped case, the paper's first."""
+    whole-process times) or every shipped case with one seam, the paper's first."""
     chosen = os.environ.get("TRACKPLAN_BENCH_CASES")
     if chosen == "none":
         return []
     if chosen:
         return [name.strip() for name in chosen.split(",") if name.strip()]
     others = sorted(f.stem for f in CASES.glob("*.yaml") if f.stem not in PAPER_CASES)
-    return [*PAPER_CASES, *others]
+    several = [name for name in others if load_case(CASES / f"{name}.yaml").cycle is not None]
+    if several:
+        print(
+            f"(cases with several seams, searched by optimize_cycle: {', '.join(several)}; "
+            "python -m benchmarks seams)"
+        )
+    return [*PAPER_CASES, *(name for name in others if name not in several)]
 
 
 def _quality_rows(name: str, rows: list, refs: list) -> list[float]:  # type: ignore[type-arg]
