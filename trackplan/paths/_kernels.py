@@ -363,34 +363,6 @@ def fit_deviation(
     return vertex_distance, bound
 
 
-@njit(cache=True)
-def nearest_distance(
-    points: np.ndarray,
-    is_arc: np.ndarray,
-    start: np.ndarray,
-    direction: np.ndarray,
-    length: np.ndarray,
-    center: np.ndarray,
-    axis: np.ndarray,
-    e1: np.ndarray,
-    e2: np.ndarray,
-    radius: np.ndarray,
-    angle: np.ndarray,
-) -> np.ndarray:  # pragma: no cover
-    """Kernel: distance (N,) of ``points`` (N, 3) from the nearest of a few pieces, m."""
-    out = np.empty(points.shape[0])
-    for b in range(points.shape[0]):
-        nearest = np.inf
-        for k in range(length.shape[0]):
-            d = project_point(
-                points[b], k, is_arc, start, direction, length, center, axis, e1, e2,
-                radius, angle,
-            )[1]  # fmt: skip
-            nearest = min(nearest, d)
-        out[b] = nearest
-    return out
-
-
 @njit(cache=True, inline="always")
 def _horner(coefficients: np.ndarray, x: float) -> float:  # pragma: no cover
     """Kernel: the polynomial with ascending ``coefficients`` at ``x`` (numpy's polyval)."""

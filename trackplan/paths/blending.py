@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.paths._kernels import nearest_distance
+from trackplan.paths._kernels import dense_pieces
 from trackplan.paths.geometry import (
     Arc,
     Line,
@@ -166,10 +166,10 @@ def _distances(points: np.ndarray, neighbours: tuple[Primitive, ...]) -> np.ndar
     """Distance (N,) of ``points`` (N, 3) from the nearest of ``neighbours``, m (compiled:
     the blend search measures a few dozen points hundreds of times)."""
     t = PieceTable.from_curves(neighbours)
-    return nearest_distance(
-        np.ascontiguousarray(points, dtype=float), t.is_arc, t.start, t.direction, t.length,
-        t.center, t.axis, t.e1, t.e2, t.radius, t.angle,
-    )  # fmt: skip
+    return dense_pieces(
+        np.ascontiguousarray(points, dtype=float), 0.0, t.is_arc, t.start, t.direction,
+        t.length, t.center, t.axis, t.e1, t.e2, t.radius, t.angle,
+    )[4]  # fmt: skip
 
 
 def _curvature(offsets: np.ndarray) -> np.ndarray:
