@@ -46,11 +46,16 @@ from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, run_motion
 
 NODE_SPACING = 1e-3
 """Largest distance between two nodes of the speed curve, m."""
+NODE_GROWTH = 0.25
+"""Largest growth of the node spacing per metre of distance from a finer part, m/m."""
 MIN_NODES = 24
 """Fewest nodes of a stretch between stops (a short stretch gets a finer spacing)."""
 ROUNDS = 2
-"""Linear programs per plan: the first bounds √x by the speed caps, the second by
-:data:`SPEED_ROOM` times the first solution."""
+"""Linear programs per plan: the first bounds √x by :data:`FIRST_ROOM` times the
+constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the first solution."""
+FIRST_ROOM = 1.2
+"""How far above the constant-speed cap the joints allow (at each node) the first round's
+speed may go (its jerk bound assumes the speed stays below it)."""
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
@@ -201,25 +206,66 @@ def _stretches(joint_path: JointPath, task: Task) -> list[_Stretch]:
     for a, b in itertools.pairwise(bounds):
         if b - a <= 1e-12:
             continue
-        count = max(MIN_NODES, int(np.ceil((b - a) / NODE_SPACING)) + 1)
-        s = np.linspace(a, b, count)
-        h = s[1] - s[0]
         inside = [(z, zone) for z, zone in moving if zone[0] < b and zone[1] > a]
+        rows = np.isin(joint_path.zone, [z for z, _ in inside])
+        grid = joint_path.s[rows]
+        s = _nodes(grid, a, b)
+        count = len(s)
+        before = np.concatenate([[s[0]], s[:-1]])
+        after = np.concatenate([s[1:], [s[-1]]])
         cap = np.full(count, np.inf)
         for _, (s0, s1, kind) in inside:
             speed = task.rated_speed
             if kind != "straight":
                 speed = min(task.rated_speed, task.corner_speed * (1.0 - LIMIT_MARGIN))
-            near = (s >= s0 - h) & (s <= s1 + h)  # a node's neighbourhood touches the zone
+            near = (after >= s0) & (before <= s1)  # a node's neighbourhood touches the zone
             cap[near] = np.minimum(cap[near], CAP_SHARE * speed)
-        rows = np.isin(joint_path.zone, [z for z, _ in inside])
-        grid = joint_path.s[rows]
         sides = []
         for derivative in (joint_path.dq, joint_path.ddq, joint_path.dddq):
             values = derivative[rows]
             sides.append(np.stack([_interp(s, grid, values, last) for last in (True, False)]))
         out.append(_Stretch(s, cap, *sides))
     return out
+
+
+def _nodes(grid: np.ndarray, a: float, b: float) -> np.ndarray:
+    """Nodes of the stretch ``a..b`` (G,), m: the planning grid's own points (fine where the
+    path bends quickly) and, between them, nodes at most :data:`NODE_SPACING` apart (and at
+    least :data:`MIN_NODES` in all) whose spacing grows by at most :data:`NODE_GROWTH` of
+    the distance away from a finer part, so that neighbouring steps stay alike and the
+    three-point differences stay accurate.
+
+    The spacing wanted at each grid point is its shorter gap; it is limited to
+    ``t_j + NODE_GROWTH |s - s_j|`` from every other point j and varies linearly inside a gap,
+    where the nodes lie at equal steps of ``∫ ds / t(s)``.
+    """
+    points = np.unique(np.clip(np.concatenate([[a, b], grid]), a, b))
+    spacing = min(NODE_SPACING, (b - a) / (MIN_NODES - 1))
+    # grid points closer than a thousandth of the spacing would give ill-conditioned
+    # difference quotients: keep the first of them (and the end)
+    keep = np.concatenate([[True], np.diff(points) > 1e-3 * spacing])
+    points = points[keep]
+    points[-1] = b
+    gaps = np.diff(points)
+    wanted = np.minimum(
+        spacing, np.minimum(np.append(gaps, np.inf), np.insert(gaps, 0, np.inf))
+    )
+    slope = NODE_GROWTH
+    wanted = np.minimum.accumulate(wanted - slope * points) + slope * points
+    wanted = np.minimum.accumulate((wanted + slope * points)[::-1])[::-1] - slope * points
+    t0, t1 = wanted[:-1], wanted[1:]
+    rate = (t1 - t0) / gaps  # dt/ds inside each gap
+    flat = np.abs(rate) < 1e-9
+    steps = np.where(flat, gaps / t0, np.log(t1 / t0) / np.where(flat, 1.0, rate))
+    pieces = np.maximum(1, np.ceil(steps - 1e-9)).astype(int)
+    gap = np.repeat(np.arange(len(gaps)), pieces)
+    index = np.arange(pieces.sum()) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    u = index * (steps / pieces)[gap]  # ∫ ds / t from the gap's start
+    r = rate[gap]
+    offset = np.where(
+        flat[gap], u * t0[gap], t0[gap] * np.expm1(r * u) / np.where(flat[gap], 1.0, r)
+    )
+    return np.concatenate([points[:-1][gap] + offset, [b]])
 
 
 def _interp(s: np.ndarray, grid: np.ndarray, values: np.ndarray, last: bool) -> np.ndarray:
@@ -250,20 +296,20 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
 
     s, d1, d2, d3 = stretch.s, stretch.d1, stretch.d2, stretch.d3
     count = len(s)
-    h = s[1] - s[0]
     with np.errstate(divide="ignore"):
         velocity = np.min(limits[0] / np.abs(d1), axis=(0, 2))
     cap = stretch.cap * cap_scale
     top = np.minimum(np.minimum(cap, velocity) ** 2, _rest_envelope(s, d1, limits[2]))
     k = np.arange(1, count - 1)
-    # accel:  q' (x[k+1] - x[k-1]) / (4h) + q'' x[k]
-    # jerk:   q' (x[k+1] - 2 x[k] + x[k-1]) / (2h²) + 1.5 q'' (x[k+1] - x[k-1]) / (2h) + q''' x[k]
-    q1, q2, q3 = d1[:, k], d2[:, k], d3[:, k]  # (2, m, n)
-    c1, c2 = q1 / (2 * h * h), 0.75 * q2 / h
+    slope, bend = _differences(s)  # x'[k] = slope @ x[k-1:k+2], x''[k] = bend @ ...
+    # accel:  q' x'/2 + q'' x
+    # jerk:   q' x''/2 + 1.5 q'' x' + q''' x
+    q1, q2, q3 = (d[:, k, :, None] for d in (d1, d2, d3))  # (2, m, n, 1)
+    centre = np.array([0.0, 1.0, 0.0])
     coefficients = np.stack(
         [
-            np.stack([-q1 / (4 * h), q2, q1 / (4 * h)], axis=-1),
-            np.stack([c1 - c2, q3 - 2 * c1, c1 + c2], axis=-1),
+            q1 * slope[:, None] / 2 + q2 * centre,
+            q1 * bend[:, None] / 2 + 1.5 * q2 * slope[:, None] + q3 * centre,
         ]
     )  # (2 kinds, 2 sides, m, n, 3 columns)
     columns = np.broadcast_to(
@@ -272,7 +318,14 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     matrix_coefficients = np.concatenate([coefficients, -coefficients], axis=0).reshape(-1, 3)
     matrix_columns = np.concatenate([columns, columns], axis=0).reshape(-1, 3)
     rows = np.repeat(np.arange(len(matrix_columns)), 3)
-    x = top
+    with np.errstate(divide="ignore"):
+        steady = np.min(
+            np.minimum(
+                np.sqrt(limits[1] / np.abs(d2)), np.cbrt(limits[2] / np.abs(d3))
+            ),
+            axis=(0, 2),
+        )
+    x = np.minimum(top, (FIRST_ROOM * steady) ** 2)
     for _ in range(ROUNDS):
         bound = np.sqrt(x)
         with np.errstate(divide="ignore"):
@@ -295,6 +348,18 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
         solution = np.clip(result.x, 0.0, x)
         x = np.minimum(top, SPEED_ROOM**2 * solution)
     return solution
+
+
+def _differences(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Three-point difference weights at the inner nodes of ``s`` (G,): the first and the
+    second derivative at node k are the weights (G - 2, 3) times the values at k - 1, k and
+    k + 1 (exact for quadratics on any spacing; the central differences on a uniform one)."""
+    h1 = np.diff(s)[:-1, None]
+    h2 = np.diff(s)[1:, None]
+    total = h1 + h2
+    slope = np.hstack([-h2 / (h1 * total), (h2 - h1) / (h1 * h2), h1 / (h2 * total)])
+    bend = np.hstack([2.0 / (h1 * total), -2.0 / (h1 * h2), 2.0 / (h2 * total)])
+    return slope, bend
 
 
 def _rest_envelope(s: np.ndarray, d1: np.ndarray, jerk: np.ndarray) -> np.ndarray:
@@ -328,7 +393,7 @@ def _rest_envelope(s: np.ndarray, d1: np.ndarray, jerk: np.ndarray) -> np.ndarra
 def _node_steps(stretch: _Stretch, speed: np.ndarray) -> np.ndarray:
     """Time between consecutive nodes, shape (G - 1,), s, at the node speeds ``speed`` (G,):
     constant acceleration between nodes, constant jerk next to the rests at both ends."""
-    step = 2.0 * (stretch.s[1] - stretch.s[0]) / np.maximum(speed[1:] + speed[:-1], 1e-300)
+    step = 2.0 * np.diff(stretch.s) / np.maximum(speed[1:] + speed[:-1], 1e-300)
     step[[0, -1]] *= 1.5  # from and to rest at constant jerk: s/ṡ = t/3, not t/2
     return step
 
@@ -392,14 +457,15 @@ def _lower(
 ) -> None:
     """Lower the limit of each failing order at the nodes around each failing sample
     (order 4: the speed cap, by the excess found and twice as much again)."""
-    h = s_nodes[1] - s_nodes[0]
-    reach = REBUILD_REACH * h
-    inside = (s_bad >= s_nodes[0] - reach) & (s_bad <= s_nodes[-1] + reach)
+    inside = (s_bad >= s_nodes[0]) & (s_bad <= s_nodes[-1])
+    # positions in nodes (fractional): the reach counts nodes, wherever they are finer
+    position = np.interp(s_bad[inside], s_nodes, np.arange(len(s_nodes)))
+    index = np.arange(len(s_nodes))
     factor = np.ones_like(scale)
-    for where, o, r in zip(s_bad[inside], order[inside], ratio[inside], strict=True):
+    for where, o, r in zip(position, order[inside], ratio[inside], strict=True):
         # full lowering within the reach, tapering off over as much again beyond it, so
         # the lowered limit has no step of its own
-        taper = np.clip(2.0 - np.abs(s_nodes - where) / reach, 0.0, 1.0)
+        taper = np.clip(2.0 - np.abs(index - where) / REBUILD_REACH, 0.0, 1.0)
         target = REBUILD_FACTOR / r if o < 4 else (1.0 - 2.0 * (r - 1.0)) / r
         lowered = 1.0 - taper * (1.0 - target)
         factor[o - 1] = np.minimum(factor[o - 1], lowered)
