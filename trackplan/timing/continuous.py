@@ -59,6 +59,11 @@ speed may go (its jerk bound assumes the speed stays below it)."""
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
+CRUISE_ROOM = 1.5
+"""How far above the speed cap the joints must allow a constant speed for a node to cruise
+at its cap without the linear program (see :func:`_cruising`)."""
+CRUISE_CLEARANCE = 0.02
+"""Distance from any slowed or changing node beyond which a node cruises at its cap, m."""
 MAX_DURATION = 2000.0
 """Longest curve sampled, s (the window law's longest, 2 000 000 samples at 1 ms): a curve
 that would take longer has (almost) stopped inside a stretch, and the window law stands."""
@@ -247,9 +252,7 @@ def _nodes(grid: np.ndarray, a: float, b: float) -> np.ndarray:
     points = points[keep]
     points[-1] = b
     gaps = np.diff(points)
-    wanted = np.minimum(
-        spacing, np.minimum(np.append(gaps, np.inf), np.insert(gaps, 0, np.inf))
-    )
+    wanted = np.minimum(spacing, np.minimum(np.append(gaps, np.inf), np.insert(gaps, 0, np.inf)))
     slope = NODE_GROWTH
     wanted = np.minimum.accumulate(wanted - slope * points) + slope * points
     wanted = np.minimum.accumulate((wanted + slope * points)[::-1])[::-1] - slope * points
@@ -315,39 +318,76 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     columns = np.broadcast_to(
         np.stack([k - 1, k, k + 1], axis=-1)[None, None, :, None, :], coefficients.shape
     )
-    matrix_coefficients = np.concatenate([coefficients, -coefficients], axis=0).reshape(-1, 3)
-    matrix_columns = np.concatenate([columns, columns], axis=0).reshape(-1, 3)
-    rows = np.repeat(np.arange(len(matrix_columns)), 3)
+    # the side after a node repeats the side before it except at zone boundaries
+    same = np.all([np.all(d[0, k] == d[1, k], axis=-1) for d in (d1, d2, d3)], axis=0)  # (m,)
+    distinct = np.stack([np.ones_like(same), ~same])[None, None, :, :, None]  # (1,1,2,m,1)
+    signed = np.stack([coefficients, -coefficients])  # rows ≤ rhs in both directions
+    positive = np.maximum(signed, 0.0)
+    signed_columns = np.stack([columns, columns])
     with np.errstate(divide="ignore"):
         steady = np.min(
-            np.minimum(
-                np.sqrt(limits[1] / np.abs(d2)), np.cbrt(limits[2] / np.abs(d3))
-            ),
+            np.minimum(np.sqrt(limits[1] / np.abs(d2)), np.cbrt(limits[2] / np.abs(d3))),
             axis=(0, 2),
         )
-    x = np.minimum(top, (FIRST_ROOM * steady) ** 2)
-    for _ in range(ROUNDS):
-        bound = np.sqrt(x)
-        with np.errstate(divide="ignore"):
-            jerk = limits[2][k] / np.maximum(bound[k], 1e-9)[:, None]
-        rhs = np.stack([np.broadcast_to(limits[1][k], jerk.shape), jerk])[:, None]  # (2,1,m,n)
-        rhs = np.broadcast_to(rhs, coefficients.shape[:-1])
-        matrix = sparse.csr_matrix(
-            (matrix_coefficients.ravel(), (rows, matrix_columns.ravel())),
-            shape=(len(matrix_columns), count),
-        )
-        result = linprog(
-            -np.ones(count),
-            A_ub=matrix,
-            b_ub=np.concatenate([rhs, rhs]).ravel(),
-            bounds=np.stack([np.zeros(count), x], axis=1),
-            method="highs",
-        )
-        if result.status != 0:
-            return None
-        solution = np.clip(result.x, 0.0, x)
-        x = np.minimum(top, SPEED_ROOM**2 * solution)
-    return solution
+    cruise = _cruising(s, top, steady)
+    solution = None
+    for held in (cruise, np.zeros_like(cruise)) if cruise.any() else (cruise,):
+        # held at the cap first; if that leaves no room for a speed change, everything free
+        x = np.minimum(top, (FIRST_ROOM * steady) ** 2)
+        for _ in range(ROUNDS):
+            bound = np.sqrt(x)
+            with np.errstate(divide="ignore"):
+                jerk = limits[2][k] / np.maximum(bound[k], 1e-9)[:, None]
+            rhs = np.stack([np.broadcast_to(limits[1][k], jerk.shape), jerk])[:, None]
+            rhs = np.broadcast_to(rhs, signed.shape[:-1])  # (2 signs, 2 kinds, 2 sides, m, n)
+            # a row binds only if its largest value for 0 ≤ x ≤ the round's bound passes
+            # rhs, and only if it reaches a node that is not held
+            keep = distinct & (np.einsum("...c,...c->...", positive, x[signed_columns]) > rhs)
+            keep &= ~np.all(held[signed_columns], axis=-1)
+            solution = x
+            if keep.any():
+                kept = signed[keep]
+                matrix = sparse.csr_matrix(
+                    (
+                        kept.ravel(),
+                        (np.repeat(np.arange(len(kept)), 3), signed_columns[keep].ravel()),
+                    ),
+                    shape=(len(kept), count),
+                )
+                result = linprog(
+                    -np.ones(count),
+                    A_ub=matrix,
+                    b_ub=rhs[keep],
+                    bounds=np.stack([np.where(held, x, 0.0), x], axis=1),
+                    method="highs",
+                )
+                if result.status != 0:
+                    solution = None
+                    break
+                solution = np.clip(result.x, 0.0, x)
+            x = np.minimum(top, SPEED_ROOM**2 * solution)
+        if solution is not None:
+            return solution
+    return None
+
+
+def _cruising(s: np.ndarray, top: np.ndarray, steady: np.ndarray) -> np.ndarray:
+    """Nodes the linear program holds at their bound ``top`` (G,), bool: those farther than
+    :data:`CRUISE_CLEARANCE` from any node where ``top`` changes or where the joints allow
+    less than ``1 / CRUISE_ROOM`` of the speed ``√top`` at a constant speed. There the curve
+    cruises at its cap (the window plan's plateaus), and the linear program only plans the
+    slowed parts and the speed changes around them."""
+    flat = np.ones(len(s), dtype=bool)
+    flat[1:-1] = (top[1:-1] == top[:-2]) & (top[1:-1] == top[2:])
+    flat[[0, -1]] = False
+    busy = s[~(flat & (CRUISE_ROOM**2 * top <= steady**2))]
+    if not busy.size:
+        return np.ones(len(s), dtype=bool)
+    index = np.searchsorted(busy, s)
+    after = busy[np.minimum(index, len(busy) - 1)]
+    before = busy[np.maximum(index - 1, 0)]
+    nearest = np.minimum(np.abs(after - s), np.abs(s - before))
+    return nearest > CRUISE_CLEARANCE
 
 
 def _differences(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
