@@ -53,12 +53,14 @@ MIN_NODES = 24
 ROUNDS = 2
 """Linear programs per plan: the first bounds √x by :data:`FIRST_ROOM` times the
 constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the first solution."""
-FIRST_ROOM = 1.2
+FIRST_ROOM = 1.5
 """How far above the constant-speed cap the joints allow (at each node) the first round's
 speed may go (its jerk bound assumes the speed stays below it)."""
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
+SLOW_FLOOR = 0.05
+"""Share of the fastest speed below which the objective weighs a node as if it ran at it."""
 CRUISE_ROOM = 1.5
 """How far above the speed cap the joints must allow a constant speed for a node to cruise
 at its cap without the linear program (see :func:`_cruising`)."""
@@ -334,6 +336,7 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     for held in (cruise, np.zeros_like(cruise)) if cruise.any() else (cruise,):
         # held at the cap first; if that leaves no room for a speed change, everything free
         x = np.minimum(top, (FIRST_ROOM * steady) ** 2)
+        reference = x
         for _ in range(ROUNDS):
             bound = np.sqrt(x)
             with np.errstate(divide="ignore"):
@@ -355,7 +358,7 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                     shape=(len(kept), count),
                 )
                 result = linprog(
-                    -np.ones(count),
+                    -_time_weights(s, reference),
                     A_ub=matrix,
                     b_ub=rhs[keep],
                     bounds=np.stack([np.where(held, x, 0.0), x], axis=1),
@@ -366,9 +369,22 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                     break
                 solution = np.clip(result.x, 0.0, x)
             x = np.minimum(top, SPEED_ROOM**2 * solution)
+            reference = solution
         if solution is not None:
             return solution
     return None
+
+
+def _time_weights(s: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Weights (G,) of the linear program's objective ``Σ w x``: the travel time
+    ``∫ ds / √x`` falls by ``Δx · ds / (2 x^1.5)`` when x rises by ``Δx``, so each node
+    weighs its share of the path over ``x^1.5`` at the reference ``x`` (the round's bound,
+    then the previous solution), floored at :data:`SLOW_FLOOR` of the fastest node's speed so
+    that a node at rest still counts. Largest weight 1."""
+    length = np.diff(s, prepend=s[0]) + np.diff(s, append=s[-1])
+    floor = (SLOW_FLOOR**2) * max(float(reference.max()), 1e-300)
+    weights = length / np.maximum(reference, floor) ** 1.5
+    return weights / weights.max()
 
 
 def _cruising(s: np.ndarray, top: np.ndarray, steady: np.ndarray) -> np.ndarray:
