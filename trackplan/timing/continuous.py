@@ -64,7 +64,7 @@ SLOW_FLOOR = 0.05
 CRUISE_ROOM = 1.5
 """How far above the speed cap the joints must allow a constant speed for a node to cruise
 at its cap without the linear program (see :func:`_cruising`)."""
-CRUISE_CLEARANCE = 0.02
+CRUISE_CLEARANCE = 0.05
 """Distance from any slowed or changing node beyond which a node cruises at its cap, m."""
 MAX_DURATION = 2000.0
 """Longest curve sampled, s (the window law's longest, 2 000 000 samples at 1 ms): a curve
@@ -74,7 +74,11 @@ MAX_REBUILDS = 10
 REST_JERK_SHARE = 0.7
 """Share of the path jerk the joints allow that a start from rest or a stop plans with."""
 REBUILD_REACH = 3
-"""Nodes on each side of a failing sample whose limits a rebuild lowers."""
+"""Nodes on each side of a failing sample whose limits the first rebuild lowers."""
+REBUILD_SPREAD = 1.5
+"""Growth of that reach from one rebuild to the next: a speed change whose start fails
+again just beside the lowered nodes (the spline rings where the jerk steps) is caught
+within a few rebuilds instead of creeping away one node at a time."""
 CAP_SHARE = 0.999
 """Share of the task's speed caps the curve plans against: its spline rings slightly (about
 1e-4) above a cruise it joins."""
@@ -200,7 +204,8 @@ def plan_speed_curve(
         order = np.concatenate([order, np.full(fast.size, 4)])
         ratio = np.concatenate([ratio, excess])
         for stretch, scale in zip(stretches, scales, strict=True):
-            _lower(stretch.s, scale, s[sample], order, ratio)
+            reach = REBUILD_REACH * REBUILD_SPREAD ** (rebuild - 1)
+            _lower(stretch.s, scale, s[sample], order, ratio, reach)
     return None
 
 
@@ -509,7 +514,12 @@ def _over_speed(
 
 
 def _lower(
-    s_nodes: np.ndarray, scale: np.ndarray, s_bad: np.ndarray, order: np.ndarray, ratio: np.ndarray
+    s_nodes: np.ndarray,
+    scale: np.ndarray,
+    s_bad: np.ndarray,
+    order: np.ndarray,
+    ratio: np.ndarray,
+    reach: float,
 ) -> None:
     """Lower the limit of each failing order at the nodes around each failing sample
     (order 4: the speed cap, by the excess found and twice as much again)."""
@@ -521,7 +531,7 @@ def _lower(
     for where, o, r in zip(position, order[inside], ratio[inside], strict=True):
         # full lowering within the reach, tapering off over as much again beyond it, so
         # the lowered limit has no step of its own
-        taper = np.clip(2.0 - np.abs(index - where) / REBUILD_REACH, 0.0, 1.0)
+        taper = np.clip(2.0 - np.abs(index - where) / reach, 0.0, 1.0)
         target = REBUILD_FACTOR / r if o < 4 else (1.0 - 2.0 * (r - 1.0)) / r
         lowered = 1.0 - taper * (1.0 - target)
         factor[o - 1] = np.minimum(factor[o - 1], lowered)
