@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
@@ -19,6 +21,26 @@ WRIST_TOPP3 = 4.667
 """copp-py's TOPP3 on that joint path, s (``python -m benchmarks plan``'s reference)."""
 WINDOWS_ONLY = 7.092
 """The window plan alone on that joint path, s (before the continuous curve)."""
+
+
+CORNER_X = np.array([0.3838, 0.5001, 0.0963, 1.1437, -1.3496, -0.6161])
+"""A random paper-corner placement (``python -m benchmarks plan``, seed 0) whose blend turns
+joints 3, 4 and 6 hard within its 5 mm: the window plan took 8.56 s there, 1.135 × TOPP3."""
+CORNER_TOPP3 = 7.541
+"""copp-py's TOPP3 on that joint path, s."""
+BRACKET_X = np.array([0.3969, -0.0753, 0.1047, 0.2625, -0.2849, 2.4899])
+"""A random bracket-two-faces placement (seed 1) where the curve used to collapse at a blend
+and the window plan stood at 30.3 s, 1.65 × TOPP3."""
+BRACKET_TOPP3 = 18.380
+"""copp-py's TOPP3 on that joint path, s."""
+
+
+def _divided_differences(s: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """x' and x'' at the inner nodes from the quadratic through each three neighbours
+    (Newton's divided differences), shape (G - 2,) each."""
+    first = np.diff(x) / np.diff(s)  # x[k, k+1]
+    second = np.diff(first) / (s[2:] - s[:-2])  # x[k-1, k, k+1]
+    return first[:-1] + second * (s[1:-1] - s[:-2]), 2.0 * second
 
 
 @pytest.fixture(scope="module")
@@ -47,12 +69,10 @@ def test_the_linear_program_meets_its_node_bounds(wrist):
     limits = np.broadcast_to(limits, (3, len(stretch.s), robot.n_dof))
     x = continuous._solve(stretch, limits, np.ones(len(stretch.s)))
     assert x is not None
-    h = stretch.s[1] - stretch.s[0]
     v = np.sqrt(x)
     assert v.max() <= case.task.rated_speed
     assert np.all(np.abs(stretch.d1 * v[None, :, None]) <= limits[0] * (1 + 1e-6))
-    slope = (x[2:] - x[:-2]) / (2 * h)
-    bend = (x[2:] - 2 * x[1:-1] + x[:-2]) / h**2
+    slope, bend = _divided_differences(stretch.s, x)
     d1, d2, d3 = (d[:, 1:-1] for d in (stretch.d1, stretch.d2, stretch.d3))
     accel = d1 * slope[None, :, None] / 2 + d2 * x[None, 1:-1, None]
     jerk = v[None, 1:-1, None] * (
@@ -94,3 +114,69 @@ def test_a_curve_that_cannot_beat_the_windows_is_given_up(wrist):
         )
         is None
     )
+
+
+@pytest.mark.parametrize(
+    ("name", "X", "topp3"),
+    [("paper-corner", CORNER_X, CORNER_TOPP3), ("bracket-two-faces", BRACKET_X, BRACKET_TOPP3)],
+)
+def test_a_short_blend_that_turns_the_wrist_is_within_4_percent_of_topp3(name, X, topp3):
+    """The nodes follow the planning grid into the blend, so the curve resolves it and is
+    taken (the window plan was 1.135 and 1.65 × TOPP3 there), every sample re-checked."""
+    case = load_case(CASES / f"{name}.yaml")
+    result = plan_placement(case, X)
+    assert result.feasible, result.message
+    assert result.duration <= 1.04 * topp3
+    report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
+    assert report.success, report.violations[:3]
+
+
+def test_no_node_inside_a_stretch_comes_to_rest_in_a_short_blend():
+    """On the corner placement's joint path the linear program keeps every node of the
+    blend above 80 % of the lowest speed the joints allow there at a constant speed (the
+    window plan's plateau); with nodes 1 mm apart across the 5 mm blend and Σ x as
+    objective, nodes came to rest there."""
+    case = load_case(CASES / "paper-corner.yaml")
+    joint_path = plan_placement(case, CORNER_X).joint_path
+    robot = case.robot
+    (stretch,) = continuous._stretches(joint_path, case.task)
+    limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
+    limits = np.broadcast_to(limits, (3, len(stretch.s), robot.n_dof))
+    x = continuous._solve(stretch, limits, np.ones(len(stretch.s)))
+    assert x is not None
+    cap, _ = continuous._joint_caps(stretch, robot, LIMIT_SHARE)
+    blend = (stretch.s > 0.4964) & (stretch.s < 0.5014)
+    assert blend.sum() >= 50  # the grid's own points, 0.06 mm apart
+    assert np.sqrt(x[blend]).min() >= 0.8 * cap[blend].min()
+
+
+def test_nodes_keep_the_grid_points_and_grow_gradually():
+    grid = np.concatenate(
+        [np.linspace(0.0, 0.5, 251), np.linspace(0.5, 0.505, 83), np.linspace(0.505, 1.0, 250)]
+    )
+    nodes = continuous._nodes(grid, 0.0, 1.0)
+    steps = np.diff(nodes)
+    assert nodes[0] == 0.0 and nodes[-1] == 1.0
+    assert np.all(np.isin(np.unique(grid), nodes))
+    assert steps.max() <= continuous.NODE_SPACING * (1 + 1e-9)
+    # neighbouring steps stay alike: at most NODE_GROWTH of the step apart (and a rounding)
+    growth = np.maximum(steps[1:] / steps[:-1], steps[:-1] / steps[1:])
+    assert growth.max() <= 1.0 + 1.2 * continuous.NODE_GROWTH
+    assert len(nodes) < 1.2 * (1.0 / continuous.NODE_SPACING + 83)
+
+
+@given(
+    steps=st.lists(st.floats(1e-5, 1e-3), min_size=3, max_size=12),
+    a=st.floats(-5.0, 5.0),
+    b=st.floats(-5.0, 5.0),
+    c=st.floats(-5.0, 5.0),
+)
+@settings(max_examples=40, deadline=None)
+def test_three_point_differences_are_exact_for_quadratics(steps, a, b, c):
+    s = np.concatenate([[0.0], np.cumsum(steps)])
+    x = a + b * s + c * s**2
+    slope, bend = continuous._differences(s)
+    rows = np.stack([x[:-2], x[1:-1], x[2:]], axis=1)
+    scale = 1.0 + abs(b) + abs(c)
+    assert np.allclose((slope * rows).sum(axis=1), b + 2 * c * s[1:-1], atol=1e-6 * scale)
+    assert np.allclose((bend * rows).sum(axis=1), 2 * c, atol=1e-6 * scale / min(steps))
