@@ -12,14 +12,23 @@ and jerk are
 
     q̇ = q' √x,    q̈ = q' x'/2 + q'' x,    q⃛ = √x (q' x''/2 + 3 q'' x'/2 + q''' x).
 
-On a uniform grid of nodes (spacing at most :data:`NODE_SPACING`) with central differences
-for ``x'`` and ``x''`` the acceleration is linear in x, and so is the jerk once ``√x`` is
-bounded by a speed ``v̄`` known to lie above it: ``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄``
-with ``x ≤ v̄²`` is a sufficient (conservative) form. Maximising ``Σ x`` under these linear
-bounds, the velocity limits and the task's speed caps is a linear program (HiGHS, through
-:func:`scipy.optimize.linprog`), solved :data:`ROUNDS` times with ``v̄`` lowered towards the
-previous solution. The signed joint-path derivatives enter as they are, so the curve uses
-the cancellations the optimum uses.
+The nodes are the planning grid's own points (fine inside a blend, where q'' and q''' change
+within a fraction of a millimetre) with the gaps between them cut to at most
+:data:`NODE_SPACING`, the spacing growing gradually away from a fine part
+(:data:`NODE_GROWTH`). With three-point differences on these nodes for ``x'`` and ``x''``
+(exact for quadratics on any spacing) the acceleration is linear in x, and so is the jerk
+once ``√x`` is bounded by a speed ``v̄`` known to lie above it:
+``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄`` with ``x ≤ v̄²`` is a sufficient
+(conservative) form. Under these linear bounds, the velocity limits and the task's speed
+caps, a linear program (HiGHS, through :func:`scipy.optimize.linprog`) maximises ``Σ w x``,
+each node weighted by its share of the travel time (``ds / x^1.5`` at a reference x, so a
+node near rest costs what it costs in time). It is solved :data:`ROUNDS` times: first with
+``v̄`` :data:`FIRST_ROOM` times the constant speed the joints allow at each node, then with
+``v̄`` :data:`SPEED_ROOM` times the previous solution (the reference x of the weights). The
+signed joint-path derivatives enter as they are, so the curve uses the cancellations the
+optimum uses. Only rows that can bind enter the program (a row whose largest value for
+``0 ≤ x ≤ v̄²`` stays within its limit cannot), and nodes far from any slowed or changing
+part cruise at their cap outside it (:func:`_cruising`).
 
 Each stretch between stops is planned from rest to rest; next to a rest, where the
 difference quotients cannot see the acceleration grow from zero, x is also bounded by a
@@ -28,7 +37,8 @@ constant-acceleration step ``Δt = 2h / (ṡ_k + ṡ_{k+1})`` (constant jerk nex
 s(t) is the quintic spline through (t, s) at the nodes, at rest at both ends, sampled at Ts.
 The samples go through the law's sample checks and the speed caps; where one fails, the
 limits (or the cap) of the nodes around it are lowered by the ratio found and the curve is
-planned again (:data:`MAX_REBUILDS` times at most).
+planned again (:data:`MAX_REBUILDS` times at most), over a reach that grows by
+:data:`REBUILD_SPREAD` per rebuild.
 """
 
 from __future__ import annotations
@@ -292,7 +302,8 @@ def _interp(s: np.ndarray, grid: np.ndarray, values: np.ndarray, last: bool) -> 
 
 
 def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.ndarray | None:
-    """Node values of ``x = ṡ²`` (G,) maximising ``Σ x`` under the limits (see the module).
+    """Node values of ``x = ṡ²`` (G,) maximising the time-weighted ``Σ w x`` under the limits
+    (see the module), or None when the linear program fails.
 
     Parameters
     ----------
@@ -395,9 +406,10 @@ def _time_weights(s: np.ndarray, reference: np.ndarray) -> np.ndarray:
 def _cruising(s: np.ndarray, top: np.ndarray, steady: np.ndarray) -> np.ndarray:
     """Nodes the linear program holds at their bound ``top`` (G,), bool: those farther than
     :data:`CRUISE_CLEARANCE` from any node where ``top`` changes or where the joints allow
-    less than ``1 / CRUISE_ROOM`` of the speed ``√top`` at a constant speed. There the curve
-    cruises at its cap (the window plan's plateaus), and the linear program only plans the
-    slowed parts and the speed changes around them."""
+    less than :data:`CRUISE_ROOM` times the speed ``√top`` at a constant speed. There the
+    curve cruises at its cap (the window plan's plateaus), and the linear program only plans
+    the slowed parts and the speed changes around them (if that leaves a speed change too
+    little room, :func:`_solve` plans again with every node free)."""
     flat = np.ones(len(s), dtype=bool)
     flat[1:-1] = (top[1:-1] == top[:-2]) & (top[1:-1] == top[2:])
     flat[[0, -1]] = False
