@@ -38,7 +38,7 @@ s(t) is the quintic spline through (t, s) at the nodes, at rest at both ends, sa
 The samples go through the law's sample checks and the speed caps; where one fails, the
 limits (or the cap) of the nodes around it are lowered by the ratio found and the curve is
 planned again (:data:`MAX_REBUILDS` times at most), over a reach that grows by
-:data:`REBUILD_SPREAD` per rebuild.
+:data:`REBUILD_SPREAD` each time the same nodes fail again.
 """
 
 from __future__ import annotations
@@ -84,11 +84,9 @@ MAX_REBUILDS = 10
 REST_JERK_SHARE = 0.7
 """Share of the path jerk the joints allow that a start from rest or a stop plans with."""
 REBUILD_REACH = 3
-"""Nodes on each side of a failing sample whose limits the first rebuild lowers."""
+"""Nodes on each side of a failing sample whose limits a rebuild lowers (the first time)."""
 REBUILD_SPREAD = 1.5
-"""Growth of that reach from one rebuild to the next: a speed change whose start fails
-again just beside the lowered nodes (the spline rings where the jerk steps) is caught
-within a few rebuilds instead of creeping away one node at a time."""
+"""Growth of that reach for each earlier rebuild that lowered the same nodes."""
 CAP_SHARE = 0.999
 """Share of the task's speed caps the curve plans against: its spline rings slightly (about
 1e-4) above a cruise it joins."""
@@ -179,6 +177,7 @@ def plan_speed_curve(
     stretches = _stretches(joint_path, task)
     robot = joint_path.robot
     scales = [np.ones((4, len(st.s))) for st in stretches]  # v, a, j limits; speed cap
+    hits = [np.zeros(len(st.s), dtype=int) for st in stretches]  # rebuilds that lowered a node
     for rebuild in range(1, MAX_REBUILDS + 1):
         speeds = []
         for stretch, scale in zip(stretches, scales, strict=True):
@@ -213,9 +212,8 @@ def plan_speed_curve(
         sample = np.concatenate([sample, fast])
         order = np.concatenate([order, np.full(fast.size, 4)])
         ratio = np.concatenate([ratio, excess])
-        for stretch, scale in zip(stretches, scales, strict=True):
-            reach = REBUILD_REACH * REBUILD_SPREAD ** (rebuild - 1)
-            _lower(stretch.s, scale, s[sample], order, ratio, reach)
+        for stretch, scale, hit in zip(stretches, scales, hits, strict=True):
+            _lower(stretch.s, scale, hit, s[sample], order, ratio)
     return None
 
 
@@ -528,26 +526,36 @@ def _over_speed(
 def _lower(
     s_nodes: np.ndarray,
     scale: np.ndarray,
+    hits: np.ndarray,
     s_bad: np.ndarray,
     order: np.ndarray,
     ratio: np.ndarray,
-    reach: float,
 ) -> None:
     """Lower the limit of each failing order at the nodes around each failing sample
-    (order 4: the speed cap, by the excess found and twice as much again)."""
+    (order 4: the speed cap, by the excess found and twice as much again).
+
+    The reach is :data:`REBUILD_REACH` nodes, times :data:`REBUILD_SPREAD` for each earlier
+    rebuild that lowered the node nearest the sample (``hits`` (G,), counted here): a speed
+    change whose start fails again just beside the lowered nodes (the spline rings where
+    the jerk steps) is caught within a few rebuilds instead of creeping one node a time.
+    """
     inside = (s_bad >= s_nodes[0]) & (s_bad <= s_nodes[-1])
     # positions in nodes (fractional): the reach counts nodes, wherever they are finer
     position = np.interp(s_bad[inside], s_nodes, np.arange(len(s_nodes)))
     index = np.arange(len(s_nodes))
     factor = np.ones_like(scale)
+    touched = np.zeros(len(s_nodes), dtype=bool)
     for where, o, r in zip(position, order[inside], ratio[inside], strict=True):
+        reach = REBUILD_REACH * REBUILD_SPREAD ** hits[int(where + 0.5)]
         # full lowering within the reach, tapering off over as much again beyond it, so
         # the lowered limit has no step of its own
         taper = np.clip(2.0 - np.abs(index - where) / reach, 0.0, 1.0)
         target = REBUILD_FACTOR / r if o < 4 else (1.0 - 2.0 * (r - 1.0)) / r
         lowered = 1.0 - taper * (1.0 - target)
         factor[o - 1] = np.minimum(factor[o - 1], lowered)
+        touched |= taper > 0.0
     scale *= factor
+    hits += touched
 
 
 def _joint_caps(stretch: _Stretch, robot: Robot, share: float) -> tuple[np.ndarray, np.ndarray]:
