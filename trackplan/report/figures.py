@@ -9,6 +9,8 @@ matplotlib is imported inside the functions so that importing trackplan stays fa
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
@@ -88,6 +90,45 @@ def save_png(figure: Figure, path: Path) -> None:
     figure.savefig(path, dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESSION})
 
 
+def figure_pixels(figure: Figure) -> np.ndarray:
+    """``figure`` drawn at :data:`DPI`, as RGBA pixels of shape (height, width, 4), uint8."""
+    figure.canvas.draw()
+    return np.array(figure.canvas.buffer_rgba())  # type: ignore[attr-defined]
+
+
+def save_pixels(pixels: np.ndarray, path: Path) -> None:
+    """Write RGBA pixels (height, width, 4) as a PNG file as :func:`save_png` writes one."""
+    from matplotlib.image import imsave
+
+    imsave(path, pixels, dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESSION})
+
+
+@dataclass(frozen=True)
+class BandedFigure:
+    """A plot drawn as horizontal bands, each its own figure of the same width; its image is
+    the bands stacked top to bottom. The bands can be drawn in different processes
+    (:func:`~trackplan.report.run_report.write_run_report`).
+
+    Attributes
+    ----------
+    bands
+        Builders of the band figures, top to bottom.
+    """
+
+    bands: tuple[Callable[[], Figure], ...]
+
+    def save(self, path: Path, pixels: Sequence[np.ndarray] | None = None) -> None:
+        """Write the PNG file from the bands' pixels (:func:`figure_pixels`), drawn here when
+        not given."""
+        if pixels is None:
+            pixels = [figure_pixels(build()) for build in self.bands]
+        save_pixels(np.concatenate(pixels, axis=0), path)
+
+
+PlotBuilder = Callable[[], "Figure"] | BandedFigure
+"""How a plot of a run is drawn: one figure, or bands stacked into one image."""
+
+
 ENVELOPE_POINTS = 2000
 """Most points drawn per series: longer series are drawn as their min/max envelope."""
 
@@ -120,7 +161,15 @@ def envelope(t: np.ndarray, y: np.ndarray, n_points: int = ENVELOPE_POINTS) -> t
     return t[picks], y[picks]
 
 
-def joints_figure(result: PlanResult, case: Case) -> Figure:
+JOINT_BANDS = ((0, 1), (2, 3))
+"""Rows of ``joints.png`` drawn as separate figures (bands) and stacked: the plot is the
+largest of a run, and its two bands are drawn in two processes."""
+# joints.png in pixels at DPI: title space, axes height, space between rows, x-axis space
+# and where a band ends below a row (under its tick marks, above the next row's title)
+_JOINT_TOP, _JOINT_ROW, _JOINT_GAP, _JOINT_BOTTOM, _JOINT_CUT = 63, 166, 28, 90, 8
+
+
+def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = None) -> Figure:
     """Joint positions and their three derivatives against every joint limit.
 
     A grid of 4 rows (q, q̇, q̈, q⃛) by one column per joint, so that each panel holds
@@ -138,32 +187,54 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
         The planned placement; time in s, joint data in rad, rad/s, rad/s², rad/s³.
     case
         The case (robot limits).
+    rows
+        Consecutive rows (indices into ``LIMIT_KINDS``) to draw, all by default. The
+        figure of some rows is the horizontal band of the full figure that holds them, to
+        the pixel: the bands of :data:`JOINT_BANDS` stacked make the full figure
+        (:class:`BandedFigure`).
 
     Returns
     -------
     matplotlib.figure.Figure
-        4 × n axes.
+        ``len(rows)`` × n axes.
     """
     from matplotlib.ticker import MaxNLocator
 
     trajectory = result.trajectory
     robot = case.robot
     n = robot.n_dof
-    # a fixed grid: constrained layout over 4 × n panels took longer than the drawing
-    figure = _new_figure(2.3 * n + 1.0, 9.0, layout=None)
-    figure.subplots_adjust(left=0.06, right=0.99, bottom=0.1, top=0.93, wspace=0.35, hspace=0.12)
-    axes = figure.subplots(len(LIMIT_KINDS), n, sharex=True, squeeze=False)
+    rows = list(range(len(LIMIT_KINDS)) if rows is None else rows)
+    if not rows or rows != list(range(rows[0], rows[0] + len(rows))):
+        raise ValueError(f"joints_figure draws consecutive rows, not {rows}")
+    first, last = rows[0] == 0, rows[-1] == len(LIMIT_KINDS) - 1
+    # a fixed grid in pixels: constrained layout over 4 × n panels took longer than the
+    # drawing, and fixed pixels let a band of rows be drawn on its own
+    top = _JOINT_TOP if first else _JOINT_GAP - _JOINT_CUT
+    bottom = _JOINT_BOTTOM if last else _JOINT_CUT
+    height = top + len(rows) * _JOINT_ROW + (len(rows) - 1) * _JOINT_GAP + bottom
+    width = (230 * n + 100) / DPI
+    figure = _new_figure(width, height / DPI, layout=None)
+    figure.subplots_adjust(
+        left=0.06,
+        right=0.99,
+        bottom=bottom / height,
+        top=1 - top / height,
+        wspace=0.35,
+        hspace=_JOINT_GAP / _JOINT_ROW,
+    )
+    axes = figure.subplots(len(rows), n, sharex=True, squeeze=False)
     axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
     if trajectory.n_samples:
         t_margin = 0.02 * (trajectory.t[-1] - trajectory.t[0])
         axes[0, 0].set_xlim(trajectory.t[0] - t_margin, trajectory.t[-1] + t_margin)
     half = 0.5 * trajectory.sample_time
-    for row, kind in enumerate(LIMIT_KINDS):
+    for band_row, row in enumerate(rows):
+        kind = LIMIT_KINDS[row]
         values = joint_series(trajectory, kind)
         lower, upper = joint_bounds(robot, kind)
         margins = result.check.joint_margins.get(kind)
         for j in range(n):
-            ax = axes[row, j]
+            ax = axes[band_row, j]
             series = values[:, j]
             # limits first: every artist added to an axes with autoscaling on recomputes
             # the view limits of all the axes sharing its time axis
@@ -221,8 +292,15 @@ def joints_figure(result: PlanResult, case: Case) -> Figure:
             if row == len(LIMIT_KINDS) - 1:
                 ax.set_xlabel("time [s]", fontsize=8)
                 ax.xaxis.set_label_coords(0.5, -0.14)
-    note = "" if trajectory.n_samples else f" — no trajectory: {result.message}"
-    figure.suptitle(f"{_status_line(result)}: joint trajectories and limits{note}", fontsize=10)
+            else:  # the last row of a band that is not the last row of the figure
+                ax.tick_params(labelbottom=False)
+    if first:
+        note = "" if trajectory.n_samples else f" — no trajectory: {result.message}"
+        figure.suptitle(
+            f"{_status_line(result)}: joint trajectories and limits{note}",
+            fontsize=10,
+            y=1 - 18 / height,
+        )
     return figure
 
 
@@ -589,10 +667,13 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
 
 def plot_figures(
     result: PlanResult, case: Case, history: Mapping[str, Mapping[str, np.ndarray]] | None = None
-) -> dict[str, Callable[[], Figure]]:
-    """The plots of a run as ``{file name: figure builder}``, in report order."""
-    builders: dict[str, Callable[[], Figure]] = {
-        "joints.png": lambda: joints_figure(result, case),
+) -> dict[str, PlotBuilder]:
+    """The plots of a run as ``{file name: figure builder or banded figure}``, in report
+    order."""
+    builders: dict[str, PlotBuilder] = {
+        "joints.png": BandedFigure(
+            tuple(partial(joints_figure, result, case, rows) for rows in JOINT_BANDS)
+        ),
         "path.png": lambda: path_figure(result, case),
         "speed.png": lambda: speed_figure(result, case),
     }
@@ -638,6 +719,9 @@ def write_plots(
     written = []
     for name, build in plot_figures(result, case, history).items():
         path = out_dir / name
-        save_png(build(), path)
+        if isinstance(build, BandedFigure):
+            build.save(path)
+        else:
+            save_png(build(), path)
         written.append(path)
     return written
