@@ -18,6 +18,7 @@ from trackplan.robots.describe import robot_info
 
 if TYPE_CHECKING:  # the search (pymoo) is not needed to write a plan
     from trackplan.planning.cycle import CycleResult
+    from trackplan.report.plot_worker import PlotWorker
     from trackplan.search import OptimizeResult
     from trackplan.search.cycle_search import CycleSearchResult
 
@@ -31,6 +32,7 @@ def write_run(
     extra: dict | None = None,
     report: bool = True,
     search: OptimizeResult | None = None,
+    plot_worker: PlotWorker | None = None,
 ) -> dict:
     """Write trajectory.csv, result.json and, with ``report``, the plots and report.html.
 
@@ -52,6 +54,8 @@ def write_run(
     search
         The :class:`~trackplan.search.optimize.OptimizeResult` whose ``history.csv`` to
         write, or None.
+    plot_worker
+        A :class:`~trackplan.report.plot_worker.PlotWorker` to draw the plots, or None.
 
     Returns
     -------
@@ -65,7 +69,7 @@ def write_run(
         if report:
             from trackplan.report.run_report import write_run_report
 
-            write_run_report(result, case, folder, history, extra)
+            write_run_report(result, case, folder, history, extra, worker=plot_worker)
         if search is not None:
             from trackplan.io.history import write_history
 
@@ -83,6 +87,7 @@ def write_search_run(
     *,
     report: bool,
     extra: dict | None = None,
+    plot_worker: PlotWorker | None = None,
 ) -> dict:
     """Write a placement search's run folder: :func:`write_run` for the final plan, with the
     ``optimizer`` and ``initial`` blocks (and ``extra``) in ``result.json``, and ``history.csv``.
@@ -99,6 +104,8 @@ def write_search_run(
         Also write the plots and the HTML report.
     extra
         More keys for ``result.json`` (an interrupted search's marks).
+    plot_worker
+        A :class:`~trackplan.report.plot_worker.PlotWorker` to draw the plots, or None.
 
     Returns
     -------
@@ -110,7 +117,14 @@ def write_search_run(
     history = {result.method: result.history.as_columns()} if len(result.history) else None
     blocks = {**optimizer_summary(result, case.robot.joint_names), **(extra or {})}
     return write_run(
-        out_dir, result.final, case, history=history, extra=blocks, report=report, search=result
+        out_dir,
+        result.final,
+        case,
+        history=history,
+        extra=blocks,
+        report=report,
+        search=result,
+        plot_worker=plot_worker,
     )
 
 

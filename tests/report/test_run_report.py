@@ -1,54 +1,119 @@
-"""A run's plots and report.html: the same files whether the first plot is drawn in a forked
-process or in turn, and a failure in the forked process is raised by the caller."""
+"""A run's plots and report.html: the same files whether they are drawn in two processes, in
+turn or by a plot worker, and a failure anywhere is raised by the caller."""
 
 from __future__ import annotations
 
+import os
+import signal
 import threading
 
+import numpy as np
 import pytest
 
-from tests.report.conftest import REPORT_FRAMES, REPORT_INFO
-from trackplan.report import run_report
+from tests.report.conftest import REPORT_FRAMES, REPORT_INFO, optimizer_history
+from trackplan.report import drawing, figures, run_report
 from trackplan.report.figures import joints_figure
+from trackplan.report.plot_worker import PlotWorker, plot_worker
 from trackplan.report.run_report import can_fork, write_run_report
 
 needs_fork = pytest.mark.skipif(
     not can_fork(), reason="no second core or no fork here: the plots are drawn in turn"
 )
+PLOTS = ["joints.png", "path.png", "speed.png", "convergence.png"]
+
+
+def _write(out_dir, corner, corner_result, **options):
+    """The files of a run's report, by name."""
+    history = optimizer_history(np.random.default_rng(7))
+    plots, report = write_run_report(
+        corner_result, corner, out_dir, history, REPORT_INFO, n_frames=REPORT_FRAMES, **options
+    )
+    assert [p.name for p in plots] == PLOTS
+    return {p.name: p.read_bytes() for p in [*plots, report]}
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory, corner, corner_result):
+    return _write(tmp_path_factory.mktemp("serial"), corner, corner_result, parallel=False)
+
+
+def _assert_same(files, serial):
+    assert files.keys() == serial.keys()
+    for name, data in files.items():
+        assert data == serial[name], name
 
 
 @needs_fork
-def test_forked_and_serial_reports_are_the_same_files(tmp_path, corner, corner_result, history):
-    outputs = {}
-    for parallel in (True, False):
-        plots, report = write_run_report(
-            corner_result,
-            corner,
-            tmp_path / str(parallel),
-            history,
-            REPORT_INFO,
-            parallel=parallel,
-            n_frames=REPORT_FRAMES,
-        )
-        assert [p.name for p in plots] == ["joints.png", "path.png", "speed.png", "convergence.png"]
-        outputs[parallel] = {p.name: p.read_bytes() for p in [*plots, report]}
-    assert outputs[True].keys() == outputs[False].keys()
-    for name, data in outputs[True].items():
-        assert data == outputs[False][name], name
+def test_forked_and_serial_reports_are_the_same_files(tmp_path, corner, corner_result, serial):
+    files = _write(tmp_path, corner, corner_result, parallel=True)
+    _assert_same(files, serial)
+
+
+def _not_here(*args, **kwargs):
+    raise AssertionError("the plots were drawn in the caller")
+
+
+@needs_fork
+def test_a_plot_worker_writes_the_same_files(tmp_path, monkeypatch, corner, corner_result, serial):
+    monkeypatch.setattr(run_report, "draw_plots", _not_here)
+    with plot_worker(corner) as worker:
+        assert worker is not None
+        os.kill(worker.pid, signal.SIGINT)  # ignored: the caller decides about interruptions
+        files = _write(tmp_path, corner, corner_result, worker=worker)
+    _assert_same(files, serial)
+    with pytest.raises(ChildProcessError):  # it ended and was collected
+        os.waitpid(worker.pid, os.WNOHANG)
+
+
+@needs_fork
+def test_the_plots_are_drawn_here_when_the_worker_is_gone(tmp_path, corner, corner_result, serial):
+    worker = PlotWorker.start()
+    assert worker is not None
+    os.kill(worker.pid, signal.SIGKILL)
+    files = _write(tmp_path, corner, corner_result, worker=worker)
+    _assert_same(files, serial)
+
+
+def test_bands_stack_into_the_full_joints_figure(corner, corner_result):
+    full = figures.figure_pixels(joints_figure(corner_result, corner))
+    bands = [
+        figures.figure_pixels(joints_figure(corner_result, corner, rows))
+        for rows in figures.JOINT_BANDS
+    ]
+    assert len(bands) > 1
+    stacked = np.concatenate(bands)
+    assert stacked.shape == full.shape
+    np.testing.assert_array_equal(stacked, full)  # to the pixel
+
+
+def _broken_plots(corner, corner_result):
+    def broken():
+        raise ValueError("no figure for you")
+
+    return {"broken.png": broken, "joints.png": lambda: joints_figure(corner_result, corner)}
 
 
 @needs_fork
 def test_a_plot_failing_in_the_forked_process_raises_in_the_caller(
     tmp_path, monkeypatch, corner, corner_result
 ):
-    def broken():
-        raise ValueError("no figure for you")
-
-    builders = {"broken.png": broken, "joints.png": lambda: joints_figure(corner_result, corner)}
+    builders = _broken_plots(corner, corner_result)
     monkeypatch.setattr(run_report, "plot_figures", lambda *args: builders)
     with pytest.raises(ValueError, match="no figure for you"):
         write_run_report(corner_result, corner, tmp_path, n_frames=5)
     assert (tmp_path / "joints.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not (tmp_path / "report.html").exists()
+
+
+@needs_fork
+def test_a_plot_failing_in_the_worker_raises_in_the_caller(
+    tmp_path, monkeypatch, corner, corner_result
+):
+    builders = _broken_plots(corner, corner_result)
+    monkeypatch.setattr(figures, "plot_figures", lambda *args: builders)  # the worker's
+    monkeypatch.setattr(run_report, "plot_figures", lambda *args: builders)
+    with plot_worker() as worker, pytest.raises(ValueError, match="no figure for you"):
+        write_run_report(corner_result, corner, tmp_path, n_frames=5, worker=worker)
     assert not (tmp_path / "report.html").exists()
 
 
@@ -67,6 +132,7 @@ def test_no_fork_beside_other_python_threads():
     assert seen == [False]
 
 
-def test_no_fork_on_one_core(monkeypatch):
-    monkeypatch.setattr(run_report.os, "sched_getaffinity", lambda pid: {0})
+def test_no_fork_and_no_worker_on_one_core(monkeypatch):
+    monkeypatch.setattr(drawing.os, "sched_getaffinity", lambda pid: {0})
     assert not can_fork()
+    assert PlotWorker.start() is None

@@ -221,16 +221,22 @@ def _pareto(
 
 def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> ExitCode:  # type: ignore[no-untyped-def]
     """Search (SIGINT and SIGTERM stop it), write the run, print it; the exit code."""
+    from contextlib import nullcontext
+
     from trackplan.cli.summaries import print_search
     from trackplan.outputs import write_search_run
 
-    with stop_on_signals() as signals:  # a second signal while writing stops the writing
+    if report:  # a worker gets matplotlib ready on the second core while the search runs
+        from trackplan.report.plot_worker import plot_worker
+    workers = plot_worker(case) if report else nullcontext()
+    # a second signal while writing stops the writing
+    with workers as worker, stop_on_signals() as signals:
         signals.deferring = True  # the search polls after each generation
         result = _search(case, signals, **options)
         signals.deferring = False
         interrupted = result.stop_reason == "interrupted" or signals.first is not None
         marks = _interrupted_marks(result, signals) if interrupted else None
-        write_search_run(out, result, case, report=report, extra=marks)
+        write_search_run(out, result, case, report=report, extra=marks, plot_worker=worker)
     print_search(console(), result, out)
     if interrupted:
         return ExitCode(signals.exit_code)

@@ -546,13 +546,18 @@ def history_columns(
     return columns
 
 
+MINOR_DECADES = 2.0
+"""Log fitness axes spanning more decades than this get no minor ticks."""
+
+
 def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figure:
     """Best and mean fitness and feasible share per generation, one colour per method.
 
     Each generation is drawn at its cumulative number of placement evaluations, the
     budget all methods share (their population sizes differ). Fitness axes are
     logarithmic when every value is positive (penalised candidates sit decades above
-    feasible ones).
+    feasible ones), with labelled minor ticks when they span at most
+    :data:`MINOR_DECADES` decades and a tick per decade otherwise.
 
     Parameters
     ----------
@@ -567,7 +572,7 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
         Three axes (best, mean, feasible share), one line per method in each
         (``gid=method``).
     """
-    from matplotlib.ticker import LogFormatter
+    from matplotlib.ticker import LogFormatter, NullLocator
 
     columns = history_columns(history)
     figure = _new_figure(9.0, 8.0, layout=None)
@@ -602,7 +607,12 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
             # plain-text labels: the default ones are mathtext, whose parser costs more
             # than the rest of the figure
             ax.yaxis.set_major_formatter(LogFormatter())
-            ax.yaxis.set_minor_formatter(LogFormatter(labelOnlyBase=False))
+            if np.log10(values.max() / values.min()) > MINOR_DECADES:
+                # a labelled tick per decade is enough; eight minor ticks per decade
+                # cost more than the rest of the figure
+                ax.yaxis.set_minor_locator(NullLocator())
+            else:
+                ax.yaxis.set_minor_formatter(LogFormatter(labelOnlyBase=False))
         ax.set_ylabel(f"{label} [–]")
     ax_share.set_ylabel("feasible share [%]")
     ax_share.set_ylim(-2, 102)
