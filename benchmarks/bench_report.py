@@ -4,16 +4,18 @@ Run with ``python -m benchmarks report``. Prints, in one run:
 
 - the reference: planning the corner case at the placement the default search finds
   (in-process CPU time, warm, best of 5);
-- writing that run's plots and ``report.html`` with its search history, as ``trackplan
-  optimize`` writes them (:func:`~trackplan.report.run_report.write_run_report`), warm, best
-  of 3: with the first plot drawn in a forked process and with every plot drawn in turn;
-  wall time, CPU time of this process and of the forked one, and the busier of the two
-  against the plan;
+- writing that run's plots and ``report.html`` with its search history
+  (:func:`~trackplan.report.run_report.write_run_report`), warm, best of 3: drawn in two
+  processes (the caller and a forked one take the next plot, or band of ``joints.png``, in
+  turn) and drawn in this process alone; wall time, CPU time of this process and of the
+  forked one, and the busier of the two against the plan;
 - the imports the report adds to a process (matplotlib, plotly), in a fresh process;
 - ``trackplan optimize cases/paper-corner.yaml`` as a whole process with and without the
-  report (median of 3 after one run that fills numba's cache): wall and CPU time, and their
-  difference, the report's cost; issue 8's targets on an idle machine are ≤ 5 s with the
-  report and ≤ 3 s without.
+  report (median of 3 after one run that fills numba's cache): wall and CPU time (the
+  plot worker's included), and their difference, the report's cost. There the plot worker,
+  forked before the search, imports matplotlib during the search and draws the plots after
+  it. Issue 8's targets on an idle machine are ≤ 5 s with the report and ≤ 3 s without: the
+  report adds at most 2 s.
 
 Wall times count the other load of the machine; on a shared machine read the CPU times.
 """
@@ -103,7 +105,7 @@ def _in_process() -> None:
                 write_run_report(result, case, Path(out), history, parallel=parallel)
 
             wall, cpu, children = _report_seconds(write)
-            label = "first plot in a forked process" if parallel else "plots in turn"
+            label = "two processes" if parallel else "this process alone"
             longest = max(cpu, children) / plan
             print(f"  {label:<44}{wall:>8.2f}{cpu:>8.2f}{children:>14.2f}{longest:>15.0f}×")
     print("  longest: the CPU time of the busier process, the wall time on an idle 2-core machine")
@@ -136,7 +138,8 @@ def _whole_process() -> None:
         print(f"  {label:<58}{wall:>8.2f}{cpu:>8.2f}  ≤ {TARGETS[report]:g} s wall: {verdict}")
     print(
         f"  {'  the report (difference)':<58}{seconds[True][0] - seconds[False][0]:>+8.2f}"
-        f"{seconds[True][1] - seconds[False][1]:>+8.2f}"
+        f"{seconds[True][1] - seconds[False][1]:>+8.2f}  ≤ +2 s wall: "
+        f"{'MET' if seconds[True][0] - seconds[False][0] <= 2.0 else 'MISSED'}"
     )
     print("  (wall time on a loaded machine exceeds the CPU time; the targets are for an idle one)")
 

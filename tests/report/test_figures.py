@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from trackplan.frames import placement_transform
 from trackplan.planning.result import LIMIT_KINDS, Violation
@@ -16,6 +19,7 @@ from trackplan.report import (
     speed_figure,
     write_plots,
 )
+from trackplan.report.figures import envelope
 from trackplan.report.scene import JOINT_QUANTITIES, joint_bounds, joint_series, transform_points
 
 
@@ -212,3 +216,43 @@ def test_joints_use_symlog_when_violations_dwarf_the_limits(corner, corner_resul
     assert {ax.get_yscale() for ax in grid[jerk]} == {"symlog"}
     assert {ax.get_yscale() for ax in grid[:jerk].ravel()} == {"linear"}
     assert all(len(_by_gid(ax, "limit")) == 2 for ax in grid[jerk])
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(
+    n=st.integers(min_value=1, max_value=9000),
+    n_points=st.integers(min_value=4, max_value=3000),
+    seed=st.integers(min_value=0, max_value=2**32 - 1),
+)
+def test_envelope_keeps_the_extremes_of_every_stretch(n, n_points, seed):
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(0.1, 1.0, n))
+    y = np.cumsum(rng.normal(size=n)) * rng.choice([1.0, 1e-9, 1e9])
+    t_env, y_env = envelope(t, y, n_points)
+    if n <= n_points:
+        assert t_env is t and y_env is y
+        return
+    assert len(t_env) <= n_points
+    assert np.all(np.diff(t_env) > 0)  # samples of the series, in time order
+    np.testing.assert_array_equal(y_env, y[np.searchsorted(t, t_env)])
+    assert y_env.max() == y.max() and y_env.min() == y.min()
+    # every stretch between kept samples stays within what the envelope draws about it
+    edges = np.linspace(0, n, n_points // 2 + 1).astype(int)
+    for lo, hi in itertools.pairwise(edges):
+        inside = (t_env >= t[lo]) & (t_env <= t[hi - 1])
+        assert y[lo:hi].max() in y_env[inside] and y[lo:hi].min() in y_env[inside]
+
+
+def test_convergence_minor_ticks_only_over_few_decades():
+    evaluations = np.arange(1, 11) * 10.0
+    wide = {"evaluations": evaluations, "generation": np.arange(1, 11)}
+    wide |= {"feasible_share": np.linspace(0, 1, 10), "wall_time": evaluations / 100}
+    wide |= {"best": np.geomspace(1e4, 1.0, 10), "mean": np.geomspace(1e6, 1.0, 10)}
+    narrow = dict(wide, best=np.linspace(1.2, 0.8, 10), mean=np.linspace(3.0, 1.0, 10))
+    for table, minor in ((wide, False), (narrow, True)):
+        figure = convergence_figure({"ga": table})
+        for ax in figure.axes[:2]:
+            assert ax.get_yscale() == "log"
+            low, high = ax.get_ylim()
+            ticks = [v for v in ax.yaxis.get_minorticklocs() if low <= v <= high]
+            assert bool(ticks) is minor

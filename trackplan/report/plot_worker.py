@@ -39,6 +39,7 @@ class PlotWorker:
     def __init__(self, pid: int, connection: Connection) -> None:
         self.pid = pid
         self._connection: Connection | None = connection
+        self._drawing = False
 
     @classmethod
     def start(cls, case: Case | None = None) -> PlotWorker | None:
@@ -86,6 +87,7 @@ class PlotWorker:
         except (OSError, EOFError):
             self.close()
             return False
+        self._drawing = True
         return True
 
     def wait(self) -> bool:
@@ -97,15 +99,20 @@ class PlotWorker:
                 written = self._connection.recv() is True
             except (OSError, EOFError):
                 written = False
+            self._drawing = False
         self.close()
         return written
 
     def close(self) -> None:
-        """End the worker (it is waiting for a run, or done) and collect its exit."""
+        """End the worker and collect its exit: one still drawing (the caller stopped
+        waiting, on an error or a signal) is terminated."""
         if self._connection is None:
             return
         self._connection.close()
         self._connection = None
+        if self._drawing:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(self.pid, signal.SIGTERM)
         with contextlib.suppress(ChildProcessError):
             os.waitpid(self.pid, 0)
 
