@@ -5,10 +5,12 @@ Run with ``python -m benchmarks report``. Prints, in one run:
 - the reference: planning the corner case at the placement the default search finds
   (in-process CPU time, warm, best of 5);
 - writing that run's plots and ``report.html`` with its search history
-  (:func:`~trackplan.report.run_report.write_run_report`), warm, best of 3: drawn in two
-  processes (the caller and a forked one take the next plot, or band of ``joints.png``, in
-  turn) and drawn in this process alone; wall time, CPU time of this process and of the
-  forked one, and the busier of the two against the plan;
+  (:func:`~trackplan.report.run_report.write_run_report`), warm, best of 3: by a plot
+  worker started and warmed up beforehand (untimed), as ``trackplan optimize`` has one after
+  its search; drawn in two processes (the caller and a forked one take the next plot, or
+  band of ``joints.png``, in turn); and drawn in this process alone; wall time, CPU time of
+  this process and of the forked ones, and the busier process against the plan (the worker
+  mode's two drawing processes share the forked CPU time about equally);
 - the imports the report adds to a process (matplotlib, plotly), in a fresh process;
 - ``trackplan optimize cases/paper-corner.yaml`` as a whole process with and without the
   report (median of 3 after one run that fills numba's cache): wall and CPU time (the
@@ -22,6 +24,7 @@ Wall times count the other load of the machine; on a shared machine read the CPU
 
 from __future__ import annotations
 
+import os
 import resource
 import statistics
 import subprocess
@@ -33,6 +36,7 @@ from pathlib import Path
 from benchmarks import best_time
 from trackplan.io.case_file import load_case
 from trackplan.planning.plan import plan_placement
+from trackplan.report.plot_worker import PlotWorker
 from trackplan.report.run_report import can_fork, write_run_report
 from trackplan.search import optimize_placement
 
@@ -53,19 +57,28 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def _report_seconds(write) -> tuple[float, float, float]:  # type: ignore[no-untyped-def]
+def _process_cpu(pid: int) -> float:
+    """CPU time (user + system) a running child has used so far, s (Linux)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _report_seconds(write, prepare) -> tuple[float, float, float]:  # type: ignore[no-untyped-def]
     """Best wall time, CPU time of this process and CPU time of its children over
-    :data:`REPORT_REPEATS` calls after a warm-up call, s (the best by wall time)."""
-    write()
+    :data:`REPORT_REPEATS` calls of ``write(prepared)`` after a warm-up call, s (the best by
+    wall time). ``prepare()`` is not timed and returns what ``write`` takes and the CPU time
+    its children had used already."""
+    write(prepare()[0])
     runs = []
     for _ in range(REPORT_REPEATS):
+        prepared, used = prepare()
         wall, cpu, children = time.perf_counter(), time.process_time(), _children_cpu()
-        write()
+        write(prepared)
         runs.append(
             (
                 time.perf_counter() - wall,
                 time.process_time() - cpu,
-                _children_cpu() - children,
+                _children_cpu() - children - used,
             )
         )
     return min(runs)
@@ -97,18 +110,33 @@ def _in_process() -> None:
     print(f"  plan_placement (reference, CPU, warm): {1e3 * plan:.1f} ms")
     print(f"\n  {'report (plots + report.html), warm':<44}{'wall s':>8}{'CPU s':>8}", end="")
     print(f"{'forked CPU s':>14}{'longest / plan':>16}")
-    modes = (True, False) if can_fork() else (False,)
+    modes = ("worker", "two processes", "alone") if can_fork() else ("alone",)
+    labels = {
+        "worker": "plot worker (warm, as after a search)",
+        "two processes": "two processes",
+        "alone": "this process alone",
+    }
     with tempfile.TemporaryDirectory() as out:
-        for parallel in modes:
+        for mode in modes:
 
-            def write(parallel: bool = parallel) -> None:
-                write_run_report(result, case, Path(out), history, parallel=parallel)
+            def prepare(mode: str = mode) -> tuple[PlotWorker | None, float]:
+                if mode != "worker":
+                    return None, 0.0
+                worker = PlotWorker.start(case)
+                assert worker is not None and worker.ready()
+                return worker, _process_cpu(worker.pid)  # its warm-up
 
-            wall, cpu, children = _report_seconds(write)
-            label = "two processes" if parallel else "this process alone"
-            longest = max(cpu, children) / plan
+            def write(worker: PlotWorker | None, mode: str = mode) -> None:
+                parallel = mode != "alone"
+                write_run_report(result, case, Path(out), history, parallel=parallel, worker=worker)
+
+            wall, cpu, children = _report_seconds(write, prepare)
+            label = labels[mode]
+            # the worker draws in two processes, sharing the work about equally
+            longest = max(cpu, children / 2 if mode == "worker" else children) / plan
             print(f"  {label:<44}{wall:>8.2f}{cpu:>8.2f}{children:>14.2f}{longest:>15.0f}×")
     print("  longest: the CPU time of the busier process, the wall time on an idle 2-core machine")
+    print("  (the worker's forked CPU time is its drawing, without its warm-up, in two processes)")
     if not can_fork():
         print("  (no second core or no fork here: the forked mode was not measured)")
 

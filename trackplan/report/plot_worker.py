@@ -33,6 +33,10 @@ if TYPE_CHECKING:  # imported by the command line before its search: stays light
     from trackplan.planning.result import PlanResult
 
 
+_READY = "ready"
+"""What the worker sends once it has warmed up."""
+
+
 class PlotWorker:
     """A forked process ready to draw one run's plots (:meth:`start`)."""
 
@@ -40,6 +44,7 @@ class PlotWorker:
         self.pid = pid
         self._connection: Connection | None = connection
         self._drawing = False
+        self._ready = False
 
     @classmethod
     def start(cls, case: Case | None = None) -> PlotWorker | None:
@@ -90,16 +95,28 @@ class PlotWorker:
         self._drawing = True
         return True
 
+    def ready(self) -> bool:
+        """Wait until the worker is ready to draw (it has warmed up); False when it is
+        gone."""
+        if self._connection is None:
+            return False
+        if not self._ready:
+            try:
+                self._ready = self._connection.recv() == _READY
+            except (OSError, EOFError):
+                return False
+        return self._ready
+
     def wait(self) -> bool:
         """Wait for the plots sent with :meth:`draw`; True when the worker wrote them all.
         The worker ends either way."""
         written = False
-        if self._connection is not None:
+        if self._connection is not None and self.ready():
             try:
                 written = self._connection.recv() is True
             except (OSError, EOFError):
                 written = False
-            self._drawing = False
+        self._drawing = False
         self.close()
         return written
 
@@ -157,6 +174,7 @@ def _serve(connection: Connection, case: Case | None) -> None:
     from trackplan.report.figures import plot_figures
 
     _warm_up(case)
+    connection.send(_READY)
     try:
         result, run_case, history, out_dir = connection.recv()
     except (EOFError, OSError):
