@@ -161,6 +161,16 @@ def envelope(t: np.ndarray, y: np.ndarray, n_points: int = ENVELOPE_POINTS) -> t
     return t[picks], y[picks]
 
 
+def _inside_ticks(locator: object, low: float, high: float) -> np.ndarray:
+    """The ticks ``locator`` (a matplotlib tick locator) places from ``low`` to ``high``,
+    without those it adds beyond them: matplotlib makes a tick (two marks, a grid line, two
+    labels) for every location its locator gives, drawn or not, a third more in the joint
+    grid."""
+    ticks = np.asarray(locator.tick_values(low, high))  # type: ignore[attr-defined]
+    tolerance = 1e-10 * (high - low)
+    return ticks[(ticks >= low - tolerance) & (ticks <= high + tolerance)]
+
+
 JOINT_BANDS = ((0, 1), (2, 3))
 """Rows of ``joints.png`` drawn as separate figures (bands) and stacked: the plot is the
 largest of a run, and its two bands are drawn in two processes."""
@@ -226,7 +236,9 @@ def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = N
     axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
     if trajectory.n_samples:
         t_margin = 0.02 * (trajectory.t[-1] - trajectory.t[0])
-        axes[0, 0].set_xlim(trajectory.t[0] - t_margin, trajectory.t[-1] + t_margin)
+        t_limits = (trajectory.t[0] - t_margin, trajectory.t[-1] + t_margin)
+        axes[0, 0].set_xlim(*t_limits)
+        axes[0, 0].set_xticks(_inside_ticks(MaxNLocator(nbins=5), *t_limits))
     half = 0.5 * trajectory.sample_time
     for band_row, row in enumerate(rows):
         kind = LIMIT_KINDS[row]
@@ -245,10 +257,13 @@ def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = N
                 # linear inside ±limit, logarithmic beyond: the limits stay visible next
                 # to violations that exceed them by orders of magnitude
                 ax.set_yscale("symlog", linthresh=limit)
-                ax.set_ylim(1.5 * low, 1.5 * high)
+                y_limits = (1.5 * low, 1.5 * high)
             else:
                 pad = 0.08 * (high - low)
-                ax.set_ylim(low - pad, high + pad)
+                y_limits = (low - pad, high + pad)
+            ax.set_ylim(*y_limits)
+            y_locator = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10])
+            ax.set_yticks(_inside_ticks(y_locator, *y_limits))
             ax.plot(
                 *envelope(trajectory.t, series), color=f"C{j}", lw=1.0, label=robot.joint_names[j]
             )
@@ -280,7 +295,6 @@ def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = N
                     y=1.0,
                     pad=2.0,
                 )
-            ax.yaxis.set_major_locator(MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]))
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3, lw=0.5)
             if row == 0:
@@ -317,8 +331,8 @@ def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
     ax.set_xlim(*limits[0])
     ax.set_ylim(*limits[1])
     ax.set_zlim(*limits[2])
-    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
-        axis.set_major_locator(MaxNLocator(nbins=5))
+    for axis, (low, high) in zip((ax.xaxis, ax.yaxis, ax.zaxis), limits, strict=True):
+        axis.set_ticks(_inside_ticks(MaxNLocator(nbins=5), low, high))
     ax.set_box_aspect((1.0, 1.0, 1.0))
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
