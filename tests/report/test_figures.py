@@ -88,6 +88,18 @@ def test_joints_mark_the_planted_violation_and_nothing_else(joints, corner, corn
                 assert not markers and not windows, (kind, j)
 
 
+def test_joints_tick_only_inside_each_panel(joints):
+    # matplotlib makes a tick object for every location, drawn or not
+    for ax in joints.axes:
+        for ticks, (low, high) in (
+            (ax.get_xticks(), ax.get_xlim()),
+            (ax.get_yticks(), ax.get_ylim()),
+        ):
+            tolerance = 1e-9 * (high - low)
+            assert len(ticks) >= 2
+            assert np.all((ticks >= low - tolerance) & (ticks <= high + tolerance))
+
+
 @pytest.fixture(scope="module")
 def path(corner, corner_result):
     return path_figure(corner_result, corner)
@@ -127,6 +139,14 @@ def test_path_axes_have_equal_aspect(path):
         widths = [np.ptp(ax.get_xlim()), np.ptp(ax.get_ylim()), np.ptp(ax.get_zlim())]
         np.testing.assert_allclose(widths, widths[0])
         assert ax.get_xlabel() == "x [m]" and ax.get_zlabel() == "z [m]"
+        for ticks, (low, high) in zip(
+            (ax.get_xticks(), ax.get_yticks(), ax.get_zticks()),
+            (ax.get_xlim(), ax.get_ylim(), ax.get_zlim()),
+            strict=True,
+        ):
+            tolerance = 1e-9 * (high - low)
+            assert len(ticks) >= 2
+            assert np.all((ticks >= low - tolerance) & (ticks <= high + tolerance))
 
 
 def test_speed_figure_bounds_and_series(corner, corner_result):
