@@ -107,7 +107,7 @@ def save_pixels(pixels: np.ndarray, path: Path) -> None:
 class BandedFigure:
     """A plot drawn as horizontal bands, each its own figure of the same width; its image is
     the bands stacked top to bottom. The bands can be drawn in different processes
-    (:func:`~trackplan.report.run_report.write_run_report`).
+    (:func:`~trackplan.report.drawing.draw_plots`).
 
     Attributes
     ----------
