@@ -26,6 +26,8 @@ Run with ``python -m benchmarks optimize``. Prints, in one run:
 
 from __future__ import annotations
 
+import compileall
+import json
 import math
 import os
 import resource
@@ -38,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
+import trackplan
 from trackplan.choices import Method
 from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
@@ -165,11 +168,94 @@ def _process_seconds(args: list[str]) -> tuple[float, float]:
     return statistics.median(walls), statistics.median(cpus)
 
 
+def _fill_bytecode_cache() -> str:
+    """Write trackplan's bytecode (``__pycache__/*.pyc``) as a first run does, also where
+    ``PYTHONDONTWRITEBYTECODE`` is set; what was done, for the table's heading.
+
+    An installed wheel brings its bytecode, and the first run from a source tree writes it;
+    with the variable set no run ever does, and every start compiles the package's sources
+    again (0.3 s to 0.5 s of CPU, issue 8's "after the first compile" does not hold).
+    """
+    package = Path(trackplan.__file__).parent
+    compileall.compile_dir(package, quiet=1)
+    skipped = os.environ.get("PYTHONDONTWRITEBYTECODE", "") not in ("", "0")
+    return "bytecode compiled first" + (" (PYTHONDONTWRITEBYTECODE is set)" if skipped else "")
+
+
+PHASES_PROBE = """
+import json, sys, time
+marks = {"started": time.time()}
+import trackplan.cli.app, trackplan.io.case_file, trackplan.search, trackplan.outputs
+import trackplan.search.optimize as search
+marks["imported"] = time.time()
+phases = ("load case", "paths (numba starts)", "search", "before plan", "final plan", "writing")
+spans = dict.fromkeys(phases, 0.0)
+plans = []
+
+def timed(name, function):
+    def run(*args, **kwargs):
+        start = time.time()
+        try:
+            return function(*args, **kwargs)
+        finally:
+            spans[name] += time.time() - start
+    return run
+
+def plan(*args, **kwargs):
+    plans.append(None)
+    return timed("before plan" if len(plans) == 1 else "final plan", plan_placement)(
+        *args, **kwargs
+    )
+
+plan_placement = search.plan_placement
+search.plan_placement = plan
+search._run = timed("search", search._run)
+paths = search.PathGeometry
+paths.from_case = classmethod(timed("paths (numba starts)", paths.from_case.__func__))
+trackplan.io.case_file.load_case = timed("load case", trackplan.io.case_file.load_case)
+trackplan.outputs.write_search_run = timed("writing", trackplan.outputs.write_search_run)
+code = trackplan.cli.main(sys.argv[1:])
+marks["ended"] = time.time()
+print(json.dumps({"marks": marks, "spans": spans, "code": int(code)}))
+"""
+"""Runs ``trackplan optimize`` in one process and times its phases (the functions wrapped
+are those :func:`~trackplan.search.optimize_placement` and the command call)."""
+
+
+def _phases(case: str) -> None:
+    """Where the wall time of one ``trackplan optimize CASE --no-report`` goes."""
+    with tempfile.TemporaryDirectory() as out:
+        args = ["optimize", str(CASES / f"{case}.yaml"), "--no-report", "--out", out]
+        spawned = time.time()
+        done = subprocess.run(
+            [sys.executable, "-c", PHASES_PROBE, *args], check=True, capture_output=True, text=True
+        )
+        exited = time.time()
+    probe = json.loads(done.stdout.splitlines()[-1])
+    marks, spans = probe["marks"], probe["spans"]
+    rest = marks["ended"] - marks["imported"] - sum(spans.values())
+    rows = {
+        "interpreter start": marks["started"] - spawned,
+        "imports (what optimize uses)": marks["imported"] - marks["started"],
+        **spans,
+        "the rest (lazy imports, summary)": rest,
+        "exit": exited - marks["ended"],
+    }
+    print(f"\n  where one run of optimize {case} --no-report goes (wall s):")
+    for name, seconds in rows.items():
+        print(f"    {name:<36}{seconds:>6.2f}")
+    print(f"    {'total':<36}{exited - spawned:>6.2f}")
+
+
 def _whole_process() -> None:
     """Wall and CPU time of ``trackplan optimize`` as a whole process against the import time
     of the command and the targets (issue 8: the corner case; issue 9: the cell cases)."""
     corner = str(CASES / "paper-corner.yaml")
-    print(f"\nWhole process, median of {PROCESS_RUNS} runs (after one that fills numba's cache)")
+    compiled = _fill_bytecode_cache()
+    print(
+        f"\nWhole process, median of {PROCESS_RUNS} runs (after one that fills numba's cache; "
+        f"{compiled})"
+    )
     print(f"  {'command':<56}{'wall s':>8}{'CPU s':>8}  target")
     for label, args in STARTUP_COMMANDS:
         wall, cpu = _process_seconds(
@@ -187,6 +273,7 @@ def _whole_process() -> None:
         label = f"trackplan optimize {name}" + ("" if report else " --no-report")
         print(f"  {label:<56}{wall:>8.2f}{cpu:>8.2f}  ≤ {target:g} s wall: {verdict}")
     print("  (wall time on a loaded machine exceeds the CPU time; the targets are for an idle one)")
+    _phases("paper-corner")
     _corner_seeds()
 
 

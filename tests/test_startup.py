@@ -26,10 +26,13 @@ REPORT_AND_OPTIONAL = (
     "toppra",
     "ruckig",
     "pymoo.algorithms",
+    "rich.progress",
+    "rich.table",
     "trackplan.report",
     "trackplan.search.operators",
 )
-"""Modules a search with the default method and ``--no-report`` does not use."""
+"""Modules a search with the default method and ``--no-report`` does not use (rich's
+progress bar only on a terminal, its tables only for the commands that print one)."""
 
 
 def _loaded_after(code: str, modules: tuple[str, ...]) -> list[str]:

@@ -261,15 +261,16 @@ def _interrupted_marks(result, signals: SignalLog) -> dict:  # type: ignore[no-u
 def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyped-def]
     """Run the placement search, with a progress bar when stderr is a terminal; a signal
     recorded in ``signals`` stops it after the current generation."""
-    import numpy as np
     from rich.console import Console
-    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from trackplan.search import optimize_placement
 
     err = Console(stderr=True)
     if not err.is_terminal:
         return optimize_placement(case, progress=lambda _: signals.raise_if_stopped(), **options)
+    import numpy as np
+    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
     columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
     with Progress(*columns, console=err, transient=True) as bar:
         task = bar.add_task("placement search: starting", total=None)

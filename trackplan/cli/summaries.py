@@ -3,16 +3,19 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from rich.console import Console
 from rich.markup import escape
-from rich.table import Table
 
 from trackplan.case import Case
 from trackplan.paths import NominalPath
 from trackplan.planning.result import CheckReport, PlanResult
 from trackplan.robots.model import Robot
+
+if TYPE_CHECKING:  # rich's tables only for the commands that print one
+    from rich.console import Console
+    from rich.table import Table
 
 
 def describe_case(case: Case, file: Path | str) -> list[str]:
@@ -69,6 +72,8 @@ def segment_corners(path: NominalPath) -> list[tuple[int, float]]:
 
 def robot_table(robot: Robot) -> Table:
     """A table of one robot's chain (origin and axis per joint) and joint limits."""
+    from rich.table import Table
+
     from trackplan.frames import rpy_from_matrix
 
     table = Table(

@@ -142,12 +142,22 @@ def _torques(
     g = np.array(gravity, dtype=float)
     q, qd, qdd = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (q, qd, qdd)))
     shape = q.shape
-    q_flat, qd_flat, qdd_flat = (
-        np.ascontiguousarray(x.reshape(-1, shape[-1])) for x in (q, qd, qdd)
-    )
-    tau = np.empty_like(q_flat)
+    q_flat, qd_flat, qdd_flat = (_read_only(x.reshape(-1, shape[-1])) for x in (q, qd, qdd))
+    tau = np.empty(q_flat.shape)
     kernels.rne_kernel(K, g, q_flat, qd_flat, qdd_flat, tau)
     return tau.reshape(shape)
+
+
+def _read_only(x: np.ndarray) -> np.ndarray:
+    """A C-contiguous read-only view (a copy where x is not contiguous) of x.
+
+    numba compiles one specialisation per writable flag: the search passes fresh arrays,
+    a plan its frozen result's, and each specialisation is a kernel more to load from the
+    cache in every process. Read-only inputs whatever the caller's give one.
+    """
+    view = np.ascontiguousarray(x).view()
+    view.flags.writeable = False
+    return view
 
 
 def inverse_dynamics(
