@@ -30,9 +30,11 @@ REPORT_AND_OPTIONAL = (
     "rich.table",
     "trackplan.report",
     "trackplan.search.operators",
+    "trackplan.cell.screening",
 )
 """Modules a search with the default method and ``--no-report`` does not use (rich's
-progress bar only on a terminal, its tables only for the commands that print one)."""
+progress bar only on a terminal, its tables only for the commands that print one; the
+cell's compiled screening only for a case with a cell)."""
 
 
 def _loaded_after(code: str, modules: tuple[str, ...]) -> list[str]:

@@ -8,11 +8,11 @@ depends on which law runs.
 from __future__ import annotations
 
 import weakref
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.cell.screening import CellGeometry
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform
 from trackplan.jointpath import JointPath
@@ -33,6 +33,9 @@ from trackplan.tool import (
     ToolSpec,
     tool_axis_twist,
 )
+
+if TYPE_CHECKING:  # the cell's compiled screening only for cases with a cell
+    from trackplan.cell.screening import CellGeometry
 
 CELL_KINDS = ("collision", "clearance")
 """Violation kinds of the cell check."""
@@ -363,4 +366,8 @@ def check_case_trajectory(
 
 def cell_geometry(case: Case) -> CellGeometry | None:
     """The case's cell laid out for its robot, or None without a cell."""
-    return CellGeometry.from_cell(case.cell, case.robot) if case.cell is not None else None
+    if case.cell is None:
+        return None
+    from trackplan.cell.screening import CellGeometry
+
+    return CellGeometry.from_cell(case.cell, case.robot)

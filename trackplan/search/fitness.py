@@ -50,11 +50,11 @@ import enum
 from collections.abc import Callable, Iterable
 from concurrent.futures import Executor
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from trackplan.case import Case, Objective
-from trackplan.cell.screening import CellGeometry
 from trackplan.choices import Penalty
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
@@ -67,6 +67,9 @@ from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.search.space import SearchSpace
 from trackplan.timing import time_law
 from trackplan.tool import ToolOrientation, spin_rotations, spin_values
+
+if TYPE_CHECKING:  # the cell's compiled screening only for cases with a cell
+    from trackplan.cell.screening import CellGeometry
 
 SCREEN_POSES = 150
 """Target number of poses of the screening grid along the planned path. 100 poses screen a
@@ -258,7 +261,11 @@ class PlacementFitness:
         curved = geometry.on_curved_zone(0.5 * (self.s_grid[1:] + self.s_grid[:-1]))
         cap = np.where(curved, case.task.corner_speed, case.task.rated_speed)
         self.tool_time = np.diff(self.s_grid) / cap  # (M - 1,), s
-        self.cell = CellGeometry.from_cell(case.cell, case.robot) if case.cell else None
+        self.cell: CellGeometry | None = None
+        if case.cell:
+            from trackplan.cell.screening import CellGeometry
+
+            self.cell = CellGeometry.from_cell(case.cell, case.robot)
         self._map: Callable[[Callable, Iterable], Iterable] = (
             executor.map if executor is not None else map
         )
