@@ -39,25 +39,45 @@ def project_point(
         d1 = r1 - along * direction[k, 1]
         d2 = r2 - along * direction[k, 2]
         return along, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-    r0, r1, r2 = x[0] - center[k, 0], x[1] - center[k, 1], x[2] - center[k, 2]
-    u = r0 * e1[k, 0] + r1 * e1[k, 1] + r2 * e1[k, 2]
-    v = r0 * e2[k, 0] + r1 * e2[k, 1] + r2 * e2[k, 2]
-    w = r0 * axis[k, 0] + r1 * axis[k, 1] + r2 * axis[k, 2]
+    return _project_arc(
+        x[0], x[1], x[2], center[k, 0], center[k, 1], center[k, 2],
+        axis[k, 0], axis[k, 1], axis[k, 2], e1[k, 0], e1[k, 1], e1[k, 2],
+        e2[k, 0], e2[k, 1], e2[k, 2], radius[k], angle[k],
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _project_arc(
+    x0: float, x1: float, x2: float, c0: float, c1: float, c2: float,
+    a0: float, a1: float, a2: float, u0: float, u1: float, u2: float,
+    v0: float, v1: float, v2: float, radius: float, angle: float,
+) -> tuple[float, float]:  # pragma: no cover  # fmt: skip
+    """Kernel: :func:`project_point` on an arc of centre c, axis a, in-plane unit vectors
+    u (towards the start) and v, radius and angle.
+
+    Scalars only: a call that passes no arrays costs no reference counting, so the line
+    case of :func:`project_point` stays a few arithmetic operations per piece.
+    """
+    r0, r1, r2 = x0 - c0, x1 - c1, x2 - c2
+    u = r0 * u0 + r1 * u1 + r2 * u2
+    v = r0 * v0 + r1 * v1 + r2 * v2
+    w = r0 * a0 + r1 * a1 + r2 * a2
     phi = math.atan2(v, u)
     if phi < 0.0:
         phi += 2.0 * math.pi
-    if phi <= angle[k]:
-        return phi * radius[k], math.hypot(w, math.hypot(u, v) - radius[k])
-    c, s = math.cos(angle[k]), math.sin(angle[k])
-    first = 0.0
-    last = 0.0
-    for i in range(3):
-        a = x[i] - (center[k, i] + radius[k] * e1[k, i])
-        b = x[i] - (center[k, i] + radius[k] * (c * e1[k, i] + s * e2[k, i]))
-        first += a * a
-        last += b * b
+    if phi <= angle:
+        return phi * radius, math.hypot(w, math.hypot(u, v) - radius)
+    c, s = math.cos(angle), math.sin(angle)
+    f0 = x0 - (c0 + radius * u0)
+    f1 = x1 - (c1 + radius * u1)
+    f2 = x2 - (c2 + radius * u2)
+    l0 = x0 - (c0 + radius * (c * u0 + s * v0))
+    l1 = x1 - (c1 + radius * (c * u1 + s * v1))
+    l2 = x2 - (c2 + radius * (c * u2 + s * v2))
+    first = f0 * f0 + f1 * f1 + f2 * f2
+    last = l0 * l0 + l1 * l1 + l2 * l2
     if last < first:
-        return angle[k] * radius[k], math.sqrt(last)
+        return angle * radius, math.sqrt(last)
     return 0.0, math.sqrt(first)
 
 
@@ -75,7 +95,9 @@ def dense_pieces(
     e2: np.ndarray,
     arc_radius: np.ndarray,
     angle: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover
+) -> tuple[
+    np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray
+]:  # pragma: no cover
     """Kernel: the pieces within ``slack`` of the nearest piece of each point, every piece
     projected (a path of few pieces: no tree).
 
@@ -96,10 +118,13 @@ def dense_pieces(
         The pairs: piece (ascending within a point), arc length along it and distance, m.
     nearest
         Distance of each point from the whole path, shape (B,), m.
+    row
+        The point of each pair, shape (K,).
     """
     n = points.shape[0]
     n_pieces = length.shape[0]
     bounds = np.zeros(n + 1, dtype=np.int64)
+    out_row = np.empty(n * n_pieces, dtype=np.int64)
     out_piece = np.empty(n * n_pieces, dtype=np.int64)
     out_sigma = np.empty(n * n_pieces)
     out_distance = np.empty(n * n_pieces)
@@ -120,12 +145,15 @@ def dense_pieces(
         for k in range(n_pieces):
             if distances[k] > closest + slack:
                 continue
+            out_row[used] = b
             out_piece[used] = k
             out_sigma[used] = sigmas[k]
             out_distance[used] = distances[k]
             used += 1
     bounds[n] = used
-    return bounds, out_piece[:used], out_sigma[:used], out_distance[:used], nearest
+    return (
+        bounds, out_piece[:used], out_sigma[:used], out_distance[:used], nearest, out_row[:used]
+    )  # fmt: skip
 
 
 @njit(cache=True)

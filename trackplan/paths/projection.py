@@ -120,18 +120,17 @@ class PieceIndex:
             The pairs (point, piece) with distance ≤ nearest + ``slack``, each piece once.
         """
         points = np.asarray(points, dtype=float).reshape(-1, 3)
-        finite = np.flatnonzero(np.isfinite(points).all(axis=1))
-        parts = [(np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
         n_pieces = self.table.n_pieces
-        if n_pieces <= _DENSE_PIECES and len(finite) == len(points):
+        if n_pieces <= _DENSE_PIECES and np.isfinite(points).all():
             # every piece for every point, in one compiled pass: cheaper than a tree
             t = self.table
-            bounds, piece, sigma, gap, nearest = dense_pieces(
-                points, slack, t.is_arc, t.start, t.direction, t.length, t.center, t.axis,
-                t.e1, t.e2, t.radius, t.angle,
+            _, piece, sigma, gap, nearest, row = dense_pieces(
+                np.ascontiguousarray(points), slack, t.is_arc, t.start, t.direction, t.length,
+                t.center, t.axis, t.e1, t.e2, t.radius, t.angle,
             )  # fmt: skip
-            row = np.repeat(np.arange(len(points)), np.diff(bounds))
             return Candidates(row, piece, sigma, gap, nearest)
+        finite = np.flatnonzero(np.isfinite(points).all(axis=1))
+        parts = [(np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
         if n_pieces <= _DENSE_PIECES:  # the same with points that are not finite
             every = np.arange(n_pieces)
             for start in range(0, len(finite), _POINTS_PER_BLOCK):
