@@ -22,7 +22,7 @@ from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import PathIK, branch_joints, solve_path_ik
 from trackplan.status import Status
 from trackplan.stencils import stencil_derivatives, stencil_points
-from trackplan.tool import ToolOrientation
+from trackplan.tool import ToolFrame, ToolOrientation
 
 STENCIL_FRACTION = 0.1
 """Stencil spacing as a share of the grid step: small against the scale on which the
@@ -100,7 +100,7 @@ class JointPath:
         """
         placement = np.asarray(placement, dtype=float)
         grid = _planning_grid(geometry)
-        rotations = tool.rotations(grid.points.ravel(), grid.tangents)
+        rotations = _rotations(tool, grid.points.ravel(), grid.tangents)
         poses = tool_poses(placement, grid.positions, rotations)
         ik = solve_path_ik(robot, poses[None], branch=branch)
         q_points = ik.q[0].reshape(*grid.points.shape, robot.n_dof)
@@ -146,7 +146,7 @@ class JointPath:
     def poses(self, s: np.ndarray) -> np.ndarray:
         """Tool poses in the base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
         sample = self.geometry.planned.sample(np.asarray(s, dtype=float))
-        rotations = self.tool.rotations(sample.s, sample.tangent)
+        rotations = _rotations(self.tool, sample.s, sample.tangent)
         return tool_poses(self.placement, sample.position, rotations)
 
     def joints(self, s: np.ndarray) -> np.ndarray:
@@ -207,6 +207,15 @@ class JointPath:
         points, offset = stencil_points(np.asarray(s, dtype=float), lo, hi, spacing)
         q = self.joints(points.ravel()).reshape(*points.shape, self.robot.n_dof)
         return stencil_derivatives(q, offset, spacing)
+
+
+def _rotations(tool: ToolOrientation, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:
+    """``R_part_tool`` at arc lengths ``s`` (M,) with planned tangents (M, 3): shape
+    (M, 3, 3), or one (3, 3) where the tool holds one orientation along the whole path
+    (part frame, constant spin): the rotation every row would repeat, computed once."""
+    if tool.spec.frame is ToolFrame.PART and len(tool.spin.coefficients) == 1 and len(s):
+        return tool.rotations(s[:1], tangent[:1])[0]
+    return tool.rotations(s, tangent)
 
 
 @dataclass(frozen=True, eq=False)

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.frames import rotate_each
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
@@ -23,7 +22,7 @@ from trackplan.planning.tracking import between_samples, jump_allowance, locate_
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
-from trackplan.tool import SpinMode, ToolSpec
+from trackplan.tool import SpinMode, ToolFrame, ToolSpec
 
 if TYPE_CHECKING:
     from trackplan.cell.screening import CellGeometry
@@ -299,8 +298,11 @@ def _check_task(
             violations.append(replace(found, message=message))
     margins["tracking"] = float(_met(1.0 - worst / ref.tolerance, RELATIVE_SLACK))
 
-    R_part_tool = rotate_each(R_part_base, T_base_tool[:, :3, :3])
-    orientation_error, tool_found = _check_tool(ref, R_part_tool, s_nominal, piece, t, margins)
+    # the tool's x and z axes in the definition frame: all the tool checks read
+    x_part, z_part = (T_base_tool[:, :3, j] @ R_part_base.T for j in (0, 2))
+    orientation_error, tool_found = _check_tool(
+        ref, x_part, z_part, s_nominal, piece, t, margins
+    )
     violations.extend(tool_found)
 
     # Cartesian speed against the cap that applies where the tool is
@@ -332,7 +334,8 @@ def violations_of(violations: list[Violation], limit: str) -> list[Violation]:
 
 def _check_tool(
     ref: TrackingReference,
-    R_part_tool: np.ndarray,
+    x_part: np.ndarray,
+    z_part: np.ndarray,
     s_nominal: np.ndarray,
     piece: np.ndarray,
     t: np.ndarray,
@@ -344,14 +347,23 @@ def _check_tool(
     tolerance; inside, to the tolerance plus the zone's bound. The spin is measured about
     the actual tool axis from the spec's zero-spin frame, outside transition zones.
 
+    Parameters
+    ----------
+    x_part, z_part
+        The tool's x axis and its axis (z) at the samples in the definition frame, shape
+        (N, 3) each.
+
     Returns
     -------
     tuple
         The tool axis error per sample (N,), rad, and the violations found.
     """
     nominal, spec, tol = ref.nominal, ref.tool, ref.orientation_tolerance
-    R_spec = nominal_rotations(spec, nominal, s_nominal, piece)
-    axis_cos = np.einsum("ni,ni->n", R_spec[:, :, 2], R_part_tool[:, :, 2])
+    if spec.frame is ToolFrame.PART:  # one rotation (3, 3) for the whole path
+        R_spec = spec.base_rotations(np.zeros((1, 3)))[0]
+    else:
+        R_spec = nominal_rotations(spec, nominal, s_nominal, piece)
+    axis_cos = _along(z_part, R_spec, 2)
     axis_error = np.arccos(np.clip(axis_cos, -1.0, 1.0))
     allowed = np.full(len(t), tol)
     for s0, s1, bound in np.asarray(ref.tool_zones).reshape(-1, 3):
@@ -365,11 +377,7 @@ def _check_tool(
     outside = allowed == tol
     if not outside.any():
         return axis_error, found
-    x_actual = R_part_tool[:, :, 0]
-    spin = np.arctan2(
-        np.einsum("ni,ni->n", x_actual, R_spec[:, :, 1]),
-        np.einsum("ni,ni->n", x_actual, R_spec[:, :, 0]),
-    )
+    spin = np.arctan2(_along(x_part, R_spec, 1), _along(x_part, R_spec, 0))
     everywhere = outside.all()  # no transition zone: no copies
     spin = np.unwrap(spin if everywhere else spin[outside])
     t_out, s_out, piece_out = (
@@ -412,6 +420,14 @@ def _check_tool(
             )
         )
     return axis_error, found
+
+
+def _along(v: np.ndarray, R: np.ndarray, j: int) -> np.ndarray:
+    """Per sample, ``v`` (N, 3) dotted with column j of R: one rotation (3, 3) or one per
+    sample (N, 3, 3); shape (N,)."""
+    if R.ndim == 2:
+        return v @ R[:, j]
+    return np.einsum("ni,ni->n", v, R[:, :, j])
 
 
 def _coverage_violations(
