@@ -165,10 +165,11 @@ def tool_poses(X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray) ->
         poses[..., :3, :3] = rotate_each(R, R_part_tool[0])
     else:
         poses[..., :3, :3] = R[:, None] @ R_part_tool
-    poses[..., :3, 3] = np.asarray(positions, dtype=float) @ R.transpose(0, 2, 1)
-    poses[..., :3, 3] += T_base_part[:, None, :3, 3]
-    poses[..., 3, :3] = 0.0
-    poses[..., 3, 3] = 1.0
+    # the positions in a contiguous array first: one strided write into the poses
+    placed = np.asarray(positions, dtype=float) @ R.transpose(0, 2, 1)  # (B, M, 3)
+    placed += T_base_part[:, None, :3, 3]
+    poses[..., :3, 3] = placed
+    poses[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
     return poses[0] if single else poses
 
 
