@@ -300,9 +300,7 @@ def _check_task(
 
     # the tool's x and z axes in the definition frame: all the tool checks read
     x_part, z_part = (T_base_tool[:, :3, j] @ R_part_base.T for j in (0, 2))
-    orientation_error, tool_found = _check_tool(
-        ref, x_part, z_part, s_nominal, piece, t, margins
-    )
+    orientation_error, tool_found = _check_tool(ref, x_part, z_part, s_nominal, piece, t, margins)
     violations.extend(tool_found)
 
     # Cartesian speed against the cap that applies where the tool is

@@ -128,13 +128,25 @@ class SpeedProfile:
             ``(s, v, a)``, each shape (N,); ``s`` is clipped to [0, length].
         """
         t = np.asarray(t, dtype=float)
-        k = np.clip(np.searchsorted(self.t_start, t, side="right") - 1, 0, len(self.t_start) - 1)
+        k = self.phase_index(t)
         tau = t - self.t_start[k]
         j = self.jerk[k]
-        s = self.s0[k] + self.v0[k] * tau + self.a0[k] * tau**2 / 2.0 + j * tau**3 / 6.0
         v = self.v0[k] + self.a0[k] * tau + j * tau**2 / 2.0
         a = self.a0[k] + j * tau
-        return np.clip(s, 0.0, self.length), v, a
+        return self._position(k, tau), v, a
+
+    def position(self, t: np.ndarray) -> np.ndarray:
+        """Path position at times ``t`` (N,), s: the ``s`` of :meth:`evaluate` alone, shape
+        (N,), m, clipped to [0, length]."""
+        t = np.asarray(t, dtype=float)
+        k = self.phase_index(t)
+        return self._position(k, t - self.t_start[k])
+
+    def _position(self, k: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Path position at ``tau`` (N,) s into phases ``k`` (N,), clipped, m."""
+        j = self.jerk[k]
+        s = self.s0[k] + self.v0[k] * tau + self.a0[k] * tau**2 / 2.0 + j * tau**3 / 6.0
+        return np.clip(s, 0.0, self.length, out=s)
 
     def phase_index(self, t: np.ndarray) -> np.ndarray:
         """Index of the phase each time falls in, shape (N,)."""

@@ -144,7 +144,7 @@ def plan_smooth_time_law(
             )
         time_scale = max(1.0, n_steps * sample_time / profile.duration)
         t = np.arange(n_steps + 1) * sample_time
-        s = profile.evaluate(t / time_scale)[0]
+        s = profile.position(t / time_scale)
         s[-1] = length
         motion = SampledMotion(robot, joint_path.joints(s), sample_time)
         worst = run_motion_checks(checks, motion)
