@@ -441,9 +441,15 @@ class _ZonePlanner:
         def needed(z: int, v: np.ndarray) -> np.ndarray:
             before = plateau[z - 1] if z > 0 else 0.0
             after = plateau[z + 1] if z < n - 1 else 0.0
-            rise = self.quick_distances(z, np.full_like(v, before), np.maximum(v, before))
-            fall = self.quick_distances(z, np.maximum(v, after), np.full_like(v, after))
-            return np.where(before < v, rise, 0.0) + np.where(after < v, fall, 0.0)
+            total = np.zeros_like(v)
+            top = v.max()
+            if before < top:  # a rise into some of the speeds (only theirs count)
+                rise = self.quick_distances(z, np.full_like(v, before), np.maximum(v, before))
+                total += np.where(before < v, rise, 0.0)
+            if after < top:
+                fall = self.quick_distances(z, np.maximum(v, after), np.full_like(v, after))
+                total += np.where(after < v, fall, 0.0)
+            return total
 
         fitting: set[tuple[int, float, float, float]] = set()
         for _ in range(10 * n + 10):  # look-ahead passes until every zone fits
