@@ -135,6 +135,16 @@ def rotate_each(R: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     return np.swapaxes(rotated, -3, -2)
 
 
+def vector_norms(v: np.ndarray) -> np.ndarray:
+    """Euclidean lengths of 3-vectors ``v`` (N, 3), shape (N,).
+
+    The same bits as ``np.linalg.norm(v, axis=1)`` (the squares summed in the same order),
+    a few times faster: numpy reduces a short last axis slowly.
+    """
+    x, y, z = v[:, 0], v[:, 1], v[:, 2]
+    return np.sqrt(x * x + y * y + z * z)
+
+
 def tool_poses(X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray) -> np.ndarray:
     """``T_base_tool = T_X · [R_part_tool  p; 0 1]`` for every placement and path point.
 

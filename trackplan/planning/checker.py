@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from trackplan.frames import vector_norms
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
@@ -304,7 +305,7 @@ def _check_task(
     violations.extend(tool_found)
 
     # Cartesian speed against the cap that applies where the tool is
-    speed = np.linalg.norm(velocity, axis=1)
+    speed = vector_norms(velocity)
     in_corner = np.zeros(len(q), dtype=bool)
     for s0, s1 in np.asarray(ref.corner_intervals).reshape(-1, 2):
         in_corner |= (s_nominal >= s0) & (s_nominal <= s1)

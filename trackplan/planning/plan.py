@@ -14,7 +14,7 @@ import numpy as np
 
 from trackplan.case import Case
 from trackplan.errors import CaseError
-from trackplan.frames import as_placement, placement_transform
+from trackplan.frames import as_placement, placement_transform, vector_norms
 from trackplan.jointpath import JointPath
 from trackplan.motion import SampledMotion
 from trackplan.paths.path_geometry import PathGeometry, PathMode
@@ -127,7 +127,7 @@ def motion_trajectory(
     """
     q, sample_time, n = motion.q, motion.sample_time, motion.n_samples
     position = motion.T_base_tool[:, :3, 3]
-    speed = np.linalg.norm(np.diff(position, axis=0, prepend=position[:1]), axis=1) / sample_time
+    speed = vector_norms(np.diff(position, axis=0, prepend=position[:1])) / sample_time
     return Trajectory(
         sample_time=sample_time,
         t=np.arange(n) * sample_time,

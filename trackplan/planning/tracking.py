@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from trackplan.frames import vector_norms
 from trackplan.paths.geometry import unwrap_closed_arc
 from trackplan.paths.nominal import NominalPath
 from trackplan.planning._kernels import monotone_assignment
@@ -52,7 +53,7 @@ def locate_on_nominal(
     """
     points = np.asarray(points, dtype=float)
     table = nominal.table
-    speed = np.linalg.norm(velocity, axis=1)
+    speed = vector_norms(velocity)
     nearest = np.empty(len(points))
     assigned = np.empty(len(points), dtype=int)
     local = np.empty(len(points))
@@ -146,7 +147,7 @@ def between_samples(
     """
     if len(q) < 2:
         return np.zeros((0, q.shape[1] if q.ndim == 2 else 0)), np.zeros(0)
-    chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    chord = vector_norms(np.diff(points, axis=0))
     if chord.max() <= 2 * BETWEEN_STEP * tolerance:  # (NaN: False) every period in halves
         midpoints = q[:-1] + 0.5 * (q[1:] - q[:-1])  # as below with the fraction 1/2
         return midpoints, np.arange(len(chord)) + 0.5
