@@ -43,13 +43,15 @@ planned again (:data:`MAX_REBUILDS` times at most), over a reach that grows by
 
 from __future__ import annotations
 
+import functools
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from trackplan.case import Task
-from trackplan.jointpath import JointPath
+from trackplan.jointpath import STENCIL_FRACTION, JointPath
 from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
 from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, run_motion_checks
@@ -90,6 +92,15 @@ REBUILD_SPREAD = 1.5
 CAP_SHARE = 0.999
 """Share of the task's speed caps the curve plans against: its spline rings slightly (about
 1e-4) above a cruise it joins."""
+REFINE_DEPTH = 7
+"""Bisections of a gap between nodes where the joint demand steps (:func:`_features`)."""
+REFINE_RATIO = 1.25
+"""Change of the constant speed the joints allow from one node to the next above which the
+gap between them is bisected."""
+REFINE_ROOM = 1.0
+"""A gap is bisected only where the joints allow less than this times the rated speed."""
+REFINE_GAP = 1e-5
+"""Shortest gap between nodes that is bisected, m."""
 REBUILD_FACTOR = 0.97
 """A rebuild lowers the failing limit to this share of its value over the ratio found."""
 
@@ -229,7 +240,17 @@ def _stretches(joint_path: JointPath, task: Task) -> list[_Stretch]:
         inside = [(z, zone) for z, zone in moving if zone[0] < b and zone[1] > a]
         rows = np.isin(joint_path.zone, [z for z, _ in inside])
         grid = joint_path.s[rows]
+        spans = np.array([zone[:2] for _, zone in inside])
+        steps = np.array([_grid_step(joint_path.s[joint_path.zone == z]) for z, _ in inside])
+        exact = functools.partial(_exact_derivatives, joint_path, spans, steps)
+        values = [d[rows] for d in (joint_path.dq, joint_path.ddq, joint_path.dddq)]
         s = _nodes(grid, a, b)
+        sides, missed = _demand(s, grid, values, exact, joint_path.robot)
+        if missed.size:
+            window = _within(s, missed)
+            features = _features(s[window], missed, exact, joint_path.robot, task.rated_speed)
+            s = _nodes(np.concatenate([grid, features]), a, b)
+            sides, _ = _demand(s, grid, values, exact, joint_path.robot)
         count = len(s)
         before = np.concatenate([[s[0]], s[:-1]])
         after = np.concatenate([s[1:], [s[-1]]])
@@ -240,12 +261,128 @@ def _stretches(joint_path: JointPath, task: Task) -> list[_Stretch]:
                 speed = min(task.rated_speed, task.corner_speed * (1.0 - LIMIT_MARGIN))
             near = (after >= s0) & (before <= s1)  # a node's neighbourhood touches the zone
             cap[near] = np.minimum(cap[near], CAP_SHARE * speed)
-        sides = []
-        for derivative in (joint_path.dq, joint_path.ddq, joint_path.dddq):
-            values = derivative[rows]
-            sides.append(np.stack([_interp(s, grid, values, last) for last in (True, False)]))
         out.append(_Stretch(s, cap, *sides))
     return out
+
+
+def _demand(
+    s: np.ndarray,
+    grid: np.ndarray,
+    values: list[np.ndarray],
+    exact: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+    robot: Robot,
+) -> tuple[list[np.ndarray], np.ndarray]:
+    """q', q'', q''' at the nodes ``s`` (G,) just before and just after each, shape
+    (2, G, n) each, and the gaps of the planning grid where the joint demand rises between
+    its points, shape (M, 2), m.
+
+    On the grid's own points they are the grid's ``values`` (q', q'', q''' at ``grid``,
+    each (R, n)); between them, the linear interpolation of these or the derivatives from
+    IK (``exact``), whichever asks the joints for more at a constant speed
+    (:func:`_steady_demand`): the interpolation overstates the demand where it falls
+    quickly (which keeps the plans that work as they were) and misses it where it rises
+    within a gap. Those gaps are returned: the ones holding a node whose demand from IK
+    passes :data:`REFINE_RATIO` cubed times the interpolated one.
+    """
+    sides = [np.stack([_interp(s, grid, v, last) for last in (True, False)]) for v in values]
+    fill = np.flatnonzero(~np.isin(s, grid))
+    if not fill.size:
+        return sides, np.zeros((0, 2))
+    from_ik = exact(s[fill])
+    interpolated = tuple(np.abs(side[:, fill]).max(axis=0) for side in sides)
+    demand = _steady_demand(from_ik, robot)
+    guess = _steady_demand(interpolated, robot)
+    higher = demand >= guess
+    for side, value in zip(sides, from_ik, strict=True):
+        side[:, fill[higher]] = value[higher]
+    distinct = np.unique(grid)
+    cell = np.unique(np.searchsorted(distinct, s[fill[demand > REFINE_RATIO**3 * guess]]))
+    return sides, np.stack([distinct[cell - 1], distinct[cell]], axis=1)
+
+
+def _within(s: np.ndarray, gaps: np.ndarray) -> np.ndarray:
+    """Whether each point of ``s`` (G,) lies in one of the closed ``gaps`` (M, 2), (G,) bool."""
+    inside = (s[:, None] >= gaps[None, :, 0]) & (s[:, None] <= gaps[None, :, 1])
+    return np.any(inside, axis=1)
+
+
+def _grid_step(grid: np.ndarray) -> float:
+    """Mean step of a zone's planning grid (G,), m, as the joint path's stencils use it."""
+    return float(grid[-1] - grid[0]) / max(len(grid) - 1, 1)
+
+
+def _exact_derivatives(
+    joint_path: JointPath, spans: np.ndarray, steps: np.ndarray, s: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """q', q'', q''' at arc lengths ``s`` (M,) by IK on stencils inside the zone of each
+    point, with the planning grid's spacing (:data:`~trackplan.jointpath.STENCIL_FRACTION`
+    of the zone's grid step); each shape (M, n), rad/m, rad/m², rad/m³.
+
+    Parameters
+    ----------
+    spans
+        Start and end of the stretch's zones, shape (Z, 2), m.
+    steps
+        Grid step of each zone, shape (Z,), m.
+    """
+    zone = np.clip(np.searchsorted(spans[:, 1], s), 0, len(spans) - 1)
+    lo, hi = spans[zone, 0], spans[zone, 1]
+    h = np.minimum(STENCIL_FRACTION * steps[zone], (hi - lo) / 4.0)
+    return joint_path.derivatives(s, lo, hi, h)
+
+
+def _features(
+    s: np.ndarray,
+    missed: np.ndarray,
+    exact: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+    robot: Robot,
+    rated: float,
+) -> np.ndarray:
+    """Points (F,), m, where the joint demand steps between two nodes.
+
+    The planning grid is coarse on a straight piece, but the tool's seam frame turns within
+    a few millimetres of a junction (``docs/tool.md``), and the joints' q''' rises there from
+    nothing to its peak at once. The gaps between the nodes ``s`` (G,) that lie in the grid
+    gaps ``missed`` (M, 2), m (see :func:`_missed`) are bisected, up to :data:`REFINE_DEPTH`
+    times, with the derivatives from IK (``exact``), wherever the constant speed the joints'
+    acceleration and jerk allow changes by more than :data:`REFINE_RATIO` from one node to
+    the next while staying below :data:`REFINE_ROOM` times the rated speed ``rated``, m/s.
+    The points found go to :func:`_nodes` with the grid's.
+    """
+    points = s
+    demand = _steady_demand(exact(points), robot)
+    found = []
+    for _ in range(REFINE_DEPTH):
+        gaps = np.diff(points)
+        low = np.minimum(demand[:-1], demand[1:])
+        high = np.maximum(demand[:-1], demand[1:])
+        wide = (
+            (high > REFINE_RATIO**3 * low)
+            & (high * (REFINE_ROOM * rated) ** 3 > 1.0)
+            & (gaps > REFINE_GAP)
+            & _within(points[:-1] + 0.5 * gaps, missed)
+        )
+        if not wide.any():
+            break
+        middle = points[:-1][wide] + 0.5 * gaps[wide]
+        found.append(middle)
+        order = np.argsort(np.concatenate([points, middle]), kind="stable")
+        points = np.concatenate([points, middle])[order]
+        demand = np.concatenate([demand, _steady_demand(exact(middle), robot)])[order]
+    if not found:
+        return np.zeros(0)
+    return np.concatenate(found)
+
+
+def _steady_demand(
+    derivatives: tuple[np.ndarray, np.ndarray, np.ndarray], robot: Robot
+) -> np.ndarray:
+    """One over the cube of the constant speed the joints' acceleration and jerk limits
+    allow at each point, shape (M,), s³/m³: the largest ``(|q''| / a_max)^1.5`` and
+    ``|q'''| / j_max`` over the joints."""
+    _, d2, d3 = derivatives
+    acceleration = np.max(np.abs(d2) / robot.a_max, axis=1) ** 1.5
+    return np.maximum(acceleration, np.max(np.abs(d3) / robot.j_max, axis=1))
 
 
 def _nodes(grid: np.ndarray, a: float, b: float) -> np.ndarray:
@@ -376,7 +513,8 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                     A_ub=matrix,
                     b_ub=rhs[keep],
                     bounds=np.stack([np.where(held, x, 0.0), x], axis=1),
-                    method="highs",
+                    method="highs-ds",
+                    options={"presolve": False},
                 )
                 if result.status != 0:
                     solution = None
