@@ -15,20 +15,24 @@ and jerk are
 The nodes are the planning grid's own points (fine inside a blend, where q'' and q''' change
 within a fraction of a millimetre) with the gaps between them cut to at most
 :data:`NODE_SPACING`, the spacing growing gradually away from a fine part
-(:data:`NODE_GROWTH`). With three-point differences on these nodes for ``x'`` and ``x''``
-(exact for quadratics on any spacing) the acceleration is linear in x, and so is the jerk
-once ``√x`` is bounded by a speed ``v̄`` known to lie above it:
-``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄`` with ``x ≤ v̄²`` is a sufficient
+(:data:`NODE_GROWTH`). Between the grid's points a node takes the joint derivatives from IK
+where they ask for more than the grid's interpolated ones, and a grid gap where they rise
+unseen (a seam frame that starts turning between two points of a straight's coarse grid) is
+bisected and graded (:func:`_demand`, :func:`_features`). With three-point differences on
+these nodes for ``x'`` and ``x''`` (exact for quadratics on any spacing) the acceleration is
+linear in x, and so is the jerk once ``√x`` is bounded by a speed ``v̄`` known to lie above
+it: ``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄`` with ``x ≤ v̄²`` is a sufficient
 (conservative) form. Under these linear bounds, the velocity limits and the task's speed
-caps, a linear program (HiGHS, through :func:`scipy.optimize.linprog`) maximises ``Σ w x``,
-each node weighted by its share of the travel time (``ds / x^1.5`` at a reference x, so a
-node near rest costs what it costs in time). It is solved :data:`ROUNDS` times: first with
-``v̄`` :data:`FIRST_ROOM` times the constant speed the joints allow at each node, then with
-``v̄`` :data:`SPEED_ROOM` times the previous solution (the reference x of the weights). The
-signed joint-path derivatives enter as they are, so the curve uses the cancellations the
-optimum uses. Only rows that can bind enter the program (a row whose largest value for
-``0 ≤ x ≤ v̄²`` stays within its limit cannot), and nodes far from any slowed or changing
-part cruise at their cap outside it (:func:`_cruising`).
+caps, a linear program (HiGHS's dual simplex, through :func:`scipy.optimize.linprog`)
+maximises ``Σ w x``, each node weighted by its share of the travel time (``ds / x^1.5`` at
+a reference x, so a node near rest costs what it costs in time). It is solved
+:data:`ROUNDS` times: first with ``v̄`` :data:`FIRST_ROOM` times the constant speed the
+joints allow at each node, then with ``v̄`` :data:`SPEED_ROOM` times the previous solution
+(the reference x of the weights). The signed joint-path derivatives enter as they are, so
+the curve uses the cancellations the optimum uses. Only rows that can bind enter the
+program (a row whose largest value for ``0 ≤ x ≤ v̄²`` stays within its limit cannot), and
+nodes far from any slowed or changing part cruise at their cap outside it
+(:func:`_cruising`).
 
 Each stretch between stops is planned from rest to rest; next to a rest, where the
 difference quotients cannot see the acceleration grow from zero, x is also bounded by a
