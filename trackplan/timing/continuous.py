@@ -347,7 +347,7 @@ def _features(
     The planning grid is coarse on a straight piece, but the tool's seam frame turns within
     a few millimetres of a junction (``docs/tool.md``), and the joints' q''' rises there from
     nothing to its peak at once. The gaps between the nodes ``s`` (G,) that lie in the grid
-    gaps ``missed`` (M, 2), m (see :func:`_missed`) are bisected, up to :data:`REFINE_DEPTH`
+    gaps ``missed`` (M, 2), m (see :func:`_demand`) are bisected, up to :data:`REFINE_DEPTH`
     times, with the derivatives from IK (``exact``), wherever the constant speed the joints'
     acceleration and jerk allow changes by more than :data:`REFINE_RATIO` from one node to
     the next while staying below :data:`REFINE_ROOM` times the rated speed ``rated``, m/s.
