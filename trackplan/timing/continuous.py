@@ -26,7 +26,7 @@ it: ``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄`` with ``x ≤ v̄²`` 
 caps, a linear program (HiGHS's dual simplex, through :func:`scipy.optimize.linprog`)
 maximises ``Σ w x``, each node weighted by its share of the travel time (``ds / x^1.5`` at
 a reference x, so a node near rest costs what it costs in time). It is solved
-:data:`ROUNDS` times: first with ``v̄`` :data:`FIRST_ROOM` times the constant speed the
+:data:`ROUNDS` times: first with ``v̄`` :data:`FIRST_ROOMS` times the constant speed the
 joints allow at each node, then with ``v̄`` :data:`SPEED_ROOM` times the previous solution
 (the reference x of the weights). The signed joint-path derivatives enter as they are, so
 the curve uses the cancellations the optimum uses. Only rows that can bind enter the
@@ -67,11 +67,14 @@ NODE_GROWTH = 0.25
 MIN_NODES = 24
 """Fewest nodes of a stretch between stops (a short stretch gets a finer spacing)."""
 ROUNDS = 2
-"""Linear programs per plan: the first bounds √x by :data:`FIRST_ROOM` times the
+"""Linear programs per plan: the first bounds √x by :data:`FIRST_ROOMS` times the
 constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the first solution."""
-FIRST_ROOM = 1.5
+FIRST_ROOMS = (1.5, 1.0)
 """How far above the constant-speed cap the joints allow (at each node) the first round's
-speed may go (its jerk bound assumes the speed stays below it)."""
+speed may go (its jerk bound assumes the speed stays below it): the first room, and the
+next one tried when a solution leaves a node inside the stretch at rest."""
+RESTING = 1e-12
+"""A node whose ``x`` is below this share of the largest is at rest (the curve would stop)."""
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
@@ -488,9 +491,10 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
         )
     cruise = _cruising(s, top, steady)
     solution = None
-    for held in (cruise, np.zeros_like(cruise)) if cruise.any() else (cruise,):
+    tries = [(held, room) for room in FIRST_ROOMS for held in _holds(cruise)]
+    for held, room in tries:
         # held at the cap first; if that leaves no room for a speed change, everything free
-        x = np.minimum(top, (FIRST_ROOM * steady) ** 2)
+        x = np.minimum(top, (room * steady) ** 2)
         reference = x
         for _ in range(ROUNDS):
             bound = np.sqrt(x)
@@ -526,9 +530,14 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                 solution = np.clip(result.x, 0.0, x)
             x = np.minimum(top, SPEED_ROOM**2 * solution)
             reference = solution
-        if solution is not None:
+        if solution is not None and solution[1:-1].min() > RESTING * solution.max():
             return solution
     return None
+
+
+def _holds(cruise: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The nodes held at their cap in turn (G,), bool: the cruising ones, then none."""
+    return (cruise, np.zeros_like(cruise)) if cruise.any() else (cruise,)
 
 
 def _time_weights(s: np.ndarray, reference: np.ndarray) -> np.ndarray:
