@@ -72,9 +72,8 @@ constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the fir
 FIRST_ROOMS = (1.5, 1.0)
 """How far above the constant-speed cap the joints allow (at each node) the first round's
 speed may go (its jerk bound assumes the speed stays below it): the first room, and the
-next one tried when a solution leaves a node inside the stretch at rest."""
-RESTING = 1e-12
-"""A node whose ``x`` is below this share of the largest is at rest (the curve would stop)."""
+next one tried when a solution stops inside the stretch (its travel time reaches
+:data:`MAX_DURATION`)."""
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
@@ -530,9 +529,17 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                 solution = np.clip(result.x, 0.0, x)
             x = np.minimum(top, SPEED_ROOM**2 * solution)
             reference = solution
-        if solution is not None and solution[1:-1].min() > RESTING * solution.max():
+        if solution is not None and _travel_time(s, solution) < MAX_DURATION:
             return solution
     return None
+
+
+def _travel_time(s: np.ndarray, x: np.ndarray) -> float:
+    """Time, s, to run the nodes ``s`` (G,) at ``x = ṡ²`` (G,) at constant acceleration
+    between them: :data:`MAX_DURATION` or more where the solution stops inside the stretch."""
+    speed = np.sqrt(x)
+    with np.errstate(divide="ignore"):
+        return float(np.sum(2.0 * np.diff(s) / (speed[1:] + speed[:-1])))
 
 
 def _holds(cruise: np.ndarray) -> tuple[np.ndarray, ...]:
