@@ -529,17 +529,9 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                 solution = np.clip(result.x, 0.0, x)
             x = np.minimum(top, SPEED_ROOM**2 * solution)
             reference = solution
-        if solution is not None and _travel_time(s, solution) < MAX_DURATION:
+        if solution is not None and _node_steps(stretch, np.sqrt(solution)).sum() < MAX_DURATION:
             return solution
     return None
-
-
-def _travel_time(s: np.ndarray, x: np.ndarray) -> float:
-    """Time, s, to run the nodes ``s`` (G,) at ``x = ṡ²`` (G,) at constant acceleration
-    between them: :data:`MAX_DURATION` or more where the solution stops inside the stretch."""
-    speed = np.sqrt(x)
-    with np.errstate(divide="ignore"):
-        return float(np.sum(2.0 * np.diff(s) / (speed[1:] + speed[:-1])))
 
 
 def _holds(cruise: np.ndarray) -> tuple[np.ndarray, ...]:
