@@ -138,24 +138,25 @@ def test_a_short_blend_that_turns_the_wrist_is_within_4_percent_of_topp3(name, X
     """The nodes follow the planning grid into the blend, and off the grid where the seam
     frame turns, so the curve resolves them and is taken (the window plan was 1.135, 1.65
     and 1.05 × TOPP3 there), every sample re-checked."""
-    case = load_case(CASES / f"{name}.yaml")
-    result = plan_placement(case, X)
-    assert result.feasible, result.message
-    assert result.duration <= 1.04 * topp3
-    report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
-    assert report.success, report.violations[:3]
+    _assert_planned_within(name, X, 1.04 * topp3)
 
 
 def test_a_first_round_that_leaves_blend_nodes_at_rest_is_solved_again_lower():
     """At this corner placement (a fresh draw, seed 2 of the benchmark) the first round's
     room of 1.5 × the constant-speed cap left four nodes of the blend at rest, the curve was
     given up, and the window plan took 8.222 s, 1.089 × TOPP3; the room of 1.0 plans the
-    curve (7.866 s, 1.041 ×), every sample re-checked."""
-    case = load_case(CASES / "paper-corner.yaml")
-    result = plan_placement(case, FRESH_X)
+    curve (7.866 s at these rounded coordinates, 1.041 ×), every sample re-checked."""
+    _assert_planned_within("paper-corner", FRESH_X, 1.05 * FRESH_TOPP3)
+
+
+def _assert_planned_within(name: str, X: np.ndarray, duration: float) -> None:
+    """The case ``name`` plans feasible at X within ``duration`` (s), and its trajectory
+    passes the checker sample by sample."""
+    case = load_case(CASES / f"{name}.yaml")
+    result = plan_placement(case, X)
     assert result.feasible, result.message
-    assert result.duration <= 1.05 * FRESH_TOPP3
-    report = check_case_trajectory(case, FRESH_X, result.trajectory.q, case.task.sample_time)
+    assert result.duration <= duration
+    report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
     assert report.success, report.violations[:3]
 
 
