@@ -329,3 +329,378 @@ def rate_ratios(q: np.ndarray, steps: np.ndarray, limits: np.ndarray) -> np.ndar
             out[r, 1] = max(out[r, 1], abs(second_b / steps[1]) / limits[1, i])
             out[r, 2] = max(out[r, 2], abs(third / steps[2]) / limits[2, i])
     return out
+
+
+@njit(cache=True)
+def _needed(
+    z: int,
+    v: np.ndarray,
+    plateau: np.ndarray,
+    lengths: np.ndarray,
+    offsets: np.ndarray,
+    s: np.ndarray,
+    peaks: np.ndarray,
+    running_from_start: np.ndarray,
+    running_from_end: np.ndarray,
+    a_limit: np.ndarray,
+    j_limit: np.ndarray,
+) -> np.ndarray:
+    """Length zone z needs for its rise into and fall out of each plateau of ``v`` (V,), m."""
+    n_zones = plateau.size
+    before = plateau[z - 1] if z > 0 else 0.0
+    after = plateau[z + 1] if z < n_zones - 1 else 0.0
+    first, stop = offsets[z], offsets[z + 1]
+    total = np.zeros(v.size)
+    top = v.max()
+    if before < top:  # a rise into some of the speeds (only theirs count)
+        rise = quick_distances(
+            s[first:stop],
+            peaks[z],
+            running_from_start[first:stop],
+            np.full(v.size, before),
+            np.maximum(v, before),
+            True,
+            lengths[z],
+            a_limit[z],
+            j_limit[z],
+        )
+        for k in range(v.size):
+            total[k] += rise[k] if before < v[k] else 0.0
+    if after < top:
+        fall = quick_distances(
+            s[first:stop],
+            peaks[z],
+            running_from_end[first:stop],
+            np.maximum(v, after),
+            np.full(v.size, after),
+            False,
+            lengths[z],
+            a_limit[z],
+            j_limit[z],
+        )
+        for k in range(v.size):
+            total[k] += fall[k] if after < v[k] else 0.0
+    return total
+
+
+@njit(cache=True)
+def plateau_search(
+    lengths: np.ndarray,
+    caps: np.ndarray,
+    offsets: np.ndarray,
+    s: np.ndarray,
+    peaks: np.ndarray,
+    running_from_start: np.ndarray,
+    running_from_end: np.ndarray,
+    a_limit: np.ndarray,
+    j_limit: np.ndarray,
+    grid: int,
+    rounds: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Plateaus lowered until every zone fits its speed changes (look-ahead over the zones).
+
+    A zone whose rise and fall at its plateau (:func:`quick_distances`, from the plateaus of
+    its neighbours) need more than its length is lowered to the highest speed that fits, found
+    on a grid of ``grid`` speeds below it, ``rounds`` times finer each round (the grid as
+    ``np.linspace(low, high, grid + 1)[1:]``); passes over the zones repeat until none
+    changes (at most ``10 Z + 10``).
+
+    Parameters
+    ----------
+    lengths, caps
+        Length (m) and speed cap (m/s) of each zone, shape (Z,); a cap of 0 is a stop.
+    offsets
+        Zone z's grid rows are ``offsets[z]:offsets[z + 1]`` of the next arrays, shape (Z + 1,).
+    s
+        The zones' grids one after the other, shape (G,), m.
+    peaks
+        Largest |q'|, |q''|, |q'''| over each zone, shape (Z, 3, n).
+    running_from_start, running_from_end
+        Running maxima of |q'|, |q''|, |q'''| from each zone's start and from its end,
+        shape (G, 3, n) (:meth:`~trackplan.timing.demand.ZoneDemand.running_maxima`).
+    a_limit, j_limit
+        Share of the joint acceleration and jerk limits in each zone, shape (Z, n).
+    grid, rounds
+        The speed grid of a lowered plateau.
+
+    Returns
+    -------
+    plateau : numpy.ndarray
+        Shape (Z,), m/s.
+    lowered : numpy.ndarray
+        Shape (Z,), bool: the zones lowered below their cap.
+    """
+    n_zones = caps.size
+    plateau = caps.copy()
+    lowered = np.zeros(n_zones, dtype=np.bool_)
+    one = np.empty(1)
+    for _ in range(10 * n_zones + 10):
+        changed = False
+        for z in range(n_zones):
+            top = plateau[z]
+            if top == 0.0:
+                continue
+            one[0] = top
+            need = _needed(
+                z,
+                one,
+                plateau,
+                lengths,
+                offsets,
+                s,
+                peaks,
+                running_from_start,
+                running_from_end,
+                a_limit,
+                j_limit,
+            )
+            if need[0] <= lengths[z]:
+                continue
+            low, high = 0.0, top
+            for _ in range(rounds):  # a grid of speeds, then a finer one
+                delta = high - low
+                step = delta / grid
+                trial = np.empty(grid)
+                for i in range(1, grid):  # np.linspace(low, high, grid + 1)[1:]
+                    trial[i - 1] = (i / grid * delta if step == 0.0 else i * step) + low
+                trial[grid - 1] = high
+                need = _needed(
+                    z,
+                    trial,
+                    plateau,
+                    lengths,
+                    offsets,
+                    s,
+                    peaks,
+                    running_from_start,
+                    running_from_end,
+                    a_limit,
+                    j_limit,
+                )
+                fits = need <= lengths[z]
+                k = grid
+                for i in range(grid):
+                    if not fits[i]:
+                        k = i
+                        break
+                low = trial[k - 1] if k > 0 else low
+                high = trial[k] if k < grid else high
+            plateau[z] = low
+            lowered[z] = True
+            changed = True
+        if not changed:
+            break
+    return plateau, lowered
+
+
+@njit(cache=True)
+def _stretch_peaks(
+    s: np.ndarray,
+    d1: np.ndarray,
+    d2: np.ndarray,
+    d3: np.ndarray,
+    running_from_start: np.ndarray,
+    running_from_end: np.ndarray,
+    s_from: float,
+    s_to: float,
+) -> np.ndarray:
+    """:meth:`~trackplan.timing.demand.ZoneDemand.peaks` over [s_from, s_to], shape (3, n)
+    (G ≥ 2)."""
+    n_grid = s.size
+    first = max(np.searchsorted(s, s_from, side="right") - 2, 0)
+    stop = min(np.searchsorted(s, s_to, side="left") + 2, n_grid)
+    stop = max(stop, first + 1)
+    if first == 0:
+        return running_from_start[stop - 1]
+    if stop == n_grid:
+        return running_from_end[first]
+    out = np.zeros((3, d1.shape[1]))
+    for r in range(first, stop):
+        for i in range(d1.shape[1]):
+            out[0, i] = max(out[0, i], abs(d1[r, i]))
+            out[1, i] = max(out[1, i], abs(d2[r, i]))
+            out[2, i] = max(out[2, i], abs(d3[r, i]))
+    return out
+
+
+@njit(cache=True)
+def quick_change(
+    s: np.ndarray,
+    d1: np.ndarray,
+    d2: np.ndarray,
+    d3: np.ndarray,
+    peaks: np.ndarray,
+    running_from_start: np.ndarray,
+    running_from_end: np.ndarray,
+    s_start: float,
+    s_end: float,
+    v_from: float,
+    v_to: float,
+    a_limit: np.ndarray,
+    j_limit: np.ndarray,
+) -> tuple[float, float, float]:
+    """One speed change under bounds valid over the stretch it covers.
+
+    The bounds over the whole zone at the top speed (:func:`change_bounds`); where that
+    change fits the zone, raised to those over the shorter stretch it covers (a rise from
+    ``s_start``, a fall to ``s_end``; :meth:`~trackplan.timing.demand.ZoneDemand.peaks`).
+
+    Parameters
+    ----------
+    s, d1, d2, d3
+        The zone's grid (G,), m (G ≥ 1), and signed q', q'', q''' on it, shape (G, n).
+    peaks
+        Largest |q'|, |q''|, |q'''| over the grid, shape (3, n).
+    running_from_start, running_from_end
+        Their running maxima from the grid's start and from its end, shape (G, 3, n).
+    s_start, s_end
+        The zone, m.
+    v_from, v_to
+        Speeds before and after, m/s.
+    a_limit, j_limit
+        Share of the joint acceleration and jerk limits, shape (n,).
+
+    Returns
+    -------
+    tuple of float
+        ``(distance, accel, jerk)``: m (inf when the joints leave no room), m/s², m/s³.
+    """
+    top = max(v_from, v_to)
+    accel, jerk = change_bounds(peaks[0], peaks[1], peaks[2], top, a_limit, j_limit)
+    if accel <= 0.0 or jerk <= 0.0:
+        return np.inf, accel, jerk
+    distance = _distance(v_from, v_to, accel, jerk)
+    if distance < s_end - s_start:
+        if v_to > v_from:
+            s_from, s_to = s_start, s_start + distance
+        else:
+            s_from, s_to = s_end - distance, s_end
+        if s.size < 2:
+            local_accel, local_jerk = accel, jerk
+        else:
+            local = _stretch_peaks(
+                s, d1, d2, d3, running_from_start, running_from_end, s_from, s_to
+            )
+            local_accel, local_jerk = change_bounds(
+                local[0], local[1], local[2], top, a_limit, j_limit
+            )
+        accel, jerk = max(accel, local_accel), max(jerk, local_jerk)
+        distance = _distance(v_from, v_to, accel, jerk)
+    return distance, accel, jerk
+
+
+@njit(cache=True)
+def change_search(
+    s: np.ndarray,
+    d1: np.ndarray,
+    d2: np.ndarray,
+    d3: np.ndarray,
+    peaks: np.ndarray,
+    s_start: float,
+    s_end: float,
+    v_from: float,
+    v_to: float,
+    at_start: bool,
+    a_limit: np.ndarray,
+    j_limit: np.ndarray,
+    start: tuple[float, float, float],
+    factors: np.ndarray,
+    fine_factors: np.ndarray,
+    u: np.ndarray,
+) -> tuple[float, float, float]:
+    """The fastest speed change inside a zone whose bounds hold along its own stretch
+    (:func:`trackplan.timing.demand.speed_change`).
+
+    From the change over the zone at the top speed (or ``start`` when shorter), candidate
+    bounds on the grids ``best · factors`` then ``best · fine_factors`` (each axis), each
+    checked along its stretch (:func:`changes_within_limits`); the shortest that passes wins.
+
+    Parameters
+    ----------
+    s, d1, d2, d3
+        The zone's grid (G,), m, and signed q', q'', q''' on it, shape (G, n).
+    peaks
+        Largest |q'|, |q''|, |q'''| over the grid, shape (3, n).
+    s_start, s_end
+        The zone, m.
+    v_from, v_to
+        Speeds before and after, m/s.
+    at_start
+        True when the change starts at ``s_start``, False when it ends at ``s_end``.
+    a_limit, j_limit
+        Share of the joint acceleration and jerk limits, shape (n,).
+    start
+        ``(distance, accel, jerk)`` of a change known to meet the limits (inf: none).
+    factors, fine_factors
+        Multiples of the bounds tried in the first and second round.
+    u
+        Check points in each constant-jerk phase, as shares of it, shape (P,).
+
+    Returns
+    -------
+    tuple of float
+        ``(distance, accel, jerk)``: m (inf when the joints leave no room), m/s², m/s³.
+    """
+    top = max(v_from, v_to)
+    accel, jerk = change_bounds(peaks[0], peaks[1], peaks[2], top, a_limit, j_limit)
+    best = (np.inf, accel, jerk)
+    if accel > 0.0 and jerk > 0.0:
+        best = (_distance(v_from, v_to, accel, jerk), accel, jerk)
+    if start[0] < best[0]:
+        best = start
+    if not np.isfinite(best[0]) or v_from == v_to or s.size < 2:
+        return best
+    for round_ in range(2):
+        grid = factors if round_ == 0 else fine_factors
+        n = grid.size
+        a_grid = np.empty(n * n)
+        j_grid = np.empty(n * n)
+        for i in range(n):
+            for k in range(n):
+                a_grid[i * n + k] = min(best[1] * grid[i], MAX_PATH_ACCELERATION)
+                j_grid[i * n + k] = min(best[2] * grid[k], MAX_PATH_JERK)
+        ok, distance = changes_within_limits(
+            s,
+            d1,
+            d2,
+            d3,
+            s_start,
+            s_end,
+            v_from,
+            v_to,
+            at_start,
+            a_limit,
+            j_limit,
+            a_grid,
+            j_grid,
+            u,
+        )
+        pick = -1
+        for k in range(n * n):
+            if ok[k] and (pick < 0 or distance[k] < distance[pick]):
+                pick = k
+        if pick >= 0 and distance[pick] < best[0]:
+            best = (distance[pick], a_grid[pick], j_grid[pick])
+    return best
+
+
+@njit(cache=True)
+def profile_position(
+    t_start: np.ndarray,
+    s0: np.ndarray,
+    v0: np.ndarray,
+    a0: np.ndarray,
+    jerk: np.ndarray,
+    length: float,
+    t: np.ndarray,
+) -> np.ndarray:
+    """Path position of a constant-jerk profile at times ``t`` (N,), clipped to
+    [0, length], shape (N,), m (:meth:`~trackplan.timing.profile.SpeedProfile.position`)."""
+    out = np.empty(t.size)
+    last = t_start.size - 1
+    for r in range(t.size):
+        k = min(max(np.searchsorted(t_start, t[r], side="right") - 1, 0), last)
+        tau = t[r] - t_start[k]
+        value = s0[k] + v0[k] * tau + a0[k] * (tau * tau) / 2.0 + jerk[k] * tau**3.0 / 6.0
+        out[r] = min(max(value, 0.0), length)
+    return out

@@ -23,7 +23,6 @@ import numpy as np
 from trackplan.robots.model import Robot
 from trackplan.timing import _kernels
 from trackplan.timing._kernels import MAX_PATH_ACCELERATION, MAX_PATH_JERK
-from trackplan.timing.profile import speed_change_distance
 
 
 def safe_ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
@@ -62,6 +61,11 @@ class ZoneDemand:
         object.__setattr__(self, "_maxima", [None, None])
 
     @property
+    def peak_array(self) -> np.ndarray:
+        """Largest |q'|, |q''|, |q'''| per joint over the zone, shape (3, n)."""
+        return self._peak_array
+
+    @property
     def absolute(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """|q'|, |q''|, |q'''| at the grid, each shape (G, n)."""
         return self._abs
@@ -84,9 +88,9 @@ class ZoneDemand:
             return self._peaks
         rows = self._rows(s_from, s_to)
         if rows.start == 0:  # a stretch from the zone start: running maxima
-            return self._running(0)[rows.stop - 1]
+            return self.running_maxima(0)[rows.stop - 1]
         if rows.stop == len(self.s):  # a stretch to the zone end
-            return self._running(1)[rows.start]
+            return self.running_maxima(1)[rows.start]
         q1, q2, q3 = self._abs
         return q1[rows].max(axis=0), q2[rows].max(axis=0), q3[rows].max(axis=0)
 
@@ -98,9 +102,9 @@ class ZoneDemand:
         """
         if at_start:
             stop = np.searchsorted(self.s, self.s[0] + distance, side="left") + 2
-            return self._running(0)[np.clip(stop, 1, len(self.s)) - 1]
+            return self.running_maxima(0)[np.clip(stop, 1, len(self.s)) - 1]
         first = np.searchsorted(self.s, self.s[-1] - distance, side="right") - 2
-        return self._running(1)[np.clip(first, 0, len(self.s) - 1)]
+        return self.running_maxima(1)[np.clip(first, 0, len(self.s) - 1)]
 
     def quick_distances(
         self,
@@ -138,7 +142,7 @@ class ZoneDemand:
         return _kernels.quick_distances(  # type: ignore[no-any-return]
             self.s,
             self._peak_array,
-            self._running(0 if rise else 1),
+            self.running_maxima(0 if rise else 1),
             v_from,
             v_to,
             rise,
@@ -147,9 +151,9 @@ class ZoneDemand:
             j_limit,
         )
 
-    def _running(self, backward: int) -> np.ndarray:
+    def running_maxima(self, backward: int) -> np.ndarray:
         """Running maxima of |q'|, |q''|, |q'''| from the zone start (0) or from its end (1),
-        shape (G, 3, n): row k covers rows 0 … k, or k … G - 1."""
+        shape (G, 3, n): row k covers rows 0 … k, or k … G - 1 (computed once)."""
         if self._maxima[backward] is None:
             stacked = np.stack(self._abs, axis=1)  # (G, 3, n)
             if backward:
@@ -333,34 +337,87 @@ def speed_change(
         A change known to meet the limits (bounds valid over its own stretch): the
         search starts from it when it is shorter than the zone-wide one.
 
+    Compiled: :func:`trackplan.timing._kernels.change_search`.
+
     Returns
     -------
     SpeedChange
         Its distance and bounds.
     """
-    top = max(v_from, v_to)
-    accel, jerk = uniform_change_bounds(robot, demand.peaks(), top, share)
-    best = SpeedChange(np.inf, accel, jerk)
-    if accel > 0.0 and jerk > 0.0:
-        best = SpeedChange(speed_change_distance(v_from, v_to, accel, jerk), accel, jerk)
-    if start is not None and start.distance < best.distance:
-        best = start
-    if not np.isfinite(best.distance):
-        return best
-    if v_from == v_to or len(demand.s) < 2:
-        return best
-    for factors in (BOUND_FACTORS, FINE_FACTORS):
-        a_trial = np.minimum(best.accel * factors, MAX_PATH_ACCELERATION)
-        j_trial = np.minimum(best.jerk * factors, MAX_PATH_JERK)
-        a_grid, j_grid = np.repeat(a_trial, j_trial.size), np.tile(j_trial, a_trial.size)
-        ok, distance = _changes_within_limits(
-            robot, demand, s_start, s_end, v_from, v_to, at_start, share, a_grid, j_grid
+    known = (np.inf, 0.0, 0.0) if start is None else (start.distance, start.accel, start.jerk)
+    distance, accel, jerk = _kernels.change_search(
+        demand.s,
+        demand.d1,
+        demand.d2,
+        demand.d3,
+        demand.peak_array,
+        float(s_start),
+        float(s_end),
+        float(v_from),
+        float(v_to),
+        bool(at_start),
+        share * robot.a_max,
+        share * robot.j_max,
+        (float(known[0]), float(known[1]), float(known[2])),
+        BOUND_FACTORS,
+        FINE_FACTORS,
+        _PHASE_SHARES,
+    )
+    return SpeedChange(distance, accel, jerk)
+
+
+def quick_speed_change(
+    robot: Robot,
+    demand: ZoneDemand,
+    s_start: float,
+    s_end: float,
+    v_from: float,
+    v_to: float,
+    share: float,
+) -> SpeedChange:
+    """A speed change under bounds valid over the stretch it covers: quick, and never
+    shorter than the one :func:`speed_change` finds from it.
+
+    The bounds over the whole zone at the top speed (:func:`uniform_change_bounds`); where
+    that change fits the zone, raised to those over the stretch it covers (a rise starts
+    at ``s_start``, a fall ends at ``s_end``; :meth:`ZoneDemand.peaks`). Compiled:
+    :func:`trackplan.timing._kernels.quick_change`.
+
+    Parameters
+    ----------
+    robot
+        Joint limits, each shape (n,).
+    demand
+        The zone's joint-path derivatives.
+    s_start, s_end
+        The zone, m.
+    v_from, v_to
+        Speeds before and after, m/s.
+    share
+        Share of each limit planned against.
+
+    Returns
+    -------
+    SpeedChange
+        Its distance and bounds.
+    """
+    return SpeedChange(
+        *_kernels.quick_change(
+            demand.s,
+            demand.d1,
+            demand.d2,
+            demand.d3,
+            demand.peak_array,
+            demand.running_maxima(0),
+            demand.running_maxima(1),
+            float(s_start),
+            float(s_end),
+            float(v_from),
+            float(v_to),
+            share * robot.a_max,
+            share * robot.j_max,
         )
-        if ok.any():
-            k = int(np.flatnonzero(ok)[np.argmin(distance[ok])])
-            if distance[k] < best.distance:
-                best = SpeedChange(float(distance[k]), float(a_grid[k]), float(j_grid[k]))
-    return best
+    )
 
 
 BOUND_FACTORS = np.geomspace(1.0, 8.0, 6)

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trackplan.timing import _kernels
+
 
 def speed_change_phases(
     v_from: float, v_to: float, accel: float, jerk: float
@@ -137,10 +139,17 @@ class SpeedProfile:
 
     def position(self, t: np.ndarray) -> np.ndarray:
         """Path position at times ``t`` (N,), s: the ``s`` of :meth:`evaluate` alone, shape
-        (N,), m, clipped to [0, length]."""
-        t = np.asarray(t, dtype=float)
-        k = self.phase_index(t)
-        return self._position(k, t - self.t_start[k])
+        (N,), m, clipped to [0, length] (compiled, same operations:
+        :func:`trackplan.timing._kernels.profile_position`)."""
+        return _kernels.profile_position(  # type: ignore[no-any-return]
+            self.t_start,
+            self.s0,
+            self.v0,
+            self.a0,
+            self.jerk,
+            self.length,
+            np.ascontiguousarray(t, dtype=float),
+        )
 
     def _position(self, k: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Path position at ``tau`` (N,) s into phases ``k`` (N,), clipped, m."""

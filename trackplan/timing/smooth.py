@@ -43,8 +43,8 @@ from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
     cruise_cap,
+    quick_speed_change,
     speed_change,
-    uniform_change_bounds,
 )
 from trackplan.timing.profile import (
     SpeedProfile,
@@ -348,77 +348,52 @@ class _ZonePlanner:
         self.cap_scale = np.ones(len(zones))
         self.change_scale = np.ones(len(zones))
         self._changes: dict[tuple[int, float, float], SpeedChange] = {}
+        self._zone_arrays: tuple[np.ndarray, ...] | None = None
 
-    def quick_distances(self, z: int, v_from: np.ndarray, v_to: np.ndarray) -> np.ndarray:
-        """Distances of speed changes in zone z under bounds valid over their stretch, m.
-
-        First the bounds over the whole zone at the top speed, then those over the shorter
-        stretch that needs (valid: it lies inside). Never shorter than :meth:`change`'s,
-        so a zone that fits its quick changes fits the refined ones: the plateau search
-        uses these cheaper ones, for many speeds at once.
-
-        Parameters
-        ----------
-        v_from, v_to
-            Speeds before and after, shape (V,), m/s; all rises or all falls.
-
-        Returns
-        -------
-        numpy.ndarray
-            Shape (V,), m (inf where the joints leave no room).
-        """
-        s0, s1, _ = self.zones[z]
-        share = LIMIT_SHARE * self.change_scale[z]
-        return self.demands[z].quick_distances(
-            np.asarray(v_from, dtype=float),
-            np.asarray(v_to, dtype=float),
-            bool(np.all(v_to >= v_from)),
-            s1 - s0,
-            share * self.robot.a_max,
-            share * self.robot.j_max,
-        )
-
-    def quick_change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
-        """One change of :meth:`quick_distances`, with its bounds."""
-        s0, s1, _ = self.zones[z]
-        share = LIMIT_SHARE * self.change_scale[z]
-        demand = self.demands[z]
-        top = max(v_from, v_to)
-        accel, jerk = uniform_change_bounds(self.robot, demand.peaks(), top, share)
-        if accel <= 0.0 or jerk <= 0.0:
-            return SpeedChange(np.inf, accel, jerk)
-        distance = speed_change_distance(v_from, v_to, accel, jerk)
-        if distance < s1 - s0:
-            stretch = (s0, s0 + distance) if v_to > v_from else (s1 - distance, s1)
-            local = uniform_change_bounds(self.robot, demand.peaks(*stretch), top, share)
-            accel, jerk = max(accel, local[0]), max(jerk, local[1])
-            distance = speed_change_distance(v_from, v_to, accel, jerk)
-        return SpeedChange(distance, accel, jerk)
+    def _packed(self) -> tuple[np.ndarray, ...]:
+        """The zones' grids and peaks one after the other, for the compiled plateau search:
+        ``offsets (Z + 1,), s (G,), peaks (Z, 3, n)`` and the running maxima from each
+        zone's start and from its end, ``(G, 3, n)`` each (built once)."""
+        if self._zone_arrays is None:
+            demands = self.demands
+            sizes = [len(d.s) for d in demands]
+            self._zone_arrays = (
+                np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+                np.concatenate([d.s for d in demands]),
+                np.stack([d.peak_array for d in demands]),
+                np.concatenate([d.running_maxima(0) for d in demands]),
+                np.concatenate([d.running_maxima(1) for d in demands]),
+            )
+        return self._zone_arrays
 
     def change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
         """The speed change inside zone z: a rise starts at its start, a fall ends at its end.
 
         Its bounds come from the joint demand along the stretch it covers, at the speed it
-        has there (:func:`~trackplan.timing.demand.speed_change`).
+        has there (:func:`~trackplan.timing.demand.speed_change`, started from
+        :func:`~trackplan.timing.demand.quick_speed_change`).
         """
         key = (z, v_from, v_to)
         if key not in self._changes:
             s0, s1, _ = self.zones[z]
+            share = LIMIT_SHARE * self.change_scale[z]
+            demand = self.demands[z]
+            quick = quick_speed_change(self.robot, demand, s0, s1, v_from, v_to, share)
             self._changes[key] = speed_change(
-                self.robot,
-                self.demands[z],
-                s0,
-                s1,
-                v_from,
-                v_to,
-                at_start=v_to > v_from,
-                share=LIMIT_SHARE * self.change_scale[z],
-                start=self.quick_change(z, v_from, v_to),
+                self.robot, demand, s0, s1, v_from, v_to, v_to > v_from, share, start=quick
             )
         return self._changes[key]
 
     def plan(self) -> list[ZonePlan]:
-        """Caps per zone, then plateaus lowered until every zone fits its speed changes."""
+        """Caps per zone, then plateaus lowered until every zone fits its speed changes.
+
+        The plateau search runs compiled over all zones
+        (:func:`trackplan.timing._kernels.plateau_search`): a zone whose quick speed
+        changes (:func:`~trackplan.timing._kernels.quick_distances`, never shorter than
+        :meth:`change`'s) need more than its length is lowered to the highest speed of a
+        :data:`PLATEAU_GRID` grid that fits, :data:`PLATEAU_ROUNDS` times finer each round,
+        in look-ahead passes until every zone fits.
+        """
         zones = self.zones
         n = len(zones)
         caps = np.zeros(n)
@@ -436,50 +411,23 @@ class _ZonePlanner:
                 caps[z] = task_cap
                 reasons[z] = "rated speed" if kind == "straight" else "corner speed"
         lengths = np.array([s1 - s0 for s0, s1, _ in zones])
-        plateau = caps.copy()
-
-        def needed(z: int, v: np.ndarray) -> np.ndarray:
-            before = plateau[z - 1] if z > 0 else 0.0
-            after = plateau[z + 1] if z < n - 1 else 0.0
-            total = np.zeros_like(v)
-            top = v.max()
-            if before < top:  # a rise into some of the speeds (only theirs count)
-                rise = self.quick_distances(z, np.full_like(v, before), np.maximum(v, before))
-                total += np.where(before < v, rise, 0.0)
-            if after < top:
-                fall = self.quick_distances(z, np.maximum(v, after), np.full_like(v, after))
-                total += np.where(after < v, fall, 0.0)
-            return total
-
-        fitting: set[tuple[int, float, float, float]] = set()
-        for _ in range(10 * n + 10):  # look-ahead passes until every zone fits
-            changed = False
-            for z in range(n):
-                top = plateau[z]
-                key = (
-                    z,
-                    plateau[z - 1] if z > 0 else 0.0,
-                    top,
-                    plateau[z + 1] if z < n - 1 else 0.0,
-                )
-                if top == 0.0 or key in fitting:
-                    continue
-                if needed(z, np.array([top]))[0] <= lengths[z]:
-                    fitting.add(key)
-                    continue
-                low, high = 0.0, top
-                for _ in range(PLATEAU_ROUNDS):  # a grid of speeds, then a finer one
-                    trial = np.linspace(low, high, PLATEAU_GRID + 1)[1:]
-                    fits = needed(z, trial) <= lengths[z]
-                    k = int(np.argmin(fits)) if not fits.all() else len(trial)
-                    low = float(trial[k - 1]) if k > 0 else low
-                    high = float(trial[k]) if k < len(trial) else high
-                plateau[z] = low
-                if "too short" not in reasons[z]:
-                    reasons[z] = _too_short(reasons[z])
-                changed = True
-            if not changed:
-                break
+        offsets, s, peaks, from_start, from_end = self._packed()
+        share = (LIMIT_SHARE * self.change_scale)[:, None]
+        plateau, lowered = _kernels.plateau_search(
+            lengths,
+            caps,
+            offsets,
+            s,
+            peaks,
+            from_start,
+            from_end,
+            share * self.robot.a_max,
+            share * self.robot.j_max,
+            PLATEAU_GRID,
+            PLATEAU_ROUNDS,
+        )
+        for z in np.flatnonzero(lowered):
+            reasons[z] = _too_short(reasons[z])
         return [
             ZonePlan(s0, s1, kind, float(caps[z]), float(plateau[z]), reasons[z])
             for z, (s0, s1, kind) in enumerate(zones)
