@@ -7,6 +7,9 @@
   temporary array and a separate reduction per step. The kernel reads each array once, in
   the same order of operations as the numpy expressions it replaces, so the results are
   the same to the bit.
+- :func:`energy_sums`: the energy figures' sums (:func:`trackplan.planning.energy.motion_energy`)
+  in one pass over the torques instead of a temporary array per term (sums in sample order:
+  the same to round-off).
 """
 
 from __future__ import annotations
@@ -103,3 +106,45 @@ def peak_use(
         peak[j] = best
         row[j] = where
     return peak, row
+
+
+@njit(cache=True)
+def energy_sums(
+    tau: np.ndarray, qd: np.ndarray, motor_scale: np.ndarray, torque_max: np.ndarray
+) -> tuple[float, float, float, int]:
+    """The energy figures' sums in one pass over the samples.
+
+    Parameters
+    ----------
+    tau, qd
+        Joint torques and velocities, shape (M, n), N·m and rad/s.
+    motor_scale
+        ``G_i k_m,i`` per joint, shape (n,).
+    torque_max
+        Shape (n,), N·m.
+
+    Returns
+    -------
+    tuple
+        ``Σ max(τ q̇, 0)``, ``Σ (τ / (G k_m))²``, the largest ``|τ| / τ_max`` (the first
+        where it occurs, NaN included as numpy's argmax) and its joint (0-based).
+    """
+    n_rows, n_dof = tau.shape
+    work = 0.0
+    loss = 0.0
+    peak = -np.inf
+    peak_row = peak_joint = 0
+    inverse = 1.0 / torque_max
+    for r in range(n_rows):
+        for i in range(n_dof):
+            power = tau[r, i] * qd[r, i]
+            if power > 0.0:
+                work += power
+            motor = tau[r, i] / motor_scale[i]
+            loss += motor * motor
+            use = abs(tau[r, i]) * inverse[i]
+            if use > peak or (use != use and peak == peak):
+                peak, peak_row, peak_joint = use, r, i
+    if peak == peak:  # the ratio itself as numpy divides it
+        peak = abs(tau[peak_row, peak_joint]) / torque_max[peak_joint]
+    return work, loss, peak, peak_joint
