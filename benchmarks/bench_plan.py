@@ -9,7 +9,7 @@ Run with ``python -m benchmarks plan``. Prints three tables:
    copp-py's compute on that joint path, and the plan's poses solved one by one with
    roboticstoolbox-python's analytic IK (``ikine_a`` of its Puma560 with our DH table:
    d1 = 0, d3 = 0.15); their ratios to the plan are taken on CPU time. Then where the
-   plan's time goes, each stage timed alone on the plan's own inputs.
+   plan's time goes, each stage clocked inside warm plans (exclusive of the stages it calls).
 2. The three paper cases at their ``placement.example``: our duration against toppra
    (velocity and acceleration only: a lower bound) and copp-py's TOPP3 (the jerk-limited
    optimum), both on the same joint path, task speed caps and joint limits
@@ -28,6 +28,8 @@ has not reached the optimum; those placements are counted, and the ratio against
 
 from __future__ import annotations
 
+import dataclasses
+import inspect
 import statistics
 import time
 from pathlib import Path
@@ -35,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 import trackplan
+from trackplan.choices import Timing
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
 from trackplan.robots.kinematics import forward_kinematics
@@ -44,7 +47,6 @@ from trackplan.timing.references import (
     topp3_reference,
     toppra_reference,
 )
-from trackplan.timing.smooth import plan_smooth_time_law
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 PAPER_CASES = ("paper-line", "paper-corner", "paper-circle")
@@ -120,76 +122,119 @@ def _jerk_ratio(robot, q: np.ndarray, Ts: float) -> float:  # type: ignore[no-un
     return float(1.0 - np.min(report.joint_margins["jerk"]))
 
 
-def _interleaved_cpu(functions: dict[str, object], runs: int = PLAN_RUNS) -> dict[str, float]:
-    """Median CPU time of each function, s, over runs that take turns (one call of each per
-    round), so that a change of the machine's load reaches every function alike."""
-    for function in functions.values():
-        function()  # type: ignore[operator]
-    times: dict[str, list[float]] = {name: [] for name in functions}
-    for _ in range(runs):
-        for name, function in functions.items():
-            start = time.process_time()
-            function()  # type: ignore[operator]
-            times[name].append(time.process_time() - start)
-    return {name: statistics.median(values) for name, values in times.items()}
+class _StageClocks:
+    """CPU time of named stages inside real plans, each counted once (exclusive).
+
+    Each stage is a function the plan calls, wrapped while the clocks run (a law of
+    :data:`trackplan.timing.TIME_LAWS`, or an attribute of a module or class); a stage
+    called inside another (the sample poses inside the time law) stops the outer one's
+    clock, so the stages and the rest of the plan add up to the whole plan.
+    """
+
+    def __init__(self, targets: dict[str, tuple[object, object]]) -> None:
+        self.targets = targets
+        self.totals = dict.fromkeys(targets, 0.0)
+        self._stack: list[list] = []  # [stage, start of its current stretch]
+        self._saved: list[tuple[object, object, object]] = []
+
+    def _wrap(self, stage: str, function):  # type: ignore[no-untyped-def]
+        def timed(*args, **kwargs):  # type: ignore[no-untyped-def]
+            now = time.process_time()
+            if self._stack:  # the outer stage's clock stops
+                self.totals[self._stack[-1][0]] += now - self._stack[-1][1]
+            self._stack.append([stage, now])
+            try:
+                return function(*args, **kwargs)
+            finally:
+                now = time.process_time()
+                self.totals[stage] += now - self._stack.pop()[1]
+                if self._stack:
+                    self._stack[-1][1] = now
+
+        return timed
+
+    def __enter__(self) -> _StageClocks:
+        for stage, (owner, name) in self.targets.items():
+            if isinstance(owner, dict):  # a time law: its planner
+                raw = owner[name]
+                owner[name] = dataclasses.replace(raw, plan=self._wrap(stage, raw.plan))
+            else:
+                raw = inspect.getattr_static(owner, str(name))
+                wrapped = self._wrap(stage, getattr(raw, "__func__", raw))
+                setattr(
+                    owner,
+                    str(name),
+                    classmethod(wrapped) if isinstance(raw, classmethod) else wrapped,
+                )
+            self._saved.append((owner, name, raw))
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for owner, name, raw in reversed(self._saved):
+            if isinstance(owner, dict):
+                owner[name] = raw
+            else:
+                setattr(owner, str(name), raw)
+        self._saved.clear()
 
 
-def _breakdown(case, X: np.ndarray) -> list[tuple[str, float]]:  # type: ignore[no-untyped-def]
+def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str, float]]:  # type: ignore[no-untyped-def]
     """Where the CPU time of one warm plan goes, s.
 
-    The plan and each of its stages, timed alone on the plan's own inputs in interleaved
-    runs (:func:`_interleaved_cpu`, 3 × :data:`PLAN_RUNS`); the time law's own work and the
-    rest are the differences.
+    The stages are timed inside real plans (:class:`_StageClocks`), each exclusive of the
+    stages it calls: the time law's own work (zones, plateaus, speed changes, profile) is
+    what the law spends outside its sample poses, IK, rate checks and RNE, and the rest
+    (trajectory, energy, summaries) what the plan spends outside every stage. Means over
+    the middle half of ``runs`` warm plans ranked by their whole time, so that the stages
+    add up to the whole.
     """
+    import trackplan.jointpath as jointpath_module
+    import trackplan.motion as motion_module
+    import trackplan.planning.plan as plan_module
     from trackplan.jointpath import JointPath
-    from trackplan.motion import SampledMotion
-    from trackplan.planning.checker import check_motion
-    from trackplan.planning.plan import tracking_reference
-    from trackplan.robots.dynamics.rne import inverse_dynamics
-    from trackplan.robots.path_ik import branch_joints
+    from trackplan.timing import TIME_LAWS
     from trackplan.timing.sample_checks import RateLimits
 
-    result = trackplan.plan_placement(case, X)
-    joint_path, trajectory = result.joint_path, result.trajectory
-    robot, q, s = case.robot, trajectory.q, trajectory.s
-    motion = SampledMotion(robot, q, trajectory.sample_time)
-    _ = motion.T_base_tool, motion.torque  # computed once, as in a plan
-    poses, q_reference = joint_path.poses(s), joint_path.interpolate(s)
-    reference = tracking_reference(case, joint_path.geometry, joint_path.placement)
-    n_grid, n = joint_path.ik.q.shape[1], len(q)
-    cpu = _interleaved_cpu(
-        {
-            "plan": lambda: trackplan.plan_placement(case, X),
-            "grid": lambda: JointPath.solve(
-                robot, joint_path.geometry, joint_path.placement, joint_path.tool
-            ),
-            "law": lambda: plan_smooth_time_law(joint_path, case.task),
-            "poses": lambda: joint_path.poses(s),
-            "ik": lambda: branch_joints(robot, poses, joint_path.branch, q_reference),
-            "rates": lambda: RateLimits(robot).check_motion(motion),
-            "rne": lambda: inverse_dynamics(robot, motion.q_held, motion.qd, motion.qdd),
-            "fk": lambda: forward_kinematics(robot, q),
-            "check": lambda: check_motion(motion, reference),
-        },
-        runs=3 * PLAN_RUNS,
-    )
-    in_law = ("poses", "ik", "rates", "rne")
-    own = cpu["law"] - sum(cpu[k] for k in in_law)
+    targets: dict[str, tuple[object, object]] = {
+        "grid": (JointPath, "solve"),
+        "law": (TIME_LAWS, Timing(case.task.timing)),
+        "poses": (JointPath, "poses"),
+        "seeds": (JointPath, "interpolate"),
+        "ik": (jointpath_module, "branch_joints"),
+        "rates": (RateLimits, "check_motion"),
+        "rne": (motion_module, "inverse_dynamics"),
+        "fk": (motion_module, "forward_kinematics"),
+        "check": (plan_module, "check_motion"),
+    }
+    trackplan.plan_placement(case, X)  # warm
+    rows = []
+    for _ in range(runs):
+        with _StageClocks(targets) as clocks:
+            start = time.process_time()
+            result = trackplan.plan_placement(case, X)
+            whole = time.process_time() - start
+        rows.append((whole, clocks.totals))
+    rows.sort(key=lambda row: row[0])
+    middle = rows[len(rows) // 4 : len(rows) - len(rows) // 4]
+    mean = {stage: statistics.fmean(r[1][stage] for r in middle) for stage in targets}
+    whole = statistics.fmean(r[0] for r in middle)
+    n_grid, n = result.joint_path.ik.q.shape[1], result.trajectory.n_samples
+    in_law = ("law", "poses", "seeds", "ik", "rates", "rne")
     return [
-        ("the whole plan", cpu["plan"]),
-        (f"joint path on the grid: poses and IK of {n_grid} poses", cpu["grid"]),
-        ("time law", cpu["law"]),
-        ("  zones, plateaus, speed changes, profile", own),
-        (f"  sample poses ({n})", cpu["poses"]),
-        (f"  sample IK ({n} poses, the grid's branch only)", cpu["ik"]),
-        ("  sample rate checks (compiled)", cpu["rates"]),
-        ("  RNE of the samples (the plan's one pass)", cpu["rne"]),
-        ("FK of the samples (the plan's one pass)", cpu["fk"]),
-        ("checker: joint limits, tracking, tool, speed, coverage", cpu["check"]),
+        ("the whole plan (stage clocks on)", whole),
+        (f"joint path on the grid: poses and IK of {n_grid} poses", mean["grid"]),
+        ("time law", sum(mean[k] for k in in_law)),
+        ("  zones, plateaus, speed changes, profile", mean["law"]),
+        (f"  sample poses ({n})", mean["poses"]),
         (
-            "difference: trajectory, energy, summaries, timing noise",
-            cpu["plan"] - cpu["grid"] - cpu["law"] - cpu["fk"] - cpu["check"],
+            f"  sample IK ({n} poses, the grid's branch only, and its seeds)",
+            mean["ik"] + mean["seeds"],
         ),
+        ("  sample rate checks (compiled)", mean["rates"]),
+        ("  RNE of the samples (the plan's one pass)", mean["rne"]),
+        ("FK of the samples (the plan's one pass)", mean["fk"]),
+        ("checker: joint limits, tracking, tool, speed, coverage", mean["check"]),
+        ("the rest: trajectory, energy, summaries", whole - sum(mean.values())),
     ]
 
 
@@ -232,7 +277,7 @@ def _speed_table() -> None:
         f"  rtb ikine_a, one pose at a time:        {1e3 * rtb_time:8.1f} ms wall;"
         f" {1e3 * rtb_cpu:.1f} ms CPU ({rtb_cpu / plan_cpu:.0f}× trackplan's whole plan)"
     )
-    print("  where the plan's CPU time goes (each stage timed alone, interleaved runs):")
+    print("  where the plan's CPU time goes (each stage clocked inside the plans, exclusive):")
     stages = _breakdown(case, X)
     whole = stages[0][1]
     for label, seconds in stages:

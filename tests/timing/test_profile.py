@@ -66,3 +66,12 @@ def test_acceleration_step_breaks_sampled_jerk():
     _, _, sddd = backward_derivatives(s[:, None], Ts)
     # the unit acceleration step is spread over two samples: 0.5/Ts each
     assert np.abs(sddd).max() == pytest.approx(0.5 / Ts, rel=1e-6)
+
+
+def test_compiled_positions_are_those_of_evaluate():
+    """SpeedProfile.position (compiled) gives the bits of evaluate's s, clipped, even
+    outside [0, duration]."""
+    phases = [(0.02, 40.0), (0.05, 0.0), (0.02, -40.0), (0.3, 0.0), (0.03, -30.0), (0.03, 30.0)]
+    profile = SpeedProfile.from_phases(phases, 0.05)
+    t = np.linspace(-0.01, profile.duration + 0.01, 997)
+    assert np.array_equal(profile.position(t), profile.evaluate(t)[0])

@@ -704,3 +704,41 @@ def profile_position(
         value = s0[k] + v0[k] * tau + a0[k] * (tau * tau) / 2.0 + jerk[k] * tau**3.0 / 6.0
         out[r] = min(max(value, 0.0), length)
     return out
+
+
+@njit(cache=True)
+def least_ratios(
+    q1: np.ndarray,
+    q2: np.ndarray,
+    q3: np.ndarray,
+    v_limit: np.ndarray,
+    a_limit: np.ndarray,
+    j_limit: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least ``limit / |q^(k)|`` over the joints at each grid point (inf where it is 0).
+
+    :meth:`~trackplan.timing.demand.ZoneDemand.local_caps` before its roots.
+
+    Parameters
+    ----------
+    q1, q2, q3
+        |q'|, |q''|, |q'''| on a grid, shape (G, n).
+    v_limit, a_limit, j_limit
+        The shares of the joint velocity, acceleration and jerk limits, shape (n,).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Shape (G,) each: velocity, acceleration and jerk ratios.
+    """
+    n_grid, n_dof = q1.shape
+    out = np.full((3, n_grid), np.inf)
+    for r in range(n_grid):
+        for i in range(n_dof):
+            if q1[r, i] > 0.0:
+                out[0, r] = min(out[0, r], v_limit[i] / q1[r, i])
+            if q2[r, i] > 0.0:
+                out[1, r] = min(out[1, r], a_limit[i] / q2[r, i])
+            if q3[r, i] > 0.0:
+                out[2, r] = min(out[2, r], j_limit[i] / q3[r, i])
+    return out[0], out[1], out[2]

@@ -172,11 +172,13 @@ class ZoneDemand:
     def local_caps(self, robot: Robot, share: float) -> np.ndarray:
         """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s."""
         q1, q2, q3 = self._abs
-        caps = np.minimum(
-            safe_ratio(share * robot.v_max, q1).min(axis=1),
-            np.sqrt(safe_ratio(share * robot.a_max, q2)).min(axis=1),
+        # the least ratio over the joints in one compiled pass; the square and cube roots
+        # are increasing, so taking them after the least is the least of the roots
+        v_ratio, a_ratio, j_ratio = _kernels.least_ratios(
+            q1, q2, q3, share * robot.v_max, share * robot.a_max, share * robot.j_max
         )
-        return np.minimum(caps, np.cbrt(safe_ratio(share * robot.j_max, q3)).min(axis=1))
+        caps = np.minimum(v_ratio, np.sqrt(a_ratio))
+        return np.minimum(caps, np.cbrt(j_ratio))
 
 
 def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:

@@ -27,6 +27,7 @@ Straight windows therefore run at exactly the rated speed wherever the limits al
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -259,12 +260,21 @@ def _sampled(
 
 
 def _zone_demands(joint_path: JointPath) -> list[ZoneDemand]:
-    """Signed dq/ds, d²q/ds², d³q/ds³ of each zone, from the joint path's planning grid."""
+    """Signed dq/ds, d²q/ds², d³q/ds³ of each zone, from the joint path's planning grid
+    (views of its rows: the grid runs zone after zone)."""
+    zone = joint_path.zone
+    n_zones = len(joint_path.geometry.zones())
+    rows_of: list[slice | np.ndarray]
+    if np.all(zone[1:] >= zone[:-1]):
+        bounds = np.searchsorted(zone, np.arange(n_zones + 1)).tolist()
+        rows_of = [slice(a, b) for a, b in itertools.pairwise(bounds)]
+    else:
+        rows_of = [np.flatnonzero(zone == z) for z in range(n_zones)]
     return [
         ZoneDemand(
             joint_path.s[rows], joint_path.dq[rows], joint_path.ddq[rows], joint_path.dddq[rows]
         )
-        for rows in (joint_path.zone == z for z in range(len(joint_path.geometry.zones())))
+        for rows in rows_of
     ]
 
 
