@@ -507,8 +507,8 @@ def _stretch_peaks(
     """:meth:`~trackplan.timing.demand.ZoneDemand.peaks` over [s_from, s_to], shape (3, n)
     (G ≥ 2)."""
     n_grid = s.size
-    first = max(np.searchsorted(s, s_from, side="right") - 2, 0)
-    stop = min(np.searchsorted(s, s_to, side="left") + 2, n_grid)
+    first = max(int(np.searchsorted(s, s_from, side="right")) - 2, 0)
+    stop = min(int(np.searchsorted(s, s_to, side="left")) + 2, n_grid)
     stop = max(stop, first + 1)
     if first == 0:
         return running_from_start[stop - 1]

@@ -436,7 +436,7 @@ class _ZonePlanner:
             PLATEAU_GRID,
             PLATEAU_ROUNDS,
         )
-        for z in np.flatnonzero(lowered):
+        for z in np.flatnonzero(lowered).tolist():
             reasons[z] = _too_short(reasons[z])
         return [
             ZonePlan(s0, s1, kind, float(caps[z]), float(plateau[z]), reasons[z])
