@@ -224,3 +224,26 @@ def test_compiled_change_check_matches_numpy(puma, amplitude, rate, slope, v_fro
     np.testing.assert_allclose(distance, expected, rtol=1e-12)
     clear = np.abs(worst - 1.0) > 1e-9
     np.testing.assert_array_equal(ok[clear], (worst <= 1.0)[clear])
+
+
+def test_cruise_cap_is_numpys_least_root_and_its_joint(puma):
+    """The scalar loop of cruise_cap against the numpy expression it replaces: the same
+    speed to the bit and the same binding joint and limit, zeros (no demand) included."""
+    from trackplan.timing.demand import cruise_cap, safe_ratio
+
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        peaks = [np.abs(rng.normal(size=6)) * 10.0 ** rng.uniform(-3, 3, 6) for _ in range(3)]
+        for p in peaks:
+            p[rng.random(6) < 0.2] = 0.0
+        share = float(rng.uniform(0.5, 1.0))
+        expected, reason = np.inf, ""
+        for values, kind in (
+            (safe_ratio(share * puma.v_max, peaks[0]), "velocity"),
+            (np.sqrt(safe_ratio(share * puma.a_max, peaks[1])), "acceleration"),
+            (np.cbrt(safe_ratio(share * puma.j_max, peaks[2])), "jerk"),
+        ):
+            j = int(np.argmin(values))
+            if values[j] < expected:
+                expected, reason = float(values[j]), f"joint {j + 1} {kind}"
+        assert cruise_cap(puma, tuple(peaks), share) == (expected, reason)

@@ -148,3 +148,42 @@ def energy_sums(
     if peak == peak:  # the ratio itself as numpy divides it
         peak = abs(tau[peak_row, peak_joint]) / torque_max[peak_joint]
     return work, loss, peak, peak_joint
+
+
+@njit(cache=True)
+def part_points(
+    T_base_tool: np.ndarray, T_base_part: np.ndarray, sample_time: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Tool points in the definition (part) frame, their velocity and speed, in one pass.
+
+    Parameters
+    ----------
+    T_base_tool
+        Tool poses in the base frame, shape (N, 4, 4).
+    T_base_part
+        The definition frame in the base frame, shape (4, 4).
+    sample_time
+        Ts, s.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The points (N, 3), m; their backward difference over Ts, at rest before the first
+        (N, 3), m/s; its length, the speed (N,), m/s.
+    """
+    n = T_base_tool.shape[0]
+    point = np.empty((n, 3))
+    velocity = np.zeros((n, 3))
+    speed = np.zeros(n)
+    for k in range(n):
+        d0 = T_base_tool[k, 0, 3] - T_base_part[0, 3]
+        d1 = T_base_tool[k, 1, 3] - T_base_part[1, 3]
+        d2 = T_base_tool[k, 2, 3] - T_base_part[2, 3]
+        for i in range(3):  # the rotation's transpose: column i of T_base_part dotted in
+            point[k, i] = d0 * T_base_part[0, i] + d1 * T_base_part[1, i] + d2 * T_base_part[2, i]
+        if k > 0:
+            for i in range(3):
+                velocity[k, i] = (point[k, i] - point[k - 1, i]) / sample_time
+            vx, vy, vz = velocity[k, 0], velocity[k, 1], velocity[k, 2]
+            speed[k] = np.sqrt(vx * vx + vy * vy + vz * vz)
+    return point, velocity, speed

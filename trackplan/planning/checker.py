@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.frames import vector_norms
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
@@ -217,6 +216,8 @@ def _count(n: int, noun: str) -> str:
 
 def _met(margin: np.ndarray | float, slack: float) -> np.ndarray:
     """A margin within the round-off slack of a limit counts as met: reported as 0, not < 0."""
+    if isinstance(margin, float):  # one number: no array round trip
+        return np.asarray(0.0 if -slack <= margin < 0 else margin)
     margin = np.asarray(margin, dtype=float)
     return np.where((margin < 0) & (margin >= -slack), 0.0, margin)
 
@@ -267,15 +268,18 @@ def _check_task(
     """Tracking, orientation, Cartesian speed and coverage checks."""
     robot, q, sample_time = motion.robot, motion.q, motion.sample_time
     T_base_tool = motion.T_base_tool
-    R_part_base = ref.T_base_part[:3, :3].T
-    p_part = (T_base_tool[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
+    T_base_part = np.ascontiguousarray(ref.T_base_part, dtype=float)
+    R_part_base = T_base_part[:3, :3].T
+    # the tool points in the definition frame, their velocity and speed (one pass)
+    p_part, velocity, speed = _kernels.part_points(T_base_tool, T_base_part, sample_time)
     t = np.arange(len(q)) * sample_time
     violations: list[Violation] = []
     margins: dict[str, float] = {}
 
     # tracking error and the position along the nominal path, in order of travel
-    velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
-    s_nominal, distance, piece = locate_on_nominal(ref.nominal, p_part, velocity, ref.tolerance)
+    s_nominal, distance, piece = locate_on_nominal(
+        ref.nominal, p_part, velocity, ref.tolerance, speed
+    )
     worst = float(distance.max())
     if distance.max() > ref.tolerance * (1 + RELATIVE_SLACK):
         violations.append(
@@ -285,7 +289,7 @@ def _check_task(
     q_between, t_between = between_samples(q, p_part, ref.tolerance)
     if len(q_between):
         T_between = forward_kinematics(robot, q_between)
-        p_between = (T_between[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
+        p_between = _kernels.part_points(T_between, T_base_part, sample_time)[0]
         d_between = ref.nominal.index.candidates(p_between, 0.0).nearest  # distances only
         worst = max(worst, float(d_between.max()))
         if d_between.max() > ref.tolerance * (1 + RELATIVE_SLACK) and not violations_of(
@@ -305,7 +309,6 @@ def _check_task(
     violations.extend(tool_found)
 
     # Cartesian speed against the cap that applies where the tool is
-    speed = vector_norms(velocity)
     in_corner = np.zeros(len(q), dtype=bool)
     for s0, s1 in np.asarray(ref.corner_intervals).reshape(-1, 2):
         in_corner |= (s_nominal >= s0) & (s_nominal <= s1)

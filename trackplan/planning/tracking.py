@@ -23,7 +23,11 @@ LOCATE_BLOCK = 1 << 13
 
 
 def locate_on_nominal(
-    nominal: NominalPath, points: np.ndarray, velocity: np.ndarray, tolerance: float
+    nominal: NominalPath,
+    points: np.ndarray,
+    velocity: np.ndarray,
+    tolerance: float,
+    speed: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Arc length along the nominal path of each sample, its distance, and its piece.
 
@@ -41,6 +45,8 @@ def locate_on_nominal(
         Their velocities, shape (N, 3), m/s (only the direction is used).
     tolerance
         ρ, m: pieces within ρ of the nearest one are candidates.
+    speed
+        The velocities' lengths, shape (N,), m/s, when known; default: computed.
 
     Returns
     -------
@@ -53,7 +59,7 @@ def locate_on_nominal(
     """
     points = np.asarray(points, dtype=float)
     table = nominal.table
-    speed = vector_norms(velocity)
+    speed = vector_norms(velocity) if speed is None else speed
     nearest = np.empty(len(points))
     assigned = np.empty(len(points), dtype=int)
     local = np.empty(len(points))
@@ -77,7 +83,8 @@ def locate_on_nominal(
             keep = np.ones(len(row), dtype=bool)
             keep[pairs] = agrees | ~any_agrees[row[pairs]]
             row, piece, sigma = row[keep], piece[keep], sigma[keep]
-        bounds = np.searchsorted(row, np.arange(n_block + 1))
+        bounds = np.zeros(n_block + 1, dtype=np.int64)  # row is sorted: its run starts
+        np.cumsum(np.bincount(row, minlength=n_block), out=bounds[1:])
         chosen = monotone_assignment(bounds, piece, current)
         assigned[block], local[block] = piece[chosen], sigma[chosen]
         current = int(assigned[block][-1])

@@ -742,3 +742,32 @@ def least_ratios(
             if q3[r, i] > 0.0:
                 out[2, r] = min(out[2, r], j_limit[i] / q3[r, i])
     return out[0], out[1], out[2]
+
+
+@njit(cache=True)
+def rows_over(values: np.ndarray, cap: np.ndarray) -> np.ndarray:
+    """Rows where some ``|values[:, i]| > cap[i]``, ascending
+    (``np.flatnonzero((np.abs(values) > cap).any(axis=1))``).
+
+    Parameters
+    ----------
+    values
+        Shape (M, n).
+    cap
+        Shape (n,).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (R,), int.
+    """
+    n_rows, n_cols = values.shape
+    found = np.empty(n_rows, dtype=np.int64)
+    count = 0
+    for r in range(n_rows):
+        for i in range(n_cols):
+            if abs(values[r, i]) > cap[i]:
+                found[count] = r
+                count += 1
+                break
+    return found[:count].copy()

@@ -16,6 +16,7 @@ turns them into
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -198,17 +199,24 @@ def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
     tuple of (float, str)
         The speed, m/s, and e.g. ``"joint 3 jerk"``.
     """
-    q1, q2, q3 = peaks
-    candidates = [
-        (safe_ratio(share * robot.v_max, q1), "velocity"),
-        (np.sqrt(safe_ratio(share * robot.a_max, q2)), "acceleration"),
-        (np.cbrt(safe_ratio(share * robot.j_max, q3)), "jerk"),
-    ]
-    best, reason = np.inf, ""
-    for values, kind in candidates:
-        j = int(np.argmin(values))
+    # a handful of joints: Python floats, the same IEEE operations as numpy's (math.sqrt
+    # and math.cbrt are libm's, as np.sqrt and np.cbrt), without numpy's per-call cost
+    best, reason = math.inf, ""
+    for kind, limit, demand, root in (
+        ("velocity", robot.v_max, peaks[0], None),
+        ("acceleration", robot.a_max, peaks[1], math.sqrt),
+        ("jerk", robot.j_max, peaks[2], math.cbrt),
+    ):
+        room = (share * np.asarray(limit, dtype=float)).tolist()
+        values = [
+            r / d if d > 0 else math.inf
+            for r, d in zip(room, np.asarray(demand, dtype=float).tolist(), strict=True)
+        ]
+        if root is not None:
+            values = [root(v) for v in values]
+        j = min(range(len(values)), key=values.__getitem__)  # the first least, as argmin
         if values[j] < best:
-            best, reason = float(values[j]), f"joint {j + 1} {kind}"
+            best, reason = values[j], f"joint {j + 1} {kind}"
     return best, reason
 
 

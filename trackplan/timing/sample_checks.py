@@ -144,7 +144,7 @@ class TorqueLimits:
             return empty.astype(int), empty.astype(int), empty
         q, qd, q_held, tau = motion.q, motion.qd, motion.q_held, motion.torque
         cap = (1.0 - self.margin) * dynamics.torque_max
-        rows = np.flatnonzero((np.abs(tau) > cap).any(axis=1))
+        rows = _kernels.rows_over(tau, cap)  # one compiled pass
         if not rows.size:
             empty = np.zeros(0)
             return empty.astype(int), empty.astype(int), empty
