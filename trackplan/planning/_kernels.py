@@ -92,19 +92,42 @@ def peak_use(
     peak = np.full(n_cols, -np.inf)
     row = np.zeros(n_cols, dtype=np.int64)
     for j in range(n_cols):
-        best = -np.inf
-        where = 0
+        s = scale[j]
+        if not (0.0 < s < np.inf):  # a zero or odd scale: every quotient as numpy takes it
+            best = -np.inf
+            for r in range(n_rows):
+                use = abs(values[r, j] - centre[j]) / s
+                if use != use or use > best:
+                    best, row[j] = use, r
+                    if use != use:
+                        break
+            peak[j] = best
+            continue
+        # dividing by s > 0 keeps the order: the largest |v - c| gives the peak, and the
+        # peak's first row is the first whose quotient rounds to it (such rows lie within
+        # 1e-15 of the largest: only those are divided)
+        largest = -np.inf
+        first_nan = -1
         for r in range(n_rows):
-            use = abs(values[r, j] - centre[j]) / scale[j]
-            if use != use:  # NaN: numpy's max and argmax stop at the first one
-                best = use
-                where = r
+            x = abs(values[r, j] - centre[j])
+            if x != x:
+                first_nan = r
                 break
-            if use > best:
-                best = use
-                where = r
+            if x > largest:
+                largest = x
+        if first_nan >= 0:
+            peak[j], row[j] = np.nan, first_nan
+            continue
+        if n_rows == 0:
+            continue
+        best = largest / s
+        near = largest * (1.0 - 1e-15)
+        for r in range(n_rows):
+            x = abs(values[r, j] - centre[j])
+            if x >= near and x / s == best:
+                row[j] = r
+                break
         peak[j] = best
-        row[j] = where
     return peak, row
 
 
