@@ -771,3 +771,49 @@ def rows_over(values: np.ndarray, cap: np.ndarray) -> np.ndarray:
                 count += 1
                 break
     return found[:count].copy()
+
+
+@njit(cache=True, inline="always")
+def _maximum(a: float, b: float) -> float:
+    """``np.maximum`` of two numbers (NaN propagates)."""
+    if a != a:
+        return a
+    if b != b:
+        return b
+    return a if a >= b else b
+
+
+@njit(cache=True)
+def running_maxima(q1: np.ndarray, q2: np.ndarray, q3: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Running maxima of three (G, n) arrays down and up their rows
+    (``np.maximum.accumulate`` of them stacked, from the first row and from the last).
+
+    Parameters
+    ----------
+    q1, q2, q3
+        |q'|, |q''|, |q'''| on a grid, shape (G, n).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Shape (G, 3, n) each: row k covers rows 0 … k, and rows k … G - 1.
+    """
+    n_grid, n_dof = q1.shape
+    forward = np.empty((n_grid, 3, n_dof))
+    backward = np.empty((n_grid, 3, n_dof))
+    for r in range(n_grid):
+        back = n_grid - 1 - r
+        for i in range(n_dof):
+            if r == 0:
+                forward[r, 0, i], forward[r, 1, i], forward[r, 2, i] = q1[r, i], q2[r, i], q3[r, i]
+                backward[back, 0, i] = q1[back, i]
+                backward[back, 1, i] = q2[back, i]
+                backward[back, 2, i] = q3[back, i]
+                continue
+            forward[r, 0, i] = _maximum(forward[r - 1, 0, i], q1[r, i])
+            forward[r, 1, i] = _maximum(forward[r - 1, 1, i], q2[r, i])
+            forward[r, 2, i] = _maximum(forward[r - 1, 2, i], q3[r, i])
+            backward[back, 0, i] = _maximum(backward[back + 1, 0, i], q1[back, i])
+            backward[back, 1, i] = _maximum(backward[back + 1, 1, i], q2[back, i])
+            backward[back, 2, i] = _maximum(backward[back + 1, 2, i], q3[back, i])
+    return forward, backward

@@ -155,13 +155,8 @@ class ZoneDemand:
     def running_maxima(self, backward: int) -> np.ndarray:
         """Running maxima of |q'|, |q''|, |q'''| from the zone start (0) or from its end (1),
         shape (G, 3, n): row k covers rows 0 … k, or k … G - 1 (computed once)."""
-        if self._maxima[backward] is None:
-            stacked = np.stack(self._abs, axis=1)  # (G, 3, n)
-            if backward:
-                running = np.maximum.accumulate(stacked[::-1], axis=0)[::-1]
-            else:
-                running = np.maximum.accumulate(stacked, axis=0)
-            self._maxima[backward] = running
+        if self._maxima[backward] is None:  # both at once, in one compiled pass
+            self._maxima[:] = _kernels.running_maxima(*self._abs)
         return self._maxima[backward]  # type: ignore[return-value]
 
     def _rows(self, s_from: float, s_to: float) -> slice:
