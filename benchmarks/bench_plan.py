@@ -227,7 +227,7 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
         ("  zones, plateaus, speed changes, profile", mean["law"]),
         (f"  sample poses ({n})", mean["poses"]),
         (
-            f"  sample IK ({n} poses, the grid's branch only, and its seeds)",
+            f"  sample IK ({n} poses, the grid's branch only) and seeds",
             mean["ik"] + mean["seeds"],
         ),
         ("  sample rate checks (compiled)", mean["rates"]),
