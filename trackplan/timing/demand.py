@@ -168,8 +168,9 @@ class ZoneDemand:
     def local_caps(self, robot: Robot, share: float) -> np.ndarray:
         """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s."""
         q1, q2, q3 = self._abs
-        # the least ratio over the joints in one compiled pass; the square and cube roots
-        # are increasing, so taking them after the least is the least of the roots
+        # the least ratio over the joints in one compiled pass; the roots are increasing, so
+        # the root of the least is the least root (sqrt is correctly rounded; libm's cbrt is
+        # within an ulp: these caps only set the windows' speed levels)
         v_ratio, a_ratio, j_ratio = _kernels.least_ratios(
             q1, q2, q3, share * robot.v_max, share * robot.a_max, share * robot.j_max
         )
