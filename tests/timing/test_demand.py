@@ -247,18 +247,3 @@ def test_cruise_cap_is_numpys_least_root_and_its_joint(puma):
             if values[j] < expected:
                 expected, reason = float(values[j]), f"joint {j + 1} {kind}"
         assert cruise_cap(puma, tuple(peaks), share) == (expected, reason)
-
-
-def test_running_maxima_are_numpys_accumulated_maxima():
-    """Both directions against np.maximum.accumulate of the stacked demands, NaN included."""
-    from trackplan.timing._kernels import running_maxima
-
-    rng = np.random.default_rng(2)
-    for n_grid in (1, 2, 7, 60):
-        demands = [np.abs(rng.normal(size=(n_grid, 6))) for _ in range(3)]
-        if n_grid > 2:
-            demands[1][1, 2] = np.nan
-        stacked = np.stack(demands, axis=1)
-        forward, backward = running_maxima(*demands)
-        np.testing.assert_array_equal(forward, np.maximum.accumulate(stacked, axis=0))
-        np.testing.assert_array_equal(backward, np.maximum.accumulate(stacked[::-1], axis=0)[::-1])

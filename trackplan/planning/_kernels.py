@@ -7,9 +7,6 @@
   temporary array and a separate reduction per step. The kernel reads each array once, in
   the same order of operations as the numpy expressions it replaces, so the results are
   the same to the bit.
-- :func:`energy_sums`: the energy figures' sums (:func:`trackplan.planning.energy.motion_energy`)
-  in one pass over the torques instead of a temporary array per term (sums in sample order:
-  the same to round-off).
 """
 
 from __future__ import annotations
@@ -93,7 +90,7 @@ def peak_use(
     row = np.zeros(n_cols, dtype=np.int64)
     for j in range(n_cols):
         s = scale[j]
-        if not (0.0 < s < np.inf):  # a zero or odd scale: every quotient as numpy takes it
+        if not (0.0 < s < np.inf):  # not a positive finite scale: each quotient as numpy
             best = -np.inf
             for r in range(n_rows):
                 use = abs(values[r, j] - centre[j]) / s
@@ -129,84 +126,3 @@ def peak_use(
                 break
         peak[j] = best
     return peak, row
-
-
-@njit(cache=True)
-def energy_sums(
-    tau: np.ndarray, qd: np.ndarray, motor_scale: np.ndarray, torque_max: np.ndarray
-) -> tuple[float, float, float, int]:
-    """The energy figures' sums in one pass over the samples.
-
-    Parameters
-    ----------
-    tau, qd
-        Joint torques and velocities, shape (M, n), N·m and rad/s.
-    motor_scale
-        ``G_i k_m,i`` per joint, shape (n,).
-    torque_max
-        Shape (n,), N·m.
-
-    Returns
-    -------
-    tuple
-        ``Σ max(τ q̇, 0)``, ``Σ (τ / (G k_m))²``, the largest ``|τ| / τ_max`` (the first
-        where it occurs, NaN included as numpy's argmax) and its joint (0-based).
-    """
-    n_rows, n_dof = tau.shape
-    work = 0.0
-    loss = 0.0
-    peak = -np.inf
-    peak_row = peak_joint = 0
-    inverse = 1.0 / torque_max
-    for r in range(n_rows):
-        for i in range(n_dof):
-            power = tau[r, i] * qd[r, i]
-            if power > 0.0:
-                work += power
-            motor = tau[r, i] / motor_scale[i]
-            loss += motor * motor
-            use = abs(tau[r, i]) * inverse[i]
-            if use > peak or (use != use and peak == peak):
-                peak, peak_row, peak_joint = use, r, i
-    if peak == peak:  # the ratio itself as numpy divides it
-        peak = abs(tau[peak_row, peak_joint]) / torque_max[peak_joint]
-    return work, loss, peak, peak_joint
-
-
-@njit(cache=True)
-def part_points(
-    T_base_tool: np.ndarray, T_base_part: np.ndarray, sample_time: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Tool points in the definition (part) frame, their velocity and speed, in one pass.
-
-    Parameters
-    ----------
-    T_base_tool
-        Tool poses in the base frame, shape (N, 4, 4).
-    T_base_part
-        The definition frame in the base frame, shape (4, 4).
-    sample_time
-        Ts, s.
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        The points (N, 3), m; their backward difference over Ts, at rest before the first
-        (N, 3), m/s; its length, the speed (N,), m/s.
-    """
-    n = T_base_tool.shape[0]
-    point = np.empty((n, 3))
-    velocity = np.zeros((n, 3))
-    speed = np.zeros(n)
-    for k in range(n):
-        d0 = T_base_tool[k, 0, 3] - T_base_part[0, 3]
-        d1 = T_base_tool[k, 1, 3] - T_base_part[1, 3]
-        d2 = T_base_tool[k, 2, 3] - T_base_part[2, 3]
-        for i in range(3):  # the rotation's transpose: column i of T_base_part dotted in
-            point[k, i] = d0 * T_base_part[0, i] + d1 * T_base_part[1, i] + d2 * T_base_part[2, i]
-        if k > 0:
-            for i in range(3):
-                velocity[k, i] = (point[k, i] - point[k - 1, i]) / sample_time
-            vx, vy, vz = velocity[k, 0], velocity[k, 1], velocity[k, 2]
-            speed[k] = np.sqrt(vx * vx + vy * vy + vz * vz)
-    return point, velocity, speed

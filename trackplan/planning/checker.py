@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from trackplan.frames import vector_norms
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
@@ -268,10 +269,10 @@ def _check_task(
     """Tracking, orientation, Cartesian speed and coverage checks."""
     robot, q, sample_time = motion.robot, motion.q, motion.sample_time
     T_base_tool = motion.T_base_tool
-    T_base_part = np.ascontiguousarray(ref.T_base_part, dtype=float)
-    R_part_base = T_base_part[:3, :3].T
-    # the tool points in the definition frame, their velocity and speed (one pass)
-    p_part, velocity, speed = _kernels.part_points(T_base_tool, T_base_part, sample_time)
+    R_part_base = ref.T_base_part[:3, :3].T
+    p_part = (T_base_tool[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
+    velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
+    speed = vector_norms(velocity)
     t = np.arange(len(q)) * sample_time
     violations: list[Violation] = []
     margins: dict[str, float] = {}
@@ -289,7 +290,7 @@ def _check_task(
     q_between, t_between = between_samples(q, p_part, ref.tolerance)
     if len(q_between):
         T_between = forward_kinematics(robot, q_between)
-        p_between = _kernels.part_points(T_between, T_base_part, sample_time)[0]
+        p_between = (T_between[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
         d_between = ref.nominal.index.candidates(p_between, 0.0).nearest  # distances only
         worst = max(worst, float(d_between.max()))
         if d_between.max() > ref.tolerance * (1 + RELATIVE_SLACK) and not violations_of(

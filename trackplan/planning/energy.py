@@ -12,7 +12,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.motion import SampledMotion
-from trackplan.planning import _kernels
 from trackplan.robots.model import Robot
 
 
@@ -97,23 +96,20 @@ def motion_energy(motion: SampledMotion) -> EnergyFigures:
     Returns
     -------
     EnergyFigures
-        The sums in one compiled pass (:func:`trackplan.planning._kernels.energy_sums`).
     """
     robot, sample_time = motion.robot, motion.sample_time
     dynamics = robot.dynamics
     if dynamics is None or motion.torque is None:
         raise ValueError(f"robot {robot.name!r} has no dynamic parameters")
+    tau, qd = motion.torque, motion.qd
     k_m = np.ones(robot.n_dof) if dynamics.motor_constant is None else dynamics.motor_constant
-    work, loss, peak, joint = _kernels.energy_sums(
-        motion.torque,
-        motion.qd,
-        np.asarray(dynamics.gear_ratio, dtype=float) * k_m,
-        np.asarray(dynamics.torque_max, dtype=float),
-    )
+    motor_torque = tau / (np.asarray(dynamics.gear_ratio) * k_m)
+    use = np.abs(tau) / dynamics.torque_max
+    worst = np.unravel_index(int(np.argmax(use)), use.shape)
     return EnergyFigures(
-        mechanical_energy=work * sample_time,
-        copper_loss=loss * sample_time,
+        mechanical_energy=float(np.maximum(tau * qd, 0.0).sum() * sample_time),
+        copper_loss=float(np.square(motor_torque).sum() * sample_time),
         copper_loss_unit=dynamics.copper_loss_unit,
-        peak_torque_ratio=peak,
-        peak_torque_joint=joint + 1,
+        peak_torque_ratio=float(use[worst]),
+        peak_torque_joint=int(worst[1]) + 1,
     )

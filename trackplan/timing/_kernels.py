@@ -604,6 +604,9 @@ def change_search(
     a_limit: np.ndarray,
     j_limit: np.ndarray,
     start: tuple[float, float, float],
+    running_from_start: np.ndarray,
+    running_from_end: np.ndarray,
+    quick_start: bool,
     factors: np.ndarray,
     fine_factors: np.ndarray,
     u: np.ndarray,
@@ -611,7 +614,8 @@ def change_search(
     """The fastest speed change inside a zone whose bounds hold along its own stretch
     (:func:`trackplan.timing.demand.speed_change`).
 
-    From the change over the zone at the top speed (or ``start`` when shorter), candidate
+    From the change over the zone at the top speed (or ``start``, or with ``quick_start`` the
+    :func:`quick_change`, when shorter), candidate
     bounds on the grids ``best · factors`` then ``best · fine_factors`` (each axis), each
     checked along its stretch (:func:`changes_within_limits`); the shortest that passes wins.
 
@@ -631,6 +635,11 @@ def change_search(
         Share of the joint acceleration and jerk limits, shape (n,).
     start
         ``(distance, accel, jerk)`` of a change known to meet the limits (inf: none).
+    running_from_start, running_from_end
+        Running maxima of |q'|, |q''|, |q'''| from the grid's start and from its end, shape
+        (G, 3, n) (read with ``quick_start``).
+    quick_start
+        Start from :func:`quick_change` instead of ``start``.
     factors, fine_factors
         Multiples of the bounds tried in the first and second round.
     u
@@ -646,6 +655,11 @@ def change_search(
     best = (np.inf, accel, jerk)
     if accel > 0.0 and jerk > 0.0:
         best = (_distance(v_from, v_to, accel, jerk), accel, jerk)
+    if quick_start:
+        start = quick_change(
+            s, d1, d2, d3, peaks, running_from_start, running_from_end,
+            s_start, s_end, v_from, v_to, a_limit, j_limit,
+        )  # fmt: skip
     if start[0] < best[0]:
         best = start
     if not np.isfinite(best[0]) or v_from == v_to or s.size < 2:
@@ -704,116 +718,3 @@ def profile_position(
         value = s0[k] + v0[k] * tau + a0[k] * (tau * tau) / 2.0 + jerk[k] * tau**3.0 / 6.0
         out[r] = min(max(value, 0.0), length)
     return out
-
-
-@njit(cache=True)
-def least_ratios(
-    q1: np.ndarray,
-    q2: np.ndarray,
-    q3: np.ndarray,
-    v_limit: np.ndarray,
-    a_limit: np.ndarray,
-    j_limit: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Least ``limit / |q^(k)|`` over the joints at each grid point (inf where it is 0).
-
-    :meth:`~trackplan.timing.demand.ZoneDemand.local_caps` before its roots.
-
-    Parameters
-    ----------
-    q1, q2, q3
-        |q'|, |q''|, |q'''| on a grid, shape (G, n).
-    v_limit, a_limit, j_limit
-        The shares of the joint velocity, acceleration and jerk limits, shape (n,).
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        Shape (G,) each: velocity, acceleration and jerk ratios.
-    """
-    n_grid, n_dof = q1.shape
-    out = np.full((3, n_grid), np.inf)
-    for r in range(n_grid):
-        for i in range(n_dof):
-            if q1[r, i] > 0.0:
-                out[0, r] = min(out[0, r], v_limit[i] / q1[r, i])
-            if q2[r, i] > 0.0:
-                out[1, r] = min(out[1, r], a_limit[i] / q2[r, i])
-            if q3[r, i] > 0.0:
-                out[2, r] = min(out[2, r], j_limit[i] / q3[r, i])
-    return out[0], out[1], out[2]
-
-
-@njit(cache=True)
-def rows_over(values: np.ndarray, cap: np.ndarray) -> np.ndarray:
-    """Rows where some ``|values[:, i]| > cap[i]``, ascending
-    (``np.flatnonzero((np.abs(values) > cap).any(axis=1))``).
-
-    Parameters
-    ----------
-    values
-        Shape (M, n).
-    cap
-        Shape (n,).
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (R,), int.
-    """
-    n_rows, n_cols = values.shape
-    found = np.empty(n_rows, dtype=np.int64)
-    count = 0
-    for r in range(n_rows):
-        for i in range(n_cols):
-            if abs(values[r, i]) > cap[i]:
-                found[count] = r
-                count += 1
-                break
-    return found[:count].copy()
-
-
-@njit(cache=True, inline="always")
-def _maximum(a: float, b: float) -> float:
-    """``np.maximum`` of two numbers (NaN propagates)."""
-    if a != a:
-        return a
-    if b != b:
-        return b
-    return a if a >= b else b
-
-
-@njit(cache=True)
-def running_maxima(q1: np.ndarray, q2: np.ndarray, q3: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Running maxima of three (G, n) arrays down and up their rows
-    (``np.maximum.accumulate`` of them stacked, from the first row and from the last).
-
-    Parameters
-    ----------
-    q1, q2, q3
-        |q'|, |q''|, |q'''| on a grid, shape (G, n).
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        Shape (G, 3, n) each: row k covers rows 0 … k, and rows k … G - 1.
-    """
-    n_grid, n_dof = q1.shape
-    forward = np.empty((n_grid, 3, n_dof))
-    backward = np.empty((n_grid, 3, n_dof))
-    for r in range(n_grid):
-        back = n_grid - 1 - r
-        for i in range(n_dof):
-            if r == 0:
-                forward[r, 0, i], forward[r, 1, i], forward[r, 2, i] = q1[r, i], q2[r, i], q3[r, i]
-                backward[back, 0, i] = q1[back, i]
-                backward[back, 1, i] = q2[back, i]
-                backward[back, 2, i] = q3[back, i]
-                continue
-            forward[r, 0, i] = _maximum(forward[r - 1, 0, i], q1[r, i])
-            forward[r, 1, i] = _maximum(forward[r - 1, 1, i], q2[r, i])
-            forward[r, 2, i] = _maximum(forward[r - 1, 2, i], q3[r, i])
-            backward[back, 0, i] = _maximum(backward[back + 1, 0, i], q1[back, i])
-            backward[back, 1, i] = _maximum(backward[back + 1, 1, i], q2[back, i])
-            backward[back, 2, i] = _maximum(backward[back + 1, 2, i], q3[back, i])
-    return forward, backward

@@ -154,9 +154,14 @@ class ZoneDemand:
 
     def running_maxima(self, backward: int) -> np.ndarray:
         """Running maxima of |q'|, |q''|, |q'''| from the zone start (0) or from its end (1),
-        shape (G, 3, n): row k covers rows 0 … k, or k … G - 1 (computed once)."""
-        if self._maxima[backward] is None:  # both at once, in one compiled pass
-            self._maxima[:] = _kernels.running_maxima(*self._abs)
+        shape (G, 3, n): row k covers rows 0 … k, or k … G - 1."""
+        if self._maxima[backward] is None:
+            stacked = np.stack(self._abs, axis=1)  # (G, 3, n)
+            if backward:
+                running = np.maximum.accumulate(stacked[::-1], axis=0)[::-1]
+            else:
+                running = np.maximum.accumulate(stacked, axis=0)
+            self._maxima[backward] = running
         return self._maxima[backward]  # type: ignore[return-value]
 
     def _rows(self, s_from: float, s_to: float) -> slice:
@@ -168,14 +173,11 @@ class ZoneDemand:
     def local_caps(self, robot: Robot, share: float) -> np.ndarray:
         """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s."""
         q1, q2, q3 = self._abs
-        # the least ratio over the joints in one compiled pass; the roots are increasing, so
-        # the root of the least is the least root (sqrt is correctly rounded; libm's cbrt is
-        # within an ulp: these caps only set the windows' speed levels)
-        v_ratio, a_ratio, j_ratio = _kernels.least_ratios(
-            q1, q2, q3, share * robot.v_max, share * robot.a_max, share * robot.j_max
+        caps = np.minimum(
+            safe_ratio(share * robot.v_max, q1).min(axis=1),
+            np.sqrt(safe_ratio(share * robot.a_max, q2)).min(axis=1),
         )
-        caps = np.minimum(v_ratio, np.sqrt(a_ratio))
-        return np.minimum(caps, np.cbrt(j_ratio))
+        return np.minimum(caps, np.cbrt(safe_ratio(share * robot.j_max, q3)).min(axis=1))
 
 
 def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
@@ -310,6 +312,8 @@ def speed_change(
     at_start: bool,
     share: float,
     start: SpeedChange | None = None,
+    *,
+    quick_start: bool = False,
 ) -> SpeedChange:
     """Fastest jerk-limited speed change inside a zone, bounded by the joints along its stretch.
 
@@ -342,6 +346,10 @@ def speed_change(
     start
         A change known to meet the limits (bounds valid over its own stretch): the
         search starts from it when it is shorter than the zone-wide one.
+    quick_start
+        Start instead from the quick change: the zone-wide bounds raised to those over the
+        stretch that change covers, where it fits the zone (a rise from ``s_start``, a fall
+        to ``s_end``; :func:`trackplan.timing._kernels.quick_change`).
 
     Compiled: :func:`trackplan.timing._kernels.change_search`.
 
@@ -365,65 +373,14 @@ def speed_change(
         share * robot.a_max,
         share * robot.j_max,
         (float(known[0]), float(known[1]), float(known[2])),
+        demand.running_maxima(0),
+        demand.running_maxima(1),
+        bool(quick_start),
         BOUND_FACTORS,
         FINE_FACTORS,
         _PHASE_SHARES,
     )
     return SpeedChange(distance, accel, jerk)
-
-
-def quick_speed_change(
-    robot: Robot,
-    demand: ZoneDemand,
-    s_start: float,
-    s_end: float,
-    v_from: float,
-    v_to: float,
-    share: float,
-) -> SpeedChange:
-    """A speed change under bounds valid over the stretch it covers: quick, and never
-    shorter than the one :func:`speed_change` finds from it.
-
-    The bounds over the whole zone at the top speed (:func:`uniform_change_bounds`); where
-    that change fits the zone, raised to those over the stretch it covers (a rise starts
-    at ``s_start``, a fall ends at ``s_end``; :meth:`ZoneDemand.peaks`). Compiled:
-    :func:`trackplan.timing._kernels.quick_change`.
-
-    Parameters
-    ----------
-    robot
-        Joint limits, each shape (n,).
-    demand
-        The zone's joint-path derivatives.
-    s_start, s_end
-        The zone, m.
-    v_from, v_to
-        Speeds before and after, m/s.
-    share
-        Share of each limit planned against.
-
-    Returns
-    -------
-    SpeedChange
-        Its distance and bounds.
-    """
-    return SpeedChange(
-        *_kernels.quick_change(
-            demand.s,
-            demand.d1,
-            demand.d2,
-            demand.d3,
-            demand.peak_array,
-            demand.running_maxima(0),
-            demand.running_maxima(1),
-            float(s_start),
-            float(s_end),
-            float(v_from),
-            float(v_to),
-            share * robot.a_max,
-            share * robot.j_max,
-        )
-    )
 
 
 BOUND_FACTORS = np.geomspace(1.0, 8.0, 6)

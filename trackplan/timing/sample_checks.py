@@ -144,7 +144,9 @@ class TorqueLimits:
             return empty.astype(int), empty.astype(int), empty
         q, qd, q_held, tau = motion.q, motion.qd, motion.q_held, motion.torque
         cap = (1.0 - self.margin) * dynamics.torque_max
-        rows = _kernels.rows_over(tau, cap)  # one compiled pass
+        # the rows of the values over a cap (numpy's any over a short axis is slow; these
+        # are usually none)
+        rows = np.unique(np.flatnonzero(np.abs(tau) > cap) // tau.shape[1])
         if not rows.size:
             empty = np.zeros(0)
             return empty.astype(int), empty.astype(int), empty

@@ -44,7 +44,6 @@ from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
     cruise_cap,
-    quick_speed_change,
     speed_change,
 )
 from trackplan.timing.profile import (
@@ -380,17 +379,23 @@ class _ZonePlanner:
         """The speed change inside zone z: a rise starts at its start, a fall ends at its end.
 
         Its bounds come from the joint demand along the stretch it covers, at the speed it
-        has there (:func:`~trackplan.timing.demand.speed_change`, started from
-        :func:`~trackplan.timing.demand.quick_speed_change`).
+        has there (:func:`~trackplan.timing.demand.speed_change`, started from the quick
+        change over the stretch it covers).
         """
         key = (z, v_from, v_to)
         if key not in self._changes:
             s0, s1, _ = self.zones[z]
             share = LIMIT_SHARE * self.change_scale[z]
-            demand = self.demands[z]
-            quick = quick_speed_change(self.robot, demand, s0, s1, v_from, v_to, share)
             self._changes[key] = speed_change(
-                self.robot, demand, s0, s1, v_from, v_to, v_to > v_from, share, start=quick
+                self.robot,
+                self.demands[z],
+                s0,
+                s1,
+                v_from,
+                v_to,
+                at_start=v_to > v_from,
+                share=share,
+                quick_start=True,
             )
         return self._changes[key]
 
