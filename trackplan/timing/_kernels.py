@@ -7,6 +7,14 @@ operations as the numpy reference functions of :mod:`trackplan.timing.demand`
 (:func:`~trackplan.timing.demand.uniform_change_bounds_many`,
 :func:`~trackplan.timing.demand.change_distances`,
 :meth:`~trackplan.timing.demand.ZoneDemand.stretch_peaks`), so results agree to round-off.
+
+The smooth law calls three of them per plan, each running a whole loop the law ran in
+Python before, with the same operations: :func:`plateau_search` (the plateaus over all
+zones, :class:`trackplan.timing.smooth._ZonePlanner`), :func:`change_search` (one speed
+change, :func:`~trackplan.timing.demand.speed_change`) and :func:`profile_position` (the
+profile at the samples, :meth:`~trackplan.timing.profile.SpeedProfile.position`); the
+others run inside them. The window merging (:func:`level_runs`) and the samples' rate check
+(:func:`rate_ratios`) are called on their own.
 """
 
 from __future__ import annotations
