@@ -226,13 +226,16 @@ def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> Exit
     from trackplan.cli.summaries import print_search
     from trackplan.outputs import write_search_run
 
+    from trackplan.forking import forked_pool
+
     if report:  # a worker gets matplotlib ready on the second core while the search runs
         from trackplan.report.plot_worker import plot_worker
     workers = plot_worker(case) if report else nullcontext()
     # a second signal while writing stops the writing
     with workers as worker, stop_on_signals() as signals:
         signals.deferring = True  # the search polls after each generation
-        result = _search(case, signals, **options)
+        with forked_pool() as background:  # the plans at full Ts, beside the search
+            result = _search(case, signals, background=background, **options)
         signals.deferring = False
         interrupted = result.stop_reason == "interrupted" or signals.first is not None
         marks = _interrupted_marks(result, signals) if interrupted else None
@@ -272,7 +275,8 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
-    with Progress(*columns, console=err, transient=True) as bar:
+    # refreshed after each generation, not by a thread: a background executor forks
+    with Progress(*columns, console=err, transient=True, auto_refresh=False) as bar:
         task = bar.add_task("placement search: starting", total=None)
 
         def show(record) -> None:  # type: ignore[no-untyped-def]
@@ -285,6 +289,7 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
                 task,
                 description=f"generation {record.generation}  {record.evaluations} evaluations  "
                 f"{best}  feasible {100 * record.feasible_share:.0f} %",
+                refresh=True,
             )
             signals.raise_if_stopped()
 
