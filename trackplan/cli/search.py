@@ -224,10 +224,14 @@ def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> Exit
     from contextlib import nullcontext
 
     from trackplan.cli.summaries import print_search
-    from trackplan.outputs import write_search_run
-
     from trackplan.forking import forked_pool
+    from trackplan.outputs import write_search_run
+    from trackplan.paths.path_geometry import PathGeometry
+    from trackplan.timing import time_law
 
+    # built first (numba's start), so that the processes forked below share it
+    mode = time_law(options.get("timing") or case.task.timing).path_mode
+    geometry = PathGeometry.from_case(case, mode)
     if report:  # a worker gets matplotlib ready on the second core while the search runs
         from trackplan.report.plot_worker import plot_worker
     workers = plot_worker(case) if report else nullcontext()
@@ -235,7 +239,7 @@ def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> Exit
     with workers as worker, stop_on_signals() as signals:
         signals.deferring = True  # the search polls after each generation
         with forked_pool() as background:  # the plans at full Ts, beside the search
-            result = _search(case, signals, background=background, **options)
+            result = _search(case, signals, geometry=geometry, background=background, **options)
         signals.deferring = False
         interrupted = result.stop_reason == "interrupted" or signals.first is not None
         marks = _interrupted_marks(result, signals) if interrupted else None
