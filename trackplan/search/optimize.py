@@ -412,7 +412,7 @@ class _Planner:
             return self.background.submit(
                 plan_placement, self.case, X[:6], **self._options(X, branch)
             )
-        except (BrokenExecutor, RuntimeError):  # RuntimeError: shut down
+        except BrokenExecutor:
             self.background = None
             return None
 
