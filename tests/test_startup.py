@@ -9,7 +9,10 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from tests.conftest import CASES
+from trackplan.forking import can_fork
 
 SCIPY_SOLVERS = ("scipy.optimize", "scipy.interpolate", "scipy.spatial", "scipy.stats")
 """scipy's optimisers, splines and trees: a plan whose speed stays in windows uses none."""
@@ -72,8 +75,7 @@ def test_plan_in_windows_imports_no_scipy_solver(tmp_path):
 
 def test_optimize_without_report_imports_only_what_it_uses(tmp_path):
     """A whole ``optimize --no-report`` of the corner case imports neither the report, the
-    cell's exact distances, Dask, the URDF stack nor the population methods. (Its plan at
-    the centre of the box runs the continuous speed curve, so scipy's LP solver is used.)"""
+    cell's exact distances, Dask, the URDF stack nor the population methods."""
     run = (
         "from trackplan.cli import main\n"
         f"code = main(['optimize', {str(CASES / 'paper-corner.yaml')!r}, '--no-report', "
@@ -81,3 +83,17 @@ def test_optimize_without_report_imports_only_what_it_uses(tmp_path):
         "assert code == 0, code"
     )
     assert _loaded_after(run, REPORT_AND_OPTIONAL) == []
+
+
+@pytest.mark.skipif(not can_fork(), reason="no second core or no fork here")
+def test_optimize_plans_beside_the_search(tmp_path):
+    """With a second core, the plans at full Ts (the before plan at the centre of the box runs
+    the continuous speed curve: scipy's LP solver and splines) are made in the process forked
+    at the search's start: the searching process imports none of scipy's solvers."""
+    run = (
+        "from trackplan.cli import main\n"
+        f"code = main(['optimize', {str(CASES / 'paper-corner.yaml')!r}, '--no-report', "
+        f"'--budget', '30', '--out', {str(tmp_path / 'out')!r}])\n"
+        "assert code == 0, code"
+    )
+    assert _loaded_after(run, SCIPY_SOLVERS) == []

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from tests.report.conftest import REPORT_FRAMES, REPORT_INFO, optimizer_history
-from trackplan.report import drawing, figures, run_report
+from trackplan import forking
+from trackplan.report import figures, run_report
 from trackplan.report.figures import joints_figure
 from trackplan.report.plot_worker import PlotWorker, plot_worker
 from trackplan.report.run_report import can_fork, write_run_report
@@ -133,6 +134,8 @@ def test_no_fork_beside_other_python_threads():
 
 
 def test_no_fork_and_no_worker_on_one_core(monkeypatch):
-    monkeypatch.setattr(drawing.os, "sched_getaffinity", lambda pid: {0})
+    monkeypatch.setattr(forking.os, "sched_getaffinity", lambda pid: {0})
     assert not can_fork()
     assert PlotWorker.start() is None
+    with forking.forked_pool() as pool:
+        assert pool is None

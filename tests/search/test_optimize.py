@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+import multiprocessing
+import os
+import signal
+from concurrent.futures import BrokenExecutor, Executor, Future, ThreadPoolExecutor
 from dataclasses import replace
 
 import numpy as np
@@ -11,11 +14,13 @@ import pytest
 from tests.conftest import CASES
 from trackplan.case import Case, PlacementBounds
 from trackplan.errors import CaseError
+from trackplan.forking import can_fork, forked_pool
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
 from trackplan.planning.plan import plan_placement
-from trackplan.search import GenerationRecord, optimize_placement
+from trackplan.planning.result import PlanResult
+from trackplan.search import GenerationRecord, OptimizeResult, optimize_placement
 from trackplan.search.fitness import Finding, PlacementFitness
 from trackplan.search.space import SearchSpace
 from trackplan.status import Status
@@ -94,6 +99,70 @@ def test_ctrl_c_keeps_the_best_placement(case: Case, geometry: PathGeometry) -> 
     assert result.evaluations == seen[-1].evaluations == 86
     assert result.status is Status.INTERRUPTED and not result.success and result.final.success
     assert result.fitness == pytest.approx(seen[-1].best)
+
+
+def _same_plan(a: PlanResult, b: PlanResult) -> None:
+    assert a.status is b.status and a.objective == b.objective and a.branch == b.branch
+    assert np.array_equal(a.placement, b.placement)
+    assert np.array_equal(a.trajectory.t, b.trajectory.t)
+    assert np.array_equal(a.trajectory.q, b.trajectory.q)
+
+
+@pytest.fixture(scope="module")
+def serial_ga(case: Case, geometry: PathGeometry) -> OptimizeResult:
+    return optimize_placement(case, method="ga", budget=100, geometry=geometry)
+
+
+def _worker_pids() -> list[int]:
+    return [child.pid for child in multiprocessing.active_children() if child.pid is not None]
+
+
+@pytest.mark.skipif(not can_fork(), reason="no second core or no fork here")
+@pytest.mark.parametrize("signum", [None, signal.SIGINT, signal.SIGTERM])
+def test_plans_in_the_background_are_the_same(
+    case: Case, geometry: PathGeometry, serial_ga: OptimizeResult, signum: int | None
+) -> None:
+    """The before and final plans made in a forked process while the search runs are those
+    made here after it. The process ignores Ctrl-C; killed (SIGTERM) during the search, the
+    plans are made here."""
+    sent: list[int] = []
+
+    def progress(record: GenerationRecord) -> None:
+        if signum is not None and record.generation == 2:
+            sent.extend(_worker_pids())
+            for pid in sent:
+                os.kill(pid, signum)
+
+    with forked_pool() as pool:
+        assert pool is not None
+        result = optimize_placement(
+            case, method="ga", budget=100, geometry=geometry, background=pool, progress=progress
+        )
+        alive = _worker_pids()
+    if signum is None:
+        assert len(alive) == 1
+    else:
+        assert len(sent) == 1 and alive == ([] if signum == signal.SIGTERM else sent)
+    assert np.array_equal(result.history.best, serial_ga.history.best)
+    _same_plan(result.initial, serial_ga.initial)
+    _same_plan(result.final, serial_ga.final)
+    assert result.success and result.objective == serial_ga.objective
+
+
+def test_a_broken_background_plans_here(
+    case: Case, geometry: PathGeometry, serial_ga: OptimizeResult
+) -> None:
+    class Broken(Executor):
+        def submit(self, fn, /, *args, **kwargs):  # type: ignore[no-untyped-def]
+            job: Future = Future()
+            job.set_exception(BrokenExecutor("gone"))
+            return job
+
+    result = optimize_placement(
+        case, method="ga", budget=100, geometry=geometry, background=Broken()
+    )
+    _same_plan(result.initial, serial_ga.initial)
+    _same_plan(result.final, serial_ga.final)
 
 
 def test_final_recheck_catches_a_wrong_screening(

@@ -224,15 +224,22 @@ def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> Exit
     from contextlib import nullcontext
 
     from trackplan.cli.summaries import print_search
+    from trackplan.forking import forked_pool
     from trackplan.outputs import write_search_run
+    from trackplan.paths.path_geometry import PathGeometry
+    from trackplan.timing import time_law
 
+    # built first (numba's start), so that the processes forked below share it
+    mode = time_law(options.get("timing") or case.task.timing).path_mode
+    geometry = PathGeometry.from_case(case, mode)
     if report:  # a worker gets matplotlib ready on the second core while the search runs
         from trackplan.report.plot_worker import plot_worker
     workers = plot_worker(case) if report else nullcontext()
     # a second signal while writing stops the writing
     with workers as worker, stop_on_signals() as signals:
         signals.deferring = True  # the search polls after each generation
-        result = _search(case, signals, **options)
+        with forked_pool() as background:  # the plans at full Ts, beside the search
+            result = _search(case, signals, geometry=geometry, background=background, **options)
         signals.deferring = False
         interrupted = result.stop_reason == "interrupted" or signals.first is not None
         marks = _interrupted_marks(result, signals) if interrupted else None
@@ -272,7 +279,8 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     columns = (SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn())
-    with Progress(*columns, console=err, transient=True) as bar:
+    # refreshed after each generation, not by a thread: a background executor forks
+    with Progress(*columns, console=err, transient=True, auto_refresh=False) as bar:
         task = bar.add_task("placement search: starting", total=None)
 
         def show(record) -> None:  # type: ignore[no-untyped-def]
@@ -285,6 +293,7 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
                 task,
                 description=f"generation {record.generation}  {record.evaluations} evaluations  "
                 f"{best}  feasible {100 * record.feasible_share:.0f} %",
+                refresh=True,
             )
             signals.raise_if_stopped()
 

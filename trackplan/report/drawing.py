@@ -13,10 +13,8 @@ a daemonic process such as a Dask worker, other Python threads running), or with
 from __future__ import annotations
 
 import multiprocessing
-import os
 import sys
 import tempfile
-import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,24 +22,13 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
+from trackplan.forking import can_fork
 from trackplan.report.figures import BandedFigure, PlotBuilder, figure_pixels, save_png
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 T = TypeVar("T")
-
-
-def can_fork() -> bool:
-    """Whether plots may be drawn in a forked process: Linux, at least two usable cores,
-    not a daemonic process (which may not have children) and no other Python thread (a
-    fork copies only the calling thread, whatever locks the others hold)."""
-    return (
-        sys.platform == "linux"
-        and len(os.sched_getaffinity(0)) > 1
-        and not multiprocessing.current_process().daemon
-        and threading.active_count() == 1
-    )
 
 
 @dataclass(frozen=True)

@@ -50,8 +50,8 @@ class PlotWorker:
     def start(cls, case: Case | None = None) -> PlotWorker | None:
         """Fork the worker, which imports matplotlib, draws a small figure and, given a
         case, runs its robot's kinematics once; None where
-        :func:`~trackplan.report.drawing.can_fork` says no."""
-        from trackplan.report.drawing import can_fork
+        :func:`~trackplan.forking.can_fork` says no."""
+        from trackplan.forking import can_fork
 
         if not can_fork():
             return None

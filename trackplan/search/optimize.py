@@ -6,7 +6,8 @@ them through pymoo's ask/tell interface so that it can report each generation, h
 the evaluation budget exactly and stop cleanly on Ctrl-C. The best screened candidate is
 then planned at the full sample time by :func:`~trackplan.planning.plan.plan_placement`
 and checked by the checker; should that check fail, the next best distinct candidate of
-the archive is planned instead.
+the archive is planned instead. Given a ``background`` executor, the plans are made there:
+the "before" plan while the search runs, then the final candidates.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Callable
-from concurrent.futures import Executor
+from concurrent.futures import BrokenExecutor, Executor, Future
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -190,6 +191,7 @@ def optimize_placement(
     timing: str | None = None,
     executor: Executor | None = None,
     restarts: int | None = None,
+    background: Executor | None = None,
 ) -> OptimizeResult:
     """Search the placement X of the workpiece with the least joint travel (Eq. 8, 30).
 
@@ -231,6 +233,13 @@ def optimize_placement(
         (:data:`trackplan.search.algorithms.DEFAULT_RESTARTS`; 1 for a pymoo Algorithm).
         The first run uses ``seed`` itself, so ``restarts=1`` is one run exactly as
         configured (the paper's GA).
+    background
+        Makes the plans at full Ts there: the "before" plan (``initial``) while the search
+        runs, then the final candidates, e.g. on the second core in a process forked before
+        the search (:func:`trackplan.forking.forked_pool`), whose warm-up (the time law's
+        first calls) the search then does not wait for. The results are the same; when the
+        executor breaks (its process killed), the plans are made here. None: here, after
+        the search.
 
     Returns
     -------
@@ -272,6 +281,8 @@ def optimize_placement(
     timing = law.timing
     fitness = PlacementFitness(case, space, geometry, timing, executor=executor)
     problem = PlacementProblem(space, fitness)
+    planner = _Planner(case, timing, geometry, background)
+    before = planner.submit(space.anchor)
     records: list[GenerationRecord] = []
     stop_reason = ""
     runs = 0
@@ -286,10 +297,8 @@ def optimize_placement(
         runs += 1
         if stop_reason in ("budget", "interrupted"):
             break
-    initial = plan_placement(
-        case, space.anchor[:6], timing=timing, geometry=geometry, spin=space.anchor[6:]
-    )
-    final, rejected = _final_plan(case, problem, timing, geometry)
+    initial = planner.result(before, space.anchor)
+    final, rejected = _final_plan(problem, planner)
     archive = problem.archive
     chosen = int(np.flatnonzero(np.all(archive.X[:, :6] == final.placement, axis=1))[0])
     if stop_reason == "interrupted":
@@ -385,8 +394,49 @@ def _record(
     )
 
 
+class _Planner:
+    """:func:`plan_placement` of the case's candidates ``(x, y, z, roll, pitch, yaw[,
+    spin])`` at full Ts, on ``background`` while it works, else here."""
+
+    def __init__(
+        self, case: Case, timing: str, geometry: PathGeometry, background: Executor | None
+    ) -> None:
+        self.case, self.timing, self.geometry = case, timing, geometry
+        self.background = background
+
+    def submit(self, X: np.ndarray, branch: int | None = None) -> Future[PlanResult] | None:
+        """Start planning ``X`` in the background; None without one (or a broken one)."""
+        if self.background is None:
+            return None
+        try:
+            return self.background.submit(
+                plan_placement, self.case, X[:6], **self._options(X, branch)
+            )
+        except BrokenExecutor:
+            self.background = None
+            return None
+
+    def result(
+        self, job: Future[PlanResult] | None, X: np.ndarray, branch: int | None = None
+    ) -> PlanResult:
+        """The plan of ``X`` submitted as ``job``, made here when the background broke."""
+        if job is not None:
+            try:
+                return job.result()
+            except BrokenExecutor:
+                self.background = None
+        return plan_placement(self.case, X[:6], **self._options(X, branch))
+
+    def plan(self, X: np.ndarray, branch: int | None = None) -> PlanResult:
+        """The plan of ``X``, waited for."""
+        return self.result(self.submit(X, branch), X, branch)
+
+    def _options(self, X: np.ndarray, branch: int | None) -> dict:
+        return {"timing": self.timing, "branch": branch, "geometry": self.geometry, "spin": X[6:]}
+
+
 def _final_plan(
-    case: Case, problem: PlacementProblem, timing: str, geometry: PathGeometry
+    problem: PlacementProblem, planner: _Planner
 ) -> tuple[PlanResult, list[np.ndarray]]:
     """Plan the archive's candidates best first at full Ts until one passes the checker.
 
@@ -399,9 +449,7 @@ def _final_plan(
     for X, feasible, branch in zip(archive.X, archive.feasible, archive.branch, strict=True):
         if first is not None and not feasible:
             break
-        plan = plan_placement(
-            case, X[:6], timing=timing, branch=int(branch), geometry=geometry, spin=X[6:]
-        )
+        plan = planner.plan(X, int(branch))
         if plan.feasible:
             return plan, rejected
         first = first or plan
