@@ -253,20 +253,23 @@ def test_unreachable_poses_are_invalid(name, rng):
 
 @pytest.mark.parametrize("name", ["puma560", "kuka_kr6_r700_sixx", "fanuc_m20ia", "ur5e"])
 def test_one_branch_kernel_is_that_branch_of_the_eight(name, rng):
-    """solve_branch runs the all-branch kernel's operations on one arm: the same bits,
-    on reachable, unreachable and wrist-singular poses alike."""
+    """solve_branch runs the all-branch kernel's operations on one arm: the same bits of
+    the joints and branch quantities, on reachable, unreachable and wrist-singular poses
+    alike."""
     robot = builtin_robot(name)
     q = rng.uniform(-np.pi, np.pi, (2000, 6))
     q[::5, 4] = 0.0  # wrist singular
     T = forward_kinematics(robot, q)
     T[1::7, :3, 3] *= 3.0  # out of reach
     family = ik_family(robot)
-    q_all, valid_all, _ = family.solve_flat(T)
+    q_all, valid_all, aux_all = family.solve_flat(T)
     assert not valid_all.all() and valid_all.any()
     for branch in range(8):
-        q_one, valid_one = family.solve_branch(T, branch)
+        q_one, valid_one, aux_one = family.solve_branch(T, branch, with_aux=True)
         np.testing.assert_array_equal(valid_one, valid_all[:, branch])
         np.testing.assert_array_equal(q_one, q_all[:, branch])
+        np.testing.assert_array_equal(aux_one, aux_all[:, branch])
+        np.testing.assert_array_equal(family.solve_branch(T, branch)[0], q_one)
 
 
 @pytest.mark.parametrize("name", ["puma560", "kuka_kr6_r700_sixx", "ur5e"])

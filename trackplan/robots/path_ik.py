@@ -60,7 +60,7 @@ from trackplan.robots._kernels import (
     numeric_paths,
     room_bounds,
 )
-from trackplan.robots.families import AUX_SIZE, N_BRANCHES, ik_family
+from trackplan.robots.families import AUX_SIZE, N_BRANCHES, IKFamily, ik_family
 from trackplan.robots.ik_numeric import chain_arrays
 from trackplan.robots.model import Robot
 from trackplan.status import Status
@@ -79,6 +79,10 @@ ROTATION_LENGTH = 0.2
 _ROOM_SLACK = 1e-9
 """Margin by which the screened branch must beat every other branch's bound, rad: far
 above the round-off of unwrapping a path (about 1e-12 rad over thousands of poses)."""
+
+SCREEN_STRIDE = 8
+"""Every how many poses the screen of :func:`solve_path_ik` solves all eight branches to
+bound their margins (a bound from fewer poses is looser but still a bound)."""
 
 _NEWTON_TOL = 1e-10
 _MARCH_MAX_ITER = 100  # first pose from a seed, and the coarse march
@@ -367,7 +371,7 @@ def branch_joints(
     """
     family = ik_family(robot)
     if family.closed_form:
-        q, valid = family.solve_branch(T_base_tool, branch)
+        q, valid, _ = family.solve_branch(T_base_tool, branch)
         if not valid.all() and valid.any():
             held = np.maximum.accumulate(np.where(valid, np.arange(len(valid)), -1))
             held[held < 0] = np.argmax(valid)
@@ -401,11 +405,13 @@ def _branch_paths(
     """The candidate branches' joint paths, analysed: the shared core of both solvers.
 
     Parameters are those of :func:`solve_path_ik`. With ``screen`` (closed form, no branch
-    given), the branch whose poses leave the most room in the limits one at a time
-    (:func:`~trackplan.robots._kernels.room_bounds`) is analysed first; when its path is
-    usable with a margin above every other branch's bound (by :data:`_ROOM_SLACK`), no
-    other branch can be chosen and it is returned alone (K = 1): the same branch and
-    analysis as from all eight. Otherwise all eight are analysed.
+    given), all eight branches are solved at every :data:`SCREEN_STRIDE`-th pose, and the
+    branch whose poses there leave the most room in the limits one at a time
+    (:func:`~trackplan.robots._kernels.room_bounds`) is solved alone at every pose and
+    analysed first; when its path is usable with a margin above every other branch's
+    bound (by :data:`_ROOM_SLACK`), no other branch can be chosen and it is returned alone
+    (K = 1): the same branch and analysis as from all eight. Otherwise all eight are
+    solved and analysed. A given branch is solved alone.
 
     Returns
     -------
@@ -425,26 +431,35 @@ def _branch_paths(
     if method == "auto":
         method = "closed_form" if family.closed_form else "numeric"
     if method == "closed_form":
-        q_all, valid, aux = family.solve_flat(T.reshape(-1, 4, 4))
-        shape = (n_cand, n_poses)
-        solutions = (
-            q_all.reshape(*shape, N_BRANCHES, n),
-            valid.reshape(*shape, N_BRANCHES),
-            aux.reshape(*shape, N_BRANCHES, AUX_SIZE),
-        )
         channel_kind = np.array([SHOULDER, ELBOW, WRIST])
         if screen and branch is None:
-            bound = room_bounds(*solutions[:2], robot.q_min, robot.q_max)
+            # the subset's poses bound each branch's margin from above as all poses do
+            sub = np.ascontiguousarray(T[:, ::SCREEN_STRIDE]).reshape(-1, 4, 4)
+            q_sub, valid_sub, _ = family.solve_flat(sub, with_aux=False)
+            shape = (n_cand, -1, N_BRANCHES)
+            bound = room_bounds(
+                q_sub.reshape(*shape, n), valid_sub.reshape(shape), robot.q_min, robot.q_max
+            )
             best = np.argmax(bound, axis=1)
             rival = np.where(np.arange(N_BRANCHES) == best[:, None], -np.inf, bound).max(axis=1)
             first = np.ascontiguousarray(best[:, None])
-            q, reach, magnitude, crossing = gather_closed_form(*solutions, first)
+            q, reach, magnitude, crossing = _one_branch_paths(family, T, best)
             analysed = _analysed(robot, q, reach, magnitude, channel_kind, crossing, step)
             ok, values = analysed[3], analysed[2]
             if np.all(ok[:, 0] & (values[:, 0, F_MARGIN] > rival + _ROOM_SLACK)):
                 switch, report, values, ok, windings, winding = analysed
                 return q, reach, switch, report, values, ok, first, step, method, windings, winding
-        q, reach, magnitude, crossing = gather_closed_form(*solutions, candidates)
+        if branch is None:
+            q_all, valid, aux = family.solve_flat(T.reshape(-1, 4, 4))
+            shape = (n_cand, n_poses, N_BRANCHES)
+            solutions = (
+                q_all.reshape(*shape, n),
+                valid.reshape(shape),
+                aux.reshape(*shape, AUX_SIZE),
+            )
+            q, reach, magnitude, crossing = gather_closed_form(*solutions, candidates)
+        else:
+            q, reach, magnitude, crossing = _one_branch_paths(family, T, candidates[:, 0])
     elif method == "numeric":
         seeds = np.ascontiguousarray(numeric_seeds(robot)[candidates])
         q, reach, magnitude, crossing = numeric_paths(
@@ -463,6 +478,33 @@ def _branch_paths(
         robot, q, reach, magnitude, channel_kind, crossing, step
     )
     return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
+
+
+def _one_branch_paths(
+    family: IKFamily, T: np.ndarray, branches: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`~trackplan.robots._kernels.gather_closed_form` of one closed-form branch per
+    candidate, solved alone (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch`,
+    the bits of that branch of all eight).
+
+    Parameters
+    ----------
+    family
+        A closed-form family.
+    T
+        Tool poses, shape (B, M, 4, 4), m.
+    branches
+        The branch of each candidate, shape (B,), int.
+
+    Returns
+    -------
+    q, reach, magnitude, crossing
+        Shapes (B, 1, M, 6), (B, 1, M), (B, 1, M, 3), (B, 1, M).
+    """
+    solved = [family.solve_branch(T[b], int(k), with_aux=True) for b, k in enumerate(branches)]
+    q, valid, aux = (np.stack([found[i] for found in solved])[:, :, None] for i in range(3))
+    only = np.zeros((len(branches), 1), dtype=np.int64)
+    return gather_closed_form(q, valid, aux, only)
 
 
 def _analysed(

@@ -251,6 +251,15 @@ def _unreachable(
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _keep_aux(found: np.ndarray, branch_aux: np.ndarray, k: int) -> None:  # pragma: no cover
+    """Kernel: copy one pose's branch quantities (5,) into row k of branch_aux (N, 5), or
+    into its only row when it is the (1, 5) scratch of a caller that does not keep them."""
+    row = k if branch_aux.shape[0] > 1 else 0
+    for j in range(AUX_SIZE):
+        branch_aux[row, j] = found[j]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _opw_arguments(
     g: np.ndarray,
     tail_inv: np.ndarray,
@@ -412,9 +421,11 @@ def opw_solve_branch(
     branch: int,
     q: np.ndarray,
     valid: np.ndarray,
+    branch_aux: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Kernel: OPW branch ``branch`` of poses T (N, 4, 4): q (N, 6), NaN where not
-    valid (N,); the same operations as :func:`opw_solve` on that branch alone."""
+    valid (N,), and its branch quantities branch_aux (N, 5) (a ``branch_aux`` of shape
+    (1, 5) is scratch); the same operations as :func:`opw_solve` on that branch alone."""
     Y = np.zeros(O_N_ANGLES)
     X = np.ones(O_N_ANGLES)
     angles = np.empty(O_N_ANGLES)
@@ -429,6 +440,7 @@ def opw_solve_branch(
         _opw_arguments(
             g, tail_inv, T[k], Y, X, reach, aux, (shoulder, shoulder + 1), (elbow, elbow + 1)
         )
+        _keep_aux(aux[branch], branch_aux, k)
         valid[k] = reach[branch]
         if not valid[k]:
             for j in range(6):
@@ -615,9 +627,11 @@ def ur_solve_branch(
     branch: int,
     q: np.ndarray,
     valid: np.ndarray,
+    branch_aux: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Kernel: UR branch ``branch`` of poses T (N, 4, 4): q (N, 6), NaN where not
-    valid (N,); the same operations as :func:`ur_solve` on that branch alone."""
+    valid (N,), and its branch quantities branch_aux (N, 5) (a ``branch_aux`` of shape
+    (1, 5) is scratch); the same operations as :func:`ur_solve` on that branch alone."""
     theta = np.empty(6)
     Y = np.zeros(U_N_ANGLES)
     X = np.ones(U_N_ANGLES)
@@ -651,6 +665,7 @@ def ur_solve_branch(
             (wrist, wrist + 1),
             (elbow, elbow + 1),
         )
+        _keep_aux(aux[branch], branch_aux, k)
         valid[k] = reach[branch]
         if not valid[k]:
             for j in range(6):

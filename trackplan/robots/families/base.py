@@ -99,9 +99,13 @@ class IKFamily(Protocol):
         """
         ...
 
-    def solve_branch(self, T_base_tool: np.ndarray, branch: int) -> tuple[np.ndarray, np.ndarray]:
+    def solve_branch(
+        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """One branch of a flat batch of tool poses (N, 4, 4): what :meth:`solve_flat`
         gives for that branch, solving that branch only.
+
+        ``with_aux=True`` keeps the branch quantities (else aux is (1, 5) scratch).
 
         Returns
         -------
@@ -109,6 +113,8 @@ class IKFamily(Protocol):
             Shape (N, 6), rad in (−π, π], NaN where not valid.
         valid
             Shape (N,), bool.
+        aux
+            Shape (N, :data:`AUX_SIZE`): that branch's quantities of :meth:`solve_flat`.
         """
         ...
 
@@ -155,7 +161,8 @@ def solve_branch_fused(
     tail_inv: np.ndarray,
     T_base_tool: np.ndarray,
     branch: int,
-) -> tuple[np.ndarray, np.ndarray]:
+    with_aux: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Run a closed-form family's one-branch compiled kernel over a flat batch of poses.
 
     Parameters
@@ -168,14 +175,17 @@ def solve_branch_fused(
         Tool poses, shape (N, 4, 4), m.
     branch
         The branch, 0 … 7.
+    with_aux
+        False skips the branch quantities (aux is then (1, AUX_SIZE) scratch).
 
     Returns
     -------
     tuple of numpy.ndarray
-        q (N, 6) rad (NaN where not valid), valid (N,) bool.
+        q (N, 6) rad (NaN where not valid), valid (N,) bool, aux (N, AUX_SIZE).
     """
     T = np.ascontiguousarray(T_base_tool, dtype=float)
     q = np.empty((T.shape[0], 6))
     valid = np.empty(T.shape[0], dtype=np.bool_)
-    kernel(geometry, tail_inv, T, int(branch), q, valid)
-    return q, valid
+    aux = np.empty((T.shape[0] if with_aux else 1, AUX_SIZE))
+    kernel(geometry, tail_inv, T, int(branch), q, valid, aux)
+    return q, valid, aux

@@ -47,6 +47,8 @@ class NumericFamily:
             key="robot",
         )
 
-    def solve_branch(self, T_base_tool: np.ndarray, branch: int) -> tuple[np.ndarray, np.ndarray]:
+    def solve_branch(
+        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
-        return self.solve_flat(T_base_tool)[:2]
+        return self.solve_flat(T_base_tool)

@@ -265,9 +265,11 @@ class URFamily:
         """
         return solve_fused(kern.ur_solve, self._geometry, self._tail_inv, T_base_tool, with_aux)
 
-    def solve_branch(self, T_base_tool: np.ndarray, branch: int) -> tuple[np.ndarray, np.ndarray]:
-        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), the values
-        :meth:`solve_flat` gives for it."""
+    def solve_branch(
+        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), aux (N, 5) (or
+        (1, 5) scratch without ``with_aux``), the values :meth:`solve_flat` gives for it."""
         return solve_branch_fused(
-            kern.ur_solve_branch, self._geometry, self._tail_inv, T_base_tool, branch
+            kern.ur_solve_branch, self._geometry, self._tail_inv, T_base_tool, branch, with_aux
         )
