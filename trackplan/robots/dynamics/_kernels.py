@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from trackplan.robots._kernels import REDUCTION_LIMIT, sincos
+
 BLOCK = 32
 """Samples per block (16–64 measure alike; 32 was fastest on AVX2)."""
 
@@ -66,32 +68,13 @@ _TAU = 35
 _ROWS = 36
 SEGMENT = _ROWS * BLOCK
 
-_TWO_OVER_PI = 6.36619772367581382433e-01
-_PIO2_1 = 1.57079632673412561417e00  # first 33 bits of π/2
-_PIO2_2 = 6.07710050630396597660e-11  # next 33 bits
-_PIO2_3 = 2.02226624871116645580e-21  # next 33 bits
-_S1 = -1.66666666666666324348e-01
-_S2 = 8.33333333332248946124e-03
-_S3 = -1.98412698298579493134e-04
-_S4 = 2.75573137070700676789e-06
-_S5 = -2.50507602534068634195e-08
-_S6 = 1.58969099521155010221e-10
-_C1 = 4.16666666666666019037e-02
-_C2 = -1.38888888888741095749e-03
-_C3 = 2.48015872894767294178e-05
-_C4 = -2.75573143513906633035e-07
-_C5 = 2.08757232129817482790e-09
-_C6 = -1.13596475577881948265e-11
-_REDUCTION_LIMIT = 1.0e5
-"""rad: beyond it the three-part reduction loses bits and libm takes over."""
-
 
 @njit(cache=True, nogil=True, fastmath={"contract"})
 def _sincos(seg: np.ndarray) -> None:
     """Cosine and sine of a segment's ``q`` row into its cos and sin rows."""
     exotic = False
     for b in range(BLOCK):
-        if not abs(seg[_Q * BLOCK + b]) <= _REDUCTION_LIMIT:
+        if not abs(seg[_Q * BLOCK + b]) <= REDUCTION_LIMIT:
             exotic = True
     if exotic:
         for b in range(BLOCK):
@@ -99,22 +82,9 @@ def _sincos(seg: np.ndarray) -> None:
             seg[_SIN * BLOCK + b] = np.sin(seg[_Q * BLOCK + b])
         return
     for b in range(BLOCK):
-        x = seg[_Q * BLOCK + b]
-        k = np.floor(x * _TWO_OVER_PI + 0.5)
-        r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_3  # |r| <= π/4
-        z = r * r
-        zz = z * z
-        sin_r = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
-        tail = z * (_C1 + z * (_C2 + z * _C3)) + zz * zz * (_C4 + z * (_C5 + z * _C6))
-        half = 0.5 * z
-        head = 1.0 - half
-        cos_r = head + (((1.0 - head) - half) + z * tail)
-        quadrant = k - 4.0 * np.floor(0.25 * k)
-        odd = quadrant == 1.0 or quadrant == 3.0
-        sin_abs = cos_r if odd else sin_r
-        cos_abs = sin_r if odd else cos_r
-        seg[_SIN * BLOCK + b] = -sin_abs if quadrant >= 2.0 else sin_abs
-        seg[_COS * BLOCK + b] = -cos_abs if (quadrant == 1.0 or quadrant == 2.0) else cos_abs
+        cos_q, sin_q = sincos(seg[_Q * BLOCK + b])
+        seg[_COS * BLOCK + b] = cos_q
+        seg[_SIN * BLOCK + b] = sin_q
 
 
 @njit(cache=True, nogil=True, fastmath={"contract", "reassoc"})
