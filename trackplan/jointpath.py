@@ -19,7 +19,7 @@ import numpy as np
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.robots.model import Robot
-from trackplan.robots.path_ik import PathIK, branch_joints, solve_path_ik
+from trackplan.robots.path_ik import PathIK, branch_joints_along, solve_path_ik
 from trackplan.status import Status
 from trackplan.stencils import stencil_derivatives, stencil_points
 from trackplan.tool import ToolFrame, ToolOrientation
@@ -166,7 +166,8 @@ class JointPath:
             Shape (M, n), rad.
         """
         s = np.asarray(s, dtype=float)
-        return branch_joints(self.robot, self.poses(s), self.branch, self.interpolate(s))
+        grid, q_grid = self._distinct_grid
+        return branch_joints_along(self.robot, self.poses(s), self.branch, s, grid, q_grid)
 
     def interpolate(self, s: np.ndarray) -> np.ndarray:
         """q at ``s`` (M,) by linear interpolation of the grid, shape (M, n), rad."""
@@ -180,9 +181,9 @@ class JointPath:
     @cached_property
     def _distinct_grid(self) -> tuple[np.ndarray, np.ndarray]:
         """The grid with each zone boundary once, shape (G',), m, and q there, shape
-        (G', n), rad, column-major (each joint contiguous for :meth:`interpolate`)."""
+        (G', n), rad."""
         grid, first = np.unique(self.s, return_index=True)
-        return grid, np.asfortranarray(self.q[first])
+        return grid, np.ascontiguousarray(self.q[first])
 
     def derivatives(
         self, s: np.ndarray, lo: np.ndarray, hi: np.ndarray, h: np.ndarray | float

@@ -11,6 +11,7 @@ from trackplan.robots.families import solve_ik
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.path_ik import (
     branch_joints,
+    branch_joints_along,
     numeric_seeds,
     solve_path_ik,
     solve_path_ik_branches,
@@ -314,6 +315,26 @@ def test_branch_joints_are_the_path_ik_wound_to_a_reference(robot_name, request)
         found = branch_joints(robot, T, branch, reference)
         np.testing.assert_allclose(found, path.q[0] + shifts, rtol=0, atol=1e-12)
     assert solved >= 4
+
+
+@pytest.mark.parametrize("robot_name", ["puma", "ur"])
+def test_branch_joints_along_a_grid_wind_to_its_interpolation(robot_name, request):
+    """branch_joints_along (interpolation, holding and winding in one compiled pass) gives
+    branch_joints with numpy.interp's reference, bit for bit: poses in any order, some
+    before and after the grid, some out of reach."""
+    robot = request.getfixturevalue(robot_name)
+    T = feasible_line(300) if robot_name == "puma" else ur_line(robot, 300)
+    T[100:104, :3, 3] *= 4.0
+    rng = np.random.default_rng(3)
+    s_grid = np.sort(rng.uniform(0.0, 1.0, 40))
+    q_grid = rng.uniform(-9.0, 9.0, (40, 6))
+    s = rng.uniform(-0.1, 1.1, 300)
+    s[:3] = s_grid[[0, 17, -1]]
+    reference = np.column_stack([np.interp(s, s_grid, q_grid[:, j]) for j in range(6)])
+    for branch in (0, 3, 6):
+        found = branch_joints_along(robot, T, branch, s, s_grid, q_grid)
+        np.testing.assert_array_equal(found, branch_joints(robot, T, branch, reference))
+        assert np.all(np.abs(found - reference) <= np.pi)
 
 
 def test_branch_joints_of_a_numeric_robot_are_its_path_ik():

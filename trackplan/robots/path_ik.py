@@ -59,6 +59,7 @@ from trackplan.robots._kernels import (
     gather_closed_form,
     numeric_paths,
     room_bounds,
+    wind_along,
 )
 from trackplan.robots.families import AUX_SIZE, N_BRANCHES, IKFamily, ik_family
 from trackplan.robots.ik_numeric import chain_arrays
@@ -369,16 +370,57 @@ def branch_joints(
     numpy.ndarray
         Shape (M, n), rad.
     """
+    at = np.arange(len(reference), dtype=float)  # interpolating at the nodes: the reference
+    return branch_joints_along(robot, T_base_tool, branch, at, at, reference)
+
+
+def branch_joints_along(
+    robot: Robot,
+    T_base_tool: np.ndarray,
+    branch: int,
+    s: np.ndarray,
+    s_grid: np.ndarray,
+    q_grid: np.ndarray,
+) -> np.ndarray:
+    """:func:`branch_joints` with the reference interpolated from a grid, in one pass.
+
+    The joints are those of :func:`branch_joints` with the reference
+    ``numpy.interp(s, s_grid, q_grid[:, j])`` per joint j; the interpolation, the holding
+    of missed poses and the winding are one compiled pass over the poses
+    (:func:`~trackplan.robots._kernels.wind_along`).
+
+    Parameters
+    ----------
+    robot
+        The robot.
+    T_base_tool
+        Tool poses in the base frame, shape (M, 4, 4), m.
+    branch
+        The IK branch (closed-form branch or numeric seed), 0 … 7.
+    s
+        Where each pose lies on the grid's axis, shape (M,) (arc length, m).
+    s_grid, q_grid
+        The reference: strictly increasing grid (G,) and joint positions there (G, n), rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (M, n), rad.
+    """
     family = ik_family(robot)
     if family.closed_form:
         q, valid, _ = family.solve_branch(T_base_tool, branch)
-        if not valid.all() and valid.any():
-            held = np.maximum.accumulate(np.where(valid, np.arange(len(valid)), -1))
-            held[held < 0] = np.argmax(valid)
-            q = q[held]
     else:
         q = solve_path_ik(robot, np.asarray(T_base_tool)[None], branch=branch).q[0]
-    return q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
+        valid = np.ones(len(q), dtype=np.bool_)
+    wind_along(
+        q,
+        valid,
+        np.ascontiguousarray(s, dtype=float),
+        np.ascontiguousarray(s_grid, dtype=float),
+        np.ascontiguousarray(q_grid, dtype=float),
+    )
+    return q
 
 
 def _branch_paths(
