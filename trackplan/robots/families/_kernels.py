@@ -413,6 +413,11 @@ def opw_solve(
         _opw_assemble(g, angles, valid[k], q[k])
 
 
+BLOCK = 32
+"""Poses per block of :func:`opw_solve_branch`: each pass over a block is a flat loop over
+its poses that LLVM turns into SIMD code."""
+
+
 @njit(cache=True, error_model="numpy")
 def opw_solve_branch(
     g: np.ndarray,
@@ -425,30 +430,142 @@ def opw_solve_branch(
 ) -> None:  # pragma: no cover - compiled
     """Kernel: OPW branch ``branch`` of poses T (N, 4, 4): q (N, 6), NaN where not
     valid (N,), and its branch quantities branch_aux (N, 5) (a ``branch_aux`` of shape
-    (1, 5) is scratch); the same operations as :func:`opw_solve` on that branch alone."""
-    Y = np.zeros(O_N_ANGLES)
-    X = np.ones(O_N_ANGLES)
-    angles = np.empty(O_N_ANGLES)
-    reach = np.empty(N_BRANCHES, dtype=np.bool_)
-    aux = np.empty((N_BRANCHES, AUX_SIZE))
+    (1, 5) is scratch); the same operations as :func:`opw_solve` on that branch alone.
+
+    Blocks of :data:`BLOCK` poses, in three flat passes each: the arm's arctangent
+    arguments (the expressions of :func:`_opw_arguments` for one shoulder and elbow,
+    unreachable poses computed through and marked), their arctangents, the joints.
+    """
+    a1 = g[O_A1]
+    b_off = g[O_B]
+    c1 = g[O_C1]
+    c2 = g[O_C2]
+    c4 = g[O_C4]
+    kappa = g[O_KAPPA]
+    cpsi = g[O_CPSI]
+    spsi = g[O_SPSI]
+    bx = g[O_BX]
+    by = g[O_BY]
+    c40 = g[O_C40]
+    s40 = g[O_S40]
     shoulder = (branch >> 2) & 1
     elbow = (branch >> 1) & 1
     arm = 2 * shoulder + elbow
+    flip = branch & 1
+    xr_sign = 1.0 if shoulder == 0 else -1.0
+    sg = 1.0 if shoulder == elbow else -1.0
+    keep = branch_aux.shape[0] > 1
+    n_poses = T.shape[0]
+    P = np.zeros((12, BLOCK))  # the pose's first three rows, one row per entry
+    Y = np.zeros((6, BLOCK))  # θ1, φ, θ2, θ4, θ5, θ6 arguments
+    X = np.ones((6, BLOCK))
+    A = np.empty((6, BLOCK))
+    aux = np.empty((AUX_SIZE, BLOCK))
+    ok = np.empty(BLOCK, dtype=np.bool_)
+    angles = np.empty(O_N_ANGLES)
+    slots = (O_TH1 + shoulder, O_PHI + shoulder, O_TH2 + arm)
     wrist = O_WRIST + 3 * arm
-    slots = np.array([O_TH1 + shoulder, O_PHI + shoulder, O_TH2 + arm, wrist, wrist + 1, wrist + 2])
-    for k in range(T.shape[0]):
-        _opw_arguments(
-            g, tail_inv, T[k], Y, X, reach, aux, (shoulder, shoulder + 1), (elbow, elbow + 1)
-        )
-        _keep_aux(aux[branch], branch_aux, k)
-        valid[k] = reach[branch]
-        if not valid[k]:
-            for j in range(6):
-                q[k, j] = np.nan
-            continue
-        for slot in slots:
-            angles[slot] = atan2(Y[slot], X[slot])
-        _opw_joints(g, angles, arm, branch & 1, q[k])
+    for start in range(0, n_poses, BLOCK):
+        m = min(BLOCK, n_poses - start)
+        for b in range(m):
+            for r in range(3):
+                for c in range(4):
+                    P[4 * r + c, b] = T[start + b, r, c]
+        for b in range(BLOCK):
+            w00 = P[0, b] * tail_inv[0, 0] + P[1, b] * tail_inv[1, 0]
+            w00 = w00 + P[2, b] * tail_inv[2, 0] + P[3, b] * tail_inv[3, 0]
+            w02 = P[0, b] * tail_inv[0, 2] + P[1, b] * tail_inv[1, 2]
+            w02 = w02 + P[2, b] * tail_inv[2, 2] + P[3, b] * tail_inv[3, 2]
+            w03 = P[0, b] * tail_inv[0, 3] + P[1, b] * tail_inv[1, 3]
+            w03 = w03 + P[2, b] * tail_inv[2, 3] + P[3, b] * tail_inv[3, 3]
+            w10 = P[4, b] * tail_inv[0, 0] + P[5, b] * tail_inv[1, 0]
+            w10 = w10 + P[6, b] * tail_inv[2, 0] + P[7, b] * tail_inv[3, 0]
+            w12 = P[4, b] * tail_inv[0, 2] + P[5, b] * tail_inv[1, 2]
+            w12 = w12 + P[6, b] * tail_inv[2, 2] + P[7, b] * tail_inv[3, 2]
+            w13 = P[4, b] * tail_inv[0, 3] + P[5, b] * tail_inv[1, 3]
+            w13 = w13 + P[6, b] * tail_inv[2, 3] + P[7, b] * tail_inv[3, 3]
+            w20 = P[8, b] * tail_inv[0, 0] + P[9, b] * tail_inv[1, 0]
+            w20 = w20 + P[10, b] * tail_inv[2, 0] + P[11, b] * tail_inv[3, 0]
+            w22 = P[8, b] * tail_inv[0, 2] + P[9, b] * tail_inv[1, 2]
+            w22 = w22 + P[10, b] * tail_inv[2, 2] + P[11, b] * tail_inv[3, 2]
+            w23 = P[8, b] * tail_inv[0, 3] + P[9, b] * tail_inv[1, 3]
+            w23 = w23 + P[10, b] * tail_inv[2, 3] + P[11, b] * tail_inv[3, 3]
+            cx = w03 - c4 * w02 - bx
+            cy = w13 - c4 * w12 - by
+            cz = w23 - c4 * w22
+            r2 = cx * cx + cy * cy - b_off * b_off
+            r = math.sqrt(max(r2, 0.0))
+            xr = xr_sign * r
+            c1_, s1_ = unit(cx * xr + cy * b_off, cy * xr - cx * b_off)
+            dx = xr - a1
+            dz = cz - c1
+            K = (dx * dx + dz * dz - c2 * c2 - kappa * kappa) / (2.0 * c2 * kappa)
+            ok[b] = not (r2 < -REACH_TOL or abs(K) > 1.0 + REACH_TOL)
+            K = min(max(K, -1.0), 1.0)
+            sphi = math.sqrt((1.0 - K) * (1.0 + K))
+            vx = c2 + kappa * K
+            vy = kappa * sg * sphi
+            c2_, s2_ = unit(dz * vx + dx * vy, dx * vx - dz * vy)
+            c3_ = K * cpsi + sg * sphi * spsi
+            s3_ = sg * sphi * cpsi - K * spsi
+            c23 = c2_ * c3_ - s2_ * s3_
+            s23 = s2_ * c3_ + c2_ * s3_
+            x0 = c1_ * c23
+            x1 = s1_ * c23
+            z0 = c1_ * s23
+            z1 = s1_ * s23
+            m00 = x0 * w00 + x1 * w10 + -s23 * w20
+            m02 = x0 * w02 + x1 * w12 + -s23 * w22
+            m10 = -s1_ * w00 + c1_ * w10 + 0.0 * w20
+            m12 = -s1_ * w02 + c1_ * w12 + 0.0 * w22
+            m20 = z0 * w00 + z1 * w10 + c23 * w20
+            m22 = z0 * w02 + z1 * w12 + c23 * w22
+            s5 = math.sqrt(m02 * m02 + m12 * m12)
+            c5 = m22
+            singular = not s5 > WRIST_SINGULAR
+            c4_ = c40 if singular else m02 / s5
+            s4_ = s40 if singular else m12 / s5
+            n00 = c4_ * m00 + s4_ * m10
+            n10 = -s4_ * m00 + c4_ * m10
+            Y[0, b] = s1_
+            X[0, b] = c1_
+            Y[1, b] = sphi
+            X[1, b] = K
+            Y[2, b] = s2_
+            X[2, b] = c2_
+            Y[3, b] = s4_
+            X[3, b] = c4_
+            Y[4, b] = s5
+            X[4, b] = c5
+            Y[5, b] = n10
+            X[5, b] = c5 * n00 - s5 * m20
+            aux[0, b] = r
+            aux[1, b] = sphi
+            aux[2, b] = z1 * w22 - c23 * w12
+            aux[3, b] = c23 * w02 - z0 * w22
+            aux[4, b] = z0 * w12 - z1 * w02
+        for e in range(6):
+            for b in range(BLOCK):
+                A[e, b] = atan2(Y[e, b], X[e, b])
+        for b in range(m):
+            k = start + b
+            row = k if keep else 0
+            valid[k] = ok[b]
+            if not ok[b]:
+                for j in range(AUX_SIZE):
+                    branch_aux[row, j] = np.nan
+                for j in range(6):
+                    q[k, j] = np.nan
+                continue
+            for j in range(AUX_SIZE):
+                branch_aux[row, j] = aux[j, b]
+            angles[slots[0]] = A[0, b]
+            angles[slots[1]] = A[1, b]
+            angles[slots[2]] = A[2, b]
+            angles[wrist] = A[3, b]
+            angles[wrist + 1] = A[4, b]
+            angles[wrist + 2] = A[5, b]
+            _opw_joints(g, angles, arm, flip, q[k])
 
 
 # UR geometry vector.
