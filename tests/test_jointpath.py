@@ -1,6 +1,6 @@
 """The joint path's tool poses: a tool held in one orientation along the whole path (part
 frame, constant spin) takes its one rotation once; the poses equal those from the rotation
-at every point."""
+at every point; the joints at any arc lengths are the IK of those poses."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import trackplan
 from tests.conftest import CASES
 from trackplan.frames import tool_poses
 from trackplan.jointpath import _rotations
+from trackplan.robots.path_ik import branch_joints
 
 
 def test_poses_of_a_tool_in_one_orientation_equal_those_of_every_point():
@@ -33,3 +34,17 @@ def test_a_seam_frame_tool_turns_with_the_path():
     rotations = _rotations(joint_path.tool, sample.s, sample.tangent)
     assert rotations.shape == (101, 3, 3)
     np.testing.assert_array_equal(rotations, joint_path.tool.rotations(sample.s, sample.tangent))
+
+
+def test_joints_are_the_branch_ik_of_the_poses():
+    """JointPath.joints solves the IK from the poses' rotations and positions without
+    building them: bit for bit the joints of branch_joints on :meth:`JointPath.poses`
+    wound near the interpolated grid, for a tool in one orientation and a turning one."""
+    for name in ("paper-corner", "paper-circle-seam-fixed"):
+        case = trackplan.load_case(CASES / f"{name}.yaml")
+        joint_path = trackplan.plan_placement(case, case.bounds.example).joint_path
+        s = np.linspace(0.0, joint_path.length, 777)[::-1]
+        expected = branch_joints(
+            case.robot, joint_path.poses(s), joint_path.branch, joint_path.interpolate(s)
+        )
+        np.testing.assert_array_equal(joint_path.joints(s), expected)

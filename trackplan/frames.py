@@ -164,23 +164,43 @@ def tool_poses(X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray) ->
         Shape (B, M, 4, 4) (or (M, 4, 4) for a single placement).
     """
     X = np.asarray(X, dtype=float)
+    R_base_tool, p_base_tool = tool_pose_parts(np.atleast_2d(X), positions, R_part_tool)
+    poses = np.empty((*p_base_tool.shape[:2], 4, 4))
+    poses[..., :3, :3] = R_base_tool
+    poses[..., :3, 3] = p_base_tool
+    poses[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+    return poses[0] if X.ndim == 1 else poses
+
+
+def tool_pose_parts(
+    X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rotations and positions of :func:`tool_poses`, without the (…, 4, 4) array.
+
+    Parameters are those of :func:`tool_poses`.
+
+    Returns
+    -------
+    R_base_tool
+        Shape (B, M, 3, 3), or (B, 1, 3, 3) for one ``R_part_tool`` (3, 3) (the rotation
+        every point shares); (M or 1, 3, 3) for a single placement.
+    p_base_tool
+        Shape (B, M, 3), m ((M, 3) for a single placement).
+    """
+    X = np.asarray(X, dtype=float)
     single = X.ndim == 1
     T_base_part = placement_transform(np.atleast_2d(X))  # (B, 4, 4)
     R = T_base_part[:, :3, :3]
     R_part_tool = np.asarray(R_part_tool, dtype=float)
     if R_part_tool.ndim < 4:
         R_part_tool = R_part_tool.reshape(1, -1, 3, 3)  # (1, 1 or M, 3, 3)
-    poses = np.empty((len(R), len(positions), 4, 4))
     if R_part_tool.shape[0] == 1:
-        poses[..., :3, :3] = rotate_each(R, R_part_tool[0])
+        rotations = rotate_each(R, R_part_tool[0])
     else:
-        poses[..., :3, :3] = R[:, None] @ R_part_tool
-    # the positions in a contiguous array first: one strided write into the poses
+        rotations = R[:, None] @ R_part_tool
     placed = np.asarray(positions, dtype=float) @ R.transpose(0, 2, 1)  # (B, M, 3)
     placed += T_base_part[:, None, :3, 3]
-    poses[..., :3, 3] = placed
-    poses[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
-    return poses[0] if single else poses
+    return (rotations[0], placed[0]) if single else (rotations, placed)
 
 
 def as_placement(X: object, key: str = "placement") -> np.ndarray:

@@ -16,7 +16,7 @@ from functools import cached_property
 
 import numpy as np
 
-from trackplan.frames import placement_transform, tool_poses
+from trackplan.frames import placement_transform, tool_pose_parts, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import PathIK, branch_joints_along, solve_path_ik
@@ -153,7 +153,9 @@ class JointPath:
         """Joint positions at arc lengths ``s`` by IK on this path's branch.
 
         Each joint is put on the winding of the grid solution nearest in s, so the result
-        continues :attr:`q` whatever the order of ``s``.
+        continues :attr:`q` whatever the order of ``s``. The IK reads the poses' rotations
+        and positions (:func:`trackplan.frames.tool_pose_parts`), the values of
+        :meth:`poses`, without building them.
 
         Parameters
         ----------
@@ -166,8 +168,13 @@ class JointPath:
             Shape (M, n), rad.
         """
         s = np.asarray(s, dtype=float)
+        sample = self.geometry.planned.sample(s)
+        rotations = _rotations(self.tool, sample.s, sample.tangent)
+        R_base_tool, p_base_tool = tool_pose_parts(self.placement, sample.position, rotations)
         grid, q_grid = self._distinct_grid
-        return branch_joints_along(self.robot, self.poses(s), self.branch, s, grid, q_grid)
+        return branch_joints_along(
+            self.robot, R_base_tool, p_base_tool, self.branch, s, grid, q_grid
+        )
 
     def interpolate(self, s: np.ndarray) -> np.ndarray:
         """q at ``s`` (M,) by linear interpolation of the grid, shape (M, n), rad."""

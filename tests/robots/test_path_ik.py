@@ -319,9 +319,10 @@ def test_branch_joints_are_the_path_ik_wound_to_a_reference(robot_name, request)
 
 @pytest.mark.parametrize("robot_name", ["puma", "ur"])
 def test_branch_joints_along_a_grid_wind_to_its_interpolation(robot_name, request):
-    """branch_joints_along (interpolation, holding and winding in one compiled pass) gives
-    branch_joints with numpy.interp's reference, bit for bit: poses in any order, some
-    before and after the grid, some out of reach."""
+    """branch_joints_along (poses by their parts; interpolation, holding and winding in one
+    compiled pass) gives branch_joints with numpy.interp's reference, bit for bit: poses
+    in any order, some before and after the grid, some out of reach; one rotation for
+    all poses as one per pose."""
     robot = request.getfixturevalue(robot_name)
     T = feasible_line(300) if robot_name == "puma" else ur_line(robot, 300)
     T[100:104, :3, 3] *= 4.0
@@ -331,10 +332,13 @@ def test_branch_joints_along_a_grid_wind_to_its_interpolation(robot_name, reques
     s = rng.uniform(-0.1, 1.1, 300)
     s[:3] = s_grid[[0, 17, -1]]
     reference = np.column_stack([np.interp(s, s_grid, q_grid[:, j]) for j in range(6)])
+    R, p = T[:, :3, :3], T[:, :3, 3]
     for branch in (0, 3, 6):
-        found = branch_joints_along(robot, T, branch, s, s_grid, q_grid)
+        found = branch_joints_along(robot, R, p, branch, s, s_grid, q_grid)
         np.testing.assert_array_equal(found, branch_joints(robot, T, branch, reference))
         assert np.all(np.abs(found - reference) <= np.pi)
+        one = branch_joints_along(robot, R[0], p, branch, s, s_grid, q_grid)  # line: one R
+        np.testing.assert_array_equal(one, found)
 
 
 def test_branch_joints_of_a_numeric_robot_are_its_path_ik():

@@ -370,31 +370,38 @@ def branch_joints(
     numpy.ndarray
         Shape (M, n), rad.
     """
+    T = np.asarray(T_base_tool, dtype=float)
     at = np.arange(len(reference), dtype=float)  # interpolating at the nodes: the reference
-    return branch_joints_along(robot, T_base_tool, branch, at, at, reference)
+    return branch_joints_along(robot, T[:, :3, :3], T[:, :3, 3], branch, at, at, reference)
 
 
 def branch_joints_along(
     robot: Robot,
-    T_base_tool: np.ndarray,
+    R_base_tool: np.ndarray,
+    p_base_tool: np.ndarray,
     branch: int,
     s: np.ndarray,
     s_grid: np.ndarray,
     q_grid: np.ndarray,
 ) -> np.ndarray:
-    """:func:`branch_joints` with the reference interpolated from a grid, in one pass.
+    """:func:`branch_joints` of poses given by their parts, the reference interpolated from
+    a grid, in one pass.
 
-    The joints are those of :func:`branch_joints` with the reference
-    ``numpy.interp(s, s_grid, q_grid[:, j])`` per joint j; the interpolation, the holding
-    of missed poses and the winding are one compiled pass over the poses
-    (:func:`~trackplan.robots._kernels.wind_along`).
+    The joints are those of :func:`branch_joints` of the poses ``[R_base_tool p_base_tool;
+    0 1]`` with the reference ``numpy.interp(s, s_grid, q_grid[:, j])`` per joint j. A
+    closed-form family reads the rotations and positions as they are
+    (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch_parts`: no (M, 4, 4)
+    array); the interpolation, the holding of missed poses and the winding are one
+    compiled pass over the poses (:func:`~trackplan.robots._kernels.wind_along`).
 
     Parameters
     ----------
     robot
         The robot.
-    T_base_tool
-        Tool poses in the base frame, shape (M, 4, 4), m.
+    R_base_tool
+        Tool rotations in the base frame, shape (M, 3, 3), or one for all poses, (3, 3).
+    p_base_tool
+        Tool positions in the base frame, shape (M, 3), m.
     branch
         The IK branch (closed-form branch or numeric seed), 0 … 7.
     s
@@ -409,9 +416,13 @@ def branch_joints_along(
     """
     family = ik_family(robot)
     if family.closed_form:
-        q, valid, _ = family.solve_branch(T_base_tool, branch)
+        q, valid, _ = family.solve_branch_parts(R_base_tool, p_base_tool, branch, with_aux=False)
     else:
-        q = solve_path_ik(robot, np.asarray(T_base_tool)[None], branch=branch).q[0]
+        T = np.zeros((len(p_base_tool), 4, 4))
+        T[:, :3, :3] = R_base_tool
+        T[:, :3, 3] = p_base_tool
+        T[:, 3, 3] = 1.0
+        q = solve_path_ik(robot, T[None], branch=branch).q[0]
         valid = np.ones(len(q), dtype=np.bool_)
     wind_along(
         q,

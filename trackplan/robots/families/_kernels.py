@@ -422,15 +422,17 @@ its poses that LLVM turns into SIMD code."""
 def opw_solve_branch(
     g: np.ndarray,
     tail_inv: np.ndarray,
-    T: np.ndarray,
+    R: np.ndarray,
+    p: np.ndarray,
     branch: int,
     q: np.ndarray,
     valid: np.ndarray,
     branch_aux: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
-    """Kernel: OPW branch ``branch`` of poses T (N, 4, 4): q (N, 6), NaN where not
-    valid (N,), and its branch quantities branch_aux (N, 5) (a ``branch_aux`` of shape
-    (1, 5) is scratch); the same operations as :func:`opw_solve` on that branch alone.
+    """Kernel: OPW branch ``branch`` of poses with rotations R (N, 3, 3) (or one, (1, 3,
+    3)) and positions p (N, 3): q (N, 6), NaN where not valid (N,), and its branch
+    quantities branch_aux (N, 5) (a ``branch_aux`` of shape (1, 5) is scratch); the same
+    operations as :func:`opw_solve` on that branch alone.
 
     Blocks of :data:`BLOCK` poses, in three flat passes each: the arm's arctangent
     arguments (the expressions of :func:`_opw_arguments` for one shoulder and elbow,
@@ -455,7 +457,8 @@ def opw_solve_branch(
     xr_sign = 1.0 if shoulder == 0 else -1.0
     sg = 1.0 if shoulder == elbow else -1.0
     keep = branch_aux.shape[0] > 1
-    n_poses = T.shape[0]
+    n_poses = p.shape[0]
+    one_rotation = R.shape[0] == 1
     P = np.zeros((12, BLOCK))  # the pose's first three rows, one row per entry
     Y = np.zeros((6, BLOCK))  # θ1, φ, θ2, θ4, θ5, θ6 arguments
     X = np.ones((6, BLOCK))
@@ -468,9 +471,11 @@ def opw_solve_branch(
     for start in range(0, n_poses, BLOCK):
         m = min(BLOCK, n_poses - start)
         for b in range(m):
+            Rk = R[0 if one_rotation else start + b]
             for r in range(3):
-                for c in range(4):
-                    P[4 * r + c, b] = T[start + b, r, c]
+                for c in range(3):
+                    P[4 * r + c, b] = Rk[r, c]
+                P[4 * r + 3, b] = p[start + b, r]
         for b in range(BLOCK):
             w00 = P[0, b] * tail_inv[0, 0] + P[1, b] * tail_inv[1, 0]
             w00 = w00 + P[2, b] * tail_inv[2, 0] + P[3, b] * tail_inv[3, 0]
@@ -740,15 +745,19 @@ def ur_solve(
 def ur_solve_branch(
     g: np.ndarray,
     tail_inv: np.ndarray,
-    T: np.ndarray,
+    R: np.ndarray,
+    p: np.ndarray,
     branch: int,
     q: np.ndarray,
     valid: np.ndarray,
     branch_aux: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
-    """Kernel: UR branch ``branch`` of poses T (N, 4, 4): q (N, 6), NaN where not
-    valid (N,), and its branch quantities branch_aux (N, 5) (a ``branch_aux`` of shape
-    (1, 5) is scratch); the same operations as :func:`ur_solve` on that branch alone."""
+    """Kernel: UR branch ``branch`` of poses with rotations R (N, 3, 3) (or one, (1, 3,
+    3)) and positions p (N, 3): q (N, 6), NaN where not valid (N,), and its branch
+    quantities branch_aux (N, 5) (a ``branch_aux`` of shape (1, 5) is scratch); the same
+    operations as :func:`ur_solve` on that branch alone."""
+    T_k = np.zeros((4, 4))
+    T_k[3, 3] = 1.0
     theta = np.empty(6)
     Y = np.zeros(U_N_ANGLES)
     X = np.ones(U_N_ANGLES)
@@ -769,11 +778,16 @@ def ur_solve_branch(
             U_TH2 + 2 * pair + elbow,
         ]
     )
-    for k in range(T.shape[0]):
+    for k in range(p.shape[0]):
+        Rk = R[0 if R.shape[0] == 1 else k]
+        for r in range(3):
+            for c in range(3):
+                T_k[r, c] = Rk[r, c]
+            T_k[r, 3] = p[k, r]
         _ur_arguments(
             g,
             tail_inv,
-            T[k],
+            T_k,
             Y,
             X,
             reach,

@@ -118,6 +118,13 @@ class IKFamily(Protocol):
         """
         ...
 
+    def solve_branch_parts(
+        self, R_base_tool: np.ndarray, p_base_tool: np.ndarray, branch: int, *, with_aux: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`solve_branch` of poses given by their rotations (N, 3, 3), or one rotation
+        (3, 3) for all, and positions (N, 3), m: no (N, 4, 4) array needed."""
+        ...
+
 
 def solve_fused(
     kernel: Callable[..., None],
@@ -159,7 +166,8 @@ def solve_branch_fused(
     kernel: Callable[..., None],
     geometry: np.ndarray,
     tail_inv: np.ndarray,
-    T_base_tool: np.ndarray,
+    R_base_tool: np.ndarray,
+    p_base_tool: np.ndarray,
     branch: int,
     with_aux: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -171,8 +179,10 @@ def solve_branch_fused(
         ``opw_solve_branch`` or ``ur_solve_branch`` of ``families/_kernels.py``.
     geometry, tail_inv
         As :func:`solve_fused`.
-    T_base_tool
-        Tool poses, shape (N, 4, 4), m.
+    R_base_tool
+        Tool rotations, shape (N, 3, 3), or one for every pose, (3, 3).
+    p_base_tool
+        Tool positions, shape (N, 3), m.
     branch
         The branch, 0 … 7.
     with_aux
@@ -183,9 +193,11 @@ def solve_branch_fused(
     tuple of numpy.ndarray
         q (N, 6) rad (NaN where not valid), valid (N,) bool, aux (N, AUX_SIZE).
     """
-    T = np.ascontiguousarray(T_base_tool, dtype=float)
-    q = np.empty((T.shape[0], 6))
-    valid = np.empty(T.shape[0], dtype=np.bool_)
-    aux = np.empty((T.shape[0] if with_aux else 1, AUX_SIZE))
-    kernel(geometry, tail_inv, T, int(branch), q, valid, aux)
+    R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
+    p = np.ascontiguousarray(p_base_tool, dtype=float)
+    n_poses = p.shape[0]
+    q = np.empty((n_poses, 6))
+    valid = np.empty(n_poses, dtype=np.bool_)
+    aux = np.empty((n_poses if with_aux else 1, AUX_SIZE))
+    kernel(geometry, tail_inv, R, p, int(branch), q, valid, aux)
     return q, valid, aux

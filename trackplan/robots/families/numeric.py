@@ -52,3 +52,9 @@ class NumericFamily:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
         return self.solve_flat(T_base_tool)
+
+    def solve_branch_parts(
+        self, R_base_tool: np.ndarray, p_base_tool: np.ndarray, branch: int, *, with_aux: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
+        return self.solve_flat(np.empty((0, 4, 4)))

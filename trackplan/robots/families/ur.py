@@ -270,6 +270,20 @@ class URFamily:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), aux (N, 5) (or
         (1, 5) scratch without ``with_aux``), the values :meth:`solve_flat` gives for it."""
+        T = np.asarray(T_base_tool, dtype=float)
+        return self.solve_branch_parts(T[:, :3, :3], T[:, :3, 3], branch, with_aux=with_aux)
+
+    def solve_branch_parts(
+        self, R_base_tool: np.ndarray, p_base_tool: np.ndarray, branch: int, *, with_aux: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`solve_branch` of poses given by rotations (N, 3, 3) (or one, (3, 3)) and
+        positions (N, 3), m."""
         return solve_branch_fused(
-            kern.ur_solve_branch, self._geometry, self._tail_inv, T_base_tool, branch, with_aux
+            kern.ur_solve_branch,
+            self._geometry,
+            self._tail_inv,
+            R_base_tool,
+            p_base_tool,
+            branch,
+            with_aux,
         )
