@@ -537,57 +537,6 @@ def gather_closed_form(
 
 
 @njit(cache=True, error_model="numpy")
-def wind_along(
-    q: np.ndarray, valid: np.ndarray, s: np.ndarray, s_grid: np.ndarray, q_grid: np.ndarray
-) -> None:  # pragma: no cover - compiled
-    """Kernel: one branch's joints held over the poses it misses and wound, in place.
-
-    A pose the branch does not reach takes the joints of the reachable pose before it (the
-    first reachable one before them all); every joint is then moved by the multiple of 2π
-    that brings it nearest the reference, the linear interpolation of ``q_grid`` at ``s``
-    (``numpy.interp``'s formula, its end values outside the grid). With no reachable pose
-    the joints stay as they are (NaN).
-
-    Parameters
-    ----------
-    q
-        Joint positions, shape (M, n), rad (changed in place).
-    valid
-        Shape (M,), bool: the branch reaches the pose.
-    s
-        Where each pose lies, shape (M,).
-    s_grid, q_grid
-        Reference: strictly increasing abscissae (G,) and the joints there (G, n), rad.
-    """
-    n_poses, n = q.shape
-    n_grid = s_grid.shape[0]
-    two_pi = 2.0 * math.pi
-    held = np.empty(n)
-    first = -1
-    for m in range(n_poses):
-        if valid[m]:
-            first = m
-            break
-    for j in range(n):
-        held[j] = q[first, j] if first >= 0 else np.nan
-    for m in range(n_poses):
-        if first < 0 or valid[m]:
-            for j in range(n):
-                held[j] = q[m, j]
-        x = s[m]
-        i = np.searchsorted(s_grid, x, side="right") - 1
-        for j in range(n):
-            if i < 0:
-                reference = q_grid[0, j]
-            elif i >= n_grid - 1:
-                reference = q_grid[n_grid - 1, j]
-            else:
-                slope = (q_grid[i + 1, j] - q_grid[i, j]) / (s_grid[i + 1] - s_grid[i])
-                reference = slope * (x - s_grid[i]) + q_grid[i, j]
-            q[m, j] = held[j] - two_pi * np.rint((held[j] - reference) / two_pi)
-
-
-@njit(cache=True, error_model="numpy")
 def room_bounds(
     q_all: np.ndarray, valid: np.ndarray, q_min: np.ndarray, q_max: np.ndarray
 ) -> np.ndarray:  # pragma: no cover - compiled

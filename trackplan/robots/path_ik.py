@@ -59,7 +59,6 @@ from trackplan.robots._kernels import (
     gather_closed_form,
     numeric_paths,
     room_bounds,
-    wind_along,
 )
 from trackplan.robots.families import AUX_SIZE, N_BRANCHES, IKFamily, ik_family
 from trackplan.robots.ik_numeric import chain_arrays
@@ -391,8 +390,8 @@ def branch_joints_along(
     0 1]`` with the reference ``numpy.interp(s, s_grid, q_grid[:, j])`` per joint j. A
     closed-form family reads the rotations and positions as they are
     (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch_parts`: no (M, 4, 4)
-    array); the interpolation, the holding of missed poses and the winding are one
-    compiled pass over the poses (:func:`~trackplan.robots._kernels.wind_along`).
+    array) and holds and winds the joints in the same compiled pass (``hold_and_wind`` of
+    ``families/_kernels.py``); numeric IK winds them after its path IK.
 
     Parameters
     ----------
@@ -416,22 +415,18 @@ def branch_joints_along(
     """
     family = ik_family(robot)
     if family.closed_form:
-        q, valid, _ = family.solve_branch_parts(R_base_tool, p_base_tool, branch, with_aux=False)
-    else:
-        T = np.zeros((len(p_base_tool), 4, 4))
-        T[:, :3, :3] = R_base_tool
-        T[:, :3, 3] = p_base_tool
-        T[:, 3, 3] = 1.0
-        q = solve_path_ik(robot, T[None], branch=branch).q[0]
-        valid = np.ones(len(q), dtype=np.bool_)
-    wind_along(
-        q,
-        valid,
-        np.ascontiguousarray(s, dtype=float),
-        np.ascontiguousarray(s_grid, dtype=float),
-        np.ascontiguousarray(q_grid, dtype=float),
-    )
-    return q
+        grid = (s, s_grid, q_grid)
+        return family.solve_branch_parts(
+            R_base_tool, p_base_tool, branch, with_aux=False, wind_to=grid
+        )[0]
+    T = np.zeros((len(p_base_tool), 4, 4))
+    T[:, :3, :3] = R_base_tool
+    T[:, :3, 3] = p_base_tool
+    T[:, 3, 3] = 1.0
+    q = solve_path_ik(robot, T[None], branch=branch).q[0]  # missed poses held
+    q_grid = np.asarray(q_grid, dtype=float)
+    reference = np.column_stack([np.interp(s, s_grid, column) for column in q_grid.T])
+    return q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
 
 
 def _branch_paths(

@@ -413,6 +413,57 @@ def opw_solve(
         _opw_assemble(g, angles, valid[k], q[k])
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def hold_and_wind(
+    q: np.ndarray, valid: np.ndarray, s: np.ndarray, s_grid: np.ndarray, q_grid: np.ndarray
+) -> None:  # pragma: no cover - compiled
+    """Kernel: one branch's joints held over the poses it misses and wound, in place.
+
+    A pose the branch does not reach takes the joints of the reachable pose before it (the
+    first reachable one before them all); every joint is then moved by the multiple of 2π
+    that brings it nearest the reference, the linear interpolation of ``q_grid`` at ``s``
+    (``numpy.interp``'s formula, its end values outside the grid). With no reachable pose
+    the joints stay as they are (NaN).
+
+    Parameters
+    ----------
+    q
+        Joint positions, shape (M, n), rad (changed in place).
+    valid
+        Shape (M,), bool: the branch reaches the pose.
+    s
+        Where each pose lies, shape (M,).
+    s_grid, q_grid
+        Reference: strictly increasing abscissae (G,) and the joints there (G, n), rad.
+    """
+    n_poses, n = q.shape
+    n_grid = s_grid.shape[0]
+    two_pi = 2.0 * math.pi
+    held = np.empty(n)
+    first = -1
+    for m in range(n_poses):
+        if valid[m]:
+            first = m
+            break
+    for j in range(n):
+        held[j] = q[first, j] if first >= 0 else np.nan
+    for m in range(n_poses):
+        if first < 0 or valid[m]:
+            for j in range(n):
+                held[j] = q[m, j]
+        x = s[m]
+        i = np.searchsorted(s_grid, x, side="right") - 1
+        for j in range(n):
+            if i < 0:
+                reference = q_grid[0, j]
+            elif i >= n_grid - 1:
+                reference = q_grid[n_grid - 1, j]
+            else:
+                slope = (q_grid[i + 1, j] - q_grid[i, j]) / (s_grid[i + 1] - s_grid[i])
+                reference = slope * (x - s_grid[i]) + q_grid[i, j]
+            q[m, j] = held[j] - two_pi * np.rint((held[j] - reference) / two_pi)
+
+
 BLOCK = 32
 """Poses per block of :func:`opw_solve_branch`: each pass over a block is a flat loop over
 its poses that LLVM turns into SIMD code."""
@@ -428,11 +479,15 @@ def opw_solve_branch(
     q: np.ndarray,
     valid: np.ndarray,
     branch_aux: np.ndarray,
+    s: np.ndarray,
+    s_grid: np.ndarray,
+    q_grid: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Kernel: OPW branch ``branch`` of poses with rotations R (N, 3, 3) (or one, (1, 3,
     3)) and positions p (N, 3): q (N, 6), NaN where not valid (N,), and its branch
     quantities branch_aux (N, 5) (a ``branch_aux`` of shape (1, 5) is scratch); the same
-    operations as :func:`opw_solve` on that branch alone.
+    operations as :func:`opw_solve` on that branch alone. With a reference grid (s_grid
+    (G,) not empty), the joints are then held and wound by :func:`hold_and_wind`.
 
     Blocks of :data:`BLOCK` poses, in three flat passes each: the arm's arctangent
     arguments (the expressions of :func:`_opw_arguments` for one shoulder and elbow,
@@ -571,6 +626,8 @@ def opw_solve_branch(
             angles[wrist + 1] = A[4, b]
             angles[wrist + 2] = A[5, b]
             _opw_joints(g, angles, arm, flip, q[k])
+    if s_grid.shape[0] > 0:
+        hold_and_wind(q, valid, s, s_grid, q_grid)
 
 
 # UR geometry vector.
@@ -751,11 +808,15 @@ def ur_solve_branch(
     q: np.ndarray,
     valid: np.ndarray,
     branch_aux: np.ndarray,
+    s: np.ndarray,
+    s_grid: np.ndarray,
+    q_grid: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Kernel: UR branch ``branch`` of poses with rotations R (N, 3, 3) (or one, (1, 3,
     3)) and positions p (N, 3): q (N, 6), NaN where not valid (N,), and its branch
     quantities branch_aux (N, 5) (a ``branch_aux`` of shape (1, 5) is scratch); the same
-    operations as :func:`ur_solve` on that branch alone."""
+    operations as :func:`ur_solve` on that branch alone. With a reference grid (s_grid
+    (G,) not empty), the joints are then held and wound by :func:`hold_and_wind`."""
     T_k = np.zeros((4, 4))
     T_k[3, 3] = 1.0
     theta = np.empty(6)
@@ -805,3 +866,5 @@ def ur_solve_branch(
         for slot in slots:
             angles[slot] = atan2(Y[slot], X[slot])
         _ur_joints(g, angles, branch, q[k], theta)
+    if s_grid.shape[0] > 0:
+        hold_and_wind(q, valid, s, s_grid, q_grid)

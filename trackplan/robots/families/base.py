@@ -119,10 +119,22 @@ class IKFamily(Protocol):
         ...
 
     def solve_branch_parts(
-        self, R_base_tool: np.ndarray, p_base_tool: np.ndarray, branch: int, *, with_aux: bool
+        self,
+        R_base_tool: np.ndarray,
+        p_base_tool: np.ndarray,
+        branch: int,
+        *,
+        with_aux: bool,
+        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`solve_branch` of poses given by their rotations (N, 3, 3), or one rotation
-        (3, 3) for all, and positions (N, 3), m: no (N, 4, 4) array needed."""
+        (3, 3) for all, and positions (N, 3), m: no (N, 4, 4) array needed.
+
+        ``wind_to = (s, s_grid, q_grid)`` (shapes (N,), (G,), (G, 6)) then holds the
+        joints of a missed pose at those of the reachable pose before it and moves each
+        joint by the multiple of 2π nearest the linear interpolation of ``q_grid`` at ``s``,
+        in the same compiled pass (``hold_and_wind`` of ``families/_kernels.py``).
+        """
         ...
 
 
@@ -170,6 +182,7 @@ def solve_branch_fused(
     p_base_tool: np.ndarray,
     branch: int,
     with_aux: bool,
+    wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Run a closed-form family's one-branch compiled kernel over a flat batch of poses.
 
@@ -187,11 +200,15 @@ def solve_branch_fused(
         The branch, 0 … 7.
     with_aux
         False skips the branch quantities (aux is then (1, AUX_SIZE) scratch).
+    wind_to
+        None, or (s, s_grid, q_grid) to hold and wind the joints
+        (:meth:`IKFamily.solve_branch_parts`).
 
     Returns
     -------
     tuple of numpy.ndarray
-        q (N, 6) rad (NaN where not valid), valid (N,) bool, aux (N, AUX_SIZE).
+        q (N, 6) rad (NaN where not valid, unless wound), valid (N,) bool, aux
+        (N, AUX_SIZE).
     """
     R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
     p = np.ascontiguousarray(p_base_tool, dtype=float)
@@ -199,5 +216,13 @@ def solve_branch_fused(
     q = np.empty((n_poses, 6))
     valid = np.empty(n_poses, dtype=np.bool_)
     aux = np.empty((n_poses if with_aux else 1, AUX_SIZE))
-    kernel(geometry, tail_inv, R, p, int(branch), q, valid, aux)
+    if wind_to is None:
+        s, s_grid, q_grid = _NO_GRID
+    else:
+        s, s_grid, q_grid = (np.ascontiguousarray(x, dtype=float) for x in wind_to)
+    kernel(geometry, tail_inv, R, p, int(branch), q, valid, aux, s, s_grid, q_grid)
     return q, valid, aux
+
+
+_NO_GRID = (np.empty(0), np.empty(0), np.empty((0, 6)))
+"""The kernels' reference arguments when the joints are not wound (s_grid empty)."""

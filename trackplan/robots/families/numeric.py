@@ -54,7 +54,13 @@ class NumericFamily:
         return self.solve_flat(T_base_tool)
 
     def solve_branch_parts(
-        self, R_base_tool: np.ndarray, p_base_tool: np.ndarray, branch: int, *, with_aux: bool
+        self,
+        R_base_tool: np.ndarray,
+        p_base_tool: np.ndarray,
+        branch: int,
+        *,
+        with_aux: bool,
+        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
         return self.solve_flat(np.empty((0, 4, 4)))

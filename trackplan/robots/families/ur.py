@@ -274,10 +274,17 @@ class URFamily:
         return self.solve_branch_parts(T[:, :3, :3], T[:, :3, 3], branch, with_aux=with_aux)
 
     def solve_branch_parts(
-        self, R_base_tool: np.ndarray, p_base_tool: np.ndarray, branch: int, *, with_aux: bool
+        self,
+        R_base_tool: np.ndarray,
+        p_base_tool: np.ndarray,
+        branch: int,
+        *,
+        with_aux: bool,
+        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`solve_branch` of poses given by rotations (N, 3, 3) (or one, (3, 3)) and
-        positions (N, 3), m."""
+        positions (N, 3), m; ``wind_to`` as for
+        :meth:`~trackplan.robots.families.base.IKFamily.solve_branch_parts`."""
         return solve_branch_fused(
             kern.ur_solve_branch,
             self._geometry,
@@ -286,4 +293,5 @@ class URFamily:
             p_base_tool,
             branch,
             with_aux,
+            wind_to,
         )
