@@ -527,10 +527,10 @@ def opw_solve_branch(
         m = min(BLOCK, n_poses - start)
         for b in range(m):
             Rk = R[0 if one_rotation else start + b]
-            for r in range(3):
+            for i in range(3):
                 for c in range(3):
-                    P[4 * r + c, b] = Rk[r, c]
-                P[4 * r + 3, b] = p[start + b, r]
+                    P[4 * i + c, b] = Rk[i, c]
+                P[4 * i + 3, b] = p[start + b, i]
         for b in range(BLOCK):
             w00 = P[0, b] * tail_inv[0, 0] + P[1, b] * tail_inv[1, 0]
             w00 = w00 + P[2, b] * tail_inv[2, 0] + P[3, b] * tail_inv[3, 0]
@@ -798,6 +798,20 @@ def ur_solve(
         _ur_assemble(g, angles, valid[k], q[k], theta)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _wrist_entry(
+    P: np.ndarray, b: int, r: int, c: int, tail_inv: np.ndarray
+) -> float:  # pragma: no cover - compiled
+    """Kernel: entry (r, c) of ``T · tail_inv`` for pose b of a block P (12, BLOCK), summed
+    in :func:`_wrist_frame`'s order."""
+    return (
+        P[4 * r, b] * tail_inv[0, c]
+        + P[4 * r + 1, b] * tail_inv[1, c]
+        + P[4 * r + 2, b] * tail_inv[2, c]
+        + P[4 * r + 3, b] * tail_inv[3, c]
+    )
+
+
 @njit(cache=True, error_model="numpy")
 def ur_solve_branch(
     g: np.ndarray,
@@ -816,55 +830,139 @@ def ur_solve_branch(
     3)) and positions p (N, 3): q (N, 6), NaN where not valid (N,), and its branch
     quantities branch_aux (N, 5) (a ``branch_aux`` of shape (1, 5) is scratch); the same
     operations as :func:`ur_solve` on that branch alone. With a reference grid (s_grid
-    (G,) not empty), the joints are then held and wound by :func:`hold_and_wind`."""
-    T_k = np.zeros((4, 4))
-    T_k[3, 3] = 1.0
-    theta = np.empty(6)
-    Y = np.zeros(U_N_ANGLES)
-    X = np.ones(U_N_ANGLES)
-    angles = np.empty(U_N_ANGLES)
-    reach = np.empty(N_BRANCHES, dtype=np.bool_)
-    aux = np.empty((N_BRANCHES, AUX_SIZE))
+    (G,) not empty), the joints are then held and wound by :func:`hold_and_wind`.
+
+    Blocks of :data:`BLOCK` poses in three flat passes, as :func:`opw_solve_branch`: the
+    expressions of :func:`_ur_arguments` for one shoulder, wrist and elbow, the
+    arctangents, the joints.
+    """
+    d1 = g[U_D1]
+    a2 = g[U_A2]
+    a3 = g[U_A3]
+    d4 = g[U_D4]
+    d5 = g[U_D5]
+    d6 = g[U_D6]
+    bx = g[U_BX]
+    by = g[U_BY]
+    c60 = g[U_C60]
+    s60 = g[U_S60]
     shoulder = (branch >> 2) & 1
     elbow = (branch >> 1) & 1
     wrist = branch & 1
     pair = 2 * shoulder + wrist
-    slots = np.array(
-        [
-            U_TH1 + shoulder,
-            U_TH5 + shoulder,
-            U_TH6 + shoulder,
-            U_TH234 + shoulder,
-            U_PHI + pair,
-            U_TH2 + 2 * pair + elbow,
-        ]
+    r_sign = 1.0 if shoulder == 0 else -1.0
+    sgn = 1.0 if wrist == 0 else -1.0
+    s3_sign = 1.0 if elbow == 0 else -1.0
+    keep = branch_aux.shape[0] > 1
+    n_poses = p.shape[0]
+    one_rotation = R.shape[0] == 1
+    P = np.zeros((12, BLOCK))
+    Y = np.zeros((6, BLOCK))  # θ1, θ5, θ6, θ2+θ3+θ4, |θ3|, θ2 arguments
+    X = np.ones((6, BLOCK))
+    A = np.empty((6, BLOCK))
+    aux = np.empty((AUX_SIZE, BLOCK))
+    ok = np.empty(BLOCK, dtype=np.bool_)
+    theta = np.empty(6)
+    angles = np.empty(U_N_ANGLES)
+    slots = (
+        U_TH1 + shoulder,
+        U_TH5 + shoulder,
+        U_TH6 + shoulder,
+        U_TH234 + shoulder,
+        U_PHI + pair,
+        U_TH2 + 2 * pair + elbow,
     )
-    for k in range(p.shape[0]):
-        Rk = R[0 if R.shape[0] == 1 else k]
-        for r in range(3):
-            for c in range(3):
-                T_k[r, c] = Rk[r, c]
-            T_k[r, 3] = p[k, r]
-        _ur_arguments(
-            g,
-            tail_inv,
-            T_k,
-            Y,
-            X,
-            reach,
-            aux,
-            (shoulder, shoulder + 1),
-            (wrist, wrist + 1),
-            (elbow, elbow + 1),
-        )
-        _keep_aux(aux[branch], branch_aux, k)
-        valid[k] = reach[branch]
-        if not valid[k]:
-            for j in range(6):
-                q[k, j] = np.nan
-            continue
-        for slot in slots:
-            angles[slot] = atan2(Y[slot], X[slot])
-        _ur_joints(g, angles, branch, q[k], theta)
+    for start in range(0, n_poses, BLOCK):
+        m = min(BLOCK, n_poses - start)
+        for b in range(m):
+            Rk = R[0 if one_rotation else start + b]
+            for i in range(3):
+                for c in range(3):
+                    P[4 * i + c, b] = Rk[i, c]
+                P[4 * i + 3, b] = p[start + b, i]
+        for b in range(BLOCK):
+            w00 = _wrist_entry(P, b, 0, 0, tail_inv)
+            w01 = _wrist_entry(P, b, 0, 1, tail_inv)
+            w02 = _wrist_entry(P, b, 0, 2, tail_inv)
+            w03 = _wrist_entry(P, b, 0, 3, tail_inv)
+            w10 = _wrist_entry(P, b, 1, 0, tail_inv)
+            w11 = _wrist_entry(P, b, 1, 1, tail_inv)
+            w12 = _wrist_entry(P, b, 1, 2, tail_inv)
+            w13 = _wrist_entry(P, b, 1, 3, tail_inv)
+            w20 = _wrist_entry(P, b, 2, 0, tail_inv)
+            w21 = _wrist_entry(P, b, 2, 1, tail_inv)
+            w22 = _wrist_entry(P, b, 2, 2, tail_inv)
+            w23 = _wrist_entry(P, b, 2, 3, tail_inv)
+            px = w03 - d6 * w02 - bx
+            py = w13 - d6 * w12 - by
+            pz = w23 - d6 * w22
+            rho2 = px * px + py * py - d4 * d4
+            r0 = math.sqrt(max(rho2, 0.0))
+            r = r_sign * r0
+            c1, s1 = unit(px * r - py * d4, py * r + px * d4)
+            c5 = s1 * w02 - c1 * w12
+            wx = -c1 * w22
+            wy = -s1 * w22
+            wz = s1 * w12 + c1 * w02
+            s5 = math.sqrt(wx * wx + wy * wy + wz * wz)
+            zx = s1 * w00 - c1 * w10
+            zy = s1 * w01 - c1 * w11
+            c6u, s6u = unit(zx, -zy)
+            singular = not s5 > WRIST_SINGULAR
+            c6 = c60 if singular else c6u
+            s6 = s60 if singular else s6u
+            x4x = c5 * (c6 * w00 - s6 * w01) - s5 * w02
+            x4y = c5 * (c6 * w10 - s6 * w11) - s5 * w12
+            x4z = c5 * (c6 * w20 - s6 * w21) - s5 * w22
+            z4x = sgn * (x4z * c1)
+            z4y = sgn * (x4z * s1)
+            z4z = sgn * (-x4x * c1 - x4y * s1)
+            ox = px - d5 * z4x
+            oy = py - d5 * z4y
+            oz = pz - d5 * z4z
+            u = c1 * ox + s1 * oy
+            v = oz - d1
+            c3 = (u * u + v * v - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
+            ok[b] = not (rho2 < -REACH_TOL or abs(c3) > 1.0 + REACH_TOL)
+            c3 = min(max(c3, -1.0), 1.0)
+            s3m = math.sqrt((1.0 - c3) * (1.0 + c3))
+            s3 = s3_sign * s3m
+            vx = a2 + a3 * c3
+            vy = a3 * s3
+            Y[0, b] = s1
+            X[0, b] = c1
+            Y[1, b] = s5
+            X[1, b] = c5
+            Y[2, b] = s6
+            X[2, b] = c6
+            Y[3, b] = x4z
+            X[3, b] = c1 * x4x + s1 * x4y
+            Y[4, b] = s3m
+            X[4, b] = c3
+            Y[5, b] = v * vx - u * vy
+            X[5, b] = u * vx + v * vy
+            aux[0, b] = r0
+            aux[1, b] = s3m
+            aux[2, b] = wx
+            aux[3, b] = wy
+            aux[4, b] = wz
+        for e in range(6):
+            for b in range(BLOCK):
+                A[e, b] = atan2(Y[e, b], X[e, b])
+        for b in range(m):
+            k = start + b
+            row = k if keep else 0
+            valid[k] = ok[b]
+            if not ok[b]:
+                for j in range(AUX_SIZE):
+                    branch_aux[row, j] = np.nan
+                for j in range(6):
+                    q[k, j] = np.nan
+                continue
+            for j in range(AUX_SIZE):
+                branch_aux[row, j] = aux[j, b]
+            for e in range(6):
+                angles[slots[e]] = A[e, b]
+            _ur_joints(g, angles, branch, q[k], theta)
     if s_grid.shape[0] > 0:
         hold_and_wind(q, valid, s, s_grid, q_grid)
