@@ -414,6 +414,27 @@ def opw_solve(
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _interval(grid: np.ndarray, x: float, guess: int) -> int:  # pragma: no cover - compiled
+    """Kernel: ``numpy.searchsorted(grid, x, side="right") - 1`` for a strictly increasing
+    grid (G,): the interval [grid[i], grid[i + 1]) holding x, −1 before the grid, G − 1
+    from its end on (and for NaN). The interval ``guess`` and the next one are tried
+    first (samples in order move by at most one), then a bisection."""
+    n_grid = grid.shape[0]
+    for i in (guess, guess + 1):
+        if 0 <= i < n_grid - 1 and grid[i] <= x < grid[i + 1]:
+            return i
+    lo = 0
+    hi = n_grid
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if x < grid[mid]:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo - 1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def hold_and_wind(
     q: np.ndarray, valid: np.ndarray, s: np.ndarray, s_grid: np.ndarray, q_grid: np.ndarray
 ) -> None:  # pragma: no cover - compiled
@@ -447,12 +468,13 @@ def hold_and_wind(
             break
     for j in range(n):
         held[j] = q[first, j] if first >= 0 else np.nan
+    i = -1
     for m in range(n_poses):
         if first < 0 or valid[m]:
             for j in range(n):
                 held[j] = q[m, j]
         x = s[m]
-        i = np.searchsorted(s_grid, x, side="right") - 1
+        i = _interval(s_grid, x, i)
         for j in range(n):
             if i < 0:
                 reference = q_grid[0, j]
