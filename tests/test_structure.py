@@ -18,7 +18,7 @@ from trackplan.errors import CaseError
 def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
     calls: list[tuple[str, int]] = []
     real_poses, real_ik = jointpath.tool_poses, jointpath.solve_path_ik
-    real_branch = jointpath.branch_joints
+    real_parts, real_branch = jointpath.tool_pose_parts, jointpath.branch_joints_along
 
     def poses(X, positions, R_part_tool):
         calls.append(("poses", len(positions)))
@@ -28,13 +28,18 @@ def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
         calls.append(("ik", T.shape[1]))
         return real_ik(robot, T, *args, **kwargs)
 
-    def branch_ik(robot, T, branch, reference):  # the samples: their branch only
-        calls.append(("ik", len(T)))
-        return real_branch(robot, T, branch, reference)
+    def parts(X, positions, R_part_tool):  # the samples: rotations and positions only
+        calls.append(("poses", len(positions)))
+        return real_parts(X, positions, R_part_tool)
+
+    def branch_ik(robot, R, p, *args):  # the samples: their branch only
+        calls.append(("ik", len(p)))
+        return real_branch(robot, R, p, *args)
 
     monkeypatch.setattr(jointpath, "tool_poses", poses)
     monkeypatch.setattr(jointpath, "solve_path_ik", ik)
-    monkeypatch.setattr(jointpath, "branch_joints", branch_ik)
+    monkeypatch.setattr(jointpath, "tool_pose_parts", parts)
+    monkeypatch.setattr(jointpath, "branch_joints_along", branch_ik)
     case = trackplan.load_case(CASES / "paper-corner.yaml")
     result = trackplan.plan_placement(case, case.bounds.example)
     assert result.success, result.message
@@ -42,6 +47,7 @@ def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
     assert calls[:2] == [("poses", n_grid), ("ik", n_grid)]
     # after the grid, only the trajectory samples are mapped (once per rebuild of the law)
     n_samples = result.trajectory.n_samples
+    assert len(calls) > 2
     assert all(n == n_samples for _, n in calls[2:])
     assert [kind for kind, _ in calls[2:]] == ["poses", "ik"] * (len(calls[2:]) // 2)
 
