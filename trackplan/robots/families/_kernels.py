@@ -8,7 +8,10 @@ and dominated the former three-pass design), and a per-pose pass assembles the j
 values. No array of the batch's size is allocated besides the outputs. A one-branch kernel
 per family (:func:`opw_solve_branch`, :func:`ur_solve_branch`) runs the same operations for
 the arm of one branch only (6 arctangents a pose instead of 20): a planned trajectory's
-samples need only the branch chosen on the planning grid. The Python APIs are
+samples need only the branch chosen on the planning grid. It takes blocks of
+:data:`BLOCK` poses in flat passes that vectorise (arguments, arctangents, joints), reads
+rotations and positions rather than (4, 4) poses, and can hold missed poses and wind the
+joints near a reference in the same call (:func:`hold_and_wind`). The Python APIs are
 :mod:`trackplan.robots.families.opw` and :mod:`trackplan.robots.families.ur`.
 """
 
@@ -248,15 +251,6 @@ def _unreachable(
         valid[br] = False
         for j in range(AUX_SIZE):
             aux[br, j] = np.nan
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _keep_aux(found: np.ndarray, branch_aux: np.ndarray, k: int) -> None:  # pragma: no cover
-    """Kernel: copy one pose's branch quantities (5,) into row k of branch_aux (N, 5), or
-    into its only row when it is the (1, 5) scratch of a caller that does not keep them."""
-    row = k if branch_aux.shape[0] > 1 else 0
-    for j in range(AUX_SIZE):
-        branch_aux[row, j] = found[j]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
