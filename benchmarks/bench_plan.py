@@ -183,12 +183,11 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
 
     The stages are timed inside real plans (:class:`_StageClocks`), each exclusive of the
     stages it calls: the time law's own work (zones, plateaus, speed changes, profile) is
-    what the law spends outside its sample poses, IK, rate checks and RNE, and the rest
-    (trajectory, energy, summaries) what the plan spends outside every stage. Means over
-    the middle half of ``runs`` warm plans ranked by their whole time, so that the stages
-    add up to the whole.
+    what the law spends outside its samples' poses and IK (one pass), rate checks and RNE,
+    and the rest (trajectory, energy, summaries) what the plan spends outside every stage.
+    Means over the middle half of ``runs`` warm plans ranked by their whole time, so that
+    the stages add up to the whole.
     """
-    import trackplan.jointpath as jointpath_module
     import trackplan.motion as motion_module
     import trackplan.planning.plan as plan_module
     from trackplan.jointpath import JointPath
@@ -198,9 +197,7 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
     targets: dict[str, tuple[object, object]] = {
         "grid": (JointPath, "solve"),
         "law": (TIME_LAWS, Timing(case.task.timing)),
-        "poses": (JointPath, "poses"),
-        "seeds": (JointPath, "interpolate"),
-        "ik": (jointpath_module, "branch_joints"),
+        "samples": (JointPath, "joints"),
         "rates": (RateLimits, "check_motion"),
         "rne": (motion_module, "inverse_dynamics"),
         "fk": (motion_module, "forward_kinematics"),
@@ -219,17 +216,13 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
     mean = {stage: statistics.fmean(r[1][stage] for r in middle) for stage in targets}
     whole = statistics.fmean(r[0] for r in middle)
     n_grid, n = result.joint_path.ik.q.shape[1], result.trajectory.n_samples
-    in_law = ("law", "poses", "seeds", "ik", "rates", "rne")
+    in_law = ("law", "samples", "rates", "rne")
     return [
         ("the whole plan (stage clocks on)", whole),
         (f"joint path on the grid: poses and IK of {n_grid} poses", mean["grid"]),
         ("time law", sum(mean[k] for k in in_law)),
         ("  zones, plateaus, speed changes, profile", mean["law"]),
-        (f"  sample poses ({n})", mean["poses"]),
-        (
-            f"  sample IK ({n} poses, the grid's branch only) and seeds",
-            mean["ik"] + mean["seeds"],
-        ),
+        (f"  sample poses and IK ({n} poses, one pass)", mean["samples"]),
         ("  sample rate checks (compiled)", mean["rates"]),
         ("  RNE of the samples (the plan's one pass)", mean["rne"]),
         ("FK of the samples (the plan's one pass)", mean["fk"]),
