@@ -145,8 +145,10 @@ def test_a_first_round_that_leaves_blend_nodes_at_rest_is_solved_again_lower():
     """At this corner placement (a fresh draw, seed 2 of the benchmark) the first round's
     room of 1.5 × the constant-speed cap left four nodes of the blend at rest, the curve was
     given up, and the window plan took 8.222 s, 1.089 × TOPP3; the room of 1.0 plans the
-    curve (7.866 s at these rounded coordinates, 1.041 ×), every sample re-checked."""
-    _assert_planned_within("paper-corner", FRESH_X, 1.05 * FRESH_TOPP3)
+    curve (7.866 s at these rounded coordinates, 1.041 ×; 7.786 s, 1.031 ×, with the
+    samples' time stretched evenly and the rests at 95 % of the path jerk), every sample
+    re-checked."""
+    _assert_planned_within("paper-corner", FRESH_X, 1.04 * FRESH_TOPP3)
 
 
 def _assert_planned_within(name: str, X: np.ndarray, duration: float) -> None:

@@ -89,7 +89,7 @@ MAX_DURATION = 2000.0
 that would take longer has (almost) stopped inside a stretch, and the window law stands."""
 MAX_REBUILDS = 10
 """Plans of the curve with lowered limits before the law gives up on it."""
-REST_JERK_SHARE = 0.7
+REST_JERK_SHARE = 0.95
 """Share of the path jerk the joints allow that a start from rest or a stop plans with."""
 REBUILD_REACH = 3
 """Nodes on each side of a failing sample whose limits a rebuild lowers (the first time)."""
@@ -626,20 +626,22 @@ def _sample(
     curve stops inside a stretch or would last :data:`MAX_DURATION` or more).
 
     Node times from constant acceleration between nodes (constant jerk next to a rest).
-    The fraction of a period left at the end is given to the final stop: the steps after
-    the last stretch's top speed last that much longer, so every speed before it is kept
-    exactly. s(t) of each stretch is the quintic spline through (t, s) at the nodes, at
-    rest (ṡ = s̈ = 0) at both ends, so its jerk is continuous.
+    The fraction of a period left at the end is spread over the whole curve: every step
+    lasts longer by the same factor (below 1 + Ts / duration), which lowers every speed,
+    acceleration and jerk a little and changes none of them abruptly (stretching only the
+    steps after the last top speed stepped the speed there by up to 0.3 %, and the spline's
+    jerk rang up to 3.4 times the limit over it). s(t) of each stretch is the quintic
+    spline through (t, s) at the nodes, at rest (ṡ = s̈ = 0) at both ends, so its jerk is
+    continuous.
     """
     steps = [_node_steps(stretch, v) for stretch, v in zip(stretches, speeds, strict=True)]
     duration = float(sum(step.sum() for step in steps))
     if not duration < MAX_DURATION:
         return None
     n_steps = max(1, int(np.ceil(duration / sample_time - 1e-9)))
-    last = speeds[-1]
-    top = len(last) - 1 - int(np.argmax(last[::-1]))  # the last node at the top speed
-    tail = steps[-1][top:].sum()
-    steps[-1][top:] *= (tail + n_steps * sample_time - duration) / tail
+    # every step a little longer: slower (by less than a period over the duration), and
+    # smooth: a longer step at one node would be a speed step the spline rings over
+    steps = [step * (n_steps * sample_time / duration) for step in steps]
     times = np.arange(n_steps + 1) * sample_time
     out = np.empty(len(times))
     start = 0.0

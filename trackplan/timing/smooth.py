@@ -156,7 +156,7 @@ def plan_smooth_time_law(
     return _or_curve(law, plans, profile.duration, joint_path, task, checks)
 
 
-CURVE_SHARE = 0.05
+CURVE_SHARE = 0.03
 """Share of the window plan's time spent in windows the joint limits slow down above which
 the law also plans one continuous speed curve (:mod:`trackplan.timing.continuous`) and keeps
 the faster of the two."""
