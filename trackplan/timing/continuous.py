@@ -87,6 +87,9 @@ CRUISE_CLEARANCE = 0.05
 MAX_DURATION = 2000.0
 """Longest curve sampled, s (the window law's longest, 2 000 000 samples at 1 ms): a curve
 that would take longer has (almost) stopped inside a stretch, and the window law stands."""
+RESTING = 1e-9
+"""Share of the top ``x`` below which a node inside a stretch is at rest: a solution with
+such a node is kept only if no later try of :func:`_solve` is faster."""
 MAX_REBUILDS = 10
 """Plans of the curve with lowered limits before the law gives up on it."""
 REST_JERK_SHARE = 0.95
@@ -489,7 +492,8 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
             axis=(0, 2),
         )
     cruise = _cruising(s, top, steady)
-    solution = None
+    solution = best = None
+    best_duration = MAX_DURATION
     tries = [(held, room) for room in FIRST_ROOMS for held in _holds(cruise)]
     for held, room in tries:
         # held at the cap first; if that leaves no room for a speed change, everything free
@@ -529,9 +533,14 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                 solution = np.clip(result.x, 0.0, x)
             x = np.minimum(top, SPEED_ROOM**2 * solution)
             reference = solution
-        if solution is not None and _node_steps(stretch, np.sqrt(solution)).sum() < MAX_DURATION:
-            return solution
-    return None
+        if solution is None:
+            continue
+        duration = _node_steps(stretch, np.sqrt(solution)).sum()
+        if duration < best_duration:
+            best, best_duration = solution, duration
+        if duration < MAX_DURATION and solution[1:-1].min() > RESTING * solution.max():
+            break
+    return best
 
 
 def _holds(cruise: np.ndarray) -> tuple[np.ndarray, ...]:
