@@ -72,8 +72,7 @@ constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the fir
 FIRST_ROOMS = (1.5, 1.0)
 """How far above the constant-speed cap the joints allow (at each node) the first round's
 speed may go (its jerk bound assumes the speed stays below it): the first room, and the
-next one tried when a solution stops inside the stretch (its travel time reaches
-:data:`MAX_DURATION`)."""
+next one tried when a solution leaves a node inside the stretch at rest (:data:`RESTING`)."""
 SPEED_ROOM = 1.3
 """How far above the first round's speed the second round may go (its jerk bound assumes
 the speed stays below it)."""
