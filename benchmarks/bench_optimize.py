@@ -218,9 +218,11 @@ trackplan.outputs.write_search_run = timed("writing", trackplan.outputs.write_se
 code = trackplan.cli.main(sys.argv[1:])
 marks["ended"] = time.time()
 print(json.dumps({"marks": marks, "spans": spans, "code": int(code)}))
+trackplan.cli.exit_process(code)
 """
 """Runs ``trackplan optimize`` in one process and times its phases (the functions wrapped
-are those :func:`~trackplan.search.optimize_placement` and the command call). The plans'
+are those :func:`~trackplan.search.optimize_placement` and the command call), and ends as
+the command does (:func:`trackplan.cli.exit_process`). The plans'
 times are the waits for them: with a second core they are made beside the search."""
 
 

@@ -97,3 +97,27 @@ def test_optimize_plans_beside_the_search(tmp_path):
         "assert code == 0, code"
     )
     assert _loaded_after(run, SCIPY_SOLVERS) == []
+
+
+def test_the_command_exits_with_its_code_after_the_exit_handlers(tmp_path):
+    """``run_and_exit`` (the ``trackplan`` command) skips the interpreter's teardown but
+    still runs the atexit handlers, flushes what was printed and exits with the command's
+    code: 0 for a valid case, 2 for a missing file."""
+    probe = (
+        "import atexit, sys\n"
+        "atexit.register(print, 'exit handler ran')\n"
+        "sys.argv = ['trackplan', 'validate', sys.argv[1]]\n"
+        "from trackplan.cli import run_and_exit\n"
+        "run_and_exit()\n"
+    )
+    for case, code in ((CASES / "paper-corner.yaml", 0), (tmp_path / "missing.yaml", 2)):
+        done = subprocess.run(
+            [sys.executable, "-c", probe, str(case)], capture_output=True, text=True
+        )
+        assert done.returncode == code, done.stderr
+        lines = done.stdout.splitlines()
+        assert lines[-1] == "exit handler ran"
+        if code == 0:
+            assert any("paper-corner" in line for line in lines[:-1]), done.stdout
+        else:
+            assert len(done.stderr.splitlines()) == 1 and "missing.yaml" in done.stderr

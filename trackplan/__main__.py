@@ -1,5 +1,5 @@
 """``python -m trackplan``: the same as the ``trackplan`` command."""
 
-from trackplan.cli import main
+from trackplan.cli import run_and_exit
 
-raise SystemExit(main())
+run_and_exit()

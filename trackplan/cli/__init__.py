@@ -12,6 +12,9 @@ Exit codes: 0 ok, 1 internal error, 2 bad input, 3 infeasible (:class:`ExitCode`
 stderr and exit code 2; any other exception one line ``internal error: ...`` and exit
 code 1, with the traceback only under ``trackplan --debug`` or ``TRACKPLAN_DEBUG=1``.
 
+The ``trackplan`` command and ``python -m trackplan`` run :func:`run_and_exit`, which ends
+the process without the interpreter's teardown (:func:`exit_process`).
+
 This module imports nothing heavy, so that Ctrl-C while the command starts up (numpy,
 typer and the planner are imported inside :func:`main`) ends with exit 130 and no traceback.
 """
@@ -24,6 +27,8 @@ import gc
 import os
 import signal
 import sys
+import threading
+from typing import NoReturn
 
 
 class ExitCode(enum.IntEnum):
@@ -68,3 +73,26 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt as exc:  # during start-up, or a second signal while writing
         print("interrupted", file=sys.stderr, flush=True)
         return 128 + int(getattr(exc, "signum", signal.SIGINT))
+
+
+def run_and_exit() -> NoReturn:
+    """The ``trackplan`` command: run :func:`main` on ``sys.argv``, then :func:`exit_process`."""
+    exit_process(main())
+
+
+def exit_process(code: int) -> NoReturn:
+    """End the process with exit code ``code``.
+
+    Where no other thread runs, this skips the interpreter's teardown (freeing every module
+    and object one by one: 0.12 s after a search, for memory the process returns anyway):
+    the atexit handlers run, stdout and stderr are flushed, then the process ends.
+    """
+    if threading.active_count() == 1:
+        atexit._run_exitfuncs()
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        except (OSError, ValueError):  # a closed pipe: the interpreter reports it as usual
+            sys.exit(code)
+        os._exit(code)
+    sys.exit(code)
