@@ -140,14 +140,13 @@ class JointPath:
 
     def R_part_tool(self, s: np.ndarray) -> np.ndarray:
         """Tool orientation in the definition frame at arc lengths ``s`` (M,), shape (M, 3, 3)."""
-        sample = self.geometry.planned.sample(np.asarray(s, dtype=float))
-        return self.tool.rotations(sample.s, sample.tangent)
+        s_path, _, tangent = self.geometry.planned.points(np.asarray(s, dtype=float))
+        return self.tool.rotations(s_path, tangent)
 
     def poses(self, s: np.ndarray) -> np.ndarray:
         """Tool poses in the base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
-        sample = self.geometry.planned.sample(np.asarray(s, dtype=float))
-        rotations = _rotations(self.tool, sample.s, sample.tangent)
-        return tool_poses(self.placement, sample.position, rotations)
+        s_path, position, tangent = self.geometry.planned.points(np.asarray(s, dtype=float))
+        return tool_poses(self.placement, position, _rotations(self.tool, s_path, tangent))
 
     def joints(self, s: np.ndarray) -> np.ndarray:
         """Joint positions at arc lengths ``s`` by IK on this path's branch.
@@ -168,9 +167,9 @@ class JointPath:
             Shape (M, n), rad.
         """
         s = np.asarray(s, dtype=float)
-        sample = self.geometry.planned.sample(s)
-        rotations = _rotations(self.tool, sample.s, sample.tangent)
-        R_base_tool, p_base_tool = tool_pose_parts(self.placement, sample.position, rotations)
+        s_path, position, tangent = self.geometry.planned.points(s)
+        rotations = _rotations(self.tool, s_path, tangent)
+        R_base_tool, p_base_tool = tool_pose_parts(self.placement, position, rotations)
         grid, q_grid = self._distinct_grid
         return branch_joints_along(
             self.robot, R_base_tool, p_base_tool, self.branch, s, grid, q_grid

@@ -95,6 +95,22 @@ def test_samples_are_at_their_arc_length(mixed_path):
     np.testing.assert_allclose(np.sum(sample.tangent * sample.curvature, axis=1), 0, atol=1e-9)
 
 
+def test_points_are_the_samples_positions_and_tangents_to_the_bit(mixed_path):
+    """Lines, arcs, blends and fitted pieces; in order (slices) and shuffled (masks)."""
+    kinds = {piece.kind for piece in mixed_path.pieces}
+    assert kinds == {"line", "arc", "blend"}
+    s = np.linspace(-1e-10, mixed_path.length + 1e-10, 20_001)
+    shuffled = np.random.default_rng(5).permutation(s)
+    for values in (s, shuffled):
+        sample = mixed_path.sample(values)
+        s_path, position, tangent = mixed_path.points(values)
+        np.testing.assert_array_equal(s_path, sample.s)
+        np.testing.assert_array_equal(position, sample.position)
+        np.testing.assert_array_equal(tangent, sample.tangent)
+    with pytest.raises(ValueError, match="outside the path"):
+        mixed_path.points(np.array([-1e-6]))
+
+
 def test_derivatives_match_finite_differences(mixed_path):
     h = 1e-7
     s = np.linspace(h, mixed_path.length - h, 997)

@@ -221,6 +221,13 @@ class Line:
         position = self.start + sigma[:, None] * self.direction
         return CurveJet(position, np.broadcast_to(self.direction, zero.shape).copy(), zero, zero)
 
+    def point_tangent(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Position (M, 3), m, and unit tangent (M, 3, read-only) at ``sigma`` (M,), m:
+        those of :meth:`evaluate`."""
+        sigma = np.asarray(sigma, dtype=float)
+        position = self.start + sigma[:, None] * self.direction
+        return position, np.broadcast_to(self.direction, position.shape)
+
     def trimmed(self, head: float, tail: float) -> Line:
         """The part from σ = ``head`` to σ = length − ``tail`` (m), non-empty."""
         return Line(
@@ -365,6 +372,14 @@ class Arc:
             -radial / self.radius,
             -tangent / self.radius**2,
         )
+
+    def point_tangent(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Position (M, 3), m, and unit tangent (M, 3) at ``sigma`` (M,), m: those of
+        :meth:`evaluate`."""
+        phi = np.asarray(sigma, dtype=float)[:, None] / self.radius
+        cos, sin = np.cos(phi), np.sin(phi)
+        radial = cos * self.e1 + sin * self.e2
+        return self.center + self.radius * radial, cos * self.e2 - sin * self.e1
 
     def trimmed(self, head: float, tail: float) -> Arc:
         """The part from σ = ``head`` to σ = length − ``tail`` (m), non-empty."""
@@ -533,6 +548,12 @@ class QuinticBlend:
             + 4.0 * ab * b1 * dv / v**5
         )
         return CurveJet(b0, b1 / v, curvature, d_curvature / v)
+
+    def point_tangent(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Position (M, 3), m, and unit tangent (M, 3) at ``sigma`` (M,), m: those of
+        :meth:`evaluate`, without its curvature terms."""
+        b0, b1 = self.derivatives(self.parameter(sigma), order=1)
+        return b0, b1 / np.linalg.norm(b1, axis=-1)[:, None]
 
 
 #: A primitive of the user's path or of a fit.

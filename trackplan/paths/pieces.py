@@ -74,14 +74,8 @@ def evaluate_pieces(pieces: Sequence[Piece], s: np.ndarray) -> tuple[CurveJet, n
         Index of the piece of each sample, shape (M,).
     """
     s = np.asarray(s, dtype=float)
-    starts = np.array([piece.s_start for piece in pieces])
-    index = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(pieces) - 1)
+    index, rows = _piece_rows(pieces, s)
     fields = [np.empty((s.size, 3)) for _ in range(4)]
-    if np.all(index[1:] >= index[:-1]):  # in order (a trajectory's samples): one slice a piece
-        edges = np.searchsorted(index, np.arange(len(pieces) + 1))
-        rows = [slice(a, b) for a, b in itertools.pairwise(edges)]
-    else:
-        rows = [index == k for k in range(len(pieces))]
     for piece, selected in zip(pieces, rows, strict=True):
         sigma = np.clip(s[selected] - piece.s_start, 0.0, piece.length)
         if sigma.size == 0:
@@ -89,3 +83,52 @@ def evaluate_pieces(pieces: Sequence[Piece], s: np.ndarray) -> tuple[CurveJet, n
         for out, value in zip(fields, piece.curve.evaluate(sigma), strict=True):
             out[selected] = value
     return CurveJet(*fields), index
+
+
+def evaluate_points(
+    pieces: Sequence[Piece], s: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position and unit tangent of a chain of pieces at path arc lengths ``s``.
+
+    The first two fields of :func:`evaluate_pieces`, with the same values, without the
+    curvature terms.
+
+    Parameters
+    ----------
+    pieces
+        Consecutive pieces, as made by :func:`chain`.
+    s
+        Arc lengths (M,), m, within [0, total length].
+
+    Returns
+    -------
+    position
+        Shape (M, 3), m.
+    tangent
+        Unit, shape (M, 3).
+    piece
+        Index of the piece of each sample, shape (M,).
+    """
+    s = np.asarray(s, dtype=float)
+    index, rows = _piece_rows(pieces, s)
+    position = np.empty((s.size, 3))
+    tangent = np.empty((s.size, 3))
+    for piece, selected in zip(pieces, rows, strict=True):
+        sigma = np.clip(s[selected] - piece.s_start, 0.0, piece.length)
+        if sigma.size == 0:
+            continue
+        position[selected], tangent[selected] = piece.curve.point_tangent(sigma)
+    return position, tangent, index
+
+
+def _piece_rows(
+    pieces: Sequence[Piece], s: np.ndarray
+) -> tuple[np.ndarray, list[slice] | list[np.ndarray]]:
+    """The piece of each of ``s`` (M,) and each piece's rows: slices where ``s`` is in
+    order (a trajectory's samples), masks otherwise."""
+    starts = np.array([piece.s_start for piece in pieces])
+    index = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(pieces) - 1)
+    if np.all(index[1:] >= index[:-1]):
+        edges = np.searchsorted(index, np.arange(len(pieces) + 1))
+        return index, [slice(a, b) for a, b in itertools.pairwise(edges)]
+    return index, [index == k for k in range(len(pieces))]

@@ -28,7 +28,7 @@ from trackplan.paths.blending import (
 from trackplan.paths.fitting import fit_polyline
 from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, Curve, Line, Primitive, turning_angle
 from trackplan.paths.nominal import NominalPath
-from trackplan.paths.pieces import Piece, chain, evaluate_pieces
+from trackplan.paths.pieces import Piece, chain, evaluate_pieces, evaluate_points
 from trackplan.paths.specs import PointsSpec
 
 #: Share of ρ that a blend of exact lines and arcs may use.
@@ -140,14 +140,39 @@ class Path:
         ValueError
             If a value lies outside [0, length] by more than 1e-9 m.
         """
+        s = self._clipped(s)
+        jet, piece = evaluate_pieces(self.pieces, s)
+        return PathSample(s, *jet, piece)
+
+    def points(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The arc lengths, positions and unit tangents of :meth:`sample` alone.
+
+        Parameters
+        ----------
+        s
+            Shape (M,), m, in [0, length] (values outside by up to 1e-9 m are clipped).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``s`` clipped, shape (M,), m; p(s), shape (M, 3), m; dp/ds, shape (M, 3).
+
+        Raises
+        ------
+        ValueError
+            If a value lies outside [0, length] by more than 1e-9 m.
+        """
+        s = self._clipped(s)
+        position, tangent, _ = evaluate_points(self.pieces, s)
+        return s, position, tangent
+
+    def _clipped(self, s: np.ndarray) -> np.ndarray:
         s = np.atleast_1d(np.asarray(s, dtype=float))
         outside = (s < -1e-9) | (s > self.length + 1e-9)
         if np.any(outside):
             bad = float(s[np.argmax(outside)])
             raise ValueError(f"arc length {bad} m outside the path [0, {self.length}] m")
-        s = np.clip(s, 0.0, self.length)
-        jet, piece = evaluate_pieces(self.pieces, s)
-        return PathSample(s, *jet, piece)
+        return np.clip(s, 0.0, self.length)
 
 
 @dataclass(frozen=True, eq=False)
