@@ -123,12 +123,15 @@ def evaluate_points(
 
 def _piece_rows(
     pieces: Sequence[Piece], s: np.ndarray
-) -> tuple[np.ndarray, list[slice] | list[np.ndarray]]:
+) -> tuple[np.ndarray, list[slice | np.ndarray]]:
     """The piece of each of ``s`` (M,) and each piece's rows: slices where ``s`` is in
     order (a trajectory's samples), masks otherwise."""
     starts = np.array([piece.s_start for piece in pieces])
     index = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(pieces) - 1)
+    rows: list[slice | np.ndarray]
     if np.all(index[1:] >= index[:-1]):
         edges = np.searchsorted(index, np.arange(len(pieces) + 1))
-        return index, [slice(a, b) for a, b in itertools.pairwise(edges)]
-    return index, [index == k for k in range(len(pieces))]
+        rows = [slice(a, b) for a, b in itertools.pairwise(edges)]
+    else:
+        rows = [index == k for k in range(len(pieces))]
+    return index, rows
