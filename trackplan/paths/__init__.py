@@ -2,7 +2,8 @@
 
 ``NominalPath.from_specs(start, segments)`` builds the path as given;
 ``build_path(nominal, tolerance, mode)`` plans it on one arc-length parameter s;
-``Path.sample(s)`` evaluates position and its arc-length derivatives.
+``Path.sample(s)`` evaluates position and its arc-length derivatives, ``Path.points(s)``
+position and tangent alone.
 """
 
 from trackplan.paths.blending import (
