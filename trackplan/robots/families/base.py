@@ -138,90 +138,77 @@ class IKFamily(Protocol):
         ...
 
 
-def solve_fused(
-    kernel: Callable[..., None],
-    geometry: np.ndarray,
-    tail_inv: np.ndarray,
-    T_base_tool: np.ndarray,
-    with_aux: bool,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Run a closed-form family's fused compiled kernel over a flat batch of poses.
+class FusedClosedForm:
+    r"""The solve methods of a closed-form family (:class:`IKFamily`) whose compiled kernels
+    (``families/_kernels.py``) take its parameter array and the inverse of its tool
+    transform.
 
-    Parameters
-    ----------
-    kernel
-        The family's kernel (``opw_solve`` or ``ur_solve`` of ``families/_kernels.py``):
-        pose in, eight branches out, one pose at a time.
-    geometry, tail_inv
-        The family's parameter array and the inverse of its tool transform, as the
-        kernel takes them.
-    T_base_tool
-        Tool poses, shape (N, 4, 4), m.
-    with_aux
-        False skips the branch quantities (aux is then (1, 8, AUX_SIZE) scratch).
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        q (N, 8, 6) rad, valid (N, 8) bool, aux (N, 8, AUX_SIZE).
+    A subclass sets ``_geometry`` and ``_tail_inv`` and names its kernels: ``_all_branches``
+    (pose in, eight branches out: ``opw_solve``, ``ur_solve``) and ``_one_branch``
+    (``opw_solve_branch``, ``ur_solve_branch``), as ``staticmethod``\ s.
     """
-    T = np.ascontiguousarray(T_base_tool, dtype=float)
-    n_poses = T.shape[0]
-    q = np.empty((n_poses, N_BRANCHES, 6))
-    valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
-    aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
-    kernel(geometry, tail_inv, T, q, valid, aux)
-    return q, valid, aux
 
+    closed_form = True
+    _all_branches: Callable[..., None]
+    _one_branch: Callable[..., None]
+    _geometry: np.ndarray
+    _tail_inv: np.ndarray
 
-def solve_branch_fused(
-    kernel: Callable[..., None],
-    geometry: np.ndarray,
-    tail_inv: np.ndarray,
-    R_base_tool: np.ndarray,
-    p_base_tool: np.ndarray,
-    branch: int,
-    with_aux: bool,
-    wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Run a closed-form family's one-branch compiled kernel over a flat batch of poses.
+    def solve_flat(
+        self, T_base_tool: np.ndarray, *, with_aux: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """All eight branches of poses (N, 4, 4), m: q (N, 8, 6) rad, valid (N, 8) bool,
+        aux (N, 8, AUX_SIZE); ``with_aux=False`` skips the branch quantities (aux is then
+        (1, 8, AUX_SIZE) scratch)."""
+        T = np.ascontiguousarray(T_base_tool, dtype=float)
+        n_poses = T.shape[0]
+        q = np.empty((n_poses, N_BRANCHES, 6))
+        valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
+        aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
+        self._all_branches(self._geometry, self._tail_inv, T, q, valid, aux)
+        return q, valid, aux
 
-    Parameters
-    ----------
-    kernel
-        ``opw_solve_branch`` or ``ur_solve_branch`` of ``families/_kernels.py``.
-    geometry, tail_inv
-        As :func:`solve_fused`.
-    R_base_tool
-        Tool rotations, shape (N, 3, 3), or one for every pose, (3, 3).
-    p_base_tool
-        Tool positions, shape (N, 3), m.
-    branch
-        The branch, 0 … 7.
-    with_aux
-        False skips the branch quantities (aux is then (1, AUX_SIZE) scratch).
-    wind_to
-        None, or (s, s_grid, q_grid) to hold and wind the joints
-        (:meth:`IKFamily.solve_branch_parts`).
+    def solve_branch(
+        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), aux (N, 5) (or
+        (1, 5) scratch without ``with_aux``), the values :meth:`solve_flat` gives for it."""
+        T = np.asarray(T_base_tool, dtype=float)
+        return self.solve_branch_parts(T[:, :3, :3], T[:, :3, 3], branch, with_aux=with_aux)
 
-    Returns
-    -------
-    tuple of numpy.ndarray
-        q (N, 6) rad (NaN where not valid, unless wound), valid (N,) bool, aux
-        (N, AUX_SIZE).
-    """
-    R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
-    p = np.ascontiguousarray(p_base_tool, dtype=float)
-    n_poses = p.shape[0]
-    q = np.empty((n_poses, 6))
-    valid = np.empty(n_poses, dtype=np.bool_)
-    aux = np.empty((n_poses if with_aux else 1, AUX_SIZE))
-    if wind_to is None:
-        s, s_grid, q_grid = _NO_GRID
-    else:
-        s, s_grid, q_grid = (np.ascontiguousarray(x, dtype=float) for x in wind_to)
-    kernel(geometry, tail_inv, R, p, int(branch), q, valid, aux, s, s_grid, q_grid)
-    return q, valid, aux
+    def solve_branch_parts(
+        self,
+        R_base_tool: np.ndarray,
+        p_base_tool: np.ndarray,
+        branch: int,
+        *,
+        with_aux: bool,
+        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`solve_branch` of poses given by rotations (N, 3, 3) (or one, (3, 3)) and
+        positions (N, 3), m; ``wind_to`` None, or (s, s_grid, q_grid) to hold and wind the
+        joints (:meth:`IKFamily.solve_branch_parts`).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            q (N, 6) rad (NaN where not valid, unless wound), valid (N,) bool, aux
+            (N, AUX_SIZE).
+        """
+        R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
+        p = np.ascontiguousarray(p_base_tool, dtype=float)
+        n_poses = p.shape[0]
+        q = np.empty((n_poses, 6))
+        valid = np.empty(n_poses, dtype=np.bool_)
+        aux = np.empty((n_poses if with_aux else 1, AUX_SIZE))
+        if wind_to is None:
+            s, s_grid, q_grid = _NO_GRID
+        else:
+            s, s_grid, q_grid = (np.ascontiguousarray(x, dtype=float) for x in wind_to)
+        self._one_branch(
+            self._geometry, self._tail_inv, R, p, int(branch), q, valid, aux, s, s_grid, q_grid
+        )
+        return q, valid, aux
 
 
 _NO_GRID = (np.empty(0), np.empty(0), np.empty((0, 6)))

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.robots.families import _kernels as kern
-from trackplan.robots.families.base import describe_bits, solve_branch_fused, solve_fused
+from trackplan.robots.families.base import FusedClosedForm, describe_bits
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
 
@@ -230,11 +230,12 @@ def opw_from_chain(robot: Robot) -> OPWParameters | None:
     return params
 
 
-class OPWFamily:
+class OPWFamily(FusedClosedForm):
     """The OPW closed form of one robot (:class:`~trackplan.robots.families.base.IKFamily`)."""
 
     name = "opw"
-    closed_form = True
+    _all_branches = staticmethod(kern.opw_solve)
+    _one_branch = staticmethod(kern.opw_solve_branch)
 
     def __init__(self, robot: Robot, params: OPWParameters):
         self.params = params
@@ -293,43 +294,3 @@ class OPWFamily:
         positive = self.params.signs[4] > 0
         wrist = (("q5 ≥ 0", "q5 < 0") if positive else ("q5 ≤ 0", "q5 > 0"))[branch & 1]
         return name.rsplit("/", 1)[0] + "/" + wrist
-
-    def solve_flat(
-        self, T_base_tool: np.ndarray, *, with_aux: bool = True
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """All eight branches of poses (N, 4, 4): q (N, 8, 6), valid (N, 8), aux (N, 8, 5).
-
-        ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
-        """
-        return solve_fused(kern.opw_solve, self._geometry, self._tail_inv, T_base_tool, with_aux)
-
-    def solve_branch(
-        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), aux (N, 5) (or
-        (1, 5) scratch without ``with_aux``), the values :meth:`solve_flat` gives for it."""
-        T = np.asarray(T_base_tool, dtype=float)
-        return self.solve_branch_parts(T[:, :3, :3], T[:, :3, 3], branch, with_aux=with_aux)
-
-    def solve_branch_parts(
-        self,
-        R_base_tool: np.ndarray,
-        p_base_tool: np.ndarray,
-        branch: int,
-        *,
-        with_aux: bool,
-        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`solve_branch` of poses given by rotations (N, 3, 3) (or one, (3, 3)) and
-        positions (N, 3), m; ``wind_to`` as for
-        :meth:`~trackplan.robots.families.base.IKFamily.solve_branch_parts`."""
-        return solve_branch_fused(
-            kern.opw_solve_branch,
-            self._geometry,
-            self._tail_inv,
-            R_base_tool,
-            p_base_tool,
-            branch,
-            with_aux,
-            wind_to,
-        )

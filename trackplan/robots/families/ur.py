@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from trackplan.robots.families import _kernels as kern
-from trackplan.robots.families.base import branch_bits, solve_branch_fused, solve_fused
+from trackplan.robots.families.base import FusedClosedForm, branch_bits
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
@@ -203,11 +203,12 @@ def ur_from_chain(robot: Robot) -> URParameters | None:
     return params
 
 
-class URFamily:
+class URFamily(FusedClosedForm):
     """The UR closed form of one robot (:class:`~trackplan.robots.families.base.IKFamily`)."""
 
     name = "ur"
-    closed_form = True
+    _all_branches = staticmethod(kern.ur_solve)
+    _one_branch = staticmethod(kern.ur_solve_branch)
 
     def __init__(self, robot: Robot, params: URParameters):
         self.params = params
@@ -254,44 +255,4 @@ class URFamily:
                 ("sin θ3 ≥ 0", "sin θ3 < 0")[elbow],
                 ("sin θ5 ≥ 0", "sin θ5 < 0")[wrist],
             )
-        )
-
-    def solve_flat(
-        self, T_base_tool: np.ndarray, *, with_aux: bool = True
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """All eight branches of poses (N, 4, 4): q (N, 8, 6), valid (N, 8), aux (N, 8, 5).
-
-        ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
-        """
-        return solve_fused(kern.ur_solve, self._geometry, self._tail_inv, T_base_tool, with_aux)
-
-    def solve_branch(
-        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), aux (N, 5) (or
-        (1, 5) scratch without ``with_aux``), the values :meth:`solve_flat` gives for it."""
-        T = np.asarray(T_base_tool, dtype=float)
-        return self.solve_branch_parts(T[:, :3, :3], T[:, :3, 3], branch, with_aux=with_aux)
-
-    def solve_branch_parts(
-        self,
-        R_base_tool: np.ndarray,
-        p_base_tool: np.ndarray,
-        branch: int,
-        *,
-        with_aux: bool,
-        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`solve_branch` of poses given by rotations (N, 3, 3) (or one, (3, 3)) and
-        positions (N, 3), m; ``wind_to`` as for
-        :meth:`~trackplan.robots.families.base.IKFamily.solve_branch_parts`."""
-        return solve_branch_fused(
-            kern.ur_solve_branch,
-            self._geometry,
-            self._tail_inv,
-            R_base_tool,
-            p_base_tool,
-            branch,
-            with_aux,
-            wind_to,
         )
