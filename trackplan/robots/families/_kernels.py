@@ -305,9 +305,9 @@ def opw_solve(
                 for c in range(4):
                     P[4 * i + c, b] = Tk[i, c]
         for b in range(BLOCK):
-            for r in range(3):
+            for i in range(3):
                 for c in range(4):
-                    W[4 * r + c, b] = _wrist_entry(P, b, r, c, tail_inv)
+                    W[4 * i + c, b] = _wrist_entry(P, b, i, c, tail_inv)
             cx = W[3, b] - c4 * W[2, b] - bx
             cy = W[7, b] - c4 * W[6, b] - by
             C[0, b] = cx
