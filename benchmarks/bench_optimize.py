@@ -210,7 +210,7 @@ def result(*args, **kwargs):
 
 planner_result = search._Planner.result
 search._Planner.result = result
-search._run = timed("search", search._run)
+search.run_search = timed("search", search.run_search)
 paths = search.PathGeometry
 paths.from_case = classmethod(timed("paths (numba starts)", paths.from_case.__func__))
 trackplan.io.case_file.load_case = timed("load case", trackplan.io.case_file.load_case)

@@ -29,15 +29,20 @@ REPORT_AND_OPTIONAL = (
     "toppra",
     "ruckig",
     "pymoo.algorithms",
+    "pymoo.core.algorithm",
+    "pymoo.core.evaluator",
+    "pymoo.termination",
     "rich.progress",
     "rich.table",
     "trackplan.report",
     "trackplan.search.operators",
+    "trackplan.search.pymoo_algorithms",
     "trackplan.cell.screening",
 )
 """Modules a search with the default method and ``--no-report`` does not use (rich's
 progress bar only on a terminal, its tables only for the commands that print one; the
-cell's compiled screening only for a case with a cell)."""
+cell's compiled screening only for a case with a cell; pymoo's Algorithm, evaluator and
+terminations only for the methods that run as a pymoo Algorithm)."""
 
 
 def _loaded_after(code: str, modules: tuple[str, ...]) -> list[str]:

@@ -1,4 +1,5 @@
-"""multistart's local runs (the cmaes package), their race, and what the search imports."""
+"""multistart's local runs (the cmaes package), their race, its run under a pymoo termination,
+and what the search imports."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import pytest
 
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
-from trackplan.search import algorithms
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.search import algorithms, optimize_placement
 from trackplan.search.algorithms import LocalRun, MultiStartSearch
 from trackplan.search.space import SearchSpace
 
@@ -75,6 +77,22 @@ def test_the_race_stops_the_runs_that_fell_behind() -> None:
     search._race()
     assert [run.dropped for run in runs] == [False, False, True, False]
     assert [run.stopped for run in runs] == [False, False, True, False]
+
+
+def test_a_pymoo_termination_runs_the_same_search_as_a_pymoo_algorithm() -> None:
+    """Given a pymoo termination, multistart runs as a pymoo Algorithm (AskTellAlgorithm):
+    its generations are those of the search without pymoo, draw for draw, until the
+    termination stops it."""
+    case = load_case(CASES / "paper-corner.yaml")
+    geometry = PathGeometry.from_case(case)
+    n_gen = algorithms.MULTISTART_SAMPLES // algorithms.MULTISTART_BATCH + 4  # 4 local ones
+    alone = optimize_placement(case, seed=3, geometry=geometry)
+    stopped = optimize_placement(case, seed=3, geometry=geometry, termination=("n_gen", n_gen))
+    assert stopped.stop_reason == "custom" and stopped.generations == n_gen < alone.generations
+    for key in ("evaluations", "best", "mean", "feasible_share"):
+        np.testing.assert_array_equal(
+            getattr(stopped.history, key), getattr(alone.history, key)[:n_gen]
+        )
 
 
 @pytest.mark.slow

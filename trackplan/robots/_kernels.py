@@ -518,21 +518,22 @@ def gather_closed_form(
     for b in range(n_cand):
         for k in range(n_k):
             branch = candidates[b, k]
-            for m in range(n_poses):
+            before_x = before_y = before_z = 0.0  # the previous pose's wrist vector
+            for m in range(n_poses):  # scalars, not views: no array object per pose
                 for j in range(n):
                     q[b, k, m, j] = q_all[b, m, branch, j]
-                reach[b, k, m] = valid[b, m, branch]
-                here = aux[b, m, branch]
-                magnitude[b, k, m, 0] = here[0]
-                magnitude[b, k, m, 1] = here[1]
-                magnitude[b, k, m, 2] = math.sqrt(
-                    here[2] * here[2] + here[3] * here[3] + here[4] * here[4]
-                )
-                if m > 0 and reach[b, k, m] and reach[b, k, m - 1]:
-                    before = aux[b, m - 1, branch]
-                    dot = here[2] * before[2] + here[3] * before[3] + here[4] * before[4]
-                    if dot <= 0.0:
+                reached = valid[b, m, branch]
+                reach[b, k, m] = reached
+                x = aux[b, m, branch, 2]
+                y = aux[b, m, branch, 3]
+                z = aux[b, m, branch, 4]
+                magnitude[b, k, m, 0] = aux[b, m, branch, 0]
+                magnitude[b, k, m, 1] = aux[b, m, branch, 1]
+                magnitude[b, k, m, 2] = math.sqrt(x * x + y * y + z * z)
+                if m > 0 and reached and reach[b, k, m - 1]:
+                    if x * before_x + y * before_y + z * before_z <= 0.0:
                         crossing[b, k, m] = WRIST
+                before_x, before_y, before_z = x, y, z
     return q, reach, magnitude, crossing
 
 

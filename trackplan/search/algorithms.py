@@ -1,4 +1,4 @@
-"""The placement optimisers: a pymoo Algorithm and a Termination per method.
+"""The placement optimisers: the search of each method and the stopping rules they share.
 
 - ``multistart`` (the default): uniform admissible samples, then local CMA-ES runs (the
   ``cmaes`` package) from the best mutually distant ones, side by side in one batch per
@@ -7,19 +7,23 @@
   and short local runs descend each, which reaches the best known J on every shipped case
   and seed where a single global run stops in whichever valley it first entered
   (``docs/search.md``). It imports neither ``cma`` nor matplotlib (``import cma`` alone
-  takes about 2 s);
+  takes about 2 s), nor pymoo's ``Algorithm`` (:class:`MultiStartSearch` asks for arrays
+  and is told fitness arrays; the driver evaluates them without pymoo's populations);
 - ``ga``: the paper's MATLAB GA configuration through pymoo's GeneticAlgorithm with the
   operators of :mod:`trackplan.search.operators`;
 - ``cmaes``: CMA-ES of the ``cma`` package (Hansen's reference implementation) behind
   pymoo's ask/tell interface, on the bounds scaled to [0, 1]; cma's BoundTransform keeps
-  samples in the box and the graded penalty of the fitness handles the reach constraint;
+  samples in the box and the graded penalty of the fitness handles the reach constraint
+  (:class:`~trackplan.search.pymoo_algorithms.CMAESearch`);
 - ``de``: pymoo's differential evolution, DE/rand/1/bin, with the reach repair;
 - ``random``: uniform admissible sampling in batches (pymoo's RandomSearch), the baseline.
 
 Every method but ``multistart`` evaluates ``population`` candidates per generation and
 stops on the same rules: the MATLAB stall test, 100 × 6 generations, or the evaluation
 budget (the driver); CMA-ES also stops when cma's own criteria say it has converged.
-``multistart`` stops when its last local run has converged (or on the budget).
+``multistart`` stops when its last local run has converged, after 100 × 6 generations or
+on the budget. pymoo's ``Algorithm`` and terminations are imported by the methods that
+use them only (0.1 s of an ``optimize`` run's start).
 """
 
 from __future__ import annotations
@@ -30,17 +34,17 @@ import math
 import sys
 from collections import deque
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-from pymoo.core.algorithm import Algorithm
-from pymoo.core.population import Population
-from pymoo.core.termination import TerminateIfAny, Termination
-from pymoo.termination.max_gen import MaximumGenerationTermination
 
 from trackplan.choices import Method
 from trackplan.errors import CaseError
 from trackplan.search.space import N_VAR, SearchSpace
+
+if TYPE_CHECKING:  # pymoo's Algorithm is imported by the methods that run as one only
+    from pymoo.core.algorithm import Algorithm
+    from pymoo.core.termination import Termination
 
 CROSSOVER_FRACTION = 0.8
 """MATLAB's CrossoverFraction as the paper sets it."""
@@ -89,8 +93,11 @@ DEFAULT_RESTARTS = {
 to land within 2 % of the best known J on every seed)."""
 
 
-def make_algorithm(method: str, space: SearchSpace, population: int) -> Algorithm:
-    """The pymoo Algorithm of a method (seeded by ``setup(problem, seed=...)``).
+def make_algorithm(
+    method: str, space: SearchSpace, population: int
+) -> MultiStartSearch | Algorithm:
+    """The search of a method: :class:`MultiStartSearch` (seeded by ``setup(seed)``) or a
+    pymoo Algorithm (seeded by ``setup(problem, seed=...)``).
 
     Parameters
     ----------
@@ -109,6 +116,8 @@ def make_algorithm(method: str, space: SearchSpace, population: int) -> Algorith
     if population < 2:
         raise CaseError(f"population must be ≥ 2, got {population}", key="optimizer.population")
     if method == "cmaes":
+        from trackplan.search.pymoo_algorithms import CMAESearch
+
         return CMAESearch(space, population)
     if method == "multistart":
         return MultiStartSearch(space)
@@ -178,6 +187,9 @@ def make_termination(
         The combined termination, and its parts by stop reason (``stall``,
         ``max_generations``) to tell which one fired.
     """
+    from pymoo.core.termination import TerminateIfAny
+    from pymoo.termination.max_gen import MaximumGenerationTermination
+
     if termination is not None:
         if isinstance(termination, tuple):
             from pymoo.termination import get_termination
@@ -192,69 +204,6 @@ def make_termination(
 
         parts["stall"] = StallTermination(STALL_GENERATIONS, FUNCTION_TOLERANCE)
     return TerminateIfAny(*parts.values()), parts
-
-
-class CMAESearch(Algorithm):
-    """CMA-ES (the ``cma`` package) on the bounds scaled to [0, 1], behind ask/tell.
-
-    The start is a uniform admissible sample, the step size :data:`CMA_SIGMA`; cma draws
-    its normal samples from the algorithm's seeded generator (its ``randn`` option), so no
-    global random state is touched.
-
-    Parameters
-    ----------
-    space
-        The admissible placements.
-    population
-        λ, candidates per generation.
-
-    Attributes
-    ----------
-    converged
-        cma's stop criteria that fired (empty while it runs).
-    """
-
-    def __init__(self, space: SearchSpace, population: int, **kwargs: object):
-        super().__init__(**kwargs)
-        self.space = space
-        self.population = population
-        self.es: Any = None
-        self.converged: dict = {}
-        self._asked: list[np.ndarray] = []
-
-    def _setup(self, problem: object, **kwargs: object) -> None:
-        import cma
-
-        rng = self.random_state
-        x0 = self.space.to_unit(self.space.sample(rng, 1)[0])
-        options = {
-            "bounds": [0.0, 1.0],
-            "popsize": self.population,
-            "randn": lambda *shape: rng.standard_normal(shape),
-            "seed": math.nan,
-            "verbose": -9,
-            "verb_log": 0,
-            "verb_disp": 0,
-            "maxiter": math.inf,
-        }
-        self.es = cma.CMAEvolutionStrategy(x0, CMA_SIGMA, options)
-
-    def _initialize_infill(self) -> Population:
-        return self._infill()
-
-    def _infill(self) -> Population:
-        self._asked = self.es.ask()
-        return Population.new("X", self.space.from_unit(np.asarray(self._asked)))
-
-    def _initialize_advance(self, infills: Population | None = None, **kwargs: object) -> None:
-        self._advance(infills)
-
-    def _advance(self, infills: Population | None = None, **kwargs: object) -> None:
-        if infills is None:
-            raise ValueError("CMAESearch follows ask/tell: tell it the evaluated infills")
-        self.es.tell(self._asked, infills.get("F")[:, 0].tolist())
-        self.pop = infills
-        self.converged = dict(self.es.stop())
 
 
 @functools.cache
@@ -341,8 +290,8 @@ class LocalRun:
         self.window.extend((float(fitness.min()), float(fitness.max())))
 
 
-class MultiStartSearch(Algorithm):
-    """Multi-start local search: uniform samples, then local CMA-ES runs, behind ask/tell.
+class MultiStartSearch:
+    """Multi-start local search: uniform samples, then local CMA-ES runs, asked for arrays.
 
     Phase 1 evaluates :data:`MULTISTART_SAMPLES` uniform admissible placements in batches
     of :data:`MULTISTART_BATCH`. Phase 2 takes the best of them that lie at least
@@ -351,7 +300,12 @@ class MultiStartSearch(Algorithm):
     :data:`LOCAL_SIGMA`, λ = :data:`LOCAL_POPULATION`) from each. The local runs advance
     side by side: one generation asks λ placements of every run still going, so that one
     batched screening call serves them all. Every run draws from its own generator,
-    seeded from the algorithm's, so a seed reproduces the search exactly.
+    seeded from the search's, so a seed reproduces the search exactly.
+
+    It follows ask/tell with arrays (:meth:`ask`, :meth:`tell`), not pymoo's populations:
+    the driver (:func:`trackplan.search.optimize.optimize_placement`) evaluates what it
+    asks; :class:`~trackplan.search.pymoo_algorithms.AskTellAlgorithm` runs it as a pymoo
+    Algorithm where a pymoo termination is given.
 
     Parameters
     ----------
@@ -362,28 +316,33 @@ class MultiStartSearch(Algorithm):
     ----------
     converged
         Non-empty once the last local run has stopped.
+    n_gen
+        Generations told so far.
     """
 
-    def __init__(self, space: SearchSpace, **kwargs: object):
-        super().__init__(**kwargs)
+    def __init__(self, space: SearchSpace):
         self.space = space
+        self.setup(0)
+
+    def setup(self, seed: int | None) -> None:
+        """Start afresh, every random draw from ``numpy.random.default_rng(seed)`` (the
+        generator a pymoo Algorithm's ``setup`` makes of its seed)."""
+        self.random_state = np.random.default_rng(seed)
         self.converged: dict = {}
+        self.n_gen = 0
         self.samples: list[np.ndarray] = []
         self.sample_fitness: list[np.ndarray] = []
         self.runs: list[LocalRun] | None = None
         self._asking: list[LocalRun] = []
+        self._asked = np.zeros((0, N_VAR))
 
-    def _initialize_infill(self) -> Population:
-        return self._infill()
-
-    def _initialize_advance(self, infills: Population | None = None, **kwargs: object) -> None:
-        self._advance(infills)
-
-    def _infill(self) -> Population | None:
+    def ask(self) -> np.ndarray | None:
+        """The next generation's placements, shape (B, 6); None once every run has stopped."""
         done = sum(len(x) for x in self.samples)
         if done < MULTISTART_SAMPLES:
             n = min(MULTISTART_BATCH, MULTISTART_SAMPLES - done)
-            return Population.new("X", self.space.sample(self.random_state, n))
+            self._asked = self.space.sample(self.random_state, n)
+            return self._asked
         if self.runs is None:
             starts = self._distinct_starts()
             seeds = self.random_state.integers(2**31, size=len(starts))
@@ -393,20 +352,18 @@ class MultiStartSearch(Algorithm):
             self.converged = {"local runs": len(self.runs)}
             return None
         Z = np.concatenate([run.ask() for run in self._asking])
-        return Population.new("X", self.space.from_unit(Z))
+        return self.space.from_unit(Z)
 
-    def _advance(self, infills: Population | None = None, **kwargs: object) -> None:
-        if infills is None:
-            raise ValueError("MultiStartSearch follows ask/tell: tell it the evaluated infills")
-        fitness = infills.get("F")[:, 0]
+    def tell(self, fitness: np.ndarray) -> None:
+        """Tell the fitness (B,) of the generation last asked."""
         if self.runs is None:
-            self.samples.append(infills.get("X"))
+            self.samples.append(self._asked)
             self.sample_fitness.append(fitness)
         else:
             for i, run in enumerate(self._asking):
                 run.tell(fitness[i * LOCAL_POPULATION : (i + 1) * LOCAL_POPULATION])
             self._race()
-        self.pop = infills
+        self.n_gen += 1
 
     def _race(self) -> None:
         """Stop the local runs that have fallen behind: after :data:`RACE_GENERATIONS`, a run
@@ -416,11 +373,6 @@ class MultiStartSearch(Algorithm):
         for run in self._asking:
             behind = run.best - leader > RACE_MARGIN * abs(leader)
             run.dropped |= run.generations >= RACE_GENERATIONS and behind
-
-    def _set_optimum(self) -> None:
-        """The best of the latest generation (the search's own best is the problem's
-        archive); cheaper than pymoo's filter over the whole population."""
-        self.opt = self.pop[[int(np.argmin(self.pop.get("F")[:, 0]))]]
 
     def _distinct_starts(self) -> list[np.ndarray]:
         """The best samples at least MULTISTART_DISTANCE apart, best first, scaled to [0, 1]."""

@@ -36,7 +36,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from pymoo.core.algorithm import Algorithm
 
 from trackplan.case import Case
 from trackplan.choices import Method, choose
@@ -49,7 +48,7 @@ from trackplan.planning.cycle import (
     seam_geometries,
 )
 from trackplan.planning.sequence import best_sequence
-from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm, make_termination
+from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm
 from trackplan.search.fitness import (
     REACH_LEVEL,
     REACH_SCALE,
@@ -57,7 +56,7 @@ from trackplan.search.fitness import (
     PlacementFitness,
     Screening,
 )
-from trackplan.search.optimize import GenerationRecord, SearchHistory, _run, run_seeds
+from trackplan.search.optimize import GenerationRecord, SearchHistory, run_search, run_seeds
 from trackplan.search.problem import PlacementProblem
 from trackplan.search.space import N_VAR, SearchSpace
 from trackplan.status import Status
@@ -428,10 +427,9 @@ def optimize_cycle(
     stop_reason = ""
     runs = 0
     for run_seed in run_seeds(seed, restarts):
-        algorithm: Algorithm = make_algorithm(method, space, case.optimizer.population)
-        rules, parts = make_termination(None, method)
-        algorithm.setup(problem, termination=rules, seed=run_seed)
-        stop_reason = _run(algorithm, problem, parts, budget, progress, start, records)
+        search = make_algorithm(method, space, case.optimizer.population)
+        driver = (budget, progress, start, records)
+        stop_reason = run_search(search, problem, None, method, run_seed, driver)
         runs += 1
         if stop_reason in ("budget", "interrupted"):
             break

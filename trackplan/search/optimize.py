@@ -17,11 +17,9 @@ import time
 from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-from pymoo.core.algorithm import Algorithm
-from pymoo.core.population import Population
-from pymoo.core.termination import Termination
 
 from trackplan.case import Case
 from trackplan.choices import Method, choose
@@ -30,12 +28,22 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
 from trackplan.run_files import HISTORY_KEYS
-from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm, make_termination
+from trackplan.search.algorithms import (
+    DEFAULT_RESTARTS,
+    MAX_GENERATIONS,
+    MultiStartSearch,
+    make_algorithm,
+    make_termination,
+)
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.problem import PlacementProblem
 from trackplan.search.space import SearchSpace
 from trackplan.status import Status
 from trackplan.timing import time_law
+
+if TYPE_CHECKING:  # pymoo's Algorithm is imported by the methods that run as one only
+    from pymoo.core.algorithm import Algorithm
+    from pymoo.core.termination import Termination
 
 
 @dataclass(frozen=True)
@@ -259,14 +267,14 @@ def optimize_placement(
             key="paths",
         )
     start = time.perf_counter()
-    if not isinstance(method, Algorithm):
-        method = choose(Method, method or case.optimizer.method, "method")
+    custom = None if method is None or isinstance(method, str) else method  # a pymoo Algorithm
+    chosen = None if custom else choose(Method, method or case.optimizer.method, "method")
     seed = case.optimizer.seed if seed is None else int(seed)
     budget = case.optimizer.budget if budget is None else int(budget)
     if restarts is None:
         restarts = case.optimizer.restarts
     if restarts is None:
-        restarts = DEFAULT_RESTARTS[method] if isinstance(method, Method) else 1
+        restarts = 1 if chosen is None else DEFAULT_RESTARTS[chosen]
     restarts = int(restarts)
     law = time_law(timing or case.task.timing)
     if seed < 0:
@@ -287,20 +295,19 @@ def optimize_placement(
     stop_reason = ""
     runs = 0
     for run_seed in run_seeds(seed, restarts):
-        if isinstance(method, Algorithm):
-            algorithm = copy.deepcopy(method)
+        if chosen is None:
+            search = copy.deepcopy(custom)
         else:
-            algorithm = make_algorithm(method, space, case.optimizer.population)
-        rules, parts = make_termination(termination, method if isinstance(method, Method) else None)
-        algorithm.setup(problem, termination=rules, seed=run_seed)
-        stop_reason = _run(algorithm, problem, parts, budget, progress, start, records)
+            search = make_algorithm(chosen, space, case.optimizer.population)
+        driver = (budget, progress, start, records)
+        stop_reason = run_search(search, problem, termination, chosen, run_seed, driver)
         runs += 1
         if stop_reason in ("budget", "interrupted"):
             break
     initial = planner.result(before, space.anchor)
     final, rejected = _final_plan(problem, planner)
     archive = problem.archive
-    chosen = int(np.flatnonzero(np.all(archive.X[:, :6] == final.placement, axis=1))[0])
+    kept = int(np.flatnonzero(np.all(archive.X[:, :6] == final.placement, axis=1))[0])
     if stop_reason == "interrupted":
         status = Status.INTERRUPTED
     else:
@@ -311,7 +318,7 @@ def optimize_placement(
         message=_message(final, problem, rejected, space),
         X=final.placement,
         branch=int(final.branch),
-        fitness=float(archive.fitness[chosen]),
+        fitness=float(archive.fitness[kept]),
         objective=float(final.objective),
         final=final,
         initial=initial,
@@ -320,7 +327,7 @@ def optimize_placement(
         generations=len(records),
         stop_reason=stop_reason,
         wall_time_s=time.perf_counter() - start,
-        method=method if isinstance(method, Method) else type(method).__name__,
+        method=type(custom).__name__ if chosen is None else chosen,
         seed=seed,
         runs=runs,
         rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),
@@ -331,6 +338,73 @@ def run_seeds(seed: int, restarts: int) -> list[int]:
     """Seeds of the independent runs: ``seed`` itself, then children of it."""
     children = np.random.SeedSequence(seed).spawn(restarts - 1)
     return [seed] + [int(child.generate_state(1)[0]) for child in children]
+
+
+def run_search(
+    search: MultiStartSearch | Algorithm,
+    problem: PlacementProblem,
+    termination: Termination | tuple | None,
+    method: Method | None,
+    seed: int,
+    driver: tuple[int | None, ProgressCallback | None, float, list[GenerationRecord]],
+) -> str:
+    """One run of a search from ``seed`` on ``problem``; the stop reason.
+
+    A :class:`~trackplan.search.algorithms.MultiStartSearch` asks for arrays and is told
+    fitness arrays, without pymoo (:func:`_run_arrays`), unless a pymoo ``termination``
+    is given (it then runs as a pymoo Algorithm:
+    :class:`~trackplan.search.pymoo_algorithms.AskTellAlgorithm`, the same draws); a pymoo
+    Algorithm runs with ``termination`` or the method's stopping rules
+    (:func:`~trackplan.search.algorithms.make_termination`). ``driver`` is the budget,
+    the progress callback, the search's start (``time.perf_counter``) and the records,
+    appended to one per generation.
+    """
+    if isinstance(search, MultiStartSearch):
+        if termination is None:
+            search.setup(seed)
+            return _run_arrays(search, problem, *driver)
+        from trackplan.search.pymoo_algorithms import AskTellAlgorithm
+
+        search = AskTellAlgorithm(search)
+    rules, parts = make_termination(termination, method)
+    search.setup(problem, termination=rules, seed=seed)
+    return _run(search, problem, parts, *driver)
+
+
+def _run_arrays(
+    search: MultiStartSearch,
+    problem: PlacementProblem,
+    budget: int | None,
+    progress: ProgressCallback | None,
+    start: float,
+    records: list[GenerationRecord],
+) -> str:
+    """:func:`_run` of a search that asks for arrays: the same stopping rules (the budget,
+    the search's convergence, :data:`~trackplan.search.algorithms.MAX_GENERATIONS`), the
+    same records."""
+    try:
+        while True:
+            X = search.ask()
+            if X is None or len(X) == 0:
+                return "converged"
+            remaining = None if budget is None else budget - problem.n_evaluations
+            truncated = remaining is not None and len(X) > remaining
+            if truncated:
+                X = X[:remaining]
+            fitness = problem.screen(X)
+            if not truncated:
+                search.tell(fitness)
+            records.append(_record(len(records) + 1, problem, fitness, start))
+            if progress is not None:
+                progress(records[-1])
+            if budget is not None and problem.n_evaluations >= budget:
+                return "budget"
+            if search.converged:
+                return "converged"
+            if search.n_gen >= MAX_GENERATIONS:
+                return "max_generations"
+    except KeyboardInterrupt:
+        return _interrupted(problem, start, records)
 
 
 def _run(
@@ -356,7 +430,7 @@ def _run(
             algorithm.evaluator.eval(problem, infills, algorithm=algorithm)
             if not truncated:
                 algorithm.tell(infills=infills)
-            records.append(_record(len(records) + 1, problem, infills, start))
+            records.append(_record(len(records) + 1, problem, infills.get("F")[:, 0], start))
             if progress is not None:
                 progress(records[-1])
             if budget is not None and problem.n_evaluations >= budget:
@@ -367,21 +441,25 @@ def _run(
                 fired = [name for name, part in parts.items() if part.has_terminated()]
                 return fired[0] if fired else "stall"
     except KeyboardInterrupt:
-        if problem.n_evaluations == 0:
-            raise
-        if problem.last is not None and (
-            not records or records[-1].evaluations < problem.n_evaluations
-        ):
-            records.append(_record(len(records) + 1, problem, problem.last.fitness, start))
-        return "interrupted"
+        return _interrupted(problem, start, records)
+
+
+def _interrupted(problem: PlacementProblem, start: float, records: list[GenerationRecord]) -> str:
+    """Inside the handler of a KeyboardInterrupt: the record of a generation evaluated but
+    not yet recorded, and the stop reason ``interrupted``; re-raised before any evaluation."""
+    if problem.n_evaluations == 0:
+        raise
+    if problem.last is not None and (
+        not records or records[-1].evaluations < problem.n_evaluations
+    ):
+        records.append(_record(len(records) + 1, problem, problem.last.fitness, start))
+    return "interrupted"
 
 
 def _record(
-    generation: int, problem: PlacementProblem, batch: Population | np.ndarray, start: float
+    generation: int, problem: PlacementProblem, fitness: np.ndarray, start: float
 ) -> GenerationRecord:
-    """The figures of the latest generation (``batch``: its evaluated candidates' population
-    or their fitness)."""
-    fitness = batch.get("F")[:, 0] if isinstance(batch, Population) else np.asarray(batch)
+    """The figures of the latest generation (``fitness``: its evaluated candidates', (B,))."""
     best_objective = problem.archive.objective[0] if len(problem.archive.objective) else np.nan
     return GenerationRecord(
         generation=generation,

@@ -129,10 +129,18 @@ class PlacementProblem(Problem):
         """Best fitness evaluated so far (inf before the first evaluation)."""
         return float(self.archive.fitness[0]) if len(self.archive.fitness) else np.inf
 
-    def _evaluate(self, x: np.ndarray, out: dict, *args: object, **kwargs: object) -> None:
-        """Evaluate a batch, shape (B, 6 + k), into ``out["F"]`` (B, 1)."""
-        screening = self.fitness.evaluate(x, incumbent=self.best_fitness)
+    def screen(self, X: np.ndarray) -> np.ndarray:
+        """Evaluate a batch of candidates, shape (B, 6 + k), and record it; its fitness (B,).
+
+        What pymoo's evaluator calls (through ``_evaluate``), and what the driver calls
+        for a search that asks for arrays (:class:`~trackplan.search.algorithms.MultiStartSearch`).
+        """
+        screening = self.fitness.evaluate(X, incumbent=self.best_fitness)
         self.n_evaluations += len(screening.X)
         self.archive = self.archive.merged(screening, self.space.span)
         self.last = screening
-        out["F"] = screening.fitness[:, None]
+        return screening.fitness
+
+    def _evaluate(self, x: np.ndarray, out: dict, *args: object, **kwargs: object) -> None:
+        """Evaluate a batch, shape (B, 6 + k), into ``out["F"]`` (B, 1)."""
+        out["F"] = self.screen(x)[:, None]

@@ -1,11 +1,14 @@
 """Compiled kernels of the closed-form IK families (OPW and UR).
 
-One fused kernel per family (:func:`opw_solve`, :func:`ur_solve`) takes a pose and writes
-its eight branches: a per-pose pass writes the arguments (Y, X) of every arctangent into a
-small buffer, :func:`atan2` evaluates the buffer (a compiled, branch-free arctangent that
-LLVM vectorises; libm's scalar ``atan2`` and numpy's ``arctan2`` cost about 25 ns each
-and dominated the former three-pass design), and a per-pose pass assembles the joint
-values. No array of the batch's size is allocated besides the outputs. A one-branch kernel
+One fused kernel per family (:func:`opw_solve`, :func:`ur_solve`) takes poses and writes
+their eight branches: the arguments (Y, X) of every arctangent go into a small buffer,
+:func:`atan2` evaluates the buffer (a compiled, branch-free arctangent that LLVM
+vectorises; libm's scalar ``atan2`` and numpy's ``arctan2`` cost about 25 ns each and
+dominated the former three-pass design), and the joint values are assembled from the
+angles. :func:`opw_solve` does each of the three in a flat pass over blocks of
+:data:`BLOCK` poses that vectorises (the four arms' arguments side by side, unreachable
+arms computed through and marked); :func:`ur_solve` works pose by pose. No array of the
+batch's size is allocated besides the outputs. A one-branch kernel
 per family (:func:`opw_solve_branch`, :func:`ur_solve_branch`) runs the same operations for
 the arm of one branch only (6 arctangents a pose instead of 20): a planned trajectory's
 samples need only the branch chosen on the planning grid. It takes blocks of
@@ -187,56 +190,22 @@ def _wrist_frame(
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _zyz_arguments(
-    x0: float,
-    x1: float,
-    x2: float,
-    y0: float,
-    y1: float,
-    z0: float,
-    z1: float,
-    z2: float,
-    w00: float,
-    w10: float,
-    w20: float,
-    w02: float,
-    w12: float,
-    w22: float,
-    c40: float,
-    s40: float,
-    Y: np.ndarray,
-    X: np.ndarray,
-    slot: int,
-) -> None:  # pragma: no cover - compiled
-    """Kernel: arctangent arguments of θ4, θ5, θ6 with ``M = Rᵀ W = Rz(θ4) Ry(θ5) Rz(θ6)``.
+def _wrist_entry(
+    P: np.ndarray, b: int, r: int, c: int, tail_inv: np.ndarray
+) -> float:  # pragma: no cover - compiled
+    """Kernel: entry (r, c) of ``T · tail_inv`` for pose b of a block P (12, BLOCK), summed
+    in :func:`_wrist_frame`'s order."""
+    return (
+        P[4 * r, b] * tail_inv[0, c]
+        + P[4 * r + 1, b] * tail_inv[1, c]
+        + P[4 * r + 2, b] * tail_inv[2, c]
+        + P[4 * r + 3, b] * tail_inv[3, c]
+    )
 
-    (x0, x1, x2), (y0, y1, 0), (z0, z1, z2) are the columns of R; w·0 and w·2 the first
-    and third columns of the target rotation W. Where |sin θ5| is below
-    :data:`WRIST_SINGULAR`, θ4 is set to the angle (c40, s40).
-    """
-    m00 = x0 * w00 + x1 * w10 + x2 * w20
-    m02 = x0 * w02 + x1 * w12 + x2 * w22
-    m10 = y0 * w00 + y1 * w10 + 0.0 * w20
-    m12 = y0 * w02 + y1 * w12 + 0.0 * w22
-    m20 = z0 * w00 + z1 * w10 + z2 * w20
-    m22 = z0 * w02 + z1 * w12 + z2 * w22
-    s5 = math.sqrt(m02 * m02 + m12 * m12)
-    c5 = m22
-    if s5 > WRIST_SINGULAR:
-        c4 = m02 / s5
-        s4 = m12 / s5
-    else:
-        c4 = c40
-        s4 = s40
-    # θ6 from Ry(−θ5) Rz(−θ4) M = Rz(θ6): exact for any θ4 once θ5 is exact.
-    n00 = c4 * m00 + s4 * m10
-    n10 = -s4 * m00 + c4 * m10
-    Y[slot] = s4
-    X[slot] = c4
-    Y[slot + 1] = s5
-    X[slot + 1] = c5
-    Y[slot + 2] = n10
-    X[slot + 2] = c5 * n00 - s5 * m20
+
+BLOCK = 32
+"""Poses per block of :func:`opw_solve` and :func:`opw_solve_branch`: each pass over a
+block is a flat loop over its poses that LLVM turns into SIMD code."""
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -251,90 +220,6 @@ def _unreachable(
         valid[br] = False
         for j in range(AUX_SIZE):
             aux[br, j] = np.nan
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _opw_arguments(
-    g: np.ndarray,
-    tail_inv: np.ndarray,
-    T: np.ndarray,
-    Y: np.ndarray,
-    X: np.ndarray,
-    valid: np.ndarray,
-    aux: np.ndarray,
-    shoulders: tuple[int, int],
-    elbows: tuple[int, int],
-) -> None:  # pragma: no cover - compiled
-    """Kernel: one pose's OPW arctangent arguments (20,), reachability (8,), aux (8, 5).
-
-    T is the pose (4, 4). Only the arms of shoulders ``range(*shoulders)`` and elbows
-    ``range(*elbows)`` are worked out (all four: ``(0, 2)`` and ``(0, 2)``); the slots,
-    validity and aux of the others are left as they were.
-    """
-    a1 = g[O_A1]
-    b = g[O_B]
-    c1 = g[O_C1]
-    c2 = g[O_C2]
-    c4 = g[O_C4]
-    kappa = g[O_KAPPA]
-    cpsi = g[O_CPSI]
-    spsi = g[O_SPSI]
-    w00, _w01, w02, w03, w10, _w11, w12, w13, w20, _w21, w22, w23 = _wrist_frame(T, tail_inv)
-    cx = w03 - c4 * w02 - g[O_BX]
-    cy = w13 - c4 * w12 - g[O_BY]
-    cz = w23 - c4 * w22
-    r2 = cx * cx + cy * cy - b * b
-    if r2 < -REACH_TOL:
-        _unreachable(valid, aux, 0, N_BRANCHES)
-        return
-    r = math.sqrt(max(r2, 0.0))
-    for shoulder in range(shoulders[0], shoulders[1]):
-        xr = r if shoulder == 0 else -r
-        c1_, s1_ = unit(cx * xr + cy * b, cy * xr - cx * b)
-        Y[O_TH1 + shoulder] = s1_
-        X[O_TH1 + shoulder] = c1_
-        dx = xr - a1
-        dz = cz - c1
-        K = (dx * dx + dz * dz - c2 * c2 - kappa * kappa) / (2.0 * c2 * kappa)
-        if abs(K) > 1.0 + REACH_TOL:
-            _unreachable(valid, aux, 4 * shoulder, 4 * shoulder + 4)
-            continue
-        K = min(max(K, -1.0), 1.0)
-        sphi = math.sqrt((1.0 - K) * (1.0 + K))
-        Y[O_PHI + shoulder] = sphi
-        X[O_PHI + shoulder] = K
-        for elbow in range(elbows[0], elbows[1]):
-            arm = 2 * shoulder + elbow
-            sg = 1.0 if shoulder == elbow else -1.0
-            vx = c2 + kappa * K
-            vy = kappa * sg * sphi
-            c2_, s2_ = unit(dz * vx + dx * vy, dx * vx - dz * vy)
-            Y[O_TH2 + arm] = s2_
-            X[O_TH2 + arm] = c2_
-            c3_ = K * cpsi + sg * sphi * spsi
-            s3_ = sg * sphi * cpsi - K * spsi
-            c23 = c2_ * c3_ - s2_ * s3_
-            s23 = s2_ * c3_ + c2_ * s3_
-            # R_0_3 = Rz(θ1) Ry(θ2 + θ3), by columns x, y = (−s1, c1, 0), z.
-            x0 = c1_ * c23
-            x1 = s1_ * c23
-            z0 = c1_ * s23
-            z1 = s1_ * s23
-            _zyz_arguments(
-                x0, x1, -s23, -s1_, c1_, z0, z1, c23, w00, w10, w20, w02, w12, w22,
-                g[O_C40], g[O_S40], Y, X, O_WRIST + 3 * arm,
-            )  # fmt: skip
-            wx = z1 * w22 - c23 * w12
-            wy = c23 * w02 - z0 * w22
-            wz = z0 * w12 - z1 * w02
-            for flip in range(2):
-                br = 2 * arm + flip
-                valid[br] = True
-                aux[br, 0] = r
-                aux[br, 1] = sphi
-                aux[br, 2] = wx
-                aux[br, 3] = wy
-                aux[br, 4] = wz
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -369,23 +254,6 @@ def _opw_joints(
         q[5] = sg[5] * wrap(th6 + math.pi)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def _opw_assemble(
-    g: np.ndarray, a: np.ndarray, valid: np.ndarray, q: np.ndarray
-) -> None:  # pragma: no cover - compiled
-    """Kernel: one pose's joint angles q (8, 6) of the eight OPW branches from its
-    arctangents a (20,)."""
-    for arm in range(4):
-        b0 = 2 * arm
-        if not valid[b0]:
-            for j in range(6):
-                q[b0, j] = np.nan
-                q[b0 + 1, j] = np.nan
-            continue
-        _opw_joints(g, a, arm, 0, q[b0])
-        _opw_joints(g, a, arm, 1, q[b0 + 1])
-
-
 @njit(cache=True, error_model="numpy")
 def opw_solve(
     g: np.ndarray,
@@ -396,15 +264,168 @@ def opw_solve(
     aux: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Kernel: all eight OPW branches of poses T (N, 4, 4): q (N, 8, 6), valid (N, 8),
-    aux (N, 8, 5); an ``aux`` of shape (1, 8, 5) is scratch (branch quantities not kept)."""
-    Y = np.zeros(O_N_ANGLES)
-    X = np.ones(O_N_ANGLES)
-    angles = np.empty(O_N_ANGLES)
-    for k in range(T.shape[0]):
-        ak = aux[k if aux.shape[0] > 1 else 0]
-        _opw_arguments(g, tail_inv, T[k], Y, X, valid[k], ak, (0, 2), (0, 2))
-        _atan2_all(Y, X, angles)
-        _opw_assemble(g, angles, valid[k], q[k])
+    aux (N, 8, 5); an ``aux`` of shape (1, 8, 5) is scratch (branch quantities not kept).
+
+    Blocks of :data:`BLOCK` poses in three flat passes, as :func:`opw_solve_branch`: the
+    arctangent arguments of the four arms (20 a pose; unreachable arms computed through
+    and marked), their arctangents, the joints of the eight branches.
+    """
+    a1 = g[O_A1]
+    b_off = g[O_B]
+    c1 = g[O_C1]
+    c2 = g[O_C2]
+    c4 = g[O_C4]
+    kappa = g[O_KAPPA]
+    cpsi = g[O_CPSI]
+    spsi = g[O_SPSI]
+    bx = g[O_BX]
+    by = g[O_BY]
+    c40 = g[O_C40]
+    s40 = g[O_S40]
+    keep = aux.shape[0] > 1
+    n_poses = T.shape[0]
+    P = np.zeros((12, BLOCK))  # the pose's first three rows, one row per entry
+    Y = np.zeros((O_N_ANGLES, BLOCK))
+    X = np.ones((O_N_ANGLES, BLOCK))
+    A = np.empty((O_N_ANGLES, BLOCK))
+    W = np.empty((12, BLOCK))  # the first three rows of T · tail_inv
+    C = np.empty((4, BLOCK))  # the wrist centre (x, y, z) and r², per pose
+    S = np.empty((3, BLOCK))  # r, dx, dz of the shoulder at hand
+    arm_aux = np.empty((4 * AUX_SIZE, BLOCK))  # per arm: r, sin φ, wrist vector
+    ok = np.empty((2, BLOCK), dtype=np.bool_)  # per shoulder
+    Q = np.empty((6 * N_BRANCHES, BLOCK))  # the joints, branch by branch
+    psi = g[O_PSI]
+    t0 = g[O_THETA0 : O_THETA0 + 6]
+    signs = g[O_SIGN : O_SIGN + 6]
+    for start in range(0, n_poses, BLOCK):
+        m = min(BLOCK, n_poses - start)
+        for b in range(m):
+            Tk = T[start + b]
+            for i in range(3):
+                for c in range(4):
+                    P[4 * i + c, b] = Tk[i, c]
+        for b in range(BLOCK):
+            for i in range(3):
+                for c in range(4):
+                    W[4 * i + c, b] = _wrist_entry(P, b, i, c, tail_inv)
+            cx = W[3, b] - c4 * W[2, b] - bx
+            cy = W[7, b] - c4 * W[6, b] - by
+            C[0, b] = cx
+            C[1, b] = cy
+            C[2, b] = W[11, b] - c4 * W[10, b]
+            C[3, b] = cx * cx + cy * cy - b_off * b_off
+        for shoulder in range(2):
+            for b in range(BLOCK):
+                cx = C[0, b]
+                cy = C[1, b]
+                r2 = C[3, b]
+                r = math.sqrt(max(r2, 0.0))
+                xr = r if shoulder == 0 else -r
+                c1_, s1_ = unit(cx * xr + cy * b_off, cy * xr - cx * b_off)
+                dx = xr - a1
+                dz = C[2, b] - c1
+                K = (dx * dx + dz * dz - c2 * c2 - kappa * kappa) / (2.0 * c2 * kappa)
+                ok[shoulder, b] = not (r2 < -REACH_TOL or abs(K) > 1.0 + REACH_TOL)
+                K = min(max(K, -1.0), 1.0)
+                Y[O_TH1 + shoulder, b] = s1_
+                X[O_TH1 + shoulder, b] = c1_
+                Y[O_PHI + shoulder, b] = math.sqrt((1.0 - K) * (1.0 + K))
+                X[O_PHI + shoulder, b] = K
+                S[0, b] = r
+                S[1, b] = dx
+                S[2, b] = dz
+            for elbow in range(2):
+                arm = 2 * shoulder + elbow
+                sg = 1.0 if shoulder == elbow else -1.0
+                slot = O_WRIST + 3 * arm
+                row = AUX_SIZE * arm
+                for b in range(BLOCK):
+                    w00 = W[0, b]
+                    w02 = W[2, b]
+                    w10 = W[4, b]
+                    w12 = W[6, b]
+                    w20 = W[8, b]
+                    w22 = W[10, b]
+                    s1_ = Y[O_TH1 + shoulder, b]
+                    c1_ = X[O_TH1 + shoulder, b]
+                    sphi = Y[O_PHI + shoulder, b]
+                    K = X[O_PHI + shoulder, b]
+                    dx = S[1, b]
+                    dz = S[2, b]
+                    vx = c2 + kappa * K
+                    vy = kappa * sg * sphi
+                    c2_, s2_ = unit(dz * vx + dx * vy, dx * vx - dz * vy)
+                    c3_ = K * cpsi + sg * sphi * spsi
+                    s3_ = sg * sphi * cpsi - K * spsi
+                    c23 = c2_ * c3_ - s2_ * s3_
+                    s23 = s2_ * c3_ + c2_ * s3_
+                    x0 = c1_ * c23
+                    x1 = s1_ * c23
+                    z0 = c1_ * s23
+                    z1 = s1_ * s23
+                    m00 = x0 * w00 + x1 * w10 + -s23 * w20
+                    m02 = x0 * w02 + x1 * w12 + -s23 * w22
+                    m10 = -s1_ * w00 + c1_ * w10 + 0.0 * w20
+                    m12 = -s1_ * w02 + c1_ * w12 + 0.0 * w22
+                    m20 = z0 * w00 + z1 * w10 + c23 * w20
+                    m22 = z0 * w02 + z1 * w12 + c23 * w22
+                    s5 = math.sqrt(m02 * m02 + m12 * m12)
+                    c5 = m22
+                    singular = not s5 > WRIST_SINGULAR
+                    c4_ = c40 if singular else m02 / s5
+                    s4_ = s40 if singular else m12 / s5
+                    n00 = c4_ * m00 + s4_ * m10
+                    n10 = -s4_ * m00 + c4_ * m10
+                    Y[O_TH2 + arm, b] = s2_
+                    X[O_TH2 + arm, b] = c2_
+                    Y[slot, b] = s4_
+                    X[slot, b] = c4_
+                    Y[slot + 1, b] = s5
+                    X[slot + 1, b] = c5
+                    Y[slot + 2, b] = n10
+                    X[slot + 2, b] = c5 * n00 - s5 * m20
+                    arm_aux[row, b] = S[0, b]
+                    arm_aux[row + 1, b] = sphi
+                    arm_aux[row + 2, b] = z1 * w22 - c23 * w12
+                    arm_aux[row + 3, b] = c23 * w02 - z0 * w22
+                    arm_aux[row + 4, b] = z0 * w12 - z1 * w02
+        for e in range(O_N_ANGLES):
+            for b in range(BLOCK):
+                A[e, b] = atan2(Y[e, b], X[e, b])
+        for arm in range(4):
+            shoulder = arm >> 1
+            phi_sign = 1.0 if shoulder == (arm & 1) else -1.0
+            slot = O_WRIST + 3 * arm
+            row = 12 * arm
+            for b in range(BLOCK):  # _opw_joints of both flips, side by side
+                th1 = signs[0] * wrap(A[O_TH1 + shoulder, b] - t0[0])
+                th2 = signs[1] * wrap(A[O_TH2 + arm, b] - t0[1])
+                th3 = signs[2] * wrap(phi_sign * A[O_PHI + shoulder, b] - psi - t0[2])
+                th4 = A[slot, b] - t0[3]
+                th5 = A[slot + 1, b]
+                th6 = A[slot + 2, b] - t0[5]
+                Q[row, b] = th1
+                Q[row + 1, b] = th2
+                Q[row + 2, b] = th3
+                Q[row + 3, b] = signs[3] * wrap(th4)
+                Q[row + 4, b] = signs[4] * wrap(th5 - t0[4])
+                Q[row + 5, b] = signs[5] * wrap(th6)
+                Q[row + 6, b] = th1
+                Q[row + 7, b] = th2
+                Q[row + 8, b] = th3
+                Q[row + 9, b] = signs[3] * wrap(th4 + math.pi)
+                Q[row + 10, b] = signs[4] * wrap(-th5 - t0[4])
+                Q[row + 11, b] = signs[5] * wrap(th6 + math.pi)
+        for b in range(m):
+            k = start + b
+            row = k if keep else 0
+            for br in range(N_BRANCHES):
+                reached = ok[br >> 2, b]
+                valid[k, br] = reached
+                for j in range(AUX_SIZE):
+                    aux[row, br, j] = arm_aux[AUX_SIZE * (br >> 1) + j, b] if reached else np.nan
+                for j in range(6):
+                    q[k, br, j] = Q[6 * br + j, b] if reached else np.nan
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -480,11 +501,6 @@ def hold_and_wind(
             q[m, j] = held[j] - two_pi * np.rint((held[j] - reference) / two_pi)
 
 
-BLOCK = 32
-"""Poses per block of :func:`opw_solve_branch`: each pass over a block is a flat loop over
-its poses that LLVM turns into SIMD code."""
-
-
 @njit(cache=True, error_model="numpy")
 def opw_solve_branch(
     g: np.ndarray,
@@ -506,7 +522,7 @@ def opw_solve_branch(
     (G,) not empty), the joints are then held and wound by :func:`hold_and_wind`.
 
     Blocks of :data:`BLOCK` poses, in three flat passes each: the arm's arctangent
-    arguments (the expressions of :func:`_opw_arguments` for one shoulder and elbow,
+    arguments (the expressions of :func:`opw_solve` for one shoulder and elbow,
     unreachable poses computed through and marked), their arctangents, the joints.
     """
     a1 = g[O_A1]
@@ -812,20 +828,6 @@ def ur_solve(
         _ur_arguments(g, tail_inv, T[k], Y, X, valid[k], ak, (0, 2), (0, 2), (0, 2))
         _atan2_all(Y, X, angles)
         _ur_assemble(g, angles, valid[k], q[k], theta)
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _wrist_entry(
-    P: np.ndarray, b: int, r: int, c: int, tail_inv: np.ndarray
-) -> float:  # pragma: no cover - compiled
-    """Kernel: entry (r, c) of ``T · tail_inv`` for pose b of a block P (12, BLOCK), summed
-    in :func:`_wrist_frame`'s order."""
-    return (
-        P[4 * r, b] * tail_inv[0, c]
-        + P[4 * r + 1, b] * tail_inv[1, c]
-        + P[4 * r + 2, b] * tail_inv[2, c]
-        + P[4 * r + 3, b] * tail_inv[3, c]
-    )
 
 
 @njit(cache=True, error_model="numpy")
