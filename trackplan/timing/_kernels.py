@@ -13,8 +13,9 @@ Python before, with the same operations: :func:`plateau_search` (the plateaus ov
 zones, :class:`trackplan.timing.smooth._ZonePlanner`), :func:`change_search` (one speed
 change, :func:`~trackplan.timing.demand.speed_change`) and :func:`profile_position` (the
 profile at the samples, :meth:`~trackplan.timing.profile.SpeedProfile.position`); the
-others run inside them. The window merging (:func:`level_runs`) and the samples' rate check
-(:func:`rate_ratios`) are called on their own.
+others run inside them. The window merging (:func:`level_runs`), the zones' running peaks
+(:func:`running_peaks`) and the samples' rate check (:func:`rate_ratios`) are called on
+their own.
 """
 
 from __future__ import annotations
@@ -295,6 +296,55 @@ def level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> tuple[np.nd
             level[starts[k] : ends[k] + 1] = level[starts[slower]]
         else:
             level[starts[slower] : ends[slower] + 1] = own
+
+
+@njit(cache=True)
+def running_peaks(
+    offsets: np.ndarray, d1: np.ndarray, d2: np.ndarray, d3: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """Running maxima of |q'|, |q''|, |q'''| within each zone, from its start and from its end.
+
+    :meth:`~trackplan.timing.demand.ZoneDemand.running_maxima` of every zone in one call:
+    ``np.maximum.accumulate`` of the absolute values (a NaN kept once met, as numpy).
+
+    Parameters
+    ----------
+    offsets
+        Zone z holds rows ``offsets[z]:offsets[z + 1]``, shape (Z + 1,).
+    d1, d2, d3
+        The zones' q', q'', q''' one after the other, shape (G, n) each.
+
+    Returns
+    -------
+    from_start, from_end
+        Shape (G, 3, n) each: row k of zone z covers the zone's rows from its start to k,
+        or from k to its end.
+    """
+    n_rows, n = d1.shape
+    from_start = np.empty((n_rows, 3, n))
+    from_end = np.empty((n_rows, 3, n))
+    for z in range(offsets.size - 1):
+        first, stop = offsets[z], offsets[z + 1]
+        if stop <= first:
+            continue
+        for order in range(3):
+            d = d1 if order == 0 else (d2 if order == 1 else d3)
+            for j in range(n):
+                running = abs(d[first, j])
+                from_start[first, order, j] = running
+                for r in range(first + 1, stop):
+                    x = abs(d[r, j])
+                    if x > running or (x != x and running == running):
+                        running = x
+                    from_start[r, order, j] = running
+                running = abs(d[stop - 1, j])
+                from_end[stop - 1, order, j] = running
+                for r in range(stop - 2, first - 1, -1):
+                    x = abs(d[r, j])
+                    if x > running or (x != x and running == running):
+                        running = x
+                    from_end[r, order, j] = running
+    return from_start, from_end
 
 
 @njit(cache=True)
