@@ -3,6 +3,8 @@ the sample checks' rate ratios, and the zones' running peaks."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -65,3 +67,38 @@ def test_packed_running_maxima_are_numpy_accumulates(seed, sizes, n_dof, nan):
         np.testing.assert_array_equal(demand.running_maxima(1), backward)
         np.testing.assert_array_equal(s[rows], demand.s)
         np.testing.assert_array_equal(peaks[z], demand.peak_array)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n_rows=st.integers(1, 40),
+    n_dof=st.integers(1, 7),
+    zeros=st.booleans(),
+    odd=st.sampled_from([None, np.nan, np.inf]),
+)
+def test_local_caps_are_the_numpy_expression(seed, n_rows, n_dof, zeros, odd):
+    rng = np.random.default_rng(seed)
+    d1, d2, d3 = rng.normal(size=(3, n_rows, n_dof)) * [[[1.0]], [[10.0]], [[100.0]]]
+    if zeros:  # joints that do not move: no cap from them
+        d1[:, 0] = d2[:, 0] = d3[:, 0] = 0.0
+    if odd is not None:
+        d3[rng.integers(n_rows), rng.integers(n_dof)] = odd
+    demand = ZoneDemand(np.arange(n_rows, dtype=float), d1, d2, d3)
+    robot = SimpleNamespace(
+        v_max=rng.uniform(1, 3, n_dof),
+        a_max=rng.uniform(5, 15, n_dof),
+        j_max=rng.uniform(50, 90, n_dof),
+    )
+    share = 0.97
+    q1, q2, q3 = demand.absolute
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = [
+            np.where(q > 0, share * limit / q, np.inf)
+            for q, limit in ((q1, robot.v_max), (q2, robot.a_max), (q3, robot.j_max))
+        ]
+    expected = np.minimum(
+        np.minimum(ratio[0].min(axis=1), np.sqrt(ratio[1]).min(axis=1)),
+        np.cbrt(ratio[2]).min(axis=1),
+    )
+    np.testing.assert_array_equal(demand.local_caps(robot, share), expected)

@@ -13,9 +13,9 @@ Python before, with the same operations: :func:`plateau_search` (the plateaus ov
 zones, :class:`trackplan.timing.smooth._ZonePlanner`), :func:`change_search` (one speed
 change, :func:`~trackplan.timing.demand.speed_change`) and :func:`profile_position` (the
 profile at the samples, :meth:`~trackplan.timing.profile.SpeedProfile.position`); the
-others run inside them. The window merging (:func:`level_runs`), the zones' running peaks
-(:func:`running_peaks`) and the samples' rate check (:func:`rate_ratios`) are called on
-their own.
+others run inside them. The window merging (:func:`level_runs`), the zones' local speed
+caps and running peaks (:func:`local_caps`, :func:`running_peaks`) and the samples' rate
+check (:func:`rate_ratios`) are called on their own.
 """
 
 from __future__ import annotations
@@ -296,6 +296,50 @@ def level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> tuple[np.nd
             level[starts[k] : ends[k] + 1] = level[starts[slower]]
         else:
             level[starts[slower] : ends[slower] + 1] = own
+
+
+@njit(cache=True)
+def local_caps(
+    q1: np.ndarray, q2: np.ndarray, q3: np.ndarray, rooms: np.ndarray
+) -> np.ndarray:  # pragma: no cover - compiled
+    """Highest constant speed the joint limits allow at each grid point, m/s.
+
+    :meth:`~trackplan.timing.demand.ZoneDemand.local_caps`: per point the least of
+    ``room / |q'|``, ``√(room / |q''|)`` and ``∛(room / |q'''|)`` over the joints (+inf where
+    a demand is not positive), NaN propagated as numpy's ``min`` and ``minimum``. The root
+    is taken of each order's least ratio (the roots keep the order: the same value).
+
+    Parameters
+    ----------
+    q1, q2, q3
+        |q'|, |q''|, |q'''| at the grid, shape (G, n) each.
+    rooms
+        The share of the velocity, acceleration and jerk limits, shape (3, n).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (G,), m/s.
+    """
+    n_rows, n = q1.shape
+    out = np.empty(n_rows)
+    least = np.empty(3)
+    for g in range(n_rows):
+        for order in range(3):
+            d = q1 if order == 0 else (q2 if order == 1 else q3)
+            best = np.inf
+            for j in range(n):
+                demand = d[g, j]
+                x = rooms[order, j] / demand if demand > 0 else np.inf
+                if x < best or (x != x and best == best):
+                    best = x
+            least[order] = best
+        cap = least[0]
+        root = np.sqrt(least[1])
+        cap = cap if (cap < root or cap != cap) else root
+        root = np.cbrt(least[2])
+        out[g] = cap if (cap < root or cap != cap) else root
+    return out
 
 
 @njit(cache=True)
