@@ -1,7 +1,8 @@
 """Compiled kernels of the planning package.
 
-- :func:`monotone_assignment`: the in-order assignment of samples to pieces; the Python API
-  is :func:`trackplan.planning.tracking.locate_on_nominal`.
+- :func:`assign_pieces`: the in-order assignment of samples to the candidate pieces the
+  motion agrees with, in one pass over the candidate pairs; the Python API is
+  :func:`trackplan.planning.tracking.locate_on_nominal`.
 - :func:`peak_use`: the checker's joint-limit peaks (:mod:`trackplan.planning.checker`).
   The joint limits are read from a handful of (N, n) arrays per plan; numpy would make a
   temporary array and a separate reduction per step. The kernel reads each array once,
@@ -21,49 +22,95 @@ from numba import njit
 
 
 @njit(cache=True)
-def monotone_assignment(
-    bounds: np.ndarray, piece: np.ndarray, current: int
-) -> np.ndarray:  # pragma: no cover
-    """Pick one candidate piece per sample, in time order.
+def assign_pieces(
+    row: np.ndarray,
+    piece: np.ndarray,
+    sigma: np.ndarray,
+    direction: np.ndarray,
+    is_arc: np.ndarray,
+    radius: np.ndarray,
+    e1: np.ndarray,
+    e2: np.ndarray,
+    velocity: np.ndarray,
+    speed: np.ndarray,
+    slack: float,
+    current: int,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """Pick one candidate piece per sample, in time order, among those the motion agrees with.
 
-    Stays on a piece while it remains a candidate, otherwise moves to the nearest candidate
-    ahead (the first candidate when none is ahead).
+    A sample near one piece keeps it; near several, those whose tangent at the candidate
+    point agrees with the motion (``tangent · velocity ≥ −slack · speed``), or every one
+    when none agrees. Among those kept it stays on the current piece while it remains one,
+    otherwise moves to the nearest one ahead (the first one when none is ahead).
 
     Parameters
     ----------
-    bounds
-        Candidates of sample k are ``piece[bounds[k]:bounds[k + 1]]``, shape (N + 1,); each
-        sample has at least one.
-    piece
-        Candidate pieces, ascending within each sample, shape (K,).
+    row, piece, sigma
+        The candidate pairs: sample (ascending), piece (ascending within a sample) and arc
+        length along the piece, m, shape (K,) each; each of the N samples has at least one.
+    direction, is_arc, radius, e1, e2
+        The piece table's line directions (P, 3), arc flags (P,), radii (P,) and in-plane
+        axes (P, 3) each: a line's tangent is its direction, an arc's at σ is
+        ``cos(σ/r) e2 − sin(σ/r) e1``.
+    velocity, speed
+        The samples' velocities (N, 3) and their lengths (N,).
+    slack
+        :data:`trackplan.planning.tracking.DIRECTION_SLACK`.
     current
         The piece of the sample before the first, or −1 to start on the first sample's
-        first candidate.
+        first candidate kept.
 
     Returns
     -------
     numpy.ndarray
-        Shape (N,): the index into ``piece`` of each sample's choice.
+        Shape (N,): the index of each sample's pair.
     """
-    n = len(bounds) - 1
+    n = speed.size
     chosen = np.empty(n, dtype=np.int64)
-    if current < 0 and n > 0:
-        current = piece[bounds[0]]
+    keep = np.ones(piece.size, dtype=np.bool_)
+    first = 0
     for k in range(n):
-        first, last = bounds[k], bounds[k + 1]
+        stop = first
+        while stop < row.size and row[stop] == k:
+            stop += 1
+        if stop - first > 1:
+            floor = -slack * speed[k]
+            m0, m1, m2 = velocity[k, 0], velocity[k, 1], velocity[k, 2]
+            any_agrees = False
+            for i in range(first, stop):
+                p = piece[i]
+                if is_arc[p]:
+                    phi = sigma[i] / radius[p]
+                    c, s = np.cos(phi), np.sin(phi)
+                    t0 = c * e2[p, 0] - s * e1[p, 0]
+                    t1 = c * e2[p, 1] - s * e1[p, 1]
+                    t2 = c * e2[p, 2] - s * e1[p, 2]
+                else:
+                    t0, t1, t2 = direction[p, 0], direction[p, 1], direction[p, 2]
+                # the sum in the order numpy's einsum takes over three terms
+                keep[i] = (t0 * m0 + t2 * m2) + t1 * m1 >= floor
+                any_agrees = any_agrees or keep[i]
+            if not any_agrees:
+                keep[first:stop] = True
+        if current < 0:
+            for i in range(first, stop):
+                if keep[i]:
+                    current = piece[i]
+                    break
         pick = -1
-        for i in range(first, last):
-            if piece[i] == current:
+        for i in range(first, stop):
+            if keep[i] and piece[i] == current:
                 pick = i
                 break
         if pick < 0:
-            pick = first
-            for i in range(first, last):
-                if piece[i] > current:
+            for i in range(first, stop):
+                if keep[i] and (pick < 0 or piece[i] > current):
                     pick = i
-                    break
+                    if piece[i] > current:
+                        break
             current = piece[pick]
         chosen[k] = pick
+        first = stop
     return chosen
 
 
