@@ -1,5 +1,6 @@
-"""The time law's compiled kernels against the numpy expressions they replace, to the bit:
-the sample checks' rate ratios, and the zones' running peaks."""
+"""The time law's compiled kernels against the numpy expressions they replace, to the bit
+(the sample checks' rate ratios, the zones' local caps and running peaks), and the final
+stop's jerk bisection against its fixed 80 rounds."""
 
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ from hypothesis import strategies as st
 from trackplan.derivatives import backward_derivatives
 from trackplan.timing._kernels import rate_ratios
 from trackplan.timing.demand import ZoneDemand, pack_demands
+from trackplan.timing.profile import speed_change_time
+from trackplan.timing.smooth import _jerk_for_duration
 
 
 @settings(max_examples=60, deadline=None)
@@ -102,3 +105,29 @@ def test_local_caps_are_the_numpy_expression(seed, n_rows, n_dof, zeros, odd):
         np.cbrt(ratio[2]).min(axis=1),
     )
     np.testing.assert_array_equal(demand.local_caps(robot, share), expected)
+
+
+def _jerk_for_duration_80(delta: float, accel: float, jerk: float, duration: float) -> float:
+    """The bisection as it ran before: always 80 rounds."""
+    low, high = 0.0, jerk
+    for _ in range(80):
+        mid = 0.5 * (low + high)
+        if mid > 0.0 and speed_change_time(delta, accel, mid) > duration:
+            low = mid
+        else:
+            high = mid
+    return high
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    delta=st.floats(1e-4, 2.0),
+    accel=st.floats(0.1, 50.0),
+    jerk=st.floats(1.0, 5000.0),
+    longer=st.floats(0.0, 3.0),
+)
+def test_jerk_bisection_stopping_at_rest_is_the_full_bisection(delta, accel, jerk, longer):
+    duration = speed_change_time(delta, accel, jerk) * (1.0 + longer)
+    assert _jerk_for_duration(delta, accel, jerk, duration) == _jerk_for_duration_80(
+        delta, accel, jerk, duration
+    )
