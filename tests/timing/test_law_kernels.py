@@ -1,5 +1,5 @@
 """The time law's compiled kernels against the numpy expressions they replace, to the bit
-(the sample checks' rate ratios, the zones' local caps and running peaks), and the final
+(the sample checks' rate ratios, the zones' local caps), and the final
 stop's jerk bisection against its fixed 80 rounds."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from trackplan.derivatives import backward_derivatives
 from trackplan.timing._kernels import rate_ratios
-from trackplan.timing.demand import ZoneDemand, pack_demands
+from trackplan.timing.demand import ZoneDemand
 from trackplan.timing.profile import speed_change_time
 from trackplan.timing.smooth import _jerk_for_duration
 
@@ -41,35 +41,6 @@ def test_rate_ratios_are_the_largest_backward_difference_ratios(seed, n_samples,
         for j in range(n_dof):
             expected = np.where(use[:, j] > expected, use[:, j], expected)
         np.testing.assert_array_equal(ratio[:, order], expected)
-
-
-@settings(max_examples=40, deadline=None)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    sizes=st.lists(st.integers(1, 12), min_size=1, max_size=5),
-    n_dof=st.integers(1, 7),
-    nan=st.booleans(),
-)
-def test_packed_running_maxima_are_numpy_accumulates(seed, sizes, n_dof, nan):
-    rng = np.random.default_rng(seed)
-    demands = []
-    for size in sizes:
-        d1, d2, d3 = rng.normal(size=(3, size, n_dof))
-        if nan:
-            d2[rng.integers(size), rng.integers(n_dof)] = np.nan
-        demands.append(ZoneDemand(np.sort(rng.uniform(size=size)), d1, d2, d3))
-    offsets, s, peaks, from_start, from_end = pack_demands(demands)
-    for z, demand in enumerate(demands):
-        stacked = np.stack(demand.absolute, axis=1)  # (G, 3, n)
-        forward = np.maximum.accumulate(stacked, axis=0)
-        backward = np.maximum.accumulate(stacked[::-1], axis=0)[::-1]
-        rows = slice(offsets[z], offsets[z + 1])
-        np.testing.assert_array_equal(from_start[rows], forward)
-        np.testing.assert_array_equal(from_end[rows], backward)
-        np.testing.assert_array_equal(demand.running_maxima(0), forward)
-        np.testing.assert_array_equal(demand.running_maxima(1), backward)
-        np.testing.assert_array_equal(s[rows], demand.s)
-        np.testing.assert_array_equal(peaks[z], demand.peak_array)
 
 
 @settings(max_examples=60, deadline=None)

@@ -14,8 +14,8 @@ zones, :class:`trackplan.timing.smooth._ZonePlanner`), :func:`change_search` (on
 change, :func:`~trackplan.timing.demand.speed_change`) and :func:`profile_position` (the
 profile at the samples, :meth:`~trackplan.timing.profile.SpeedProfile.position`); the
 others run inside them. The window merging (:func:`level_runs`), the zones' local speed
-caps and running peaks (:func:`local_caps`, :func:`running_peaks`) and the samples' rate
-check (:func:`rate_ratios`) are called on their own.
+caps (:func:`local_caps`) and the samples' rate check (:func:`rate_ratios`) are called on
+their own.
 """
 
 from __future__ import annotations
@@ -306,8 +306,10 @@ def local_caps(
 
     :meth:`~trackplan.timing.demand.ZoneDemand.local_caps`: per point the least of
     ``room / |q'|``, ``√(room / |q''|)`` and ``∛(room / |q'''|)`` over the joints (+inf where
-    a demand is not positive), NaN propagated as numpy's ``min`` and ``minimum``. The root
-    is taken of each order's least ratio (the roots keep the order: the same value).
+    a demand is not positive), NaN propagated as numpy's ``min`` and ``minimum``. The square
+    root is taken of the least ratio (a correctly rounded root keeps the order: the same
+    value); the cube root of the ratios within 1e-12 of the least (libm's cube root is
+    within an ulp, not correctly rounded: the least of these is the least of all).
 
     Parameters
     ----------
@@ -324,71 +326,31 @@ def local_caps(
     n_rows, n = q1.shape
     out = np.empty(n_rows)
     least = np.empty(3)
+    ratio = np.empty(n)
     for g in range(n_rows):
         for order in range(3):
             d = q1 if order == 0 else (q2 if order == 1 else q3)
             best = np.inf
             for j in range(n):
                 demand = d[g, j]
-                x = rooms[order, j] / demand if demand > 0 else np.inf
-                if x < best or (x != x and best == best):
-                    best = x
+                ratio[j] = rooms[order, j] / demand if demand > 0 else np.inf
+                if ratio[j] < best or (ratio[j] != ratio[j] and best == best):
+                    best = ratio[j]
+            if order == 1:
+                best = np.sqrt(best)
+            elif order == 2 and best == best:
+                near = best * (1.0 + 1e-12)
+                best = np.inf
+                for j in range(n):
+                    if ratio[j] <= near:
+                        best = min(best, np.cbrt(ratio[j]))
             least[order] = best
         cap = least[0]
-        root = np.sqrt(least[1])
-        cap = cap if (cap < root or cap != cap) else root
-        root = np.cbrt(least[2])
-        out[g] = cap if (cap < root or cap != cap) else root
+        for order in (1, 2):
+            root = least[order]
+            cap = cap if (cap < root or cap != cap) else root
+        out[g] = cap
     return out
-
-
-@njit(cache=True)
-def running_peaks(
-    offsets: np.ndarray, d1: np.ndarray, d2: np.ndarray, d3: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
-    """Running maxima of |q'|, |q''|, |q'''| within each zone, from its start and from its end.
-
-    :meth:`~trackplan.timing.demand.ZoneDemand.running_maxima` of every zone in one call:
-    ``np.maximum.accumulate`` of the absolute values (a NaN kept once met, as numpy).
-
-    Parameters
-    ----------
-    offsets
-        Zone z holds rows ``offsets[z]:offsets[z + 1]``, shape (Z + 1,).
-    d1, d2, d3
-        The zones' q', q'', q''' one after the other, shape (G, n) each.
-
-    Returns
-    -------
-    from_start, from_end
-        Shape (G, 3, n) each: row k of zone z covers the zone's rows from its start to k,
-        or from k to its end.
-    """
-    n_rows, n = d1.shape
-    from_start = np.empty((n_rows, 3, n))
-    from_end = np.empty((n_rows, 3, n))
-    for z in range(offsets.size - 1):
-        first, stop = offsets[z], offsets[z + 1]
-        if stop <= first:
-            continue
-        for order in range(3):
-            d = d1 if order == 0 else (d2 if order == 1 else d3)
-            for j in range(n):
-                running = abs(d[first, j])
-                from_start[first, order, j] = running
-                for r in range(first + 1, stop):
-                    x = abs(d[r, j])
-                    if x > running or (x != x and running == running):
-                        running = x
-                    from_start[r, order, j] = running
-                running = abs(d[stop - 1, j])
-                from_end[stop - 1, order, j] = running
-                for r in range(stop - 2, first - 1, -1):
-                    x = abs(d[r, j])
-                    if x > running or (x != x and running == running):
-                        running = x
-                    from_end[r, order, j] = running
-    return from_start, from_end
 
 
 @njit(cache=True)

@@ -182,44 +182,6 @@ class ZoneDemand:
         return _kernels.local_caps(q1, q2, q3, rooms)  # type: ignore[no-any-return]
 
 
-def pack_demands(
-    demands: list[ZoneDemand],
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The zones' grids, peaks and running maxima one after the other.
-
-    The running maxima of every zone come from one compiled pass
-    (:func:`trackplan.timing._kernels.running_peaks`), and each zone's
-    :meth:`ZoneDemand.running_maxima` then reads its rows of them (the same values).
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        ``offsets (Z + 1,)`` (zone z holds rows ``offsets[z]:offsets[z + 1]``), ``s (G,)``,
-        ``peaks (Z, 3, n)``, and the running maxima from each zone's start and from its
-        end, ``(G, 3, n)`` each.
-    """
-    sizes = [len(d.s) for d in demands]
-    offsets = np.zeros(len(demands) + 1, dtype=np.int64)
-    np.cumsum(sizes, out=offsets[1:])
-    d1, d2, d3 = (
-        np.concatenate([getattr(d, name) for d in demands]) for name in ("d1", "d2", "d3")
-    )
-    from_start, from_end = _kernels.running_peaks(offsets, d1, d2, d3)
-    bounds = offsets.tolist()
-    for z, demand in enumerate(demands):
-        rows = slice(bounds[z], bounds[z + 1])
-        for backward, running in enumerate((from_start, from_end)):
-            if demand._maxima[backward] is None:
-                demand._maxima[backward] = running[rows]
-    return (
-        offsets,
-        np.concatenate([d.s for d in demands]),
-        np.stack([d.peak_array for d in demands]),
-        from_start,
-        from_end,
-    )
-
-
 def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
     """Highest constant path speed the joint limits allow given peak demands, and what binds.
 

@@ -44,7 +44,6 @@ from trackplan.timing.demand import (
     SpeedChange,
     ZoneDemand,
     cruise_cap,
-    pack_demands,
     speed_change,
 )
 from trackplan.timing.profile import (
@@ -365,7 +364,15 @@ class _ZonePlanner:
         ``offsets (Z + 1,), s (G,), peaks (Z, 3, n)`` and the running maxima from each
         zone's start and from its end, ``(G, 3, n)`` each (built once)."""
         if self._zone_arrays is None:
-            self._zone_arrays = pack_demands(self.demands)
+            demands = self.demands
+            sizes = [len(d.s) for d in demands]
+            self._zone_arrays = (
+                np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+                np.concatenate([d.s for d in demands]),
+                np.stack([d.peak_array for d in demands]),
+                np.concatenate([d.running_maxima(0) for d in demands]),
+                np.concatenate([d.running_maxima(1) for d in demands]),
+            )
         return self._zone_arrays
 
     def change(self, z: int, v_from: float, v_to: float) -> SpeedChange:
