@@ -290,6 +290,7 @@ def _check_task(
     q_between, t_between = between_samples(q, p_part, ref.tolerance)
     if len(q_between):
         T_between = forward_kinematics(robot, q_between)
+        T_between.flags.writeable = False  # the samples' poses' type: one compiled version
         p_between = _kernels.task_frames(T_between, T_base_part, sample_time)[0]
         d_between = ref.nominal.index.candidates(p_between, 0.0).nearest  # distances only
         worst = max(worst, float(d_between.max()))
