@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from trackplan.frames import vector_norms
+from trackplan.frames import rpy_matrix, vector_norms
 
 
 @settings(max_examples=40, deadline=None, derandomize=True)
@@ -21,3 +21,12 @@ def test_vector_norms_of_special_values_are_numpys():
     np.testing.assert_array_equal(vector_norms(v), np.linalg.norm(v, axis=1))
     strided = np.arange(48.0).reshape(4, 4, 3)[:, 1, :]  # rows of a larger array
     np.testing.assert_array_equal(vector_norms(strided), np.linalg.norm(strided, axis=1))
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 20))
+def test_one_rpy_rotation_is_the_batch_one_to_the_bit(seed, n):
+    angles = np.random.default_rng(seed).uniform(-7.0, 7.0, size=(n, 3))
+    batch = rpy_matrix(angles)
+    for rpy, R in zip(angles, batch, strict=True):
+        np.testing.assert_array_equal(rpy_matrix(rpy), R)

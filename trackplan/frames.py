@@ -29,6 +29,16 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
         Shape (..., 3, 3): ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``.
     """
     rpy = np.asarray(rpy, dtype=float)
+    if rpy.shape == (3,):  # one rotation: the same products on Python floats, without
+        # numpy's per-call cost on 0-d arrays (the sines and cosines are numpy's)
+        (cr, cp, cy), (sr, sp, sy) = np.cos(rpy).tolist(), np.sin(rpy).tolist()
+        return np.array(
+            [
+                [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                [-sp, cp * sr, cp * cr],
+            ]
+        )
     cr, sr = np.cos(rpy[..., 0]), np.sin(rpy[..., 0])
     cp, sp = np.cos(rpy[..., 1]), np.sin(rpy[..., 1])
     cy, sy = np.cos(rpy[..., 2]), np.sin(rpy[..., 2])

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.frames import vector_norms
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
@@ -268,11 +267,12 @@ def _check_task(
 ) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
     """Tracking, orientation, Cartesian speed and coverage checks."""
     robot, q, sample_time = motion.robot, motion.q, motion.sample_time
-    T_base_tool = motion.T_base_tool
-    R_part_base = ref.T_base_part[:3, :3].T
-    p_part = (T_base_tool[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
-    velocity = np.diff(p_part, axis=0, prepend=p_part[:1]) / sample_time
-    speed = vector_norms(velocity)
+    T_base_part = np.ascontiguousarray(ref.T_base_part, dtype=float)
+    # the tool's points, velocities and speeds, and its x and z axes (all the tool checks
+    # read), in the definition frame: one compiled pass over the poses
+    p_part, velocity, speed, x_part, z_part = _kernels.task_frames(
+        motion.T_base_tool, T_base_part, sample_time
+    )
     t = np.arange(len(q)) * sample_time
     violations: list[Violation] = []
     margins: dict[str, float] = {}
@@ -290,7 +290,8 @@ def _check_task(
     q_between, t_between = between_samples(q, p_part, ref.tolerance)
     if len(q_between):
         T_between = forward_kinematics(robot, q_between)
-        p_between = (T_between[:, :3, 3] - ref.T_base_part[:3, 3]) @ R_part_base.T
+        T_between.flags.writeable = False  # the samples' poses' type: one compiled version
+        p_between = _kernels.task_frames(T_between, T_base_part, sample_time)[0]
         d_between = ref.nominal.index.candidates(p_between, 0.0).nearest  # distances only
         worst = max(worst, float(d_between.max()))
         if d_between.max() > ref.tolerance * (1 + RELATIVE_SLACK) and not violations_of(
@@ -304,8 +305,6 @@ def _check_task(
             violations.append(replace(found, message=message))
     margins["tracking"] = float(_met(1.0 - worst / ref.tolerance, RELATIVE_SLACK))
 
-    # the tool's x and z axes in the definition frame: all the tool checks read
-    x_part, z_part = (T_base_tool[:, :3, j] @ R_part_base.T for j in (0, 2))
     orientation_error, tool_found = _check_tool(ref, x_part, z_part, s_nominal, piece, t, margins)
     violations.extend(tool_found)
 
@@ -327,7 +326,7 @@ def _check_task(
     coverage = _coverage_violations(ref, t, s_nominal, piece, speed, sample_time)
     margins["coverage"] = 1.0 if not coverage else -1.0
     violations.extend(coverage)
-    return (margins, violations), worst, float(orientation_error.max())
+    return (margins, violations), worst, orientation_error
 
 
 def violations_of(violations: list[Violation], limit: str) -> list[Violation]:
@@ -343,7 +342,7 @@ def _check_tool(
     piece: np.ndarray,
     t: np.ndarray,
     margins: dict[str, float],
-) -> tuple[np.ndarray, list[Violation]]:
+) -> tuple[float, list[Violation]]:
     """Tool axis against the spec on the nominal path; spin value, range and rate.
 
     Outside transition zones the tool axis must match the spec to the orientation
@@ -359,43 +358,51 @@ def _check_tool(
     Returns
     -------
     tuple
-        The tool axis error per sample (N,), rad, and the violations found.
+        The largest tool axis error, rad, and the violations found.
     """
     nominal, spec, tol = ref.nominal, ref.tool, ref.orientation_tolerance
     if spec.frame is ToolFrame.PART:  # one rotation (3, 3) for the whole path
         R_spec = spec.base_rotations(np.zeros((1, 3)))[0]
     else:
         R_spec = nominal_rotations(spec, nominal, s_nominal, piece)
-    axis_cos = _along(z_part, R_spec, 2)
-    axis_error = np.arccos(np.clip(axis_cos, -1.0, 1.0))
+    axis_cos = np.clip(_along(z_part, R_spec, 2), -1.0, 1.0)
     allowed = np.full(len(t), tol)
     for s0, s1, bound in np.asarray(ref.tool_zones).reshape(-1, 3):
         allowed[(s_nominal >= s0) & (s_nominal <= s1)] += bound
-    found: list[Violation] = []
-    use = axis_error / allowed
-    margins["orientation"] = float(_met(1.0 - use.max(), RELATIVE_SLACK))
-    if margins["orientation"] < 0:
-        found.append(_violation("orientation", None, t, axis_error, use, tol))
-
     outside = allowed == tol
+    everywhere = bool(outside.all())  # no transition zone: one tolerance, no copies
+    found: list[Violation] = []
+    if everywhere and tol > 0.0:
+        # the largest error over the one tolerance: the arccos of the smallest cosines only
+        largest = float(np.arccos(_smallest(axis_cos)).max())
+        margins["orientation"] = float(_met(1.0 - largest / tol, RELATIVE_SLACK))
+    else:
+        axis_error = np.arccos(axis_cos)
+        largest = float(axis_error.max())
+        margins["orientation"] = float(_met(1.0 - (axis_error / allowed).max(), RELATIVE_SLACK))
+    if margins["orientation"] < 0:
+        axis_error = np.arccos(axis_cos)
+        found.append(_violation("orientation", None, t, axis_error, axis_error / allowed, tol))
+
     if not outside.any():
-        return axis_error, found
-    spin = np.arctan2(_along(x_part, R_spec, 1), _along(x_part, R_spec, 0))
-    everywhere = outside.all()  # no transition zone: no copies
-    spin = spin if everywhere else spin[outside]
+        return largest, found
+    x_along = [_along(x_part, R_spec, j) for j in (0, 1)]
+    x_along = x_along if everywhere else [x[outside] for x in x_along]
     t_out, s_out, piece_out = (
         (t, s_nominal, piece) if everywhere else (t[outside], s_nominal[outside], piece[outside])
     )
     if spec.spin is SpinMode.FIXED:
         # the error is taken modulo 2π: only a reported spin needs unwrapping
-        turn = spin - spec.spin_value
-        error = np.abs(turn - 2 * np.pi * np.round(turn / (2 * np.pi)))
+        rows = _largest_spin_errors(x_along[0], x_along[1], spec.spin_value)
+        error = _spin_error(np.arctan2(x_along[1][rows], x_along[0][rows]), spec.spin_value)
         margins["spin"] = float(_met(1.0 - error.max() / tol, RELATIVE_SLACK))
         if margins["spin"] < 0:
+            spin = np.arctan2(x_along[1], x_along[0])
+            error = _spin_error(spin, spec.spin_value)
             unwrapped = np.unwrap(spin)
             found.append(_violation("spin", None, t_out, unwrapped, error / tol, spec.spin_value))
-        return axis_error, found
-    spin = np.unwrap(spin)
+        return largest, found
+    spin = np.unwrap(np.arctan2(x_along[1], x_along[0]))
     lo, hi = spec.spin_range
     spin = spin + 2 * np.pi * np.round((0.5 * (lo + hi) - np.median(spin)) / (2 * np.pi))
     excess = np.maximum(lo - spin, spin - hi)
@@ -425,7 +432,61 @@ def _check_tool(
                 ),
             )
         )
-    return axis_error, found
+    return largest, found
+
+
+SCREEN_WINDOW = 1e-9
+"""Relative width of the screens that spare the checker most of its arccos and arctan2
+(:func:`_smallest`, :func:`_largest_spin_errors`): far wider than their round-off, so that
+the largest of the screened values is the largest of all, to the bit."""
+
+
+def _smallest(cosines: np.ndarray) -> np.ndarray:
+    """The cosines in [-1, 1] whose arccos may be the largest, shape (K,).
+
+    On [c, 1] with c ≥ 0 arccos falls with a slope of at least 1/√(1 - c²): a cosine more
+    than ``1e-3 · SCREEN_WINDOW · (1 - c)`` above the smallest c has an arccos smaller by
+    more than a thousand times its round-off, so the largest arccos of all is among these
+    few (each evaluated as numpy does). A smallest cosine below 0, or a NaN: all of them.
+    """
+    low = cosines.min()
+    if not low >= 0.0:
+        return cosines
+    return cosines[cosines <= low + 1e-3 * SCREEN_WINDOW * (1.0 - low)]
+
+
+def _spin_error(spin: np.ndarray, value: float) -> np.ndarray:
+    """The distance of each spin (M,) from ``value`` modulo 2π, rad, shape (M,)."""
+    turn = spin - value
+    return np.abs(turn - 2 * np.pi * np.round(turn / (2 * np.pi)))
+
+
+def _largest_spin_errors(x_cos: np.ndarray, x_sin: np.ndarray, value: float) -> np.ndarray:
+    """Rows whose spin ``arctan2(x_sin, x_cos)`` may be the farthest from ``value``.
+
+    While every spin error θ is under 60°, ``tan θ = |x_sin cos v - x_cos sin v| /
+    (x_cos cos v + x_sin sin v)`` ranks them: rows whose tangent is below the largest by more
+    than :data:`SCREEN_WINDOW` (relative) have a smaller θ by more than round-off. The
+    computed error also carries an absolute round-off of about 1e-15 (|v| + 8) rad (of the
+    arctan2 near v and of the turns taken off), zero for v = 0: rows within a thousand times
+    that of the largest tangent stay. Otherwise (an error of 60° or more, or a NaN) every
+    row.
+
+    Returns
+    -------
+    numpy.ndarray
+        Row indices into the (M,) inputs, shape (K,).
+    """
+    c, s = np.cos(value), np.sin(value)
+    along = x_cos * c + x_sin * s
+    if not np.all(along > 0.5 * np.sqrt(x_cos * x_cos + x_sin * x_sin)):
+        return np.arange(len(x_cos))
+    tangent = np.abs(x_sin * c - x_cos * s) / along
+    high = tangent.max()
+    if not np.isfinite(high):
+        return np.arange(len(x_cos))
+    noise = 0.0 if value == 0.0 else 1e-12 * (abs(value) + 8.0)
+    return np.flatnonzero(tangent >= high * (1.0 - SCREEN_WINDOW) - noise)
 
 
 def _along(v: np.ndarray, R: np.ndarray, j: int) -> np.ndarray:

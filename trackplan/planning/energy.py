@@ -103,12 +103,16 @@ def motion_energy(motion: SampledMotion) -> EnergyFigures:
         raise ValueError(f"robot {robot.name!r} has no dynamic parameters")
     tau, qd = motion.torque, motion.qd
     k_m = np.ones(robot.n_dof) if dynamics.motor_constant is None else dynamics.motor_constant
-    motor_torque = tau / (np.asarray(dynamics.gear_ratio) * k_m)
-    use = np.abs(tau) / dynamics.torque_max
+    # each figure in one scratch array (the same values as the plain expressions)
+    scratch = np.multiply(tau, qd)
+    mechanical = float(np.maximum(scratch, 0.0, out=scratch).sum() * sample_time)
+    np.divide(tau, np.asarray(dynamics.gear_ratio) * k_m, out=scratch)  # motor torque
+    copper = float(np.square(scratch, out=scratch).sum() * sample_time)
+    use = np.divide(np.abs(tau, out=scratch), dynamics.torque_max, out=scratch)
     worst = np.unravel_index(int(np.argmax(use)), use.shape)
     return EnergyFigures(
-        mechanical_energy=float(np.maximum(tau * qd, 0.0).sum() * sample_time),
-        copper_loss=float(np.square(motor_torque).sum() * sample_time),
+        mechanical_energy=mechanical,
+        copper_loss=copper,
         copper_loss_unit=dynamics.copper_loss_unit,
         peak_torque_ratio=float(use[worst]),
         peak_torque_joint=int(worst[1]) + 1,

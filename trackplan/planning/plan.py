@@ -127,7 +127,10 @@ def motion_trajectory(
     """
     q, sample_time, n = motion.q, motion.sample_time, motion.n_samples
     position = motion.T_base_tool[:, :3, 3]
-    speed = vector_norms(np.diff(position, axis=0, prepend=position[:1])) / sample_time
+    step = np.empty(position.shape)  # np.diff(position, axis=0, prepend=position[:1])
+    np.subtract(position[:1], position[:1], out=step[:1])
+    np.subtract(position[1:], position[:-1], out=step[1:])
+    speed = vector_norms(step) / sample_time
     return Trajectory(
         sample_time=sample_time,
         t=np.arange(n) * sample_time,

@@ -13,7 +13,7 @@ import numpy as np
 from trackplan.frames import vector_norms
 from trackplan.paths.geometry import unwrap_closed_arc
 from trackplan.paths.nominal import NominalPath
-from trackplan.planning._kernels import monotone_assignment
+from trackplan.planning._kernels import assign_pieces
 
 DIRECTION_SLACK = 0.2
 """A piece agrees with the motion when tangent · velocity ≥ −slack · |velocity|."""
@@ -68,25 +68,23 @@ def locate_on_nominal(
         block = slice(first, first + LOCATE_BLOCK)
         found = nominal.index.candidates(points[block], max(tolerance, 1e-12))
         nearest[block] = found.nearest
-        row, piece, sigma = found.row, found.piece, found.sigma
-        n_block = len(found.nearest)
         # a sample near one piece only keeps it; where several are near, those that agree
-        # with the motion, or every one when none agrees
-        several = np.bincount(row, minlength=n_block)[row] > 1
-        if several.any():
-            pairs = np.flatnonzero(several)
-            tangent = table.tangent_on(piece[pairs], sigma[pairs])
-            moving = velocity[block][row[pairs]]
-            along = np.einsum("nk,nk->n", tangent, moving)
-            agrees = along >= -DIRECTION_SLACK * speed[block][row[pairs]]
-            any_agrees = np.bincount(row[pairs][agrees], minlength=n_block) > 0
-            keep = np.ones(len(row), dtype=bool)
-            keep[pairs] = agrees | ~any_agrees[row[pairs]]
-            row, piece, sigma = row[keep], piece[keep], sigma[keep]
-        bounds = np.zeros(n_block + 1, dtype=np.int64)  # row is sorted: its run starts
-        np.cumsum(np.bincount(row, minlength=n_block), out=bounds[1:])
-        chosen = monotone_assignment(bounds, piece, current)
-        assigned[block], local[block] = piece[chosen], sigma[chosen]
+        # with the motion, or every one when none agrees; then in order of travel
+        chosen = assign_pieces(
+            found.row,
+            found.piece,
+            found.sigma,
+            table.direction,
+            table.is_arc,
+            table.radius,
+            table.e1,
+            table.e2,
+            velocity[block],
+            speed[block],
+            DIRECTION_SLACK,
+            current,
+        )
+        assigned[block], local[block] = found.piece[chosen], found.sigma[chosen]
         current = int(assigned[block][-1])
     closed = table.is_arc & (table.angle >= 2 * np.pi - 1e-9)
     for p in np.unique(assigned[closed[assigned]]):

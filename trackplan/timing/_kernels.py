@@ -13,8 +13,9 @@ Python before, with the same operations: :func:`plateau_search` (the plateaus ov
 zones, :class:`trackplan.timing.smooth._ZonePlanner`), :func:`change_search` (one speed
 change, :func:`~trackplan.timing.demand.speed_change`) and :func:`profile_position` (the
 profile at the samples, :meth:`~trackplan.timing.profile.SpeedProfile.position`); the
-others run inside them. The window merging (:func:`level_runs`) and the samples' rate check
-(:func:`rate_ratios`) are called on their own.
+others run inside them. The window merging (:func:`level_runs`), the zones' local speed
+caps (:func:`local_caps`) and the samples' rate check (:func:`rate_ratios`) are called on
+their own.
 """
 
 from __future__ import annotations
@@ -298,12 +299,68 @@ def level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> tuple[np.nd
 
 
 @njit(cache=True)
+def local_caps(
+    q1: np.ndarray, q2: np.ndarray, q3: np.ndarray, rooms: np.ndarray
+) -> np.ndarray:  # pragma: no cover - compiled
+    """Highest constant speed the joint limits allow at each grid point, m/s.
+
+    :meth:`~trackplan.timing.demand.ZoneDemand.local_caps`: per point the least of
+    ``room / |q'|``, ``√(room / |q''|)`` and ``∛(room / |q'''|)`` over the joints (+inf where
+    a demand is not positive), NaN propagated as numpy's ``min`` and ``minimum``. The square
+    root is taken of the least ratio (a correctly rounded root keeps the order: the same
+    value); the cube root of the ratios within 1e-12 of the least (libm's cube root is
+    within an ulp, not correctly rounded: the least of these is the least of all).
+
+    Parameters
+    ----------
+    q1, q2, q3
+        |q'|, |q''|, |q'''| at the grid, shape (G, n) each.
+    rooms
+        The share of the velocity, acceleration and jerk limits, shape (3, n).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (G,), m/s.
+    """
+    n_rows, n = q1.shape
+    out = np.empty(n_rows)
+    least = np.empty(3)
+    ratio = np.empty(n)
+    for g in range(n_rows):
+        for order in range(3):
+            d = q1 if order == 0 else (q2 if order == 1 else q3)
+            best = np.inf
+            for j in range(n):
+                demand = d[g, j]
+                ratio[j] = rooms[order, j] / demand if demand > 0 else np.inf
+                if ratio[j] < best or (ratio[j] != ratio[j] and best == best):
+                    best = ratio[j]
+            if order == 1:
+                best = np.sqrt(best)
+            elif order == 2 and best == best:
+                near = best * (1.0 + 1e-12)
+                best = np.inf
+                for j in range(n):
+                    if ratio[j] <= near:
+                        best = min(best, np.cbrt(ratio[j]))
+            least[order] = best
+        cap = least[0]
+        for order in (1, 2):
+            root = least[order]
+            cap = cap if (cap < root or cap != cap) else root
+        out[g] = cap
+    return out
+
+
+@njit(cache=True)
 def rate_ratios(q: np.ndarray, steps: np.ndarray, limits: np.ndarray) -> np.ndarray:
     """Largest joint velocity, acceleration and jerk over their limits, per sample.
 
     Backward differences at rest before the first sample and for the three samples after
     the last, as :func:`trackplan.derivatives.backward_derivatives` with ``pad_end``
-    computes them (same differences, same order of operations).
+    computes them (same differences, same order of operations). Joint by joint over a
+    padded copy of its column, so that the loop over the samples runs in SIMD lanes.
 
     Parameters
     ----------
@@ -317,26 +374,37 @@ def rate_ratios(q: np.ndarray, steps: np.ndarray, limits: np.ndarray) -> np.ndar
     Returns
     -------
     numpy.ndarray
-        Shape (N + 3, 3): max over the joints of ``|derivative| / limit``, per order.
+        Shape (N + 3, 3): max over the joints of ``|derivative| / limit``, per order (a
+        column-major view: each order's ratios are contiguous).
     """
     n_samples, n_dof = q.shape
-    out = np.zeros((n_samples + 3, 3))
-    for r in range(n_samples + 3):
-        for i in range(n_dof):
-            p0 = q[min(max(r - 3, 0), n_samples - 1), i]
-            p1 = q[min(max(r - 2, 0), n_samples - 1), i]
-            p2 = q[min(max(r - 1, 0), n_samples - 1), i]
-            p3 = q[min(r, n_samples - 1), i]
+    rows = n_samples + 3
+    out = np.zeros((3, rows))
+    column = np.empty(rows + 3)  # a joint's positions, three rest samples before and after
+    ts1, ts2, ts3 = steps[0], steps[1], steps[2]
+    velocity, acceleration, jerk = out[0], out[1], out[2]
+    for i in range(n_dof):
+        for r in range(3):
+            column[r] = q[0, i]
+            column[n_samples + 3 + r] = q[n_samples - 1, i]
+        for r in range(n_samples):
+            column[r + 3] = q[r, i]
+        v_limit, a_limit, j_limit = limits[0, i], limits[1, i], limits[2, i]
+        for r in range(rows):  # row r: the differences ending at padded row r + 3
+            p0 = column[r]
+            p1 = column[r + 1]
+            p2 = column[r + 2]
+            p3 = column[r + 3]
             first_a = p1 - p0
             first_b = p2 - p1
             first_c = p3 - p2
             second_b = first_c - first_b
             second_a = first_b - first_a
             third = second_b - second_a
-            out[r, 0] = max(out[r, 0], abs(first_c / steps[0]) / limits[0, i])
-            out[r, 1] = max(out[r, 1], abs(second_b / steps[1]) / limits[1, i])
-            out[r, 2] = max(out[r, 2], abs(third / steps[2]) / limits[2, i])
-    return out
+            velocity[r] = max(velocity[r], abs(first_c / ts1) / v_limit)
+            acceleration[r] = max(acceleration[r], abs(second_b / ts2) / a_limit)
+            jerk[r] = max(jerk[r], abs(third / ts3) / j_limit)
+    return out.T
 
 
 @njit(cache=True)

@@ -171,13 +171,15 @@ class ZoneDemand:
         return slice(first, max(stop, first + 1))
 
     def local_caps(self, robot: Robot, share: float) -> np.ndarray:
-        """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s."""
+        """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s.
+
+        Per point the least of ``share · v_max / |q'|``, ``√(share · a_max / |q''|)`` and
+        ``∛(share · j_max / |q'''|)`` over the joints (+inf where a demand is 0): one
+        compiled pass (:func:`trackplan.timing._kernels.local_caps`).
+        """
         q1, q2, q3 = self._abs
-        caps = np.minimum(
-            safe_ratio(share * robot.v_max, q1).min(axis=1),
-            np.sqrt(safe_ratio(share * robot.a_max, q2)).min(axis=1),
-        )
-        return np.minimum(caps, np.cbrt(safe_ratio(share * robot.j_max, q3)).min(axis=1))
+        rooms = np.stack([share * robot.v_max, share * robot.a_max, share * robot.j_max])
+        return _kernels.local_caps(q1, q2, q3, rooms)  # type: ignore[no-any-return]
 
 
 def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:

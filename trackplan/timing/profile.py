@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,7 +54,7 @@ def speed_change_time(delta: float, accel: float, jerk: float) -> float:
         return 0.0
     if delta * jerk >= accel * accel:
         return delta / accel + accel / jerk
-    return 2.0 * float(np.sqrt(delta / jerk))
+    return 2.0 * math.sqrt(delta / jerk)  # libm's correctly rounded root, as np.sqrt
 
 
 def speed_change_distance(v_from: float, v_to: float, accel: float, jerk: float) -> float:

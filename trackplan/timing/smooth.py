@@ -560,8 +560,12 @@ def _jerk_for_duration(delta: float, accel: float, jerk: float, duration: float)
     for _ in range(80):
         mid = 0.5 * (low + high)
         if mid > 0.0 and speed_change_time(delta, accel, mid) > duration:
+            if mid == low:  # the bisection has come to rest: the rounds left change nothing
+                break
             low = mid
         else:
+            if mid == high:
+                break
             high = mid
     return high
 
