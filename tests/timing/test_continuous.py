@@ -77,7 +77,7 @@ def test_the_linear_program_meets_its_node_bounds(wrist):
     stretch = continuous._stretches(result.joint_path, case.task)[0]
     limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
     limits = np.broadcast_to(limits, (3, len(stretch.s), robot.n_dof))
-    x = continuous._solve(stretch, limits, np.ones(len(stretch.s)))
+    x = continuous._solve(stretch, limits, stretch.cap)
     assert x is not None
     v = np.sqrt(x)
     assert v.max() <= case.task.rated_speed
@@ -188,7 +188,7 @@ def test_no_node_inside_a_stretch_comes_to_rest_in_a_short_blend():
     (stretch,) = continuous._stretches(joint_path, case.task)
     limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
     limits = np.broadcast_to(limits, (3, len(stretch.s), robot.n_dof))
-    x = continuous._solve(stretch, limits, np.ones(len(stretch.s)))
+    x = continuous._solve(stretch, limits, stretch.cap)
     assert x is not None
     cap, _ = continuous._joint_caps(stretch, robot, LIMIT_SHARE)
     blend = (stretch.s > 0.4964) & (stretch.s < 0.5014)

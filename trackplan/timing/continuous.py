@@ -58,7 +58,12 @@ from trackplan.case import Task
 from trackplan.jointpath import STENCIL_FRACTION, JointPath
 from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
-from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, run_motion_checks
+from trackplan.timing.sample_checks import (
+    LIMIT_MARGIN,
+    RateLimits,
+    SampleCheck,
+    run_motion_checks,
+)
 
 NODE_SPACING = 1e-3
 """Largest distance between two nodes of the speed curve, m."""
@@ -66,7 +71,7 @@ NODE_GROWTH = 0.25
 """Largest growth of the node spacing per metre of distance from a finer part, m/m."""
 MIN_NODES = 24
 """Fewest nodes of a stretch between stops (a short stretch gets a finer spacing)."""
-ROUNDS = 2
+SPEED_ROOMS = (1.3, 1.1)
 """Linear programs per plan: the first bounds √x by :data:`FIRST_ROOMS` times the
 constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the first solution."""
 FIRST_ROOMS = (1.5, 1.0)
@@ -109,6 +114,9 @@ REFINE_ROOM = 1.0
 """A gap is bisected only where the joints allow less than this times the rated speed."""
 REFINE_GAP = 1e-5
 """Shortest gap between nodes that is bisected, m."""
+CANCEL_ROOM = 2.0
+"""How far the path-jerk term ``q' x''/2`` of the joint jerk may pass the jerk bound on its
+own (the other terms cancelling the rest)."""
 REBUILD_FACTOR = 0.97
 """A rebuild lowers the failing limit to this share of its value over the ratio found."""
 
@@ -195,7 +203,10 @@ def plan_speed_curve(
     """
     stretches = _stretches(joint_path, task)
     robot = joint_path.robot
-    scales = [np.ones((4, len(st.s))) for st in stretches]  # v, a, j limits; speed cap
+    rates = tuple(c for c in checks if isinstance(c, RateLimits))
+    others = tuple(c for c in checks if not isinstance(c, RateLimits))
+    # v, a, j limits; speed cap; speed ceiling, m/s (from the checks other than the rates)
+    scales = [np.vstack([np.ones((4, len(st.s))), np.full(len(st.s), np.inf)]) for st in stretches]
     hits = [np.zeros(len(st.s), dtype=int) for st in stretches]  # rebuilds that lowered a node
     for rebuild in range(1, MAX_REBUILDS + 1):
         speeds = []
@@ -205,7 +216,7 @@ def plan_speed_curve(
                 * scale[:3, :, None]
                 * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
             )
-            x = _solve(stretch, limits, scale[3])
+            x = _solve(stretch, limits, np.minimum(stretch.cap * scale[3], scale[4]))
             if x is None:
                 return None
             speeds.append(np.sqrt(x))
@@ -218,9 +229,12 @@ def plan_speed_curve(
         if s is None:
             return None
         motion = SampledMotion(robot, joint_path.joints(s), task.sample_time)
-        sample, order, ratio = run_motion_checks(checks, motion)
+        # the rate checks name the limit to lower; any other check (the torques) asks for a
+        # lower speed where it fails (order 5)
+        sample, order, ratio = run_motion_checks(rates, motion)
+        other = run_motion_checks(others, motion) if others else (sample[:0], order[:0], ratio[:0])
         fast, excess = _over_speed(s, task, stretches)
-        if not sample.size and not fast.size:
+        if not sample.size and not fast.size and not other[0].size:
             s_nodes = np.concatenate([st.s for st in stretches])
             speed = np.concatenate(speeds)
             caps = [_joint_caps(st, robot, share) for st in stretches]
@@ -228,11 +242,11 @@ def plan_speed_curve(
             reason = np.concatenate([c[1] for c in caps])
             return SpeedCurve(s, motion, s_nodes, speed, joint_cap, reason, rebuild)
         # the spline rings above a speed cap it joins: a lower cap there (order 4)
-        sample = np.concatenate([sample, fast])
-        order = np.concatenate([order, np.full(fast.size, 4)])
-        ratio = np.concatenate([ratio, excess])
-        for stretch, scale, hit in zip(stretches, scales, hits, strict=True):
-            _lower(stretch.s, scale, hit, s[sample], order, ratio)
+        sample = np.concatenate([sample, fast, other[0]])
+        order = np.concatenate([order, np.full(fast.size, 4), 4 + other[1]])
+        ratio = np.concatenate([ratio, excess, other[2]])
+        for stretch, scale, hit, v in zip(stretches, scales, hits, speeds, strict=True):
+            _lower(stretch.s, v, scale, hit, s[sample], order, ratio)
     return None
 
 
@@ -444,7 +458,7 @@ def _interp(s: np.ndarray, grid: np.ndarray, values: np.ndarray, last: bool) -> 
     )
 
 
-def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.ndarray | None:
+def _solve(stretch: _Stretch, limits: np.ndarray, cap: np.ndarray) -> np.ndarray | None:
     """Node values of ``x = ṡ²`` (G,) maximising the time-weighted ``Σ w x`` under the limits
     (see the module), or None when the linear program fails.
 
@@ -452,8 +466,8 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     ----------
     limits
         Joint velocity, acceleration and jerk limits at each node, shape (3, G, n).
-    cap_scale
-        Share of the speed cap planned at each node, shape (G,).
+    cap
+        Speed cap planned at each node, shape (G,), m/s.
     """
     import scipy.sparse as sparse  # scipy's LP stack only where a curve is planned
     from scipy.optimize import linprog
@@ -462,7 +476,6 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     count = len(s)
     with np.errstate(divide="ignore"):
         velocity = np.min(limits[0] / np.abs(d1), axis=(0, 2))
-    cap = stretch.cap * cap_scale
     top = np.minimum(np.minimum(cap, velocity) ** 2, _rest_envelope(s, d1, limits[2]))
     k = np.arange(1, count - 1)
     slope, bend = _differences(s)  # x'[k] = slope @ x[k-1:k+2], x''[k] = bend @ ...
@@ -474,8 +487,9 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
         [
             q1 * slope[:, None] / 2 + q2 * centre,
             q1 * bend[:, None] / 2 + 1.5 * q2 * slope[:, None] + q3 * centre,
+            q1 * bend[:, None] / 2,
         ]
-    )  # (2 kinds, 2 sides, m, n, 3 columns)
+    )  # (3 kinds, 2 sides, m, n, 3 columns)
     columns = np.broadcast_to(
         np.stack([k - 1, k, k + 1], axis=-1)[None, None, :, None, :], coefficients.shape
     )
@@ -498,12 +512,14 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
         # held at the cap first; if that leaves no room for a speed change, everything free
         x = np.minimum(top, (room * steady) ** 2)
         reference = x
-        for _ in range(ROUNDS):
+        for next_room in (*SPEED_ROOMS, 1.0):
             bound = np.sqrt(x)
             with np.errstate(divide="ignore"):
                 jerk = limits[2][k] / np.maximum(bound[k], 1e-9)[:, None]
-            rhs = np.stack([np.broadcast_to(limits[1][k], jerk.shape), jerk])[:, None]
-            rhs = np.broadcast_to(rhs, signed.shape[:-1])  # (2 signs, 2 kinds, 2 sides, m, n)
+            rhs = np.stack(
+                [np.broadcast_to(limits[1][k], jerk.shape), jerk, CANCEL_ROOM * jerk]
+            )[:, None]
+            rhs = np.broadcast_to(rhs, signed.shape[:-1])  # (2 signs, 3 kinds, 2 sides, m, n)
             # a row binds only if its largest value for 0 ≤ x ≤ the round's bound passes
             # rhs, and only if it reaches a node that is not held
             keep = distinct & (np.einsum("...c,...c->...", positive, x[signed_columns]) > rhs)
@@ -530,7 +546,7 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                     solution = None
                     break
                 solution = np.clip(result.x, 0.0, x)
-            x = np.minimum(top, SPEED_ROOM**2 * solution)
+            x = np.minimum(top, next_room**2 * solution)
             reference = solution
         if solution is None:
             continue
@@ -685,36 +701,51 @@ def _over_speed(
 
 def _lower(
     s_nodes: np.ndarray,
+    speed: np.ndarray,
     scale: np.ndarray,
     hits: np.ndarray,
     s_bad: np.ndarray,
     order: np.ndarray,
     ratio: np.ndarray,
 ) -> None:
-    """Lower the limit of each failing order at the nodes around each failing sample
-    (order 4: the speed cap, by the excess found and twice as much again).
+    """Lower the limit of each failing order at the nodes around each failing sample.
+
+    Orders 1–3 are the joint velocity, acceleration and jerk (``scale`` rows 0–2: the
+    limit by :data:`REBUILD_FACTOR` over the ratio found); order 4 the speed cap (row 3, by
+    the excess found and twice as much again); order ``4 + o`` a check other than the rates
+    (the torques) whose value scales with the speed to the power ``o``: the node speeds
+    ``speed`` (G,), m/s, fall to ``(REBUILD_FACTOR / ratio)^(1/o)`` of what they are (a
+    ceiling, row 4, m/s) and the acceleration limit with their square, as if that part of
+    the curve ran slower in time.
 
     The reach is :data:`REBUILD_REACH` nodes, times :data:`REBUILD_SPREAD` for each earlier
     rebuild that lowered the node nearest the sample (``hits`` (G,), counted here): a speed
-    change whose start fails again just beside the lowered nodes (the spline rings where
-    the jerk steps) is caught within a few rebuilds instead of creeping one node a time.
+    change whose start fails again just beside the lowered nodes is caught within a few
+    rebuilds instead of creeping one node a time.
     """
     inside = (s_bad >= s_nodes[0]) & (s_bad <= s_nodes[-1])
     # positions in nodes (fractional): the reach counts nodes, wherever they are finer
     position = np.interp(s_bad[inside], s_nodes, np.arange(len(s_nodes)))
     index = np.arange(len(s_nodes))
-    factor = np.ones_like(scale)
+    factor = np.ones((4, len(s_nodes)))
+    ceiling = scale[4].copy()
     touched = np.zeros(len(s_nodes), dtype=bool)
     for where, o, r in zip(position, order[inside], ratio[inside], strict=True):
         reach = REBUILD_REACH * REBUILD_SPREAD ** hits[int(where + 0.5)]
         # full lowering within the reach, tapering off over as much again beyond it, so
         # the lowered limit has no step of its own
         taper = np.clip(2.0 - np.abs(index - where) / reach, 0.0, 1.0)
+        near = taper > 0.0
+        touched |= near
+        if o > 4:
+            lowered = 1.0 - taper * (1.0 - (REBUILD_FACTOR / r) ** (1.0 / (o - 4)))
+            ceiling[near] = np.minimum(ceiling[near], lowered[near] * speed[near])
+            factor[1] = np.minimum(factor[1], lowered**2)
+            continue
         target = REBUILD_FACTOR / r if o < 4 else (1.0 - 2.0 * (r - 1.0)) / r
-        lowered = 1.0 - taper * (1.0 - target)
-        factor[o - 1] = np.minimum(factor[o - 1], lowered)
-        touched |= taper > 0.0
-    scale *= factor
+        factor[o - 1] = np.minimum(factor[o - 1], 1.0 - taper * (1.0 - target))
+    scale[:4] *= factor
+    scale[4] = ceiling
     hits += touched
 
 
