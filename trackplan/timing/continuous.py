@@ -25,11 +25,15 @@ it: ``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄`` with ``x ≤ v̄²`` 
 (conservative) form. Under these linear bounds, the velocity limits and the task's speed
 caps, a linear program (HiGHS's dual simplex, through :func:`scipy.optimize.linprog`)
 maximises ``Σ w x``, each node weighted by its share of the travel time (``ds / x^1.5`` at
-a reference x, so a node near rest costs what it costs in time). It is solved
-:data:`ROUNDS` times: first with ``v̄`` :data:`FIRST_ROOMS` times the constant speed the
-joints allow at each node, then with ``v̄`` :data:`SPEED_ROOM` times the previous solution
-(the reference x of the weights). The signed joint-path derivatives enter as they are, so
-the curve uses the cancellations the optimum uses. Only rows that can bind enter the
+a reference x, so a node near rest costs what it costs in time). It is solved in rounds:
+first with ``v̄`` :data:`FIRST_ROOMS` times the constant speed the joints allow at each
+node, then with ``v̄`` each of :data:`SPEED_ROOMS` times the previous solution (the
+reference x of the weights), so that the last bound lies within 10 % of the speed it
+bounds. The signed joint-path derivatives enter as they are, so the curve uses the
+cancellations the optimum uses; but the path-jerk term ``q' x''/2`` alone stays within
+:data:`CANCEL_ROOM` times the jerk bound: near a wrist flip the terms are a thousand times
+the limit, and a cancellation at single nodes is one the samples between them cannot
+follow. Only rows that can bind enter the
 program (a row whose largest value for ``0 ≤ x ≤ v̄²`` stays within its limit cannot), and
 nodes far from any slowed or changing part cruise at their cap outside it
 (:func:`_cruising`).
@@ -42,7 +46,9 @@ s(t) is the quintic spline through (t, s) at the nodes, at rest at both ends, sa
 The samples go through the law's sample checks and the speed caps; where one fails, the
 limits (or the cap) of the nodes around it are lowered by the ratio found and the curve is
 planned again (:data:`MAX_REBUILDS` times at most), over a reach that grows by
-:data:`REBUILD_SPREAD` each time the same nodes fail again.
+:data:`REBUILD_SPREAD` each time the same nodes fail again. A check other than the joint
+rates (the torques) names no limit of the program: where it fails, the speed of the nodes
+around it is capped below the speed planned there, by the check's ratio and order.
 """
 
 from __future__ import annotations
@@ -72,15 +78,14 @@ NODE_GROWTH = 0.25
 MIN_NODES = 24
 """Fewest nodes of a stretch between stops (a short stretch gets a finer spacing)."""
 SPEED_ROOMS = (1.3, 1.1)
-"""Linear programs per plan: the first bounds √x by :data:`FIRST_ROOMS` times the
-constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the first solution."""
+"""How far above the previous round's solution each round after the first may plan the
+speed (its jerk bound assumes the speed stays below it): the second round 1.3 ×, the third
+1.1 × (the first bounds √x by :data:`FIRST_ROOMS` times the constant-speed cap of the
+joints)."""
 FIRST_ROOMS = (1.5, 1.0)
 """How far above the constant-speed cap the joints allow (at each node) the first round's
 speed may go (its jerk bound assumes the speed stays below it): the first room, and the
 next one tried when a solution leaves a node inside the stretch at rest (:data:`RESTING`)."""
-SPEED_ROOM = 1.3
-"""How far above the first round's speed the second round may go (its jerk bound assumes
-the speed stays below it)."""
 SLOW_FLOOR = 0.05
 """Share of the fastest speed below which the objective weighs a node as if it ran at it."""
 CRUISE_ROOM = 1.5
@@ -115,8 +120,8 @@ REFINE_ROOM = 1.0
 REFINE_GAP = 1e-5
 """Shortest gap between nodes that is bisected, m."""
 CANCEL_ROOM = 2.0
-"""How far the path-jerk term ``q' x''/2`` of the joint jerk may pass the jerk bound on its
-own (the other terms cancelling the rest)."""
+"""How far the path-jerk term ``√x q' x''/2`` of the joint jerk may pass the jerk limit on
+its own, the other terms cancelling the rest (a row of its own in the linear program)."""
 REBUILD_FACTOR = 0.97
 """A rebuild lowers the failing limit to this share of its value over the ratio found."""
 
@@ -516,9 +521,8 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap: np.ndarray) -> np.ndarray
             bound = np.sqrt(x)
             with np.errstate(divide="ignore"):
                 jerk = limits[2][k] / np.maximum(bound[k], 1e-9)[:, None]
-            rhs = np.stack(
-                [np.broadcast_to(limits[1][k], jerk.shape), jerk, CANCEL_ROOM * jerk]
-            )[:, None]
+            kinds = [np.broadcast_to(limits[1][k], jerk.shape), jerk, CANCEL_ROOM * jerk]
+            rhs = np.stack(kinds)[:, None]
             rhs = np.broadcast_to(rhs, signed.shape[:-1])  # (2 signs, 3 kinds, 2 sides, m, n)
             # a row binds only if its largest value for 0 ≤ x ≤ the round's bound passes
             # rhs, and only if it reaches a node that is not held
