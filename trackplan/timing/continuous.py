@@ -492,9 +492,8 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap: np.ndarray) -> np.ndarray
         [
             q1 * slope[:, None] / 2 + q2 * centre,
             q1 * bend[:, None] / 2 + 1.5 * q2 * slope[:, None] + q3 * centre,
-            q1 * bend[:, None] / 2,
         ]
-    )  # (3 kinds, 2 sides, m, n, 3 columns)
+    )  # (2 kinds, 2 sides, m, n, 3 columns)
     columns = np.broadcast_to(
         np.stack([k - 1, k, k + 1], axis=-1)[None, None, :, None, :], coefficients.shape
     )
@@ -504,6 +503,13 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap: np.ndarray) -> np.ndarray
     signed = np.stack([coefficients, -coefficients])  # rows ≤ rhs in both directions
     positive = np.maximum(signed, 0.0)
     signed_columns = np.stack([columns, columns])
+    # the path-jerk term alone: |q' x''/2| ≤ CANCEL_ROOM q⃛max / v̄ for every joint and side
+    # is one row each way per node, |x''/2| ≤ CANCEL_ROOM (lowest q⃛max / |q'|) / v̄
+    with np.errstate(divide="ignore"):
+        path_jerk = CANCEL_ROOM * np.min(limits[2][k][None] / np.abs(d1[:, k]), axis=(0, 2))
+    bend_rows = np.stack([bend / 2, -bend / 2])  # (2 signs, m, 3 columns)
+    bend_positive = np.maximum(bend_rows, 0.0)
+    bend_columns = np.broadcast_to(np.stack([k - 1, k, k + 1], axis=-1), bend_rows.shape)
     with np.errstate(divide="ignore"):
         steady = np.min(
             np.minimum(np.sqrt(limits[1] / np.abs(d2)), np.cbrt(limits[2] / np.abs(d3))),
@@ -521,27 +527,27 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap: np.ndarray) -> np.ndarray
             bound = np.sqrt(x)
             with np.errstate(divide="ignore"):
                 jerk = limits[2][k] / np.maximum(bound[k], 1e-9)[:, None]
-            kinds = [np.broadcast_to(limits[1][k], jerk.shape), jerk, CANCEL_ROOM * jerk]
-            rhs = np.stack(kinds)[:, None]
-            rhs = np.broadcast_to(rhs, signed.shape[:-1])  # (2 signs, 3 kinds, 2 sides, m, n)
+            rhs = np.stack([np.broadcast_to(limits[1][k], jerk.shape), jerk])[:, None]
+            rhs = np.broadcast_to(rhs, signed.shape[:-1])  # (2 signs, 2 kinds, 2 sides, m, n)
+            bend_rhs = np.broadcast_to(path_jerk / np.maximum(bound[k], 1e-9), bend_rows.shape[:-1])
             # a row binds only if its largest value for 0 ≤ x ≤ the round's bound passes
             # rhs, and only if it reaches a node that is not held
             keep = distinct & (np.einsum("...c,...c->...", positive, x[signed_columns]) > rhs)
             keep &= ~np.all(held[signed_columns], axis=-1)
+            bend_keep = np.einsum("...c,...c->...", bend_positive, x[bend_columns]) > bend_rhs
+            bend_keep &= ~np.all(held[bend_columns], axis=-1)
             solution = x
-            if keep.any():
-                kept = signed[keep]
+            if keep.any() or bend_keep.any():
+                kept = np.concatenate([signed[keep], bend_rows[bend_keep]])
+                kept_columns = np.concatenate([signed_columns[keep], bend_columns[bend_keep]])
                 matrix = sparse.csr_matrix(
-                    (
-                        kept.ravel(),
-                        (np.repeat(np.arange(len(kept)), 3), signed_columns[keep].ravel()),
-                    ),
+                    (kept.ravel(), (np.repeat(np.arange(len(kept)), 3), kept_columns.ravel())),
                     shape=(len(kept), count),
                 )
                 result = linprog(
                     -_time_weights(s, reference),
                     A_ub=matrix,
-                    b_ub=rhs[keep],
+                    b_ub=np.concatenate([rhs[keep], bend_rhs[bend_keep]]),
                     bounds=np.stack([np.where(held, x, 0.0), x], axis=1),
                     method="highs-ds",
                     options={"presolve": False},
