@@ -301,3 +301,30 @@ def test_the_nodes_see_the_seam_frame_start_turning_between_grid_points():
     k = np.searchsorted(grid, start)
     inner = (stretch.s > grid[k - 1]) & (stretch.s < grid[k])
     assert inner.sum() >= 6
+
+
+def test_once_the_rebuilds_are_spent_the_curve_runs_slower_instead_of_being_given_up(
+    monkeypatch,
+):
+    """With a single plan allowed, the corner placement's first curve (7.99 s of node timing,
+    whose start fails the jerk check by 1.36 ×) is stretched in time by the worst failure's
+    ratio (1.36^(1/3) = 1.11) until its samples pass, instead of being given up; every
+    sample re-checked."""
+    case = load_case(CASES / "paper-corner.yaml")
+    joint_path = plan_placement(case, REST_X).joint_path
+    checks = robot_checks(case.robot)
+    monkeypatch.setattr(continuous, "MAX_REBUILDS", 1)
+    curve = continuous.plan_speed_curve(joint_path, case.task, checks, LIMIT_SHARE)
+    assert curve is not None and 1 < curve.rebuilds <= 1 + continuous.SLOW_DOWNS
+    assert curve.duration <= 1.112 * 7.992
+    report = check_case_trajectory(case, REST_X, curve.motion.q, case.task.sample_time)
+    assert report.success, report.violations[:3]
+
+
+def test_the_slow_down_meets_the_worst_failure_of_each_order():
+    """A jerk 1.331 × its limit needs the time 1.1 × longer, a speed 1.01 × its cap 1.01 ×,
+    a torque whose speed factor is squared (order 4 + 2) at 1.21 × 1.1 ×."""
+    order = np.array([3, 4, 6, 2])
+    ratio = np.array([1.331, 1.01, 1.21, 1.1])
+    slower = continuous._slow_down(order, ratio)
+    assert slower == pytest.approx(1.1 * continuous.SLOW_DOWN_MARGIN)

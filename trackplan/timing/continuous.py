@@ -122,6 +122,14 @@ REFINE_GAP = 1e-5
 CANCEL_ROOM = 2.0
 """How far the path-jerk term ``√x q' x''/2`` of the joint jerk may pass the jerk limit on
 its own, the other terms cancelling the rest (a row of its own in the linear program)."""
+SLOW_DOWNS = 3
+"""Tries after the last rebuild that stretch the whole curve in time by the worst failure's
+ratio (:func:`_slow_down`) instead of giving the curve up: a failure that creeps along a
+speed change for every rebuild costs the curve a few tenths of a per cent, not the window
+plan's lead over it."""
+SLOW_DOWN_MARGIN = 1.002
+"""Extra stretch of each such try (the samples' rates do not fall exactly with the time
+scale: the samples fall elsewhere on the curve)."""
 REBUILD_FACTOR = 0.97
 """A rebuild lowers the failing limit to this share of its value over the ratio found."""
 
@@ -213,18 +221,20 @@ def plan_speed_curve(
     # v, a, j limits; speed cap; speed ceiling, m/s (from the checks other than the rates)
     scales = [np.vstack([np.ones((4, len(st.s))), np.full(len(st.s), np.inf)]) for st in stretches]
     hits = [np.zeros(len(st.s), dtype=int) for st in stretches]  # rebuilds that lowered a node
-    for rebuild in range(1, MAX_REBUILDS + 1):
-        speeds = []
-        for stretch, scale in zip(stretches, scales, strict=True):
-            limits = (
-                share
-                * scale[:3, :, None]
-                * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
-            )
-            x = _solve(stretch, limits, np.minimum(stretch.cap * scale[3], scale[4]))
-            if x is None:
-                return None
-            speeds.append(np.sqrt(x))
+    speeds: list[np.ndarray] = []
+    for rebuild in range(1, MAX_REBUILDS + SLOW_DOWNS + 1):
+        if rebuild <= MAX_REBUILDS:
+            speeds = []
+            for stretch, scale in zip(stretches, scales, strict=True):
+                limits = (
+                    share
+                    * scale[:3, :, None]
+                    * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
+                )
+                x = _solve(stretch, limits, np.minimum(stretch.cap * scale[3], scale[4]))
+                if x is None:
+                    return None
+                speeds.append(np.sqrt(x))
         if (
             sum(_node_steps(st, v).sum() for st, v in zip(stretches, speeds, strict=True))
             >= to_beat
@@ -250,9 +260,24 @@ def plan_speed_curve(
         sample = np.concatenate([sample, fast, other[0]])
         order = np.concatenate([order, np.full(fast.size, 4), 4 + other[1]])
         ratio = np.concatenate([ratio, excess, other[2]])
-        for stretch, scale, hit, v in zip(stretches, scales, hits, speeds, strict=True):
-            _lower(stretch.s, v, scale, hit, s[sample], order, ratio)
+        if rebuild < MAX_REBUILDS:
+            for stretch, scale, hit, v in zip(stretches, scales, hits, speeds, strict=True):
+                _lower(stretch.s, v, scale, hit, s[sample], order, ratio)
+        else:
+            # the rebuilds are spent (a failure creeping along a speed change): the whole
+            # curve runs slower in time, which lowers every rate alike
+            slower = _slow_down(order, ratio)
+            speeds = [v / slower for v in speeds]
     return None
+
+
+def _slow_down(order: np.ndarray, ratio: np.ndarray) -> float:
+    """Factor (> 1) by which the curve's time stretches so that failures of these orders
+    (V,) and ratios (V,) pass (see :func:`_lower` for the orders): a rate of order o falls
+    with the o-th power of the factor, the speed cap with its first power, a check other
+    than the rates (order 4 + o) as its order says; :data:`SLOW_DOWN_MARGIN` more."""
+    power = np.where(order <= 3, order, np.where(order == 4, 1, order - 4))
+    return float(np.max(ratio ** (1.0 / power))) * SLOW_DOWN_MARGIN
 
 
 def _stretches(joint_path: JointPath, task: Task) -> list[_Stretch]:
