@@ -31,9 +31,10 @@ node, then with ``v̄`` each of :data:`SPEED_ROOMS` times the previous solution 
 reference x of the weights), so that the last bound lies within 10 % of the speed it
 bounds. The signed joint-path derivatives enter as they are, so the curve uses the
 cancellations the optimum uses; but the path-jerk term ``q' x''/2`` alone stays within
-:data:`CANCEL_ROOM` times the jerk bound: near a wrist flip the terms are a thousand times
-the limit, and a cancellation at single nodes is one the samples between them cannot
-follow. Only rows that can bind enter the
+:data:`CANCEL_ROOM` times the jerk bound, so that a rebuild that lowers the jerk limit
+where the samples rang lowers the path jerk there too (near a wrist flip the terms are a
+thousand times the limit, and the program would rather cancel more of them). Only rows
+that can bind enter the
 program (a row whose largest value for ``0 ≤ x ≤ v̄²`` stays within its limit cannot), and
 nodes far from any slowed or changing part cruise at their cap outside it
 (:func:`_cruising`).
