@@ -54,10 +54,10 @@ PLAN_RUNS = 7
 """Warm planning runs whose median is reported."""
 RANDOM_PER_CASE = 6
 """Random feasible placements drawn per shipped case (and per seam of a multi-seam case)."""
-SEEDS = (0, 1, 2, 3)
+SEEDS = (0, 1, 2, 3, 4, 5)
 """Seeds of the random placements: one table each, so that a worst case found by one draw
-can be told from a law tuned to it (the law was tuned on 0–2; 3 was held out, then one fix
-was made from it: docs/timing.md)."""
+can be told from a law tuned to it (the law was tuned on 0–2, then 3 after it was held out
+once, then on 0–5; later seeds are held out: docs/timing.md)."""
 MAX_DRAWS = 4000
 """Draws per case before giving up on finding RANDOM_PER_CASE feasible placements."""
 TARGET_PLAN_MS = 10.0

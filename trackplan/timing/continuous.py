@@ -25,11 +25,16 @@ it: ``|q' x''/2 + 3 q'' x'/2 + q''' x| ≤ q⃛max / v̄`` with ``x ≤ v̄²`` 
 (conservative) form. Under these linear bounds, the velocity limits and the task's speed
 caps, a linear program (HiGHS's dual simplex, through :func:`scipy.optimize.linprog`)
 maximises ``Σ w x``, each node weighted by its share of the travel time (``ds / x^1.5`` at
-a reference x, so a node near rest costs what it costs in time). It is solved
-:data:`ROUNDS` times: first with ``v̄`` :data:`FIRST_ROOMS` times the constant speed the
-joints allow at each node, then with ``v̄`` :data:`SPEED_ROOM` times the previous solution
-(the reference x of the weights). The signed joint-path derivatives enter as they are, so
-the curve uses the cancellations the optimum uses. Only rows that can bind enter the
+a reference x, so a node near rest costs what it costs in time). It is solved in rounds:
+first with ``v̄`` :data:`FIRST_ROOMS` times the constant speed the joints allow at each
+node, then with ``v̄`` each of :data:`SPEED_ROOMS` times the previous solution (the
+reference x of the weights), so that the last bound lies within 10 % of the speed it
+bounds. The signed joint-path derivatives enter as they are, so the curve uses the
+cancellations the optimum uses; but the path-jerk term ``q' x''/2`` alone stays within
+:data:`CANCEL_ROOM` times the jerk bound, so that a rebuild that lowers the jerk limit
+where the samples rang lowers the path jerk there too (near a wrist flip the terms are a
+thousand times the limit, and the program would rather cancel more of them). Only rows
+that can bind enter the
 program (a row whose largest value for ``0 ≤ x ≤ v̄²`` stays within its limit cannot), and
 nodes far from any slowed or changing part cruise at their cap outside it
 (:func:`_cruising`).
@@ -42,7 +47,9 @@ s(t) is the quintic spline through (t, s) at the nodes, at rest at both ends, sa
 The samples go through the law's sample checks and the speed caps; where one fails, the
 limits (or the cap) of the nodes around it are lowered by the ratio found and the curve is
 planned again (:data:`MAX_REBUILDS` times at most), over a reach that grows by
-:data:`REBUILD_SPREAD` each time the same nodes fail again.
+:data:`REBUILD_SPREAD` each time the same nodes fail again. A check other than the joint
+rates (the torques) names no limit of the program: where it fails, the speed of the nodes
+around it is capped below the speed planned there, by the check's ratio and order.
 """
 
 from __future__ import annotations
@@ -58,7 +65,12 @@ from trackplan.case import Task
 from trackplan.jointpath import STENCIL_FRACTION, JointPath
 from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
-from trackplan.timing.sample_checks import LIMIT_MARGIN, SampleCheck, run_motion_checks
+from trackplan.timing.sample_checks import (
+    LIMIT_MARGIN,
+    RateLimits,
+    SampleCheck,
+    run_motion_checks,
+)
 
 NODE_SPACING = 1e-3
 """Largest distance between two nodes of the speed curve, m."""
@@ -66,16 +78,15 @@ NODE_GROWTH = 0.25
 """Largest growth of the node spacing per metre of distance from a finer part, m/m."""
 MIN_NODES = 24
 """Fewest nodes of a stretch between stops (a short stretch gets a finer spacing)."""
-ROUNDS = 2
-"""Linear programs per plan: the first bounds √x by :data:`FIRST_ROOMS` times the
-constant-speed cap of the joints, the second by :data:`SPEED_ROOM` times the first solution."""
+SPEED_ROOMS = (1.3, 1.1)
+"""How far above the previous round's solution each round after the first may plan the
+speed (its jerk bound assumes the speed stays below it): the second round 1.3 ×, the third
+1.1 × (the first bounds √x by :data:`FIRST_ROOMS` times the constant-speed cap of the
+joints)."""
 FIRST_ROOMS = (1.5, 1.0)
 """How far above the constant-speed cap the joints allow (at each node) the first round's
 speed may go (its jerk bound assumes the speed stays below it): the first room, and the
 next one tried when a solution leaves a node inside the stretch at rest (:data:`RESTING`)."""
-SPEED_ROOM = 1.3
-"""How far above the first round's speed the second round may go (its jerk bound assumes
-the speed stays below it)."""
 SLOW_FLOOR = 0.05
 """Share of the fastest speed below which the objective weighs a node as if it ran at it."""
 CRUISE_ROOM = 1.5
@@ -109,6 +120,17 @@ REFINE_ROOM = 1.0
 """A gap is bisected only where the joints allow less than this times the rated speed."""
 REFINE_GAP = 1e-5
 """Shortest gap between nodes that is bisected, m."""
+CANCEL_ROOM = 2.0
+"""How far the path-jerk term ``√x q' x''/2`` of the joint jerk may pass the jerk limit on
+its own, the other terms cancelling the rest (a row of its own in the linear program)."""
+SLOW_DOWNS = 3
+"""Tries after the last rebuild that stretch the whole curve in time by the worst failure's
+ratio (:func:`_slow_down`) instead of giving the curve up: a failure that creeps along a
+speed change for every rebuild costs the curve a few tenths of a per cent, not the window
+plan's lead over it."""
+SLOW_DOWN_MARGIN = 1.002
+"""Extra stretch of each such try (the samples' rates do not fall exactly with the time
+scale: the samples fall elsewhere on the curve)."""
 REBUILD_FACTOR = 0.97
 """A rebuild lowers the failing limit to this share of its value over the ratio found."""
 
@@ -195,20 +217,25 @@ def plan_speed_curve(
     """
     stretches = _stretches(joint_path, task)
     robot = joint_path.robot
-    scales = [np.ones((4, len(st.s))) for st in stretches]  # v, a, j limits; speed cap
+    rates = tuple(c for c in checks if isinstance(c, RateLimits))
+    others = tuple(c for c in checks if not isinstance(c, RateLimits))
+    # v, a, j limits; speed cap; speed ceiling, m/s (from the checks other than the rates)
+    scales = [np.vstack([np.ones((4, len(st.s))), np.full(len(st.s), np.inf)]) for st in stretches]
     hits = [np.zeros(len(st.s), dtype=int) for st in stretches]  # rebuilds that lowered a node
-    for rebuild in range(1, MAX_REBUILDS + 1):
-        speeds = []
-        for stretch, scale in zip(stretches, scales, strict=True):
-            limits = (
-                share
-                * scale[:3, :, None]
-                * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
-            )
-            x = _solve(stretch, limits, scale[3])
-            if x is None:
-                return None
-            speeds.append(np.sqrt(x))
+    speeds: list[np.ndarray] = []
+    for rebuild in range(1, MAX_REBUILDS + SLOW_DOWNS + 1):
+        if rebuild <= MAX_REBUILDS:
+            speeds = []
+            for stretch, scale in zip(stretches, scales, strict=True):
+                limits = (
+                    share
+                    * scale[:3, :, None]
+                    * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
+                )
+                x = _solve(stretch, limits, np.minimum(stretch.cap * scale[3], scale[4]))
+                if x is None:
+                    return None
+                speeds.append(np.sqrt(x))
         if (
             sum(_node_steps(st, v).sum() for st, v in zip(stretches, speeds, strict=True))
             >= to_beat
@@ -218,9 +245,12 @@ def plan_speed_curve(
         if s is None:
             return None
         motion = SampledMotion(robot, joint_path.joints(s), task.sample_time)
-        sample, order, ratio = run_motion_checks(checks, motion)
+        # the rate checks name the limit to lower; any other check (the torques) asks for a
+        # lower speed where it fails (order 5)
+        sample, order, ratio = run_motion_checks(rates, motion)
+        other = run_motion_checks(others, motion) if others else (sample[:0], order[:0], ratio[:0])
         fast, excess = _over_speed(s, task, stretches)
-        if not sample.size and not fast.size:
+        if not sample.size and not fast.size and not other[0].size:
             s_nodes = np.concatenate([st.s for st in stretches])
             speed = np.concatenate(speeds)
             caps = [_joint_caps(st, robot, share) for st in stretches]
@@ -228,12 +258,27 @@ def plan_speed_curve(
             reason = np.concatenate([c[1] for c in caps])
             return SpeedCurve(s, motion, s_nodes, speed, joint_cap, reason, rebuild)
         # the spline rings above a speed cap it joins: a lower cap there (order 4)
-        sample = np.concatenate([sample, fast])
-        order = np.concatenate([order, np.full(fast.size, 4)])
-        ratio = np.concatenate([ratio, excess])
-        for stretch, scale, hit in zip(stretches, scales, hits, strict=True):
-            _lower(stretch.s, scale, hit, s[sample], order, ratio)
+        sample = np.concatenate([sample, fast, other[0]])
+        order = np.concatenate([order, np.full(fast.size, 4), 4 + other[1]])
+        ratio = np.concatenate([ratio, excess, other[2]])
+        if rebuild < MAX_REBUILDS:
+            for stretch, scale, hit, v in zip(stretches, scales, hits, speeds, strict=True):
+                _lower(stretch.s, v, scale, hit, s[sample], order, ratio)
+        else:
+            # the rebuilds are spent (a failure creeping along a speed change): the whole
+            # curve runs slower in time, which lowers every rate alike
+            slower = _slow_down(order, ratio)
+            speeds = [v / slower for v in speeds]
     return None
+
+
+def _slow_down(order: np.ndarray, ratio: np.ndarray) -> float:
+    """Factor (> 1) by which the curve's time stretches so that failures of these orders
+    (V,) and ratios (V,) pass (see :func:`_lower` for the orders): a rate of order o falls
+    with the o-th power of the factor, the speed cap with its first power, a check other
+    than the rates (order 4 + o) as its order says; :data:`SLOW_DOWN_MARGIN` more."""
+    power = np.where(order <= 3, order, np.where(order == 4, 1, order - 4))
+    return float(np.max(ratio ** (1.0 / power))) * SLOW_DOWN_MARGIN
 
 
 def _stretches(joint_path: JointPath, task: Task) -> list[_Stretch]:
@@ -444,7 +489,7 @@ def _interp(s: np.ndarray, grid: np.ndarray, values: np.ndarray, last: bool) -> 
     )
 
 
-def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.ndarray | None:
+def _solve(stretch: _Stretch, limits: np.ndarray, cap: np.ndarray) -> np.ndarray | None:
     """Node values of ``x = ṡ²`` (G,) maximising the time-weighted ``Σ w x`` under the limits
     (see the module), or None when the linear program fails.
 
@@ -452,8 +497,8 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     ----------
     limits
         Joint velocity, acceleration and jerk limits at each node, shape (3, G, n).
-    cap_scale
-        Share of the speed cap planned at each node, shape (G,).
+    cap
+        Speed cap planned at each node, shape (G,), m/s.
     """
     import scipy.sparse as sparse  # scipy's LP stack only where a curve is planned
     from scipy.optimize import linprog
@@ -462,7 +507,6 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     count = len(s)
     with np.errstate(divide="ignore"):
         velocity = np.min(limits[0] / np.abs(d1), axis=(0, 2))
-    cap = stretch.cap * cap_scale
     top = np.minimum(np.minimum(cap, velocity) ** 2, _rest_envelope(s, d1, limits[2]))
     k = np.arange(1, count - 1)
     slope, bend = _differences(s)  # x'[k] = slope @ x[k-1:k+2], x''[k] = bend @ ...
@@ -485,6 +529,13 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
     signed = np.stack([coefficients, -coefficients])  # rows ≤ rhs in both directions
     positive = np.maximum(signed, 0.0)
     signed_columns = np.stack([columns, columns])
+    # the path-jerk term alone: |q' x''/2| ≤ CANCEL_ROOM q⃛max / v̄ for every joint and side
+    # is one row each way per node, |x''/2| ≤ CANCEL_ROOM (lowest q⃛max / |q'|) / v̄
+    with np.errstate(divide="ignore"):
+        path_jerk = CANCEL_ROOM * np.min(limits[2][k][None] / np.abs(d1[:, k]), axis=(0, 2))
+    bend_rows = np.stack([bend / 2, -bend / 2])  # (2 signs, m, 3 columns)
+    bend_positive = np.maximum(bend_rows, 0.0)
+    bend_columns = np.broadcast_to(np.stack([k - 1, k, k + 1], axis=-1), bend_rows.shape)
     with np.errstate(divide="ignore"):
         steady = np.min(
             np.minimum(np.sqrt(limits[1] / np.abs(d2)), np.cbrt(limits[2] / np.abs(d3))),
@@ -498,30 +549,31 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
         # held at the cap first; if that leaves no room for a speed change, everything free
         x = np.minimum(top, (room * steady) ** 2)
         reference = x
-        for _ in range(ROUNDS):
+        for next_room in (*SPEED_ROOMS, 1.0):
             bound = np.sqrt(x)
             with np.errstate(divide="ignore"):
                 jerk = limits[2][k] / np.maximum(bound[k], 1e-9)[:, None]
             rhs = np.stack([np.broadcast_to(limits[1][k], jerk.shape), jerk])[:, None]
             rhs = np.broadcast_to(rhs, signed.shape[:-1])  # (2 signs, 2 kinds, 2 sides, m, n)
+            bend_rhs = np.broadcast_to(path_jerk / np.maximum(bound[k], 1e-9), bend_rows.shape[:-1])
             # a row binds only if its largest value for 0 ≤ x ≤ the round's bound passes
             # rhs, and only if it reaches a node that is not held
             keep = distinct & (np.einsum("...c,...c->...", positive, x[signed_columns]) > rhs)
             keep &= ~np.all(held[signed_columns], axis=-1)
+            bend_keep = np.einsum("...c,...c->...", bend_positive, x[bend_columns]) > bend_rhs
+            bend_keep &= ~np.all(held[bend_columns], axis=-1)
             solution = x
-            if keep.any():
-                kept = signed[keep]
+            if keep.any() or bend_keep.any():
+                kept = np.concatenate([signed[keep], bend_rows[bend_keep]])
+                kept_columns = np.concatenate([signed_columns[keep], bend_columns[bend_keep]])
                 matrix = sparse.csr_matrix(
-                    (
-                        kept.ravel(),
-                        (np.repeat(np.arange(len(kept)), 3), signed_columns[keep].ravel()),
-                    ),
+                    (kept.ravel(), (np.repeat(np.arange(len(kept)), 3), kept_columns.ravel())),
                     shape=(len(kept), count),
                 )
                 result = linprog(
                     -_time_weights(s, reference),
                     A_ub=matrix,
-                    b_ub=rhs[keep],
+                    b_ub=np.concatenate([rhs[keep], bend_rhs[bend_keep]]),
                     bounds=np.stack([np.where(held, x, 0.0), x], axis=1),
                     method="highs-ds",
                     options={"presolve": False},
@@ -530,7 +582,7 @@ def _solve(stretch: _Stretch, limits: np.ndarray, cap_scale: np.ndarray) -> np.n
                     solution = None
                     break
                 solution = np.clip(result.x, 0.0, x)
-            x = np.minimum(top, SPEED_ROOM**2 * solution)
+            x = np.minimum(top, next_room**2 * solution)
             reference = solution
         if solution is None:
             continue
@@ -685,36 +737,51 @@ def _over_speed(
 
 def _lower(
     s_nodes: np.ndarray,
+    speed: np.ndarray,
     scale: np.ndarray,
     hits: np.ndarray,
     s_bad: np.ndarray,
     order: np.ndarray,
     ratio: np.ndarray,
 ) -> None:
-    """Lower the limit of each failing order at the nodes around each failing sample
-    (order 4: the speed cap, by the excess found and twice as much again).
+    """Lower the limit of each failing order at the nodes around each failing sample.
+
+    Orders 1–3 are the joint velocity, acceleration and jerk (``scale`` rows 0–2: the
+    limit by :data:`REBUILD_FACTOR` over the ratio found); order 4 the speed cap (row 3, by
+    the excess found and twice as much again); order ``4 + o`` a check other than the rates
+    (the torques) whose value scales with the speed to the power ``o``: the node speeds
+    ``speed`` (G,), m/s, fall to ``(REBUILD_FACTOR / ratio)^(1/o)`` of what they are (a
+    ceiling, row 4, m/s) and the acceleration limit with their square, as if that part of
+    the curve ran slower in time.
 
     The reach is :data:`REBUILD_REACH` nodes, times :data:`REBUILD_SPREAD` for each earlier
     rebuild that lowered the node nearest the sample (``hits`` (G,), counted here): a speed
-    change whose start fails again just beside the lowered nodes (the spline rings where
-    the jerk steps) is caught within a few rebuilds instead of creeping one node a time.
+    change whose start fails again just beside the lowered nodes is caught within a few
+    rebuilds instead of creeping one node a time.
     """
     inside = (s_bad >= s_nodes[0]) & (s_bad <= s_nodes[-1])
     # positions in nodes (fractional): the reach counts nodes, wherever they are finer
     position = np.interp(s_bad[inside], s_nodes, np.arange(len(s_nodes)))
     index = np.arange(len(s_nodes))
-    factor = np.ones_like(scale)
+    factor = np.ones((4, len(s_nodes)))
+    ceiling = scale[4].copy()
     touched = np.zeros(len(s_nodes), dtype=bool)
     for where, o, r in zip(position, order[inside], ratio[inside], strict=True):
         reach = REBUILD_REACH * REBUILD_SPREAD ** hits[int(where + 0.5)]
         # full lowering within the reach, tapering off over as much again beyond it, so
         # the lowered limit has no step of its own
         taper = np.clip(2.0 - np.abs(index - where) / reach, 0.0, 1.0)
+        near = taper > 0.0
+        touched |= near
+        if o > 4:
+            lowered = 1.0 - taper * (1.0 - (REBUILD_FACTOR / r) ** (1.0 / (o - 4)))
+            ceiling[near] = np.minimum(ceiling[near], lowered[near] * speed[near])
+            factor[1] = np.minimum(factor[1], lowered**2)
+            continue
         target = REBUILD_FACTOR / r if o < 4 else (1.0 - 2.0 * (r - 1.0)) / r
-        lowered = 1.0 - taper * (1.0 - target)
-        factor[o - 1] = np.minimum(factor[o - 1], lowered)
-        touched |= taper > 0.0
-    scale *= factor
+        factor[o - 1] = np.minimum(factor[o - 1], 1.0 - taper * (1.0 - target))
+    scale[:4] *= factor
+    scale[4] = ceiling
     hits += touched
 
 

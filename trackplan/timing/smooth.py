@@ -162,6 +162,12 @@ the law also plans one continuous speed curve (:mod:`trackplan.timing.continuous
 the faster of the two."""
 
 
+REBUILT_CURVE_SHARE = 0.01
+"""The same share for a window plan that its sample checks rebuilt (lowering whole plateaus
+or speed changes, e.g. for the torques): there the curve, which lowers its limits around
+the failing samples only, pays from less."""
+
+
 def _or_curve(
     law: TimeLaw,
     plans: list[ZonePlan],
@@ -177,7 +183,8 @@ def _or_curve(
         for p in plans
         if p.kind != "stop" and p.plateau > 0.0 and p.reason not in ("rated speed", "corner speed")
     )
-    if law.success and limited < CURVE_SHARE * duration:
+    share = CURVE_SHARE if law.iterations == 1 else REBUILT_CURVE_SHARE
+    if law.success and limited < share * duration:
         return law
     curve = plan_speed_curve(
         joint_path, task, checks, LIMIT_SHARE, to_beat=law.duration if law.success else np.inf
