@@ -90,6 +90,28 @@ def test_optimize_without_report_imports_only_what_it_uses(tmp_path):
     assert _loaded_after(run, REPORT_AND_OPTIONAL) == []
 
 
+def test_input_schemas_are_built_when_a_file_is_validated():
+    """Importing the file loaders builds no pydantic schema (``defer_build``); loading the
+    corner case builds the one it validates, not the cell, robot-file or tool schemas."""
+    probe = (
+        "import json, pydantic\n"
+        "from trackplan.io import case_file, cell_file, robot_file, tool_file\n"
+        "modules = (case_file, cell_file, robot_file, tool_file)\n"
+        "models = [m for mod in modules for m in vars(mod).values() if isinstance(m, type)\n"
+        "          and issubclass(m, pydantic.BaseModel) and m.__module__ == mod.__name__]\n"
+        "def built():\n"
+        "    return [m.__name__ for m in models if m.__pydantic_complete__]\n"
+        "imported = built()\n"
+        f"case_file.load_case({str(CASES / 'paper-corner.yaml')!r})\n"
+        "print(json.dumps([len(models), imported, built()]))"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    n_models, imported, loaded = json.loads(out.stdout.splitlines()[-1])
+    assert n_models > 20
+    assert imported == []
+    assert loaded == ["SinglePathCaseModel"]
+
+
 @pytest.mark.skipif(not can_fork(), reason="no second core or no fork here")
 def test_optimize_plans_beside_the_search(tmp_path):
     """With a second core, the plans at full Ts (the before plan at the centre of the box runs

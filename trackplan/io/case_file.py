@@ -209,9 +209,9 @@ class CaseModel(StrictModel):
     approach: NonNegative | None = None
     home: Annotated[list[Coordinate], Field(min_length=1)] | None = None
     task: TaskModel
-    placement: PlacementModel = PlacementModel()
-    objective: ObjectiveModel = ObjectiveModel()
-    optimizer: OptimizerModel = OptimizerModel()
+    placement: PlacementModel = Field(default_factory=PlacementModel)
+    objective: ObjectiveModel = Field(default_factory=ObjectiveModel)
+    optimizer: OptimizerModel = Field(default_factory=OptimizerModel)
     cell: CellModel | None = None
 
 
