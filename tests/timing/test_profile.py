@@ -75,3 +75,8 @@ def test_compiled_positions_are_those_of_evaluate():
     profile = SpeedProfile.from_phases(phases, 0.05)
     t = np.linspace(-0.01, profile.duration + 0.01, 997)
     assert np.array_equal(profile.position(t), profile.evaluate(t)[0])
+    # times out of order, repeated, on the phase starts and NaN: each phase by binary search
+    rng = np.random.default_rng(3)
+    t = np.concatenate([rng.permutation(t), profile.t_start, profile.t_start[::-1], t[:40]])
+    t[[5, 500, 1040]] = np.nan
+    assert np.array_equal(profile.position(t), profile.evaluate(t)[0], equal_nan=True)

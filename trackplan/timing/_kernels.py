@@ -785,11 +785,22 @@ def profile_position(
     t: np.ndarray,
 ) -> np.ndarray:
     """Path position of a constant-jerk profile at times ``t`` (N,), clipped to
-    [0, length], shape (N,), m (:meth:`~trackplan.timing.profile.SpeedProfile.position`)."""
+    [0, length], shape (N,), m (:meth:`~trackplan.timing.profile.SpeedProfile.position`).
+
+    Each time's phase is ``searchsorted(t_start, t, "right") - 1``, clipped: for times in
+    order (a plan's samples) by walking on from the previous time's count, else (the first
+    time, a time before the previous one, NaN) by binary search.
+    """
     out = np.empty(t.size)
     last = t_start.size - 1
+    count = 0  # phases starting at or before the time: searchsorted(t_start, t, "right")
     for r in range(t.size):
-        k = min(max(np.searchsorted(t_start, t[r], side="right") - 1, 0), last)
+        if r > 0 and t[r] >= t[r - 1]:
+            while count <= last and t_start[count] <= t[r]:
+                count += 1
+        else:
+            count = np.searchsorted(t_start, t[r], side="right")
+        k = min(max(count - 1, 0), last)
         tau = t[r] - t_start[k]
         value = s0[k] + v0[k] * tau + a0[k] * (tau * tau) / 2.0 + jerk[k] * tau**3.0 / 6.0
         out[r] = min(max(value, 0.0), length)
