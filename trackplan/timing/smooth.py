@@ -176,8 +176,11 @@ over its whole stretch, so a start through a stretch of high joint demand is slo
 where the curve follows the demand node by node."""
 
 RISING = 1e-9
-"""Rise of the sampled speed from one sample to the next, relative to the top speed, below
+"""Rise of the sampled speed from one sample to the next, relative to the mean speed, below
 which a start (or, backwards in time, a stop) has ended."""
+CHANGE_HEAD = 512
+"""Samples first looked at for the end of a start or a stop (4 × more each time it is not
+there)."""
 
 
 def _or_curve(
@@ -228,7 +231,8 @@ def _rest_change_loss(s: np.ndarray, sample_time: float, joint_path: JointPath) 
 
     At rest only the ``q' s̈`` and ``q' s⃛`` terms of the joint acceleration and jerk act,
     so those bounds are ``LIMIT_SHARE · min_j q̈max_j / |q'_j|`` and the same with ``q⃛max``
-    at the path's first (last) point.
+    at the path's first (last) point. A change is counted up to the first sample whose
+    backward difference is at its top speed.
 
     Parameters
     ----------
@@ -244,24 +248,35 @@ def _rest_change_loss(s: np.ndarray, sample_time: float, joint_path: JointPath) 
     float
         The two excesses (each at least 0) added, s.
     """
-    robot = joint_path.robot
-    v = np.diff(s) / sample_time
-    if v.size < 2:
+    if s.size < 3:
         return 0.0
-    rising_by = RISING * float(v.max())
+    robot = joint_path.robot
+    rise = RISING * float(s[-1] - s[0]) / (s.size - 1)  # of Δs per sample, from the mean speed
     loss = 0.0
-    for speed, d1 in ((v, joint_path.dq[0]), (v[::-1], joint_path.dq[-1])):
-        rising = np.diff(speed) > rising_by
-        top = int(np.argmin(rising)) if not rising.all() else rising.size
+    for path, d1 in ((s, joint_path.dq[0]), (s[-1] - s[::-1], joint_path.dq[-1])):
+        top = _change_end(path, rise)
         accel_need = float(np.max(np.abs(d1) / robot.a_max))
         jerk_need = float(np.max(np.abs(d1) / robot.j_max))
         if accel_need == 0.0 or jerk_need == 0.0:
             continue
-        at_rest = speed_change_time(
-            float(speed[top]), LIMIT_SHARE / accel_need, LIMIT_SHARE / jerk_need
-        )
+        speed = float(path[top + 1] - path[top]) / sample_time
+        at_rest = speed_change_time(speed, LIMIT_SHARE / accel_need, LIMIT_SHARE / jerk_need)
         loss += max(0.0, (top + 1) * sample_time - at_rest)
     return loss
+
+
+def _change_end(s: np.ndarray, rise: float) -> int:
+    """Index k of the first backward difference ``s[k + 1] - s[k]`` of a start from rest
+    after which the step grows by ``rise`` (m) or less: the top of the start. Looks at
+    growing heads of ``s`` (N,), m, since a start is short next to a whole path."""
+    head = CHANGE_HEAD
+    while True:
+        rising = np.diff(s[: head + 2], 2) > rise
+        if not rising.all():
+            return int(np.argmin(rising))
+        if head + 2 >= s.size:
+            return rising.size
+        head *= 4
 
 
 def _curve_slowdowns(
