@@ -10,7 +10,8 @@ from hypothesis import strategies as st
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.planning.plan import check_case_trajectory, plan_placement
-from trackplan.timing import continuous
+from trackplan.timing import continuous, smooth
+from trackplan.timing.profile import SpeedProfile, speed_change_phases, speed_change_time
 from trackplan.timing.sample_checks import robot_checks
 from trackplan.timing.smooth import LIMIT_SHARE
 
@@ -185,6 +186,47 @@ def test_the_held_out_placements_of_seed_3_are_within_4_percent_of_topp3(name, X
     where it fails, and a rebuild's lowered jerk limit lowers the path jerk too (the
     path-jerk rows); every sample re-checked."""
     _assert_planned_within(name, X, 1.04 * topp3)
+
+
+START_X = np.array([-0.1205, 0.5056, 0.0068, 1.1294, 0.1302, 0.8987])
+"""A paper-line placement (seed 6 of the benchmark) whose start runs through a stretch where
+joint 6 turns hard (q' 12.7 rad/m, q''' -4000 rad/m³): the window plan's start, at one
+acceleration and one jerk bound over its 76 mm, took 1.01 s against 0.59 s at the bounds the
+joints allow at rest, and the plan 4.526 s, 1.0433 × TOPP3."""
+START_TOPP3 = 4.3383
+"""copp-py's TOPP3 on that joint path, s (``topp3_reference`` on the plan's joint path at
+these rounded coordinates, as ``python -m benchmarks plan`` runs it, measured once)."""
+
+
+def test_a_slow_start_through_high_joint_demand_tries_the_curve():
+    """The start and the stop lose more than :data:`smooth.REST_CHANGE_SHARE` of the window
+    plan's time there, so the curve is tried and taken (4.375 s, 1.0085 ×), every sample
+    re-checked."""
+    _assert_planned_within("paper-line", START_X, 1.04 * START_TOPP3)
+
+
+def test_the_rest_change_loss_is_the_time_beyond_changes_at_the_rest_bounds(wrist):
+    """A start at the bounds the joints allow at rest loses nothing; a stop at half their
+    jerk loses the difference of the two changes' durations (to two samples at each end:
+    a change is counted to the first sample whose backward difference is at the top speed)."""
+    _, result = wrist
+    joint_path, robot = result.joint_path, result.joint_path.robot
+    Ts, top = 1e-3, 0.1
+    first, last = np.abs(joint_path.dq[0]), np.abs(joint_path.dq[-1])
+    accel = LIMIT_SHARE / np.max(first / robot.a_max)
+    jerk = LIMIT_SHARE / np.max(first / robot.j_max)
+    stop_accel = LIMIT_SHARE / np.max(last / robot.a_max)
+    stop_jerk = LIMIT_SHARE / np.max(last / robot.j_max)
+    phases = [*speed_change_phases(0.0, top, accel, jerk), (0.5, 0.0)]
+    phases += speed_change_phases(top, 0.0, stop_accel, 0.5 * stop_jerk)
+    duration = sum(d for d, _ in phases)
+    profile = SpeedProfile.from_phases(phases, 1.0)
+    s = profile.position(np.arange(int(np.ceil(duration / Ts)) + 1) * Ts)
+    lost = speed_change_time(top, stop_accel, 0.5 * stop_jerk) - speed_change_time(
+        top, stop_accel, stop_jerk
+    )
+    assert lost > 0.05
+    assert abs(smooth._rest_change_loss(s, Ts, joint_path) - lost) <= 4 * Ts
 
 
 def test_a_torque_failure_lowers_the_speed_around_it():

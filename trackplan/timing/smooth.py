@@ -168,6 +168,21 @@ or speed changes, e.g. for the torques): there the curve, which lowers its limit
 the failing samples only, pays from less."""
 
 
+REST_CHANGE_SHARE = 0.03
+"""Share of the window plan's time that its start and its stop take beyond the same speed
+changes at the bounds the joints allow at rest (:func:`_rest_change_loss`) above which the
+law also plans the speed curve: a speed change runs at one acceleration and one jerk bound
+over its whole stretch, so a start through a stretch of high joint demand is slow all along,
+where the curve follows the demand node by node."""
+
+RISING = 1e-9
+"""Rise of the sampled speed from one sample to the next, relative to the mean speed, below
+which a start (or, backwards in time, a stop) has ended."""
+CHANGE_HEAD = 512
+"""Samples first looked at for the end of a start or a stop (4 × more each time it is not
+there)."""
+
+
 def _or_curve(
     law: TimeLaw,
     plans: list[ZonePlan],
@@ -177,14 +192,19 @@ def _or_curve(
     checks: tuple[SampleCheck, ...],
 ) -> TimeLaw:
     """The window law, or the continuous speed curve where the joints slow the windows down
-    enough for it to pay (:data:`CURVE_SHARE`) and it is faster (or the windows failed)."""
+    enough for it to pay (:data:`CURVE_SHARE`, or :data:`REST_CHANGE_SHARE` for the start
+    and the stop) and it is faster (or the windows failed)."""
     limited = sum(
         (p.s_end - p.s_start) / p.plateau
         for p in plans
         if p.kind != "stop" and p.plateau > 0.0 and p.reason not in ("rated speed", "corner speed")
     )
     share = CURVE_SHARE if law.iterations == 1 else REBUILT_CURVE_SHARE
-    if law.success and limited < share * duration:
+    if (
+        law.success
+        and limited < share * duration
+        and _rest_change_loss(law.s, task.sample_time, joint_path) < REST_CHANGE_SHARE * duration
+    ):
         return law
     curve = plan_speed_curve(
         joint_path, task, checks, LIMIT_SHARE, to_beat=law.duration if law.success else np.inf
@@ -203,6 +223,60 @@ def _or_curve(
         iterations=law.iterations + curve.rebuilds,
         motion=curve.motion,
     )
+
+
+def _rest_change_loss(s: np.ndarray, sample_time: float, joint_path: JointPath) -> float:
+    """Time a sampled law's start and stop take beyond a jerk-limited speed change to (from)
+    the same speed at the acceleration and jerk bounds the joints allow at rest there.
+
+    At rest only the ``q' s̈`` and ``q' s⃛`` terms of the joint acceleration and jerk act,
+    so those bounds are ``LIMIT_SHARE · min_j q̈max_j / |q'_j|`` and the same with ``q⃛max``
+    at the path's first (last) point. A change is counted up to the first sample whose
+    backward difference is at its top speed.
+
+    Parameters
+    ----------
+    s
+        Sampled arc length from rest to rest, shape (N,), m.
+    sample_time
+        Ts, s.
+    joint_path
+        q(s) with its derivatives on the planning grid.
+
+    Returns
+    -------
+    float
+        The two excesses (each at least 0) added, s.
+    """
+    if s.size < 3:
+        return 0.0
+    robot = joint_path.robot
+    rise = RISING * float(s[-1] - s[0]) / (s.size - 1)  # of Δs per sample, from the mean speed
+    loss = 0.0
+    for path, d1 in ((s, joint_path.dq[0]), (s[-1] - s[::-1], joint_path.dq[-1])):
+        top = _change_end(path, rise)
+        accel_need = float(np.max(np.abs(d1) / robot.a_max))
+        jerk_need = float(np.max(np.abs(d1) / robot.j_max))
+        if accel_need == 0.0 or jerk_need == 0.0:
+            continue
+        speed = float(path[top + 1] - path[top]) / sample_time
+        at_rest = speed_change_time(speed, LIMIT_SHARE / accel_need, LIMIT_SHARE / jerk_need)
+        loss += max(0.0, (top + 1) * sample_time - at_rest)
+    return loss
+
+
+def _change_end(s: np.ndarray, rise: float) -> int:
+    """Index k of the first backward difference ``s[k + 1] - s[k]`` of a start from rest
+    after which the step grows by ``rise`` (m) or less: the top of the start. Looks at
+    growing heads of ``s`` (N,), m, since a start is short next to a whole path."""
+    head = CHANGE_HEAD
+    while True:
+        rising = np.diff(s[: head + 2], 2) > rise
+        if not rising.all():
+            return int(np.argmin(rising))
+        if head + 2 >= s.size:
+            return rising.size
+        head *= 4
 
 
 def _curve_slowdowns(
