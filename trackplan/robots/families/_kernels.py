@@ -268,7 +268,9 @@ def opw_solve(
 
     Blocks of :data:`BLOCK` poses in three flat passes, as :func:`opw_solve_branch`: the
     arctangent arguments of the four arms (20 a pose; unreachable arms computed through
-    and marked), their arctangents, the joints of the eight branches.
+    and marked), their arctangents, the joints of the eight branches. The arm and wrist
+    expressions are written out here and in :func:`opw_solve_branch` alike: shared through
+    inlined helpers, the blocked loops measured 10–15 % slower.
     """
     a1 = g[O_A1]
     b_off = g[O_B]
