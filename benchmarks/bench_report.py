@@ -122,7 +122,7 @@ def _in_process() -> None:
             def prepare(mode: str = mode) -> tuple[PlotWorker | None, float]:
                 if mode != "worker":
                     return None, 0.0
-                worker = PlotWorker.start(case)
+                worker = PlotWorker.start()
                 assert worker is not None and worker.ready()
                 return worker, _process_cpu(worker.pid)  # its warm-up
 

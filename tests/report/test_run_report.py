@@ -57,7 +57,7 @@ def _not_here(*args, **kwargs):
 @needs_fork
 def test_a_plot_worker_writes_the_same_files(tmp_path, monkeypatch, corner, corner_result, serial):
     monkeypatch.setattr(run_report, "draw_plots", _not_here)
-    with plot_worker(corner) as worker:
+    with plot_worker() as worker:
         assert worker is not None
         os.kill(worker.pid, signal.SIGINT)  # ignored: the caller decides about interruptions
         files = _write(tmp_path, corner, corner_result, worker=worker)

@@ -339,7 +339,69 @@ def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
     ax.set_zlabel("z [m]")
 
 
-def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figure:
+PATH_FRAMES = 7
+"""Tool frames drawn along the placed path in ``path.png``."""
+
+TOOL_FRAMES = 16
+"""Tool frames drawn along the path in ``tool.png``."""
+
+
+@dataclass(frozen=True)
+class PlotKinematics:
+    """What the plots of a run take from the robot's kinematics and from the nominal path:
+    numba's compiled kernels compute them, so that a process drawing the plots
+    (:class:`~trackplan.report.plot_worker.PlotWorker`) is given them and never starts numba.
+
+    Attributes
+    ----------
+    chain_start
+        The robot at the first sample (:func:`~trackplan.report.scene.chain_points`),
+        shape (n + 2, 3), m, base frame; (0, 3) without a trajectory.
+    path_frames
+        ``T_base_tool`` at the samples :func:`~trackplan.report.scene.frame_indices` picks
+        for ``path.png``, shape (F, 4, 4); (0, 4, 4) without a trajectory.
+    tool_frames
+        The same for ``tool.png``, shape (G, 4, 4); (0, 4, 4) without a trajectory or when
+        the run has no ``tool.png`` (:func:`shows_tool`).
+    tracking_error
+        :func:`~trackplan.report.scene.tracking_error`, shape (N,), m.
+    """
+
+    chain_start: np.ndarray
+    path_frames: np.ndarray
+    tool_frames: np.ndarray
+    tracking_error: np.ndarray
+
+
+def plot_kinematics(
+    result: PlanResult,
+    case: Case,
+    n_path_frames: int = PATH_FRAMES,
+    n_tool_frames: int = TOOL_FRAMES,
+) -> PlotKinematics:
+    """The :class:`PlotKinematics` of a run: ``n_path_frames`` tool frames for
+    ``path.png``, ``n_tool_frames`` for ``tool.png``."""
+    q = result.trajectory.q
+    n_samples = result.trajectory.n_samples
+    none = np.zeros((0, 4, 4))
+    if n_samples == 0:
+        return PlotKinematics(np.zeros((0, 3)), none, none, np.zeros(0))
+    robot = case.robot
+    path_frames = forward_kinematics(robot, q[frame_indices(n_samples, n_path_frames)])
+    tool_frames = none
+    if shows_tool(case):
+        tool_frames = forward_kinematics(robot, q[frame_indices(n_samples, n_tool_frames)])
+    return PlotKinematics(
+        chain_points(robot, q[0]), path_frames, tool_frames, tracking_error(result, case)
+    )
+
+
+def path_figure(
+    result: PlanResult,
+    case: Case,
+    n_tool_frames: int = PATH_FRAMES,
+    kinematics: PlotKinematics | None = None,
+) -> Figure:
     """The path before and after placement, in the robot's work cell (3D, equal aspect).
 
     Left: the work cell in the base frame: the path in its definition frame (dashed,
@@ -357,6 +419,9 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         The case (robot, reach bounds, nominal path as fallback).
     n_tool_frames
         Number of tool frames drawn along the path.
+    kinematics
+        The run's :func:`plot_kinematics` with ``n_path_frames=n_tool_frames``, computed
+        here when not given.
 
     Returns
     -------
@@ -364,6 +429,8 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         Two 3D axes.
     """
     trajectory = result.trajectory
+    if kinematics is None:
+        kinematics = plot_kinematics(result, case, n_path_frames=n_tool_frames)
     points_part, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
     figure = _new_figure(13.0, 6.8, layout=None)
@@ -402,7 +469,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
     )
     scene = [shell, points_part, points_base]
     if trajectory.n_samples:
-        chain = chain_points(case.robot, trajectory.q[0])
+        chain = kinematics.chain_start
         ax_cell.plot(*chain.T, "o-", color="0.2", lw=3.0, ms=4, gid="robot", label="robot at t = 0")
         scene.append(chain)
     _set_equal(ax_cell, np.vstack(scene))
@@ -413,8 +480,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
     ax_path.plot(*points_base[-1], "s", color="0.2", ms=6, label="end", gid="end")
     extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
     if trajectory.n_samples:
-        idx = frame_indices(trajectory.n_samples, n_tool_frames)
-        T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        T_tool = kinematics.path_frames
         _plot_triads(ax_path, triad_lines(T_tool, 0.08 * extent), "tool-frames", "tool frames")
         bad = violation_samples(trajectory, result.check.violations)
         if bad.any():
@@ -440,7 +506,9 @@ def _format_placement(result: PlanResult) -> str:
     return f"({x[0]:.4f}, {x[1]:.4f}, {x[2]:.4f}) m, rpy ({x[3]:.4f}, {x[4]:.4f}, {x[5]:.4f}) rad"
 
 
-def speed_figure(result: PlanResult, case: Case) -> Figure:
+def speed_figure(
+    result: PlanResult, case: Case, kinematics: PlotKinematics | None = None
+) -> Figure:
     """Tool speed against v_r and v_t^max, and the tracking error against ρ, over time.
 
     Top (``gid="speed"``): Cartesian speed of the tool point with the rated speed
@@ -456,6 +524,9 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
         The planned placement (speed in m/s, shown in mm/s).
     case
         The case (task bounds, nominal path).
+    kinematics
+        The run's :func:`plot_kinematics` (for the tracking error), computed here when not
+        given.
 
     Returns
     -------
@@ -512,7 +583,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
     top = max(task.rated_speed, task.corner_speed, float(np.max(trajectory.speed, initial=0.0)))
     ax_speed.set_ylim(0.0, 1.15e3 * top)
 
-    error = tracking_error(result, case)
+    error = tracking_error(result, case) if kinematics is None else kinematics.tracking_error
     ax_error.plot(
         t, 1e3 * error, color="tab:purple", lw=1.2, label="tracking error", gid="tracking-error"
     )
@@ -638,17 +709,18 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
     return figure
 
 
-TOOL_FRAMES = 16
-"""Tool frames drawn along the path in ``tool.png``."""
-
-
 def shows_tool(case: Case) -> bool:
     """Whether a run of this case gets ``tool.png``: a seam frame or a spin not fixed."""
     tool = case.task.tool
     return str(tool.frame) == "seam" or str(tool.spin) != "fixed"
 
 
-def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> Figure:
+def tool_figure(
+    result: PlanResult,
+    case: Case,
+    n_frames: int = TOOL_FRAMES,
+    kinematics: PlotKinematics | None = None,
+) -> Figure:
     """The spin along the path and the tool frames it gives (docs/tool.md).
 
     Left: spin about the tool axis against the arc length s of the planned path (rad),
@@ -680,8 +752,11 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
     ax_frames.plot(*points_base.T, color=AFTER_COLOR, lw=1.5, gid="tool-path")
     if trajectory.n_samples:
         extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
-        idx = frame_indices(trajectory.n_samples, n_frames)
-        T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        if kinematics is None:
+            idx = frame_indices(trajectory.n_samples, n_frames)
+            T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        else:
+            T_tool = kinematics.tool_frames
         _plot_triads(ax_frames, triad_lines(T_tool, 0.06 * extent), "tool-frames", "tool frames")
     _set_equal(ax_frames, points_base)
     ax_frames.set_title(f"tool frames ({tool.frame} frame)", fontsize=10, y=1.0)
@@ -690,23 +765,29 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
 
 
 def plot_figures(
-    result: PlanResult, case: Case, history: Mapping[str, Mapping[str, np.ndarray]] | None = None
+    result: PlanResult,
+    case: Case,
+    history: Mapping[str, Mapping[str, np.ndarray]] | None = None,
+    kinematics: PlotKinematics | None = None,
 ) -> dict[str, PlotBuilder]:
     """The plots of a run as ``{file name: figure builder or banded figure}``, in report
-    order."""
+    order; the builders draw with ``kinematics`` (:func:`plot_kinematics`, computed here
+    when not given) and start no compiled kernel."""
+    if kinematics is None:
+        kinematics = plot_kinematics(result, case)
     builders: dict[str, PlotBuilder] = {
         "joints.png": BandedFigure(
             tuple(partial(joints_figure, result, case, rows) for rows in JOINT_BANDS)
         ),
-        "path.png": lambda: path_figure(result, case),
-        "speed.png": lambda: speed_figure(result, case),
+        "path.png": lambda: path_figure(result, case, kinematics=kinematics),
+        "speed.png": lambda: speed_figure(result, case, kinematics),
     }
     if result.check.cell is not None and result.trajectory.n_samples:
         from trackplan.report.cell_figures import clearance_figure
 
         builders["clearance.png"] = lambda: clearance_figure(result)
     if shows_tool(case):
-        builders["tool.png"] = lambda: tool_figure(result, case)
+        builders["tool.png"] = lambda: tool_figure(result, case, kinematics=kinematics)
     if history:
         builders["convergence.png"] = lambda: convergence_figure(history)
     return builders

@@ -18,7 +18,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.planning.result import PlanResult
 from trackplan.report.drawing import can_fork, draw_plots
-from trackplan.report.figures import plot_figures
+from trackplan.report.figures import plot_figures, plot_kinematics
 from trackplan.report.html import report_page, view_section
 from trackplan.run_files import REPORT_FILE
 
@@ -70,8 +70,10 @@ def write_run_report(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    plots = [(out_dir / name, plot) for name, plot in plot_figures(result, case, history).items()]
-    if worker is not None and worker.draw(result, case, history, out_dir):
+    kinematics = plot_kinematics(result, case)  # numba's kernels run here, not in the worker
+    builders = plot_figures(result, case, history, kinematics)
+    plots = [(out_dir / name, plot) for name, plot in builders.items()]
+    if worker is not None and worker.draw(result, case, history, out_dir, kinematics):
         view = view_section(result, case, n_frames)
         if not worker.wait():
             draw_plots(plots, parallel=parallel, meanwhile=lambda: None)
