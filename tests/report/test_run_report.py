@@ -139,3 +139,25 @@ def test_no_fork_and_no_worker_on_one_core(monkeypatch):
     assert PlotWorker.start() is None
     with forking.forked_pool() as pool:
         assert pool is None
+
+
+def test_the_plots_drawn_with_given_kinematics_start_no_kernel(monkeypatch, corner, corner_result):
+    """Given the run's PlotKinematics (as a plot worker is), drawing the plots calls none of
+    the functions that run numba's kernels, and the path and speed plots are the pixels of
+    those that compute their kinematics themselves."""
+    kinematics = figures.plot_kinematics(corner_result, corner)
+    builders = figures.plot_figures(corner_result, corner, None, kinematics)
+    pixels = {}
+    with monkeypatch.context() as patched:
+        for kernel in ("forward_kinematics", "chain_points", "tracking_error"):
+            patched.setattr(figures, kernel, _not_here)
+        for name, plot in builders.items():
+            bands = plot.bands if isinstance(plot, figures.BandedFigure) else (plot,)
+            pixels[name] = [figures.figure_pixels(build()) for build in bands]
+    assert list(pixels) == ["joints.png", "path.png", "speed.png"]
+    itself = {
+        "path.png": figures.path_figure(corner_result, corner),
+        "speed.png": figures.speed_figure(corner_result, corner),
+    }
+    for name, figure in itself.items():
+        np.testing.assert_array_equal(pixels[name][0], figures.figure_pixels(figure), name)
