@@ -131,6 +131,8 @@ def _optimize(
     method = method_option(method)
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
+    if worker is not None:
+        worker.prepare(loaded.robot.n_dof)
     if objective is not None:
         from trackplan.planning.objectives import with_objective
 
@@ -177,7 +179,10 @@ def demo(
     if not file.is_file():
         raise CaseError("the shipped demo case is missing (run from a source checkout)", str(file))
     with plot_worker() as worker:  # forked first, as in optimize
-        code = _search_and_write(load_case(file), out, report=True, worker=worker)
+        loaded = load_case(file)
+        if worker is not None:
+            worker.prepare(loaded.robot.n_dof)
+        code = _search_and_write(loaded, out, report=True, worker=worker)
     typer.echo(f"report: {(out / 'report.html').resolve()}")
     return code
 

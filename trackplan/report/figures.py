@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
@@ -179,7 +179,43 @@ largest of a run, and its two bands are drawn in two processes."""
 _JOINT_TOP, _JOINT_ROW, _JOINT_GAP, _JOINT_BOTTOM, _JOINT_CUT = 63, 166, 28, 90, 8
 
 
-def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = None) -> Figure:
+def _joints_height(rows: Sequence[int]) -> tuple[int, int, int]:
+    """Space above and below the axes of ``joints.png``'s ``rows`` and the height of their
+    figure, pixels: a fixed grid in pixels (constrained layout over 4 × n panels took
+    longer than the drawing, and fixed pixels let a band of rows be drawn on its own)."""
+    first, last = rows[0] == 0, rows[-1] == len(LIMIT_KINDS) - 1
+    top = _JOINT_TOP if first else _JOINT_GAP - _JOINT_CUT
+    bottom = _JOINT_BOTTOM if last else _JOINT_CUT
+    return top, bottom, top + len(rows) * _JOINT_ROW + (len(rows) - 1) * _JOINT_GAP + bottom
+
+
+def _joints_canvas(n: int, rows: Sequence[int]) -> Canvas:
+    """The figure of :func:`joints_figure` for ``n`` joints and ``rows`` (consecutive) with
+    its grid of axes, shape (len(rows), n), before anything is drawn on them."""
+    from matplotlib.ticker import MaxNLocator
+
+    top, bottom, height = _joints_height(rows)
+    width = (230 * n + 100) / DPI
+    figure = _new_figure(width, height / DPI, layout=None)
+    figure.subplots_adjust(
+        left=0.06,
+        right=0.99,
+        bottom=bottom / height,
+        top=1 - top / height,
+        wspace=0.35,
+        hspace=_JOINT_GAP / _JOINT_ROW,
+    )
+    axes = figure.subplots(len(rows), n, sharex=True, squeeze=False)
+    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
+    return figure, axes
+
+
+def joints_figure(
+    result: PlanResult,
+    case: Case,
+    rows: Sequence[int] | None = None,
+    canvas: Canvas | None = None,
+) -> Figure:
     """Joint positions and their three derivatives against every joint limit.
 
     A grid of 4 rows (q, q̇, q̈, q⃛) by one column per joint, so that each panel holds
@@ -202,6 +238,8 @@ def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = N
         figure of some rows is the horizontal band of the full figure that holds them, to
         the pixel: the bands of :data:`JOINT_BANDS` stacked make the full figure
         (:class:`BandedFigure`).
+    canvas
+        The blank figure of these rows (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -216,24 +254,9 @@ def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = N
     rows = list(range(len(LIMIT_KINDS)) if rows is None else rows)
     if not rows or rows != list(range(rows[0], rows[0] + len(rows))):
         raise ValueError(f"joints_figure draws consecutive rows, not {rows}")
-    first, last = rows[0] == 0, rows[-1] == len(LIMIT_KINDS) - 1
-    # a fixed grid in pixels: constrained layout over 4 × n panels took longer than the
-    # drawing, and fixed pixels let a band of rows be drawn on its own
-    top = _JOINT_TOP if first else _JOINT_GAP - _JOINT_CUT
-    bottom = _JOINT_BOTTOM if last else _JOINT_CUT
-    height = top + len(rows) * _JOINT_ROW + (len(rows) - 1) * _JOINT_GAP + bottom
-    width = (230 * n + 100) / DPI
-    figure = _new_figure(width, height / DPI, layout=None)
-    figure.subplots_adjust(
-        left=0.06,
-        right=0.99,
-        bottom=bottom / height,
-        top=1 - top / height,
-        wspace=0.35,
-        hspace=_JOINT_GAP / _JOINT_ROW,
-    )
-    axes = figure.subplots(len(rows), n, sharex=True, squeeze=False)
-    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
+    first = rows[0] == 0
+    height = _joints_height(rows)[2]
+    figure, axes = canvas or _joints_canvas(n, rows)
     if trajectory.n_samples:
         t_margin = 0.02 * (trajectory.t[-1] - trajectory.t[0])
         t_limits = (trajectory.t[0] - t_margin, trajectory.t[-1] + t_margin)
@@ -339,6 +362,59 @@ def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
     ax.set_zlabel("z [m]")
 
 
+Canvas = tuple["Figure", Any]
+"""A figure with its axes (as :meth:`matplotlib.figure.Figure.subplots` returns them) on
+which nothing is drawn yet."""
+
+
+def _path_canvas() -> Canvas:
+    """The figure of :func:`path_figure` with its two 3D axes."""
+    figure = _new_figure(13.0, 6.8, layout=None)
+    figure.subplots_adjust(left=0.0, right=0.97, bottom=0.12, top=0.92, wspace=0.08)
+    ax_cell = figure.add_subplot(1, 2, 1, projection="3d")
+    ax_path = figure.add_subplot(1, 2, 2, projection="3d")
+    return figure, (ax_cell, ax_path)
+
+
+def _speed_canvas() -> Canvas:
+    """The figure of :func:`speed_figure` with its two axes sharing the time axis."""
+    figure = _new_figure(11.0, 6.5, layout=None)
+    figure.subplots_adjust(left=0.07, right=0.76, bottom=0.08, top=0.94, hspace=0.08)
+    return figure, figure.subplots(2, 1, sharex=True)
+
+
+def _convergence_canvas() -> Canvas:
+    """The figure of :func:`convergence_figure` with its three axes."""
+    figure = _new_figure(9.0, 8.0, layout=None)
+    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.07, top=0.95, hspace=0.08)
+    return figure, figure.subplots(3, 1, sharex=True)
+
+
+def blank_canvases(n_dof: int) -> dict[str, Canvas]:
+    """The figures of a run's ``joints.png`` (one per band: ``joints.png/0``, …),
+    ``path.png``, ``speed.png`` and ``convergence.png`` with their axes, before anything is
+    drawn: what they cost does not depend on the run, and a plot worker makes them while
+    the run is computed (:func:`plot_figures` takes them).
+
+    Parameters
+    ----------
+    n_dof
+        Number of joints of the robot.
+
+    Returns
+    -------
+    dict
+        ``{key: (figure, axes)}``.
+    """
+    canvases = {
+        f"joints.png/{k}": _joints_canvas(n_dof, rows) for k, rows in enumerate(JOINT_BANDS)
+    }
+    canvases["path.png"] = _path_canvas()
+    canvases["speed.png"] = _speed_canvas()
+    canvases["convergence.png"] = _convergence_canvas()
+    return canvases
+
+
 PATH_FRAMES = 7
 """Tool frames drawn along the placed path in ``path.png``."""
 
@@ -401,6 +477,7 @@ def path_figure(
     case: Case,
     n_tool_frames: int = PATH_FRAMES,
     kinematics: PlotKinematics | None = None,
+    canvas: Canvas | None = None,
 ) -> Figure:
     """The path before and after placement, in the robot's work cell (3D, equal aspect).
 
@@ -422,6 +499,8 @@ def path_figure(
     kinematics
         The run's :func:`plot_kinematics` with ``n_path_frames=n_tool_frames``, computed
         here when not given.
+    canvas
+        The blank figure (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -433,10 +512,7 @@ def path_figure(
         kinematics = plot_kinematics(result, case, n_path_frames=n_tool_frames)
     points_part, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
-    figure = _new_figure(13.0, 6.8, layout=None)
-    figure.subplots_adjust(left=0.0, right=0.97, bottom=0.12, top=0.92, wspace=0.08)
-    ax_cell = figure.add_subplot(1, 2, 1, projection="3d")
-    ax_path = figure.add_subplot(1, 2, 2, projection="3d")
+    figure, (ax_cell, ax_path) = canvas or _path_canvas()
 
     r_min, r_max = case.bounds.reach
     shell = sphere_wireframe(r_max)
@@ -507,7 +583,10 @@ def _format_placement(result: PlanResult) -> str:
 
 
 def speed_figure(
-    result: PlanResult, case: Case, kinematics: PlotKinematics | None = None
+    result: PlanResult,
+    case: Case,
+    kinematics: PlotKinematics | None = None,
+    canvas: Canvas | None = None,
 ) -> Figure:
     """Tool speed against v_r and v_t^max, and the tracking error against ρ, over time.
 
@@ -527,6 +606,8 @@ def speed_figure(
     kinematics
         The run's :func:`plot_kinematics` (for the tracking error), computed here when not
         given.
+    canvas
+        The blank figure (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -536,9 +617,7 @@ def speed_figure(
     trajectory = result.trajectory
     task = case.task
     t = trajectory.t
-    figure = _new_figure(11.0, 6.5, layout=None)
-    figure.subplots_adjust(left=0.07, right=0.76, bottom=0.08, top=0.94, hspace=0.08)
-    ax_speed, ax_error = figure.subplots(2, 1, sharex=True)
+    figure, (ax_speed, ax_error) = canvas or _speed_canvas()
 
     ax_speed.plot(
         t, 1e3 * trajectory.speed, color="tab:blue", lw=1.2, label="tool speed", gid="speed"
@@ -635,7 +714,9 @@ MINOR_DECADES = 2.0
 """Log fitness axes spanning more decades than this get no minor ticks."""
 
 
-def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figure:
+def convergence_figure(
+    history: Mapping[str, Mapping[str, np.ndarray]], canvas: Canvas | None = None
+) -> Figure:
     """Best and mean fitness and feasible share per generation, one colour per method.
 
     Each generation is drawn at its cumulative number of placement evaluations, the
@@ -650,6 +731,8 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
         ``{method: {"generation", "evaluations", "best", "mean", "feasible_share",
         "wall_time"}}``, arrays of shape (G,) per method; fitness unitless, share in [0, 1],
         wall time in s.
+    canvas
+        The blank figure (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -660,9 +743,7 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
     from matplotlib.ticker import LogFormatter, NullLocator
 
     columns = history_columns(history)
-    figure = _new_figure(9.0, 8.0, layout=None)
-    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.07, top=0.95, hspace=0.08)
-    ax_best, ax_mean, ax_share = figure.subplots(3, 1, sharex=True)
+    figure, (ax_best, ax_mean, ax_share) = canvas or _convergence_canvas()
     for k, (method, c) in enumerate(columns.items()):
         color = f"C{k}"
         final = f"{method}: best {c['best'][-1]:.4g} after {c['evaluations'][-1]:.0f} evaluations"
@@ -769,18 +850,28 @@ def plot_figures(
     case: Case,
     history: Mapping[str, Mapping[str, np.ndarray]] | None = None,
     kinematics: PlotKinematics | None = None,
+    canvases: dict[str, Canvas] | None = None,
 ) -> dict[str, PlotBuilder]:
     """The plots of a run as ``{file name: figure builder or banded figure}``, in report
     order; the builders draw with ``kinematics`` (:func:`plot_kinematics`, computed here
-    when not given) and start no compiled kernel."""
+    when not given) and start no compiled kernel, each on its blank figure from
+    ``canvases`` (:func:`blank_canvases`, which it takes out of the dict) when there is one.
+    """
     if kinematics is None:
         kinematics = plot_kinematics(result, case)
+    blank = (canvases if canvases is not None else {}).pop
+
+    def joints_band(k: int, rows: Sequence[int]) -> Figure:
+        return joints_figure(result, case, rows, blank(f"joints.png/{k}", None))
+
     builders: dict[str, PlotBuilder] = {
         "joints.png": BandedFigure(
-            tuple(partial(joints_figure, result, case, rows) for rows in JOINT_BANDS)
+            tuple(partial(joints_band, k, rows) for k, rows in enumerate(JOINT_BANDS))
         ),
-        "path.png": lambda: path_figure(result, case, kinematics=kinematics),
-        "speed.png": lambda: speed_figure(result, case, kinematics),
+        "path.png": lambda: path_figure(
+            result, case, kinematics=kinematics, canvas=blank("path.png", None)
+        ),
+        "speed.png": lambda: speed_figure(result, case, kinematics, blank("speed.png", None)),
     }
     if result.check.cell is not None and result.trajectory.n_samples:
         from trackplan.report.cell_figures import clearance_figure
@@ -789,7 +880,9 @@ def plot_figures(
     if shows_tool(case):
         builders["tool.png"] = lambda: tool_figure(result, case, kinematics=kinematics)
     if history:
-        builders["convergence.png"] = lambda: convergence_figure(history)
+        builders["convergence.png"] = lambda: convergence_figure(
+            history, blank("convergence.png", None)
+        )
     return builders
 
 

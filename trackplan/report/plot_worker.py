@@ -12,8 +12,10 @@ numba, and it draws the plots (in two processes,
 :func:`~trackplan.report.drawing.draw_plots`) while the caller builds the 3D view. When the
 worker is gone or fails, the caller draws the plots itself, and raises any error.
 
-The worker ignores SIGINT (the caller decides what an interruption means and still writes
-its report) and ends when its connection closes: after one run's plots, at
+Given the robot's number of joints early (:meth:`PlotWorker.prepare`), it also makes the
+plots' figures and axes (:func:`~trackplan.report.figures.blank_canvases`) before the
+result comes. The worker ignores SIGINT (the caller decides what an interruption means and
+still writes its report) and ends when its connection closes: after one run's plots, at
 :meth:`PlotWorker.close` (which terminates a worker that has not answered), or when the
 caller's process ends.
 """
@@ -80,6 +82,17 @@ class PlotWorker:
         theirs.close()
         return cls(pid, ours)
 
+    def prepare(self, n_dof: int) -> None:
+        """Have the worker make the blank figures of the plots of a robot with ``n_dof``
+        joints (:func:`~trackplan.report.figures.blank_canvases`) once it is ready, while
+        the run is computed; a run of another robot gets figures made when it is drawn."""
+        if self._connection is None:
+            return
+        try:
+            self._connection.send(("canvases", n_dof))
+        except (OSError, EOFError):
+            self.close()
+
     def draw(
         self,
         result: PlanResult,
@@ -94,7 +107,7 @@ class PlotWorker:
         if self._connection is None:
             return False
         try:
-            self._connection.send((result, case, history, Path(out_dir), kinematics))
+            self._connection.send(("draw", (result, case, history, Path(out_dir), kinematics)))
         except (OSError, EOFError):
             self.close()
             return False
@@ -176,15 +189,21 @@ def _serve(connection: Connection) -> None:
     whether they were all written."""
     _warm_up()
     from trackplan.report.drawing import draw_plots
-    from trackplan.report.figures import plot_figures
+    from trackplan.report.figures import blank_canvases, plot_figures
 
     connection.send(_READY)
+    canvases, n_dof = {}, None
     try:
-        result, run_case, history, out_dir, kinematics = connection.recv()
+        while (message := connection.recv())[0] == "canvases":
+            n_dof = message[1]
+            canvases = blank_canvases(n_dof)
     except (EOFError, OSError):
         return
+    result, run_case, history, out_dir, kinematics = message[1]
+    if run_case.robot.n_dof != n_dof:
+        canvases = {}
     try:
-        plots = plot_figures(result, run_case, history, kinematics)
+        plots = plot_figures(result, run_case, history, kinematics, canvases)
         draw_plots([(out_dir / name, plot) for name, plot in plots.items()], meanwhile=lambda: None)
     except Exception:
         connection.send(False)
