@@ -3,6 +3,7 @@ turn or by a plot worker, and a failure anywhere is raised by the caller."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import threading
@@ -161,3 +162,41 @@ def test_the_plots_drawn_with_given_kinematics_start_no_kernel(monkeypatch, corn
     }
     for name, figure in itself.items():
         np.testing.assert_array_equal(pixels[name][0], figures.figure_pixels(figure), name)
+
+
+def _wild(corner_result):
+    """The corner result with jerks a thousand times larger (symlog panels)."""
+    trajectory = corner_result.trajectory
+    return dataclasses.replace(
+        corner_result, trajectory=dataclasses.replace(trajectory, qddd=1000 * trajectory.qddd)
+    )
+
+
+@pytest.mark.parametrize("which", ["planted violation", "symlog jerk", "no trajectory"])
+def test_plots_on_blank_figures_made_beforehand_are_the_same_pixels(
+    which, corner, corner_result, unreachable_result
+):
+    """A plot worker draws on figures (and ticks) made before the result came
+    (blank_canvases): the same pixels as figures made when the plot is drawn, whatever the
+    panels' scales and however many ticks the data need."""
+    result = {
+        "planted violation": corner_result,
+        "symlog jerk": _wild(corner_result),
+        "no trajectory": unreachable_result,
+    }[which]
+    history = optimizer_history(np.random.default_rng(7))
+    kinematics = figures.plot_kinematics(result, corner)
+    canvases = figures.blank_canvases(corner.robot.n_dof)
+    on_blanks = figures.plot_figures(result, corner, history, kinematics, canvases)
+    fresh = figures.plot_figures(result, corner, history, kinematics)
+    assert on_blanks.keys() == fresh.keys()
+    for name, plot in on_blanks.items():
+        if isinstance(plot, figures.BandedFigure):
+            pairs = zip(plot.bands, fresh[name].bands, strict=True)  # type: ignore[union-attr]
+        else:
+            pairs = zip([plot], [fresh[name]], strict=True)
+        for build_on_blank, build_fresh in pairs:
+            np.testing.assert_array_equal(
+                figures.figure_pixels(build_on_blank()), figures.figure_pixels(build_fresh()), name
+            )
+    assert canvases == {}  # every blank figure was taken
