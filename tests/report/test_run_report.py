@@ -176,9 +176,8 @@ def _wild(corner_result):
 def test_plots_on_blank_figures_made_beforehand_are_the_same_pixels(
     which, corner, corner_result, unreachable_result
 ):
-    """A plot worker draws on figures (and ticks) made before the result came
-    (blank_canvases): the same pixels as figures made when the plot is drawn, whatever the
-    panels' scales and however many ticks the data need."""
+    """A plot worker draws on figures made before the result came (blank_canvases): the
+    same pixels as figures made when the plot is drawn, whatever the panels' scales."""
     result = {
         "planted violation": corner_result,
         "symlog jerk": _wild(corner_result),

@@ -390,26 +390,12 @@ def _convergence_canvas() -> Canvas:
     return figure, figure.subplots(3, 1, sharex=True)
 
 
-BLANK_TICKS = 7
-"""Tick objects made per axis of a 2D blank figure (:func:`blank_canvases`): matplotlib
-makes one (two marks, a grid line, two labels) for each tick location at the first draw,
-and those made beforehand it only updates."""
-
-
-def _with_ticks(canvas: Canvas) -> Canvas:
-    """``canvas`` with :data:`BLANK_TICKS` ticks made on both axes of each of its axes."""
-    for ax in np.ravel(canvas[1]):
-        ax.xaxis.get_major_ticks(BLANK_TICKS)
-        ax.yaxis.get_major_ticks(BLANK_TICKS)
-    return canvas
-
-
 def blank_canvases(n_dof: int) -> dict[str, Canvas]:
     """The figures of a run's ``joints.png`` (one per band: ``joints.png/0``, …),
-    ``path.png``, ``speed.png`` and ``convergence.png`` with their axes (and the 2D axes'
-    first :data:`BLANK_TICKS` ticks), before anything is drawn: what they cost does not
-    depend on the run, and a plot worker makes them while the run is computed
-    (:func:`plot_figures` takes them).
+    ``path.png``, ``speed.png`` and ``convergence.png`` with their axes, before anything is
+    drawn: what they cost does not depend on the run, and a plot worker makes them while
+    the run is computed (:func:`plot_figures` takes them). Their ticks are left to the first
+    draw: made beforehand, they cost the worker more than they save the drawing.
 
     Parameters
     ----------
@@ -422,12 +408,11 @@ def blank_canvases(n_dof: int) -> dict[str, Canvas]:
         ``{key: (figure, axes)}``.
     """
     canvases = {
-        f"joints.png/{k}": _with_ticks(_joints_canvas(n_dof, rows))
-        for k, rows in enumerate(JOINT_BANDS)
+        f"joints.png/{k}": _joints_canvas(n_dof, rows) for k, rows in enumerate(JOINT_BANDS)
     }
     canvases["path.png"] = _path_canvas()
-    canvases["speed.png"] = _with_ticks(_speed_canvas())
-    canvases["convergence.png"] = _with_ticks(_convergence_canvas())
+    canvases["speed.png"] = _speed_canvas()
+    canvases["convergence.png"] = _convergence_canvas()
     return canvases
 
 
