@@ -7,6 +7,7 @@ run's files that this run does not write are removed.
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -65,16 +66,24 @@ def write_run(
     extra = {"robot": robot_info(case.robot), **(extra or {})}
     written: dict = {}
 
-    def write(folder: Path) -> None:
-        if report:
-            from trackplan.report.run_report import write_run_report
-
-            write_run_report(result, case, folder, history, extra, worker=plot_worker)
+    def write_files(folder: Path) -> None:
         if search is not None:
             from trackplan.io.history import write_history
 
             write_history(search, folder)
         written.update(write_plan_files(result, case.robot.joint_names, folder, extra))
+
+    def write(folder: Path) -> None:
+        if not report:
+            write_files(folder)
+            return
+        from trackplan.report.run_report import write_run_report
+
+        # the files written while the plots are drawn
+        meanwhile = partial(write_files, folder)
+        write_run_report(
+            result, case, folder, history, extra, worker=plot_worker, meanwhile=meanwhile
+        )
 
     write_run_folder(Path(out_dir), write)
     return written

@@ -3,6 +3,7 @@ turn or by a plot worker, and a failure anywhere is raised by the caller."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import threading
@@ -57,7 +58,7 @@ def _not_here(*args, **kwargs):
 @needs_fork
 def test_a_plot_worker_writes_the_same_files(tmp_path, monkeypatch, corner, corner_result, serial):
     monkeypatch.setattr(run_report, "draw_plots", _not_here)
-    with plot_worker(corner) as worker:
+    with plot_worker() as worker:
         assert worker is not None
         os.kill(worker.pid, signal.SIGINT)  # ignored: the caller decides about interruptions
         files = _write(tmp_path, corner, corner_result, worker=worker)
@@ -139,3 +140,62 @@ def test_no_fork_and_no_worker_on_one_core(monkeypatch):
     assert PlotWorker.start() is None
     with forking.forked_pool() as pool:
         assert pool is None
+
+
+def test_the_plots_drawn_with_given_kinematics_start_no_kernel(monkeypatch, corner, corner_result):
+    """Given the run's PlotKinematics (as a plot worker is), drawing the plots calls none of
+    the functions that run numba's kernels, and the path and speed plots are the pixels of
+    those that compute their kinematics themselves."""
+    kinematics = figures.plot_kinematics(corner_result, corner)
+    builders = figures.plot_figures(corner_result, corner, None, kinematics)
+    pixels = {}
+    with monkeypatch.context() as patched:
+        for kernel in ("forward_kinematics", "chain_points", "tracking_error"):
+            patched.setattr(figures, kernel, _not_here)
+        for name, plot in builders.items():
+            bands = plot.bands if isinstance(plot, figures.BandedFigure) else (plot,)
+            pixels[name] = [figures.figure_pixels(build()) for build in bands]
+    assert list(pixels) == ["joints.png", "path.png", "speed.png"]
+    itself = {
+        "path.png": figures.path_figure(corner_result, corner),
+        "speed.png": figures.speed_figure(corner_result, corner),
+    }
+    for name, figure in itself.items():
+        np.testing.assert_array_equal(pixels[name][0], figures.figure_pixels(figure), name)
+
+
+def _wild(corner_result):
+    """The corner result with jerks a thousand times larger (symlog panels)."""
+    trajectory = corner_result.trajectory
+    return dataclasses.replace(
+        corner_result, trajectory=dataclasses.replace(trajectory, qddd=1000 * trajectory.qddd)
+    )
+
+
+@pytest.mark.parametrize("which", ["planted violation", "symlog jerk", "no trajectory"])
+def test_plots_on_blank_figures_made_beforehand_are_the_same_pixels(
+    which, corner, corner_result, unreachable_result
+):
+    """A plot worker draws on figures made before the result came (blank_canvases): the
+    same pixels as figures made when the plot is drawn, whatever the panels' scales."""
+    result = {
+        "planted violation": corner_result,
+        "symlog jerk": _wild(corner_result),
+        "no trajectory": unreachable_result,
+    }[which]
+    history = optimizer_history(np.random.default_rng(7))
+    kinematics = figures.plot_kinematics(result, corner)
+    canvases = figures.blank_canvases(corner.robot.n_dof)
+    on_blanks = figures.plot_figures(result, corner, history, kinematics, canvases)
+    fresh = figures.plot_figures(result, corner, history, kinematics)
+    assert on_blanks.keys() == fresh.keys()
+    for name, plot in on_blanks.items():
+        if isinstance(plot, figures.BandedFigure):
+            pairs = zip(plot.bands, fresh[name].bands, strict=True)  # type: ignore[union-attr]
+        else:
+            pairs = zip([plot], [fresh[name]], strict=True)
+        for build_on_blank, build_fresh in pairs:
+            np.testing.assert_array_equal(
+                figures.figure_pixels(build_on_blank()), figures.figure_pixels(build_fresh()), name
+            )
+    assert canvases == {}  # every blank figure was taken

@@ -23,7 +23,10 @@ from trackplan.cli.signals import SignalLog, stop_on_signals
 from trackplan.errors import CaseError
 
 if TYPE_CHECKING:
+    from contextlib import AbstractContextManager
+
     from trackplan.case import Case
+    from trackplan.report.plot_worker import PlotWorker
 
 
 @app.command()
@@ -80,12 +83,56 @@ def optimize(
     Ctrl-C (SIGINT) or SIGTERM stops the search and still writes everything for the best
     placement found, with ``status: interrupted`` in result.json, and exits 130 or 143.
     """
+    from contextlib import nullcontext
+
+    workers: AbstractContextManager[PlotWorker | None] = nullcontext()
+    if report and pareto is None:
+        # forked first: it gets matplotlib ready on the second core while this process
+        # loads the case and starts numba's kernels (closed unless the search uses it)
+        from trackplan.report.plot_worker import plot_worker
+
+        workers = plot_worker()
+    with workers as worker:
+        return _optimize(
+            case,
+            out,
+            method=method,
+            seed=seed,
+            budget=budget,
+            restarts=restarts,
+            timing=timing,
+            report=report,
+            objective=objective,
+            pareto=pareto,
+            assume_limits=assume_limits,
+            worker=worker,
+        )
+
+
+def _optimize(
+    case: Path,
+    out: Path,
+    *,
+    method: str | None,
+    seed: int | None,
+    budget: int | None,
+    restarts: int | None,
+    timing: str | None,
+    report: bool,
+    objective: str | None,
+    pareto: str | None,
+    assume_limits: bool,
+    worker: PlotWorker | None,
+) -> ExitCode:
+    """``optimize`` once its plot worker is started."""
     from trackplan.io.case_file import load_case
 
     out = output_folder(out)
     method = method_option(method)
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
+    if worker is not None:
+        worker.prepare(loaded.robot.n_dof)
     if objective is not None:
         from trackplan.planning.objectives import with_objective
 
@@ -110,6 +157,7 @@ def optimize(
         loaded,
         out,
         report=report,
+        worker=worker,
         method=method,
         seed=seed,
         budget=budget,
@@ -124,12 +172,17 @@ def demo(
 ) -> ExitCode:
     """Optimize the paper's corner case (cases/paper-corner.yaml) end to end, with the report."""
     from trackplan.io.case_file import load_case
+    from trackplan.report.plot_worker import plot_worker
 
     out = output_folder(out)
     file = shipped_cases_dir() / "paper-corner.yaml"
     if not file.is_file():
         raise CaseError("the shipped demo case is missing (run from a source checkout)", str(file))
-    code = _search_and_write(load_case(file), out, report=True)
+    with plot_worker() as worker:  # forked first, as in optimize
+        loaded = load_case(file)
+        if worker is not None:
+            worker.prepare(loaded.robot.n_dof)
+        code = _search_and_write(loaded, out, report=True, worker=worker)
     typer.echo(f"report: {(out / 'report.html').resolve()}")
     return code
 
@@ -219,10 +272,11 @@ def _pareto(
     return ExitCode.OK if result.success else ExitCode.INFEASIBLE
 
 
-def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> ExitCode:  # type: ignore[no-untyped-def]
-    """Search (SIGINT and SIGTERM stop it), write the run, print it; the exit code."""
-    from contextlib import nullcontext
-
+def _search_and_write(  # type: ignore[no-untyped-def]
+    case: Case, out: Path, *, report: bool, worker: PlotWorker | None, **options
+) -> ExitCode:
+    """Search (SIGINT and SIGTERM stop it), write the run (its plots by ``worker`` when
+    there is one), print it; the exit code."""
     from trackplan.cli.summaries import print_search
     from trackplan.forking import forked_pool
     from trackplan.outputs import write_search_run
@@ -232,11 +286,8 @@ def _search_and_write(case: Case, out: Path, *, report: bool, **options) -> Exit
     # built first (numba's start), so that the processes forked below share it
     mode = time_law(options.get("timing") or case.task.timing).path_mode
     geometry = PathGeometry.from_case(case, mode)
-    if report:  # a worker gets matplotlib ready on the second core while the search runs
-        from trackplan.report.plot_worker import plot_worker
-    workers = plot_worker(case) if report else nullcontext()
     # a second signal while writing stops the writing
-    with workers as worker, stop_on_signals() as signals:
+    with stop_on_signals() as signals:
         signals.deferring = True  # the search polls after each generation
         with forked_pool() as background:  # the plans at full Ts, beside the search
             result = _search(case, signals, geometry=geometry, background=background, **options)

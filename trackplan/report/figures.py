@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
@@ -179,7 +179,43 @@ largest of a run, and its two bands are drawn in two processes."""
 _JOINT_TOP, _JOINT_ROW, _JOINT_GAP, _JOINT_BOTTOM, _JOINT_CUT = 63, 166, 28, 90, 8
 
 
-def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = None) -> Figure:
+def _joints_height(rows: Sequence[int]) -> tuple[int, int, int]:
+    """Space above and below the axes of ``joints.png``'s ``rows`` and the height of their
+    figure, pixels: a fixed grid in pixels (constrained layout over 4 × n panels took
+    longer than the drawing, and fixed pixels let a band of rows be drawn on its own)."""
+    first, last = rows[0] == 0, rows[-1] == len(LIMIT_KINDS) - 1
+    top = _JOINT_TOP if first else _JOINT_GAP - _JOINT_CUT
+    bottom = _JOINT_BOTTOM if last else _JOINT_CUT
+    return top, bottom, top + len(rows) * _JOINT_ROW + (len(rows) - 1) * _JOINT_GAP + bottom
+
+
+def _joints_canvas(n: int, rows: Sequence[int]) -> Canvas:
+    """The figure of :func:`joints_figure` for ``n`` joints and ``rows`` (consecutive) with
+    its grid of axes, shape (len(rows), n), before anything is drawn on them."""
+    from matplotlib.ticker import MaxNLocator
+
+    top, bottom, height = _joints_height(rows)
+    width = (230 * n + 100) / DPI
+    figure = _new_figure(width, height / DPI, layout=None)
+    figure.subplots_adjust(
+        left=0.06,
+        right=0.99,
+        bottom=bottom / height,
+        top=1 - top / height,
+        wspace=0.35,
+        hspace=_JOINT_GAP / _JOINT_ROW,
+    )
+    axes = figure.subplots(len(rows), n, sharex=True, squeeze=False)
+    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
+    return figure, axes
+
+
+def joints_figure(
+    result: PlanResult,
+    case: Case,
+    rows: Sequence[int] | None = None,
+    canvas: Canvas | None = None,
+) -> Figure:
     """Joint positions and their three derivatives against every joint limit.
 
     A grid of 4 rows (q, q̇, q̈, q⃛) by one column per joint, so that each panel holds
@@ -202,6 +238,8 @@ def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = N
         figure of some rows is the horizontal band of the full figure that holds them, to
         the pixel: the bands of :data:`JOINT_BANDS` stacked make the full figure
         (:class:`BandedFigure`).
+    canvas
+        The blank figure of these rows (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -216,24 +254,9 @@ def joints_figure(result: PlanResult, case: Case, rows: Sequence[int] | None = N
     rows = list(range(len(LIMIT_KINDS)) if rows is None else rows)
     if not rows or rows != list(range(rows[0], rows[0] + len(rows))):
         raise ValueError(f"joints_figure draws consecutive rows, not {rows}")
-    first, last = rows[0] == 0, rows[-1] == len(LIMIT_KINDS) - 1
-    # a fixed grid in pixels: constrained layout over 4 × n panels took longer than the
-    # drawing, and fixed pixels let a band of rows be drawn on its own
-    top = _JOINT_TOP if first else _JOINT_GAP - _JOINT_CUT
-    bottom = _JOINT_BOTTOM if last else _JOINT_CUT
-    height = top + len(rows) * _JOINT_ROW + (len(rows) - 1) * _JOINT_GAP + bottom
-    width = (230 * n + 100) / DPI
-    figure = _new_figure(width, height / DPI, layout=None)
-    figure.subplots_adjust(
-        left=0.06,
-        right=0.99,
-        bottom=bottom / height,
-        top=1 - top / height,
-        wspace=0.35,
-        hspace=_JOINT_GAP / _JOINT_ROW,
-    )
-    axes = figure.subplots(len(rows), n, sharex=True, squeeze=False)
-    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=5))
+    first = rows[0] == 0
+    height = _joints_height(rows)[2]
+    figure, axes = canvas or _joints_canvas(n, rows)
     if trajectory.n_samples:
         t_margin = 0.02 * (trajectory.t[-1] - trajectory.t[0])
         t_limits = (trajectory.t[0] - t_margin, trajectory.t[-1] + t_margin)
@@ -339,7 +362,124 @@ def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
     ax.set_zlabel("z [m]")
 
 
-def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figure:
+Canvas = tuple["Figure", Any]
+"""A figure with its axes (as :meth:`matplotlib.figure.Figure.subplots` returns them) on
+which nothing is drawn yet."""
+
+
+def _path_canvas() -> Canvas:
+    """The figure of :func:`path_figure` with its two 3D axes."""
+    figure = _new_figure(13.0, 6.8, layout=None)
+    figure.subplots_adjust(left=0.0, right=0.97, bottom=0.12, top=0.92, wspace=0.08)
+    ax_cell = figure.add_subplot(1, 2, 1, projection="3d")
+    ax_path = figure.add_subplot(1, 2, 2, projection="3d")
+    return figure, (ax_cell, ax_path)
+
+
+def _speed_canvas() -> Canvas:
+    """The figure of :func:`speed_figure` with its two axes sharing the time axis."""
+    figure = _new_figure(11.0, 6.5, layout=None)
+    figure.subplots_adjust(left=0.07, right=0.76, bottom=0.08, top=0.94, hspace=0.08)
+    return figure, figure.subplots(2, 1, sharex=True)
+
+
+def _convergence_canvas() -> Canvas:
+    """The figure of :func:`convergence_figure` with its three axes."""
+    figure = _new_figure(9.0, 8.0, layout=None)
+    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.07, top=0.95, hspace=0.08)
+    return figure, figure.subplots(3, 1, sharex=True)
+
+
+def blank_canvases(n_dof: int) -> dict[str, Canvas]:
+    """The figures of a run's ``joints.png`` (one per band: ``joints.png/0``, …),
+    ``path.png``, ``speed.png`` and ``convergence.png`` with their axes, before anything is
+    drawn: what they cost does not depend on the run, and a plot worker makes them while
+    the run is computed (:func:`plot_figures` takes them). Their ticks are left to the first
+    draw: made beforehand, they cost the worker more than they save the drawing.
+
+    Parameters
+    ----------
+    n_dof
+        Number of joints of the robot.
+
+    Returns
+    -------
+    dict
+        ``{key: (figure, axes)}``.
+    """
+    canvases = {
+        f"joints.png/{k}": _joints_canvas(n_dof, rows) for k, rows in enumerate(JOINT_BANDS)
+    }
+    canvases["path.png"] = _path_canvas()
+    canvases["speed.png"] = _speed_canvas()
+    canvases["convergence.png"] = _convergence_canvas()
+    return canvases
+
+
+PATH_FRAMES = 7
+"""Tool frames drawn along the placed path in ``path.png``."""
+
+TOOL_FRAMES = 16
+"""Tool frames drawn along the path in ``tool.png``."""
+
+
+@dataclass(frozen=True)
+class PlotKinematics:
+    """What the plots of a run take from the robot's kinematics and from the nominal path:
+    numba's compiled kernels compute them, so that a process drawing the plots
+    (:class:`~trackplan.report.plot_worker.PlotWorker`) is given them and never starts numba.
+
+    Attributes
+    ----------
+    chain_start
+        The robot at the first sample (:func:`~trackplan.report.scene.chain_points`),
+        shape (n + 2, 3), m, base frame; (0, 3) without a trajectory.
+    path_frames
+        ``T_base_tool`` at the samples :func:`~trackplan.report.scene.frame_indices` picks
+        for ``path.png``, shape (F, 4, 4); (0, 4, 4) without a trajectory.
+    tool_frames
+        The same for ``tool.png``, shape (G, 4, 4); (0, 4, 4) without a trajectory or when
+        the run has no ``tool.png`` (:func:`shows_tool`).
+    tracking_error
+        :func:`~trackplan.report.scene.tracking_error`, shape (N,), m.
+    """
+
+    chain_start: np.ndarray
+    path_frames: np.ndarray
+    tool_frames: np.ndarray
+    tracking_error: np.ndarray
+
+
+def plot_kinematics(
+    result: PlanResult,
+    case: Case,
+    n_path_frames: int = PATH_FRAMES,
+    n_tool_frames: int = TOOL_FRAMES,
+) -> PlotKinematics:
+    """The :class:`PlotKinematics` of a run: ``n_path_frames`` tool frames for
+    ``path.png``, ``n_tool_frames`` for ``tool.png``."""
+    q = result.trajectory.q
+    n_samples = result.trajectory.n_samples
+    none = np.zeros((0, 4, 4))
+    if n_samples == 0:
+        return PlotKinematics(np.zeros((0, 3)), none, none, np.zeros(0))
+    robot = case.robot
+    path_frames = forward_kinematics(robot, q[frame_indices(n_samples, n_path_frames)])
+    tool_frames = none
+    if shows_tool(case):
+        tool_frames = forward_kinematics(robot, q[frame_indices(n_samples, n_tool_frames)])
+    return PlotKinematics(
+        chain_points(robot, q[0]), path_frames, tool_frames, tracking_error(result, case)
+    )
+
+
+def path_figure(
+    result: PlanResult,
+    case: Case,
+    n_tool_frames: int = PATH_FRAMES,
+    kinematics: PlotKinematics | None = None,
+    canvas: Canvas | None = None,
+) -> Figure:
     """The path before and after placement, in the robot's work cell (3D, equal aspect).
 
     Left: the work cell in the base frame: the path in its definition frame (dashed,
@@ -357,6 +497,11 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         The case (robot, reach bounds, nominal path as fallback).
     n_tool_frames
         Number of tool frames drawn along the path.
+    kinematics
+        The run's :func:`plot_kinematics` with ``n_path_frames=n_tool_frames``, computed
+        here when not given.
+    canvas
+        The blank figure (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -364,12 +509,11 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
         Two 3D axes.
     """
     trajectory = result.trajectory
+    if kinematics is None:
+        kinematics = plot_kinematics(result, case, n_path_frames=n_tool_frames)
     points_part, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
-    figure = _new_figure(13.0, 6.8, layout=None)
-    figure.subplots_adjust(left=0.0, right=0.97, bottom=0.12, top=0.92, wspace=0.08)
-    ax_cell = figure.add_subplot(1, 2, 1, projection="3d")
-    ax_path = figure.add_subplot(1, 2, 2, projection="3d")
+    figure, (ax_cell, ax_path) = canvas or _path_canvas()
 
     r_min, r_max = case.bounds.reach
     shell = sphere_wireframe(r_max)
@@ -402,7 +546,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
     )
     scene = [shell, points_part, points_base]
     if trajectory.n_samples:
-        chain = chain_points(case.robot, trajectory.q[0])
+        chain = kinematics.chain_start
         ax_cell.plot(*chain.T, "o-", color="0.2", lw=3.0, ms=4, gid="robot", label="robot at t = 0")
         scene.append(chain)
     _set_equal(ax_cell, np.vstack(scene))
@@ -413,8 +557,7 @@ def path_figure(result: PlanResult, case: Case, n_tool_frames: int = 7) -> Figur
     ax_path.plot(*points_base[-1], "s", color="0.2", ms=6, label="end", gid="end")
     extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
     if trajectory.n_samples:
-        idx = frame_indices(trajectory.n_samples, n_tool_frames)
-        T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        T_tool = kinematics.path_frames
         _plot_triads(ax_path, triad_lines(T_tool, 0.08 * extent), "tool-frames", "tool frames")
         bad = violation_samples(trajectory, result.check.violations)
         if bad.any():
@@ -440,7 +583,12 @@ def _format_placement(result: PlanResult) -> str:
     return f"({x[0]:.4f}, {x[1]:.4f}, {x[2]:.4f}) m, rpy ({x[3]:.4f}, {x[4]:.4f}, {x[5]:.4f}) rad"
 
 
-def speed_figure(result: PlanResult, case: Case) -> Figure:
+def speed_figure(
+    result: PlanResult,
+    case: Case,
+    kinematics: PlotKinematics | None = None,
+    canvas: Canvas | None = None,
+) -> Figure:
     """Tool speed against v_r and v_t^max, and the tracking error against ρ, over time.
 
     Top (``gid="speed"``): Cartesian speed of the tool point with the rated speed
@@ -456,6 +604,11 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
         The planned placement (speed in m/s, shown in mm/s).
     case
         The case (task bounds, nominal path).
+    kinematics
+        The run's :func:`plot_kinematics` (for the tracking error), computed here when not
+        given.
+    canvas
+        The blank figure (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -465,9 +618,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
     trajectory = result.trajectory
     task = case.task
     t = trajectory.t
-    figure = _new_figure(11.0, 6.5, layout=None)
-    figure.subplots_adjust(left=0.07, right=0.76, bottom=0.08, top=0.94, hspace=0.08)
-    ax_speed, ax_error = figure.subplots(2, 1, sharex=True)
+    figure, (ax_speed, ax_error) = canvas or _speed_canvas()
 
     ax_speed.plot(
         t, 1e3 * trajectory.speed, color="tab:blue", lw=1.2, label="tool speed", gid="speed"
@@ -512,7 +663,7 @@ def speed_figure(result: PlanResult, case: Case) -> Figure:
     top = max(task.rated_speed, task.corner_speed, float(np.max(trajectory.speed, initial=0.0)))
     ax_speed.set_ylim(0.0, 1.15e3 * top)
 
-    error = tracking_error(result, case)
+    error = tracking_error(result, case) if kinematics is None else kinematics.tracking_error
     ax_error.plot(
         t, 1e3 * error, color="tab:purple", lw=1.2, label="tracking error", gid="tracking-error"
     )
@@ -564,7 +715,9 @@ MINOR_DECADES = 2.0
 """Log fitness axes spanning more decades than this get no minor ticks."""
 
 
-def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figure:
+def convergence_figure(
+    history: Mapping[str, Mapping[str, np.ndarray]], canvas: Canvas | None = None
+) -> Figure:
     """Best and mean fitness and feasible share per generation, one colour per method.
 
     Each generation is drawn at its cumulative number of placement evaluations, the
@@ -579,6 +732,8 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
         ``{method: {"generation", "evaluations", "best", "mean", "feasible_share",
         "wall_time"}}``, arrays of shape (G,) per method; fitness unitless, share in [0, 1],
         wall time in s.
+    canvas
+        The blank figure (:func:`blank_canvases`), made here when not given.
 
     Returns
     -------
@@ -589,9 +744,7 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
     from matplotlib.ticker import LogFormatter, NullLocator
 
     columns = history_columns(history)
-    figure = _new_figure(9.0, 8.0, layout=None)
-    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.07, top=0.95, hspace=0.08)
-    ax_best, ax_mean, ax_share = figure.subplots(3, 1, sharex=True)
+    figure, (ax_best, ax_mean, ax_share) = canvas or _convergence_canvas()
     for k, (method, c) in enumerate(columns.items()):
         color = f"C{k}"
         final = f"{method}: best {c['best'][-1]:.4g} after {c['evaluations'][-1]:.0f} evaluations"
@@ -638,17 +791,18 @@ def convergence_figure(history: Mapping[str, Mapping[str, np.ndarray]]) -> Figur
     return figure
 
 
-TOOL_FRAMES = 16
-"""Tool frames drawn along the path in ``tool.png``."""
-
-
 def shows_tool(case: Case) -> bool:
     """Whether a run of this case gets ``tool.png``: a seam frame or a spin not fixed."""
     tool = case.task.tool
     return str(tool.frame) == "seam" or str(tool.spin) != "fixed"
 
 
-def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> Figure:
+def tool_figure(
+    result: PlanResult,
+    case: Case,
+    n_frames: int = TOOL_FRAMES,
+    kinematics: PlotKinematics | None = None,
+) -> Figure:
     """The spin along the path and the tool frames it gives (docs/tool.md).
 
     Left: spin about the tool axis against the arc length s of the planned path (rad),
@@ -680,8 +834,11 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
     ax_frames.plot(*points_base.T, color=AFTER_COLOR, lw=1.5, gid="tool-path")
     if trajectory.n_samples:
         extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
-        idx = frame_indices(trajectory.n_samples, n_frames)
-        T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        if kinematics is None:
+            idx = frame_indices(trajectory.n_samples, n_frames)
+            T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        else:
+            T_tool = kinematics.tool_frames
         _plot_triads(ax_frames, triad_lines(T_tool, 0.06 * extent), "tool-frames", "tool frames")
     _set_equal(ax_frames, points_base)
     ax_frames.set_title(f"tool frames ({tool.frame} frame)", fontsize=10, y=1.0)
@@ -690,25 +847,43 @@ def tool_figure(result: PlanResult, case: Case, n_frames: int = TOOL_FRAMES) -> 
 
 
 def plot_figures(
-    result: PlanResult, case: Case, history: Mapping[str, Mapping[str, np.ndarray]] | None = None
+    result: PlanResult,
+    case: Case,
+    history: Mapping[str, Mapping[str, np.ndarray]] | None = None,
+    kinematics: PlotKinematics | None = None,
+    canvases: dict[str, Canvas] | None = None,
 ) -> dict[str, PlotBuilder]:
     """The plots of a run as ``{file name: figure builder or banded figure}``, in report
-    order."""
+    order; the builders draw with ``kinematics`` (:func:`plot_kinematics`, computed here
+    when not given) and start no compiled kernel, each on its blank figure from
+    ``canvases`` (:func:`blank_canvases`, which it takes out of the dict) when there is one.
+    """
+    if kinematics is None:
+        kinematics = plot_kinematics(result, case)
+    blank = (canvases if canvases is not None else {}).pop
+
+    def joints_band(k: int, rows: Sequence[int]) -> Figure:
+        return joints_figure(result, case, rows, blank(f"joints.png/{k}", None))
+
     builders: dict[str, PlotBuilder] = {
         "joints.png": BandedFigure(
-            tuple(partial(joints_figure, result, case, rows) for rows in JOINT_BANDS)
+            tuple(partial(joints_band, k, rows) for k, rows in enumerate(JOINT_BANDS))
         ),
-        "path.png": lambda: path_figure(result, case),
-        "speed.png": lambda: speed_figure(result, case),
+        "path.png": lambda: path_figure(
+            result, case, kinematics=kinematics, canvas=blank("path.png", None)
+        ),
+        "speed.png": lambda: speed_figure(result, case, kinematics, blank("speed.png", None)),
     }
     if result.check.cell is not None and result.trajectory.n_samples:
         from trackplan.report.cell_figures import clearance_figure
 
         builders["clearance.png"] = lambda: clearance_figure(result)
     if shows_tool(case):
-        builders["tool.png"] = lambda: tool_figure(result, case)
+        builders["tool.png"] = lambda: tool_figure(result, case, kinematics=kinematics)
     if history:
-        builders["convergence.png"] = lambda: convergence_figure(history)
+        builders["convergence.png"] = lambda: convergence_figure(
+            history, blank("convergence.png", None)
+        )
     return builders
 
 

@@ -9,7 +9,7 @@ the worker draw them while it builds the 3D view. The files are the same either 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,7 +18,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.planning.result import PlanResult
 from trackplan.report.drawing import can_fork, draw_plots
-from trackplan.report.figures import plot_figures
+from trackplan.report.figures import plot_figures, plot_kinematics
 from trackplan.report.html import report_page, view_section
 from trackplan.run_files import REPORT_FILE
 
@@ -38,6 +38,7 @@ def write_run_report(
     parallel: bool = True,
     n_frames: int = 150,
     worker: PlotWorker | None = None,
+    meanwhile: Callable[[], object] | None = None,
 ) -> tuple[list[Path], Path]:
     """Write the plots (:func:`~trackplan.report.figures.write_plots`) and ``report.html``
     (:func:`~trackplan.report.html.write_report`) of a run.
@@ -62,6 +63,9 @@ def write_run_report(
     worker
         A plot worker started before the run was computed, which draws the plots
         (and ends); when it is gone or fails, the plots are drawn here.
+    meanwhile
+        More work of the caller (the run's other files), done while the other process
+        draws, after the 3D view.
 
     Returns
     -------
@@ -70,15 +74,22 @@ def write_run_report(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    plots = [(out_dir / name, plot) for name, plot in plot_figures(result, case, history).items()]
-    if worker is not None and worker.draw(result, case, history, out_dir):
+    kinematics = plot_kinematics(result, case)  # numba's kernels run here, not in the worker
+    builders = plot_figures(result, case, history, kinematics)
+    plots = [(out_dir / name, plot) for name, plot in builders.items()]
+
+    def view_and_more() -> str:
         view = view_section(result, case, n_frames)
+        if meanwhile is not None:
+            meanwhile()
+        return view
+
+    if worker is not None and worker.draw(result, case, history, out_dir, kinematics):
+        view = view_and_more()
         if not worker.wait():
             draw_plots(plots, parallel=parallel, meanwhile=lambda: None)
     else:
-        view = draw_plots(
-            plots, parallel=parallel, meanwhile=lambda: view_section(result, case, n_frames)
-        )
+        view = draw_plots(plots, parallel=parallel, meanwhile=view_and_more)
     paths = [path for path, _ in plots]
     report = out_dir / REPORT_FILE
     page = report_page(result, case, paths, view, history, optimizer_info)
