@@ -487,3 +487,42 @@ def test_threads_give_the_same_paths(robot_name, request):
             np.testing.assert_array_equal(getattr(several, field), getattr(one, field))
         for field in ("reachable_fraction", "n_switches", "windings", "winding"):
             np.testing.assert_array_equal(getattr(several, field), getattr(one, field))
+
+
+def test_thread_sharing_pauses_while_it_does_not_pay(monkeypatch):
+    """After a shared call below the efficiency that pays, the next calls run on one
+    thread, for a pause that doubles while sharing keeps not paying (up to the last) and
+    starts again from the first once it pays."""
+    from trackplan.robots import path_ik
+
+    monkeypatch.setattr(path_ik, "path_threads", lambda: 2)
+    sharing = path_ik.ThreadSharing()
+    assert sharing.threads() == 2
+    pauses = []
+    for _ in range(7):
+        sharing.note(0.5 * path_ik.EFFICIENT)
+        counts = [sharing.threads() for _ in range(2 * path_ik.LAST_PAUSE)]
+        pauses.append(counts.index(2))
+        assert set(counts[: pauses[-1]]) == {1}
+    first, last = path_ik.FIRST_PAUSE, path_ik.LAST_PAUSE
+    assert pauses == [min(last, first * 2**i) for i in range(7)]
+    assert pauses[-1] == last
+    sharing.note(path_ik.EFFICIENT)  # paid: no pause, and the next pause is the first
+    assert sharing.threads() == 2
+    sharing.note(0.0)
+    assert [sharing.threads() for _ in range(first + 1)] == [1] * first + [2]
+
+
+def test_shared_calls_report_their_efficiency(puma, monkeypatch):
+    """A call with threads=None on two threads reports its parallel efficiency (in
+    (0, 1.2]: the threads' CPU time over threads × wall) to the process's record."""
+    from trackplan.robots import path_ik
+
+    seen = []
+    monkeypatch.setattr(path_ik, "_SHARING", path_ik.ThreadSharing())
+    monkeypatch.setattr(path_ik.ThreadSharing, "threads", lambda self: 2)
+    monkeypatch.setattr(path_ik.ThreadSharing, "note", lambda self, e: seen.append(e))
+    T = np.broadcast_to(feasible_line(200), (12, 200, 4, 4))
+    path_ik.solve_path_ik_branches(puma, T)
+    path_ik.solve_path_ik_branches(puma, T, threads=2)  # given: nothing to record
+    assert len(seen) == 1 and 0.0 < seen[0] <= 1.2

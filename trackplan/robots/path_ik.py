@@ -33,6 +33,7 @@ consecutive poses (default :data:`DEFAULT_MAX_STEP`).
 from __future__ import annotations
 
 import os
+import time
 from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -267,8 +268,8 @@ def solve_path_ik(
         ``"closed_form"`` or ``"numeric"``.
     threads
         Threads that solve and analyse all eight closed-form branches, sharing the
-        candidates; None: one per core this process may run on (:func:`path_threads`).
-        The results do not depend on it.
+        candidates; None: one per core this process may run on (:func:`path_threads`)
+        while that pays (:class:`ThreadSharing`), else one. The results do not depend on it.
 
     Returns
     -------
@@ -607,7 +608,7 @@ def _all_branch_paths(
     step
         The step limit per joint, shape (n,), rad.
     threads
-        Threads to share the pieces among; None: :func:`path_threads`.
+        Threads to share the pieces among; None: as :class:`ThreadSharing` says.
 
     Returns
     -------
@@ -622,7 +623,8 @@ def _all_branch_paths(
     pieces = deque(range(0, n_cand, size))
     q_min, q_max = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
 
-    def work() -> None:
+    def work() -> float:  # the thread's CPU time, s
+        started = time.thread_time()
         rows = size * n_poses
         q_rows = np.empty((rows, N_BRANCHES, robot.n_dof))
         valid_rows = np.empty((rows, N_BRANCHES), dtype=np.bool_)
@@ -631,7 +633,7 @@ def _all_branch_paths(
             try:
                 start = pieces.popleft()
             except IndexError:  # no piece left
-                return
+                return time.thread_time() - started
             stop = min(start + size, n_cand)
             rows = (stop - start) * n_poses
             out = (q_rows[:rows], valid_rows[:rows], aux_rows[:rows])
@@ -648,27 +650,76 @@ def _all_branch_paths(
                 *(array[start:stop] for array in paths),
             )
 
-    helpers = min(path_threads() if threads is None else threads, len(pieces)) - 1
-    if helpers < 1:
+    n_threads = min(_SHARING.threads() if threads is None else threads, len(pieces))
+    if n_threads < 2:
         work()
         return paths
-    with ThreadPoolExecutor(helpers) as pool:
-        running = [pool.submit(work) for _ in range(helpers)]
+    start = time.perf_counter()
+    with ThreadPoolExecutor(n_threads - 1) as pool:  # its threads end with the block
+        running = [pool.submit(work) for _ in range(n_threads - 1)]
         try:
-            work()
+            cpu = work()
         finally:
             pieces.clear()  # on an exception here the helpers stop after their piece
-        for future in running:
-            future.result()
+        cpu += sum(future.result() for future in running)
+    if threads is None:
+        _SHARING.note(cpu / (n_threads * (time.perf_counter() - start)))
     return paths
 
 
 def path_threads() -> int:
-    """Threads the closed-form path IK on all branches uses by default: the cores this
-    process may run on (``os.sched_getaffinity``)."""
+    """The cores this process may run on (``os.sched_getaffinity``): the threads the
+    closed-form path IK on all branches shares its work among while that pays."""
     if hasattr(os, "sched_getaffinity"):
         return len(os.sched_getaffinity(0))
     return os.cpu_count() or 1
+
+
+EFFICIENT = 0.7
+"""Parallel efficiency (the threads' CPU time over threads × wall time) of a shared call of
+the path IK below which sharing does not pay: a thread waited for a core. Measured on two
+cores: about 0.95 with the second core free, about 0.3–0.4 at a load of 4."""
+
+FIRST_PAUSE = 4
+"""Calls of the path IK run on one thread after a shared call that did not pay; the pause
+doubles while sharing keeps not paying, up to :data:`LAST_PAUSE`."""
+LAST_PAUSE = 64
+
+
+class ThreadSharing:
+    """Whether the path IK shares its work among threads: while sharing pays.
+
+    Threads help only where a core is free. On a busy machine a thread waits for a core
+    and the caller waits for the thread: the call then takes longer than on one thread
+    (the corner case's search took 1.5× its one-thread wall time at a load of 4 on two
+    cores). So each shared call measures its parallel efficiency; below
+    :data:`EFFICIENT`, the next calls run on one thread (:data:`FIRST_PAUSE` calls, twice
+    as many after each further shared call that does not pay, at most
+    :data:`LAST_PAUSE`). The results are the same on any number of threads.
+    """
+
+    def __init__(self) -> None:
+        self.pause = 0  # the last pause, calls
+        self.left = 0  # calls still to run on one thread
+
+    def threads(self) -> int:
+        """Threads for the next call: one during a pause, else :func:`path_threads`."""
+        if self.left > 0:
+            self.left -= 1
+            return 1
+        return path_threads()
+
+    def note(self, efficiency: float) -> None:
+        """Record a shared call's parallel efficiency (in (0, 1])."""
+        if efficiency >= EFFICIENT:
+            self.pause = 0
+        else:
+            self.pause = min(LAST_PAUSE, 2 * self.pause if self.pause else FIRST_PAUSE)
+            self.left = self.pause
+
+
+_SHARING = ThreadSharing()
+"""The process's record of whether sharing the path IK among threads pays."""
 
 
 def _analysis_arrays(n_cand: int, n_k: int, n_poses: int, n: int) -> tuple[np.ndarray, ...]:
