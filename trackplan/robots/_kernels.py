@@ -702,6 +702,7 @@ def analyse_paths(
     winding = np.zeros((n_cand, n_k, n), dtype=np.int64)
     low = np.empty(n)
     high = np.empty(n)
+    offset = np.empty(n)
     for b in range(n_cand):
         for k in range(n_k):
             path = q[b, k]
@@ -743,7 +744,17 @@ def analyse_paths(
                     note_switch(rep, val, switch[b, k], m, crossing[b, k, m], -1, 0.0)
             for c in range(magnitude.shape[3]):
                 note_minima(magnitude[b, k, :, c], ok, channel_kind[c], rep, val, switch[b, k])
-            fit_limits(path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high)
+            for j in range(n):
+                low[j] = np.inf
+                high[j] = -np.inf
+            for m in range(n_poses):
+                if ok[m]:
+                    for j in range(n):
+                        low[j] = min(low[j], path[m, j])
+                        high[j] = max(high[j], path[m, j])
+            fit_limits(
+                path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high, offset
+            )
     return switch, report, values, windings, winding
 
 
@@ -794,6 +805,8 @@ def analyse_closed_form(
     mag = np.empty((3, n_poses))
     low = np.empty(n)
     high = np.empty(n)
+    offset = np.empty(n)
+    steps = np.empty(n)
     for b in range(n_cand):
         for k in range(n_k):
             branch = candidates[b, k]
@@ -839,18 +852,30 @@ def analyse_closed_form(
             for m in range(first + 1):
                 for j in range(n):
                     path[m, j] = q_all[b, first, branch, j]
+            for j in range(n):
+                low[j] = path[first, j]
+                high[j] = path[first, j]
             for m in range(first + 1, n_poses):
                 if not ok[m]:
                     for j in range(n):
                         path[m, j] = path[m - 1, j]
                     continue
+                jump = False
                 for j in range(n):
                     before = path[m - 1, j]
                     step = q_all[b, m, branch, j] - before
-                    step -= two_pi * math.floor(step / two_pi + 0.5)
-                    path[m, j] = before + step
-                    if ok[m - 1] and abs(step) > max_step[j] and not sw[m]:
-                        note_switch(rep, val, sw, m, JUMP, j, abs(step))
+                    step -= two_pi * np.floor(step / two_pi + 0.5)
+                    steps[j] = step
+                    value = before + step
+                    path[m, j] = value
+                    low[j] = min(low[j], value)
+                    high[j] = max(high[j], value)
+                    jump |= abs(step) > max_step[j]
+                if jump and ok[m - 1]:
+                    for j in range(n):
+                        step = steps[j]
+                        if abs(step) > max_step[j] and not sw[m]:
+                            note_switch(rep, val, sw, m, JUMP, j, abs(step))
                 if ok[m - 1]:
                     x = aux[b, m, branch, 2]
                     y = aux[b, m, branch, 3]
@@ -865,7 +890,9 @@ def analyse_closed_form(
             note_minima(mag[0], ok, SHOULDER, rep, val, sw)
             note_minima(mag[1], ok, ELBOW, rep, val, sw)
             note_minima(mag[2], ok, WRIST, rep, val, sw)
-            fit_limits(path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high)
+            fit_limits(
+                path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high, offset
+            )
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -897,21 +924,17 @@ def fit_limits(
     winding: np.ndarray,
     low: np.ndarray,
     high: np.ndarray,
+    offset: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Kernel: shift each joint of a continuous path (M, n) in place by the multiple of 2π
     that centres it in the limits, count its windings (n,) and keep the one of largest
-    margin, and complete the branch's report (margin, first pose outside, first problem);
-    low and high are (n,) scratch."""
+    margin, and complete the branch's report (margin, first pose outside, first problem).
+
+    low and high (n,) are the smallest and largest joint values of the reached poses;
+    offset (n,) is scratch.
+    """
     n_poses, n = path.shape
     two_pi = 2.0 * math.pi
-    for j in range(n):
-        low[j] = np.inf
-        high[j] = -np.inf
-    for m in range(n_poses):
-        if ok[m]:
-            for j in range(n):
-                low[j] = min(low[j], path[m, j])
-                high[j] = max(high[j], path[m, j])
     margin = np.inf
     for j in range(n):
         centre = ((q_min[j] + q_max[j]) - (low[j] + high[j])) / (2.0 * two_pi)
@@ -919,19 +942,20 @@ def fit_limits(
         best_margin = -np.inf
         for up in range(2):
             shift = math.floor(centre) + up
-            offset = two_pi * shift
-            room = min(low[j] + offset - q_min[j], q_max[j] - high[j] - offset)
+            room = min(low[j] + two_pi * shift - q_min[j], q_max[j] - high[j] - two_pi * shift)
             if room > best_margin:
                 best_margin = room
                 best = shift
-        for m in range(n_poses):
-            path[m, j] += two_pi * best
+        offset[j] = two_pi * best
         margin = min(margin, best_margin)
         lowest = math.ceil((q_min[j] - low[j]) / two_pi)
         highest = math.floor((q_max[j] - high[j]) / two_pi)
         if highest >= lowest:
             windings[j] = highest - lowest + 1
             winding[j] = int(best) - lowest
+    for m in range(n_poses):
+        for j in range(n):
+            path[m, j] += offset[j]
     val[F_MARGIN] = margin
     if margin < 0.0:
         for m in range(n_poses):

@@ -623,8 +623,8 @@ def _all_branch_paths(
     pieces = deque(range(0, n_cand, size))
     q_min, q_max = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
 
-    def work() -> float:  # the thread's CPU time, s
-        started = time.thread_time()
+    def work(timed: bool = True) -> float:  # the thread's CPU time, s (0 untimed)
+        started = time.thread_time() if timed else 0.0
         rows = size * n_poses
         q_rows = np.empty((rows, N_BRANCHES, robot.n_dof))
         valid_rows = np.empty((rows, N_BRANCHES), dtype=np.bool_)
@@ -633,7 +633,7 @@ def _all_branch_paths(
             try:
                 start = pieces.popleft()
             except IndexError:  # no piece left
-                return time.thread_time() - started
+                return time.thread_time() - started if timed else 0.0
             stop = min(start + size, n_cand)
             rows = (stop - start) * n_poses
             out = (q_rows[:rows], valid_rows[:rows], aux_rows[:rows])
@@ -652,7 +652,7 @@ def _all_branch_paths(
 
     n_threads = min(_SHARING.threads() if threads is None else threads, len(pieces))
     if n_threads < 2:
-        work()
+        work(timed=False)
         return paths
     start = time.perf_counter()
     with ThreadPoolExecutor(n_threads - 1) as pool:  # its threads end with the block
