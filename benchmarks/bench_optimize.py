@@ -303,6 +303,50 @@ def _corner_seeds() -> None:
     print("  (the first seed's CPU time includes loading numba's cached kernels)")
 
 
+PATH_IK_BATCHES = 40
+"""Batches of 100 placements of the corner case whose path IK on all branches is timed on
+one thread and shared among threads."""
+
+
+def _path_ik_threads() -> None:
+    """Wall and CPU time of the screening's path IK on all branches (the corner case's grid,
+    batches of 100 sampled placements), on one thread, on every core (``threads`` given) and
+    as the search runs it (``threads=None``: shared while sharing pays), alternated."""
+    from trackplan.robots.path_ik import path_threads, solve_path_ik_branches
+    from trackplan.search.fitness import PlacementFitness
+    from trackplan.search.space import SearchSpace
+
+    case = load_case(CASES / "paper-corner.yaml")
+    space = SearchSpace.from_case(case)
+    fitness = PlacementFitness(case, space, PathGeometry.from_case(case), "smooth")
+    rng = np.random.default_rng(0)
+    batches = []
+    for _ in range(PATH_IK_BATCHES):
+        X = space.sample(rng, 100)
+        batches.append(tool_poses(X, fitness.points, fitness.rotations(X[:, 6:])))
+    cores = path_threads()
+    ways = {"one thread": 1, f"{cores} threads": cores, "as the search (None)": None}
+    times: dict[str, list[tuple[float, float]]] = {name: [] for name in ways}
+    solve_path_ik_branches(case.robot, batches[0], threads=cores)  # loads the kernels
+    for _ in range(5):
+        for name, threads in ways.items():
+            wall, cpu = time.perf_counter(), time.process_time()
+            for poses in batches:
+                solve_path_ik_branches(case.robot, poses, threads=threads)
+            times[name].append((time.perf_counter() - wall, time.process_time() - cpu))
+    print(
+        f"\nPath IK on all branches, {PATH_IK_BATCHES} batches of 100 placements × "
+        f"{batches[0].shape[1]} poses (corner case), medians of 5 alternated rounds, "
+        f"load average {os.getloadavg()[0]:.1f} on {cores} cores"
+    )
+    print(f"  {'threads':<24}{'wall s':>8}{'CPU s':>8}{'wall ratio':>12}")
+    first = statistics.median(t[0] for t in times["one thread"])
+    for name, measured in times.items():
+        wall = statistics.median(t[0] for t in measured)
+        cpu = statistics.median(t[1] for t in measured)
+        print(f"  {name:<24}{wall:>8.3f}{cpu:>8.3f}{wall / first:>12.2f}")
+
+
 def _case_names() -> list[str]:
     """The cases to run: ``TRACKPLAN_BENCH_CASES`` (comma-separated names; ``none``: only the
     whole-process times) or every shipped case with one seam, the paper's first."""
@@ -349,6 +393,7 @@ def _quality_rows(name: str, rows: list, refs: list) -> list[float]:  # type: ig
 def main() -> None:
     """Print the tables (each case's rows as soon as its runs are done)."""
     _whole_process()
+    _path_ik_threads()
     names = _case_names()
     if not names:
         return

@@ -198,6 +198,7 @@ def test_bad_arguments_raise(puma):
         {"max_step": -1.0},
         {"max_step": np.ones(4)},
         {"method": "magic"},
+        {"threads": 0},
     ):
         with pytest.raises(CaseError):
             solve_path_ik(puma, T, **kwargs)
@@ -371,19 +372,19 @@ def test_screened_choice_is_the_choice_among_all_eight_branches(robot_name, requ
     rng = np.random.default_rng(8)
     X = np.column_stack([rng.normal(0.0, 0.08, (24, 3)), rng.normal(0.0, 0.4, (24, 3))])
     T = placement_transform(X)[:, None] @ base[None]
-    gathered = []
-    real_gather = path_ik.gather_closed_form
+    every_branch = []
+    real_all = path_ik._all_branch_paths
 
-    def gather(*args):  # type: ignore[no-untyped-def]
-        gathered.append(args[-1].shape[1])
-        return real_gather(*args)
+    def all_branches(*args):  # type: ignore[no-untyped-def]
+        every_branch.append(args)
+        return real_all(*args)
 
-    monkeypatch.setattr(path_ik, "gather_closed_form", gather)
+    monkeypatch.setattr(path_ik, "_all_branch_paths", all_branches)
     short = 0
     for c in range(len(X)):
-        gathered.clear()
+        every_branch.clear()
         chosen = solve_path_ik(robot, T[c : c + 1])
-        short += gathered == [1]
+        short += not every_branch
         every = solve_path_ik_branches(robot, T[c : c + 1])
         b = int(path_ik._choose(every.success, every.first_problem, every.margin)[0])
         assert chosen.branch[0] == b
@@ -397,3 +398,131 @@ def test_screened_choice_is_the_choice_among_all_eight_branches(robot_name, requ
         usable = every.success[0]
         assert np.all(bound[usable] >= every.margin[0, usable] - 1e-12)
     assert 0 < short < len(X)  # both ways are exercised
+
+
+def gathered_and_analysed(q_all, valid, aux, candidates, q_min, q_max, max_step):
+    """The oracle of analyse_closed_form: each candidate branch's joints, reach and branch
+    quantities gathered by numpy, the wrist reversals found by numpy, then analyse_paths."""
+    from trackplan.robots._kernels import ELBOW, SHOULDER, WRIST, analyse_paths
+
+    rows = np.arange(len(candidates))[:, None]
+    q = q_all[rows, :, candidates]  # (B, K, M, n): the advanced indices' axes first
+    reach = valid[rows, :, candidates]
+    quantities = aux[rows, :, candidates]  # (B, K, M, 5)
+    x, y, z = quantities[..., 2], quantities[..., 3], quantities[..., 4]
+    magnitude = np.stack(
+        [quantities[..., 0], quantities[..., 1], np.sqrt(x * x + y * y + z * z)], -1
+    )
+    crossing = np.zeros(reach.shape, dtype=np.int8)
+    dot = x[..., 1:] * x[..., :-1] + y[..., 1:] * y[..., :-1] + z[..., 1:] * z[..., :-1]
+    crossing[..., 1:][reach[..., 1:] & reach[..., :-1] & (dot <= 0.0)] = WRIST
+    kinds = np.array([SHOULDER, ELBOW, WRIST])
+    found = analyse_paths(q, reach, magnitude, kinds, crossing, q_min, q_max, max_step)
+    return (q, reach, *found)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_fused_analysis_is_the_gather_then_analysis(seed):
+    """analyse_closed_form gives, bit for bit, what gathering the candidate branches and
+    analysing them with analyse_paths gives, on random solutions with missed poses, jumps,
+    measures through zero, wrist reversals and paths beyond the limits."""
+    from trackplan.robots._kernels import N_FLOAT, N_INT, analyse_closed_form
+
+    rng = np.random.default_rng(seed)
+    n_cand, n_poses, n = 5, 60, 6
+    walk = np.cumsum(rng.normal(0.0, 0.15, (n_cand, n_poses, 8, n)), axis=1)
+    walk += rng.uniform(-np.pi, np.pi, (n_cand, 1, 8, n))
+    jumps = rng.random((n_cand, n_poses, 8, n)) < 0.01
+    walk[jumps] += rng.choice([-1.5, 1.5], jumps.sum())
+    q_all = wrapped(walk)
+    miss = [0.0, 0.02, 0.3, 1.0][seed % 4]  # share of missed poses
+    valid = rng.random((n_cand, n_poses, 8)) >= miss
+    valid[0, :, 3] = True  # one branch reaches every pose
+    aux = np.cumsum(rng.normal(0.0, 0.2, (n_cand, n_poses, 8, 5)), axis=1)
+    aux[..., :2] = np.abs(aux[..., :2] + rng.normal(0.0, 0.5, (n_cand, 1, 8, 2)))
+    q_all[~valid] = np.nan
+    aux[~valid] = np.nan
+    if seed % 2:
+        candidates = np.ascontiguousarray(np.broadcast_to(np.arange(8), (n_cand, 8)))
+    else:
+        candidates = rng.integers(0, 8, (n_cand, 3))
+    q_min = np.array([-2.8, -2.0, -1.0, -4.0, -1.9, -8.0])
+    q_max = np.array([2.8, 2.0, 1.2, 4.0, 1.9, 8.0])
+    max_step = np.full(n, 0.9)
+    n_k = candidates.shape[1]
+    fused = (
+        np.full((n_cand, n_k, n_poses, n), 7.0),
+        np.ones((n_cand, n_k, n_poses), dtype=np.bool_),
+        np.ones((n_cand, n_k, n_poses), dtype=np.bool_),
+        np.full((n_cand, n_k, N_INT), 7, dtype=np.int64),
+        np.full((n_cand, n_k, N_FLOAT), 7.0),
+        np.full((n_cand, n_k, n), 7, dtype=np.int64),
+        np.full((n_cand, n_k, n), 7, dtype=np.int64),
+    )  # every entry is to be overwritten
+    analyse_closed_form(q_all, valid, aux, candidates, q_min, q_max, max_step, *fused)
+    expected = gathered_and_analysed(q_all, valid, aux, candidates, q_min, q_max, max_step)
+    for mine, theirs in zip(fused, expected, strict=True):
+        np.testing.assert_array_equal(mine, theirs)
+    report = expected[3]
+    assert (report[..., 2] > 0).any() == (miss > 0.0)  # missed poses
+    assert (report[..., 6] > 0).any()  # switches
+
+
+@pytest.mark.parametrize("robot_name", ["puma", "ur"])
+def test_threads_give_the_same_paths(robot_name, request):
+    """Sharing the candidates among threads changes no bit of the paths on all branches,
+    whatever the number of threads and pieces."""
+    from trackplan.robots import path_ik
+
+    robot = request.getfixturevalue(robot_name)
+    base = feasible_line(120) if robot_name == "puma" else ur_line(robot, 120)
+    rng = np.random.default_rng(3)
+    X = np.column_stack([rng.normal(0.0, 0.1, (23, 3)), rng.normal(0.0, 0.5, (23, 3))])
+    T = placement_transform(X)[:, None] @ base[None]
+    one = path_ik.solve_path_ik_branches(robot, T, threads=1)
+    assert one.success.any() and not one.success.all()
+    for threads in (2, 3):
+        several = path_ik.solve_path_ik_branches(robot, T, threads=threads)
+        for field in ("q", "reachable", "switch", "success", "margin", "first_problem"):
+            np.testing.assert_array_equal(getattr(several, field), getattr(one, field))
+        for field in ("reachable_fraction", "n_switches", "windings", "winding"):
+            np.testing.assert_array_equal(getattr(several, field), getattr(one, field))
+
+
+def test_thread_sharing_pauses_while_it_does_not_pay(monkeypatch):
+    """After a shared call below the efficiency that pays, the next calls run on one
+    thread, for a pause that doubles while sharing keeps not paying (up to the last) and
+    starts again from the first once it pays."""
+    from trackplan.robots import path_ik
+
+    monkeypatch.setattr(path_ik, "path_threads", lambda: 2)
+    sharing = path_ik.ThreadSharing()
+    assert sharing.threads() == 2
+    pauses = []
+    for _ in range(7):
+        sharing.note(0.5 * path_ik.EFFICIENT)
+        counts = [sharing.threads() for _ in range(2 * path_ik.LAST_PAUSE)]
+        pauses.append(counts.index(2))
+        assert set(counts[: pauses[-1]]) == {1}
+    first, last = path_ik.FIRST_PAUSE, path_ik.LAST_PAUSE
+    assert pauses == [min(last, first * 2**i) for i in range(7)]
+    assert pauses[-1] == last
+    sharing.note(path_ik.EFFICIENT)  # paid: no pause, and the next pause is the first
+    assert sharing.threads() == 2
+    sharing.note(0.0)
+    assert [sharing.threads() for _ in range(first + 1)] == [1] * first + [2]
+
+
+def test_shared_calls_report_their_efficiency(puma, monkeypatch):
+    """A call with threads=None on two threads reports its parallel efficiency (in
+    (0, 1.2]: the threads' CPU time over threads × wall) to the process's record."""
+    from trackplan.robots import path_ik
+
+    seen = []
+    monkeypatch.setattr(path_ik, "_SHARING", path_ik.ThreadSharing())
+    monkeypatch.setattr(path_ik.ThreadSharing, "threads", lambda self: 2)
+    monkeypatch.setattr(path_ik.ThreadSharing, "note", lambda self, e: seen.append(e))
+    T = np.broadcast_to(feasible_line(200), (12, 200, 4, 4))
+    path_ik.solve_path_ik_branches(puma, T)
+    path_ik.solve_path_ik_branches(puma, T, threads=2)  # given: nothing to record
+    assert len(seen) == 1 and 0.0 < seen[0] <= 1.2

@@ -490,54 +490,6 @@ N_FLOAT = 3
 
 
 @njit(cache=True, error_model="numpy")
-def gather_closed_form(
-    q_all: np.ndarray, valid: np.ndarray, aux: np.ndarray, candidates: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
-    """Kernel: the candidate branches' paths and branch quantities.
-
-    Parameters
-    ----------
-    q_all, valid, aux
-        Closed-form solutions (B, M, 8, n), validity (B, M, 8) and branch quantities
-        (B, M, 8, 5): shoulder and elbow measures, wrist vector.
-    candidates
-        Branches per candidate, shape (B, K).
-
-    Returns
-    -------
-    q, reach, magnitude, crossing
-        Shapes (B, K, M, n), (B, K, M), (B, K, M, 3): shoulder, elbow and wrist measures,
-        and (B, K, M) int8: WRIST where the wrist vector reverses between poses k − 1 and k.
-    """
-    n_cand, n_poses, _, n = q_all.shape
-    n_k = candidates.shape[1]
-    q = np.empty((n_cand, n_k, n_poses, n))
-    reach = np.empty((n_cand, n_k, n_poses), dtype=np.bool_)
-    magnitude = np.empty((n_cand, n_k, n_poses, 3))
-    crossing = np.zeros((n_cand, n_k, n_poses), dtype=np.int8)
-    for b in range(n_cand):
-        for k in range(n_k):
-            branch = candidates[b, k]
-            before_x = before_y = before_z = 0.0  # the previous pose's wrist vector
-            for m in range(n_poses):  # scalars, not views: no array object per pose
-                for j in range(n):
-                    q[b, k, m, j] = q_all[b, m, branch, j]
-                reached = valid[b, m, branch]
-                reach[b, k, m] = reached
-                x = aux[b, m, branch, 2]
-                y = aux[b, m, branch, 3]
-                z = aux[b, m, branch, 4]
-                magnitude[b, k, m, 0] = aux[b, m, branch, 0]
-                magnitude[b, k, m, 1] = aux[b, m, branch, 1]
-                magnitude[b, k, m, 2] = math.sqrt(x * x + y * y + z * z)
-                if m > 0 and reached and reach[b, k, m - 1]:
-                    if x * before_x + y * before_y + z * before_z <= 0.0:
-                        crossing[b, k, m] = WRIST
-                before_x, before_y, before_z = x, y, z
-    return q, reach, magnitude, crossing
-
-
-@njit(cache=True, error_model="numpy")
 def room_bounds(
     q_all: np.ndarray, valid: np.ndarray, q_min: np.ndarray, q_max: np.ndarray
 ) -> np.ndarray:  # pragma: no cover - compiled
@@ -750,6 +702,7 @@ def analyse_paths(
     winding = np.zeros((n_cand, n_k, n), dtype=np.int64)
     low = np.empty(n)
     high = np.empty(n)
+    offset = np.empty(n)
     for b in range(n_cand):
         for k in range(n_k):
             path = q[b, k]
@@ -790,16 +743,7 @@ def analyse_paths(
                 if crossing[b, k, m] != NONE and ok[m - 1]:
                     note_switch(rep, val, switch[b, k], m, crossing[b, k, m], -1, 0.0)
             for c in range(magnitude.shape[3]):
-                mag = magnitude[b, k, :, c]
-                for m in range(1, n_poses - 1):
-                    if not (ok[m - 1] and ok[m] and ok[m + 1]):
-                        continue
-                    left = mag[m - 1] - mag[m]
-                    right = mag[m + 1] - mag[m]
-                    if left >= 0.0 and right >= 0.0 and (left > 0.0 or right > 0.0):
-                        if mag[m] <= max(left, right):  # reaches ~0 between poses
-                            at = m + 1 if left > right else m
-                            note_switch(rep, val, switch[b, k], at, channel_kind[c], -1, 0.0)
+                note_minima(magnitude[b, k, :, c], ok, channel_kind[c], rep, val, switch[b, k])
             for j in range(n):
                 low[j] = np.inf
                 high[j] = -np.inf
@@ -808,45 +752,228 @@ def analyse_paths(
                     for j in range(n):
                         low[j] = min(low[j], path[m, j])
                         high[j] = max(high[j], path[m, j])
-            margin = np.inf
-            for j in range(n):
-                centre = ((q_min[j] + q_max[j]) - (low[j] + high[j])) / (2.0 * two_pi)
-                best = 0.0
-                best_margin = -np.inf
-                for up in range(2):
-                    shift = math.floor(centre) + up
-                    offset = two_pi * shift
-                    room = min(low[j] + offset - q_min[j], q_max[j] - high[j] - offset)
-                    if room > best_margin:
-                        best_margin = room
-                        best = shift
-                for m in range(n_poses):
-                    path[m, j] += two_pi * best
-                margin = min(margin, best_margin)
-                lowest = math.ceil((q_min[j] - low[j]) / two_pi)
-                highest = math.floor((q_max[j] - high[j]) / two_pi)
-                if highest >= lowest:
-                    windings[b, k, j] = highest - lowest + 1
-                    winding[b, k, j] = int(best) - lowest
-            val[F_MARGIN] = margin
-            if margin < 0.0:
-                for m in range(n_poses):
-                    if not ok[m]:
-                        continue
-                    for j in range(n):
-                        if path[m, j] < q_min[j] or path[m, j] > q_max[j]:
-                            rep[I_LIMIT] = m
-                            rep[I_LIMIT_JOINT] = j
-                            val[F_VALUE] = path[m, j]
-                            break
-                    if rep[I_LIMIT] >= 0:
-                        break
-            first_problem = n_poses
-            for index in (I_UNREACH, I_SWITCH, I_LIMIT):
-                if rep[index] >= 0:
-                    first_problem = min(first_problem, rep[index])
-            rep[I_FIRST] = first_problem if first_problem < n_poses else -1
+            fit_limits(
+                path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high, offset
+            )
     return switch, report, values, windings, winding
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def analyse_closed_form(
+    q_all: np.ndarray,
+    valid: np.ndarray,
+    aux: np.ndarray,
+    candidates: np.ndarray,
+    q_min: np.ndarray,
+    q_max: np.ndarray,
+    max_step: np.ndarray,
+    q: np.ndarray,
+    reach: np.ndarray,
+    switch: np.ndarray,
+    report: np.ndarray,
+    values: np.ndarray,
+    windings: np.ndarray,
+    winding: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Kernel: :func:`analyse_paths` of the closed-form solutions' candidate branches, in
+    one pass per path written once.
+
+    The outputs are those of gathering each candidate branch's joints, reach and branch
+    quantities from all eight branches' solutions and analysing the gathered paths with
+    :func:`analyse_paths` (channels shoulder, elbow, wrist; a wrist crossing where the
+    wrist vector reverses between two reached poses), bit for bit, without the gathered
+    (B, K, M, ·) arrays: each path is unwrapped as it is read, its branch measures go to a
+    small scratch. Releases the GIL: threads may analyse separate candidates at once.
+
+    Parameters
+    ----------
+    q_all, valid, aux
+        Closed-form solutions (B, M, 8, n), rad, validity (B, M, 8) and branch quantities
+        (B, M, 8, 5): shoulder and elbow measures, wrist vector.
+    candidates
+        Branches per candidate, shape (B, K).
+    q_min, q_max, max_step
+        Joint limits and the largest step that is not a jump, shape (n,), rad.
+    q, reach, switch, report, values, windings, winding
+        Outputs: the analysed paths (B, K, M, n), rad; reach (B, K, M) and switch
+        (B, K, M) bool; the reports (B, K, N_INT) and (B, K, N_FLOAT); windings and winding
+        (B, K, n) (see :func:`analyse_paths`). Every entry is written.
+    """
+    n_cand, n_poses, _, n = q_all.shape
+    n_k = candidates.shape[1]
+    two_pi = 2.0 * math.pi
+    mag = np.empty((3, n_poses))
+    low = np.empty(n)
+    high = np.empty(n)
+    offset = np.empty(n)
+    steps = np.empty(n)
+    for b in range(n_cand):
+        for k in range(n_k):
+            branch = candidates[b, k]
+            path = q[b, k]
+            ok = reach[b, k]
+            sw = switch[b, k]
+            rep = report[b, k]
+            val = values[b, k]
+            for i in range(N_INT):
+                rep[i] = -1
+            for i in range(N_FLOAT):
+                val[i] = 0.0
+            for j in range(n):
+                windings[b, k, j] = 0
+                winding[b, k, j] = 0
+            rep[I_N_UNREACH] = 0
+            rep[I_N_SWITCH] = 0
+            first = -1
+            for m in range(n_poses):
+                reached = valid[b, m, branch]
+                ok[m] = reached
+                sw[m] = False
+                x = aux[b, m, branch, 2]
+                y = aux[b, m, branch, 3]
+                z = aux[b, m, branch, 4]
+                mag[0, m] = aux[b, m, branch, 0]
+                mag[1, m] = aux[b, m, branch, 1]
+                mag[2, m] = math.sqrt(x * x + y * y + z * z)
+                if reached:
+                    if first < 0:
+                        first = m
+                else:
+                    if rep[I_UNREACH] < 0:
+                        rep[I_UNREACH] = m
+                    rep[I_N_UNREACH] += 1
+            if first < 0:
+                for m in range(n_poses):
+                    for j in range(n):
+                        path[m, j] = q_all[b, m, branch, j]
+                val[F_MARGIN] = -np.inf
+                rep[I_FIRST] = 0
+                continue
+            for m in range(first + 1):
+                for j in range(n):
+                    path[m, j] = q_all[b, first, branch, j]
+            for j in range(n):
+                low[j] = path[first, j]
+                high[j] = path[first, j]
+            for m in range(first + 1, n_poses):
+                if not ok[m]:
+                    for j in range(n):
+                        path[m, j] = path[m - 1, j]
+                    continue
+                jump = False
+                for j in range(n):
+                    before = path[m - 1, j]
+                    step = q_all[b, m, branch, j] - before
+                    step -= two_pi * np.floor(step / two_pi + 0.5)
+                    steps[j] = step
+                    value = before + step
+                    path[m, j] = value
+                    low[j] = min(low[j], value)
+                    high[j] = max(high[j], value)
+                    jump |= abs(step) > max_step[j]
+                if jump and ok[m - 1]:
+                    for j in range(n):
+                        step = steps[j]
+                        if abs(step) > max_step[j] and not sw[m]:
+                            note_switch(rep, val, sw, m, JUMP, j, abs(step))
+                if ok[m - 1]:
+                    x = aux[b, m, branch, 2]
+                    y = aux[b, m, branch, 3]
+                    z = aux[b, m, branch, 4]
+                    dot = (
+                        x * aux[b, m - 1, branch, 2]
+                        + y * aux[b, m - 1, branch, 3]
+                        + z * aux[b, m - 1, branch, 4]
+                    )
+                    if dot <= 0.0:
+                        note_switch(rep, val, sw, m, WRIST, -1, 0.0)
+            note_minima(mag[0], ok, SHOULDER, rep, val, sw)
+            note_minima(mag[1], ok, ELBOW, rep, val, sw)
+            note_minima(mag[2], ok, WRIST, rep, val, sw)
+            fit_limits(
+                path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high, offset
+            )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def note_minima(
+    mag: np.ndarray, ok: np.ndarray, kind: int, rep: np.ndarray, val: np.ndarray, switch: np.ndarray
+) -> None:  # pragma: no cover - compiled
+    """Kernel: note a switch of ``kind`` where a branch measure mag (M,) has a local minimum
+    no larger than its change to a neighbour (it reaches about zero between the poses)."""
+    for m in range(1, mag.shape[0] - 1):
+        if not (ok[m - 1] and ok[m] and ok[m + 1]):
+            continue
+        left = mag[m - 1] - mag[m]
+        right = mag[m + 1] - mag[m]
+        if left >= 0.0 and right >= 0.0 and (left > 0.0 or right > 0.0):
+            if mag[m] <= max(left, right):  # reaches ~0 between poses
+                at = m + 1 if left > right else m
+                note_switch(rep, val, switch, at, kind, -1, 0.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def fit_limits(
+    path: np.ndarray,
+    ok: np.ndarray,
+    q_min: np.ndarray,
+    q_max: np.ndarray,
+    rep: np.ndarray,
+    val: np.ndarray,
+    windings: np.ndarray,
+    winding: np.ndarray,
+    low: np.ndarray,
+    high: np.ndarray,
+    offset: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Kernel: shift each joint of a continuous path (M, n) in place by the multiple of 2π
+    that centres it in the limits, count its windings (n,) and keep the one of largest
+    margin, and complete the branch's report (margin, first pose outside, first problem).
+
+    low and high (n,) are the smallest and largest joint values of the reached poses;
+    offset (n,) is scratch.
+    """
+    n_poses, n = path.shape
+    two_pi = 2.0 * math.pi
+    margin = np.inf
+    for j in range(n):
+        centre = ((q_min[j] + q_max[j]) - (low[j] + high[j])) / (2.0 * two_pi)
+        best = 0.0
+        best_margin = -np.inf
+        for up in range(2):
+            shift = math.floor(centre) + up
+            room = min(low[j] + two_pi * shift - q_min[j], q_max[j] - high[j] - two_pi * shift)
+            if room > best_margin:
+                best_margin = room
+                best = shift
+        offset[j] = two_pi * best
+        margin = min(margin, best_margin)
+        lowest = math.ceil((q_min[j] - low[j]) / two_pi)
+        highest = math.floor((q_max[j] - high[j]) / two_pi)
+        if highest >= lowest:
+            windings[j] = highest - lowest + 1
+            winding[j] = int(best) - lowest
+    for m in range(n_poses):
+        for j in range(n):
+            path[m, j] += offset[j]
+    val[F_MARGIN] = margin
+    if margin < 0.0:
+        for m in range(n_poses):
+            if not ok[m]:
+                continue
+            for j in range(n):
+                if path[m, j] < q_min[j] or path[m, j] > q_max[j]:
+                    rep[I_LIMIT] = m
+                    rep[I_LIMIT_JOINT] = j
+                    val[F_VALUE] = path[m, j]
+                    break
+            if rep[I_LIMIT] >= 0:
+                break
+    first_problem = n_poses
+    for index in (I_UNREACH, I_SWITCH, I_LIMIT):
+        if rep[index] >= 0:
+            first_problem = min(first_problem, rep[index])
+    rep[I_FIRST] = first_problem if first_problem < n_poses else -1
 
 
 @njit(cache=True, error_model="numpy")

@@ -32,6 +32,10 @@ consecutive poses (default :data:`DEFAULT_MAX_STEP`).
 
 from __future__ import annotations
 
+import os
+import time
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,11 +56,13 @@ from trackplan.robots._kernels import (
     I_SWITCH,
     I_UNREACH,
     JUMP,
+    N_FLOAT,
+    N_INT,
     SHOULDER,
     SINGULAR,
     WRIST,
+    analyse_closed_form,
     analyse_paths,
-    gather_closed_form,
     numeric_paths,
     room_bounds,
 )
@@ -83,6 +89,12 @@ above the round-off of unwrapping a path (about 1e-12 rad over thousands of pose
 SCREEN_STRIDE = 8
 """Every how many poses the screen of :func:`solve_path_ik` solves all eight branches to
 bound their margins (a bound from fewer poses is looser but still a bound)."""
+
+PIECE_POSES = 512
+"""Poses per piece of work of the closed-form path IK on all branches: the candidates are
+solved and analysed a few at a time (whole candidates, about this many poses), so that a
+piece's eight-branch solutions (some 200 kB) are analysed while still in the core's cache;
+threads take the pieces in turn."""
 
 _NEWTON_TOL = 1e-10
 _MARCH_MAX_ITER = 100  # first pose from a seed, and the coarse march
@@ -233,6 +245,7 @@ def solve_path_ik(
     max_step: float | np.ndarray | None = None,
     *,
     method: str = "auto",
+    threads: int | None = None,
 ) -> PathIK:
     """Joint paths of candidate pose paths on one IK branch each.
 
@@ -253,6 +266,10 @@ def solve_path_ik(
     method
         ``"auto"`` (closed form for the OPW and UR families, else numeric),
         ``"closed_form"`` or ``"numeric"``.
+    threads
+        Threads that solve and analyse all eight closed-form branches, sharing the
+        candidates; None: one per core this process may run on (:func:`path_threads`)
+        while that pays (:class:`ThreadSharing`), else one. The results do not depend on it.
 
     Returns
     -------
@@ -263,7 +280,7 @@ def solve_path_ik(
     CaseError
         When the shapes, the branch, max_step or the method are invalid.
     """
-    paths = _branch_paths(robot, T_base_tool, branch, max_step, method, screen=True)
+    paths = _branch_paths(robot, T_base_tool, branch, max_step, method, threads, screen=True)
     q, reach, switch, report, values, ok = paths[:6]
     candidates, step, method, windings, winding = paths[6:]
     n_cand, n_poses = reach.shape[0], reach.shape[2]
@@ -298,6 +315,7 @@ def solve_path_ik_branches(
     max_step: float | np.ndarray | None = None,
     *,
     method: str = "auto",
+    threads: int | None = None,
 ) -> PathIKBranches:
     """Joint paths of candidate pose paths on every IK branch, in one batched call.
 
@@ -309,7 +327,7 @@ def solve_path_ik_branches(
         Tool poses in the base frame, shape (B, M, 4, 4), metres.
     max_step
         As for :func:`solve_path_ik`.
-    method
+    method, threads
         As for :func:`solve_path_ik`.
 
     Returns
@@ -322,7 +340,7 @@ def solve_path_ik_branches(
         When the shapes, max_step or the method are invalid.
     """
     q, reach, switch, report, values, ok, _, _, method, windings, winding = _branch_paths(
-        robot, T_base_tool, None, max_step, method
+        robot, T_base_tool, None, max_step, method, threads
     )
     return PathIKBranches(
         q=q,
@@ -435,6 +453,7 @@ def _branch_paths(
     branch: int | np.ndarray | None,
     max_step: float | np.ndarray | None,
     method: str,
+    threads: int | None,
     *,
     screen: bool = False,
 ) -> tuple[
@@ -473,13 +492,14 @@ def _branch_paths(
         raise CaseError(f"T_base_tool must have shape (B, M, 4, 4), got {T.shape}")
     candidates = _candidate_branches(branch, T.shape[0])
     step = _max_step(max_step, robot.n_dof)
-    n_cand, n_poses = T.shape[:2]
+    if threads is not None and not threads >= 1:
+        raise CaseError(f"threads must be None or ≥ 1, got {threads!r}")
+    n_cand = T.shape[0]
     n = robot.n_dof
     family = ik_family(robot)
     if method == "auto":
         method = "closed_form" if family.closed_form else "numeric"
     if method == "closed_form":
-        channel_kind = np.array([SHOULDER, ELBOW, WRIST])
         if screen and branch is None:
             # the subset's poses bound each branch's margin from above as all poses do
             sub = np.ascontiguousarray(T[:, ::SCREEN_STRIDE]).reshape(-1, 4, 4)
@@ -491,24 +511,20 @@ def _branch_paths(
             best = np.argmax(bound, axis=1)
             rival = np.where(np.arange(N_BRANCHES) == best[:, None], -np.inf, bound).max(axis=1)
             first = np.ascontiguousarray(best[:, None])
-            q, reach, magnitude, crossing = _one_branch_paths(family, T, best)
-            analysed = _analysed(robot, q, reach, magnitude, channel_kind, crossing, step)
-            ok, values = analysed[3], analysed[2]
+            q, reach, switch, report, values, windings, winding = _one_branch_paths(
+                family, robot, T, best, step
+            )
+            ok = _usable(report, values)
             if np.all(ok[:, 0] & (values[:, 0, F_MARGIN] > rival + _ROOM_SLACK)):
-                switch, report, values, ok, windings, winding = analysed
                 return q, reach, switch, report, values, ok, first, step, method, windings, winding
         if branch is None:
-            q_all, valid, aux = family.solve_flat(T.reshape(-1, 4, 4))
-            shape = (n_cand, n_poses, N_BRANCHES)
-            solutions = (
-                q_all.reshape(*shape, n),
-                valid.reshape(shape),
-                aux.reshape(*shape, AUX_SIZE),
-            )
-            q, reach, magnitude, crossing = gather_closed_form(*solutions, candidates)
+            paths = _all_branch_paths(family, robot, T, candidates, step, threads)
         else:
-            q, reach, magnitude, crossing = _one_branch_paths(family, T, candidates[:, 0])
-    elif method == "numeric":
+            paths = _one_branch_paths(family, robot, T, candidates[:, 0], step)
+        q, reach, switch, report, values, windings, winding = paths
+        ok = _usable(report, values)
+        return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
+    if method == "numeric":
         seeds = np.ascontiguousarray(numeric_seeds(robot)[candidates])
         q, reach, magnitude, crossing = numeric_paths(
             *chain_arrays(robot),
@@ -522,56 +538,208 @@ def _branch_paths(
         channel_kind = np.array([SINGULAR])
     else:
         raise CaseError(f"method must be auto, closed_form or numeric, got {method!r}")
-    switch, report, values, ok, windings, winding = _analysed(
-        robot, q, reach, magnitude, channel_kind, crossing, step
+    switch, report, values, windings, winding = analyse_paths(
+        q, reach, magnitude, channel_kind, crossing, robot.q_min.copy(), robot.q_max.copy(), step
     )
+    ok = _usable(report, values)
     return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
 
 
 def _one_branch_paths(
-    family: IKFamily, T: np.ndarray, branches: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`~trackplan.robots._kernels.gather_closed_form` of one closed-form branch per
-    candidate, solved alone (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch`,
-    the bits of that branch of all eight).
+    family: IKFamily, robot: Robot, T: np.ndarray, branches: np.ndarray, step: np.ndarray
+) -> tuple[np.ndarray, ...]:
+    """:func:`_all_branch_paths` of one closed-form branch per candidate, solved alone
+    (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch`, the bits of that branch
+    of all eight).
 
     Parameters
     ----------
     family
         A closed-form family.
+    robot
+        The robot.
     T
         Tool poses, shape (B, M, 4, 4), m.
     branches
         The branch of each candidate, shape (B,), int.
+    step
+        The step limit per joint, shape (n,), rad.
 
     Returns
     -------
-    q, reach, magnitude, crossing
-        Shapes (B, 1, M, 6), (B, 1, M), (B, 1, M, 3), (B, 1, M).
+    q, reach, switch, report, values, windings, winding
+        As :func:`_all_branch_paths` with K = 1.
     """
     solved = [family.solve_branch(T[b], int(k), with_aux=True) for b, k in enumerate(branches)]
-    q, valid, aux = (np.stack([found[i] for found in solved])[:, :, None] for i in range(3))
+    q_all, valid, aux = (np.stack([found[i] for found in solved])[:, :, None] for i in range(3))
     only = np.zeros((len(branches), 1), dtype=np.int64)
-    return gather_closed_form(q, valid, aux, only)
+    paths = _analysis_arrays(len(branches), 1, T.shape[1], robot.n_dof)
+    limits = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
+    analyse_closed_form(q_all, valid, aux, only, *limits, step, *paths)
+    return paths
 
 
-def _analysed(
+def _all_branch_paths(
+    family: IKFamily,
     robot: Robot,
-    q: np.ndarray,
-    reach: np.ndarray,
-    magnitude: np.ndarray,
-    channel_kind: np.ndarray,
-    crossing: np.ndarray,
+    T: np.ndarray,
+    candidates: np.ndarray,
     step: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`~trackplan.robots._kernels.analyse_paths` of the gathered paths (q in place)
-    and which are usable: switch, report, values, ok (B, K), windings, winding."""
-    switch, report, values, windings, winding = analyse_paths(
-        q, reach, magnitude, channel_kind, crossing, robot.q_min.copy(), robot.q_max.copy(), step
+    threads: int | None,
+) -> tuple[np.ndarray, ...]:
+    """The candidate branches' closed-form joint paths, analysed
+    (:func:`~trackplan.robots._kernels.analyse_closed_form` of all eight branches'
+    solutions), in pieces of about :data:`PIECE_POSES` poses shared among threads.
+
+    Each piece's candidates are solved on all eight branches into the thread's scratch and
+    analysed from there; the pieces write disjoint parts of the outputs, so the results do
+    not depend on the number of threads.
+
+    Parameters
+    ----------
+    family
+        A closed-form family.
+    robot
+        The robot.
+    T
+        Tool poses, shape (B, M, 4, 4), m, C-contiguous.
+    candidates
+        Branches per candidate, shape (B, K), int64.
+    step
+        The step limit per joint, shape (n,), rad.
+    threads
+        Threads to share the pieces among; None: as :class:`ThreadSharing` says.
+
+    Returns
+    -------
+    q, reach, switch, report, values, windings, winding
+        Shapes (B, K, M, n), (B, K, M), (B, K, M), (B, K, N_INT), (B, K, N_FLOAT),
+        (B, K, n), (B, K, n).
+    """
+    n_cand, n_poses = T.shape[:2]
+    paths = _analysis_arrays(n_cand, candidates.shape[1], n_poses, robot.n_dof)
+    size = max(1, PIECE_POSES // n_poses)  # candidates per piece
+    flat = T.reshape(-1, 4, 4)
+    pieces = deque(range(0, n_cand, size))
+    q_min, q_max = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
+
+    def work(timed: bool = True) -> float:  # the thread's CPU time, s (0 untimed)
+        started = time.thread_time() if timed else 0.0
+        rows = size * n_poses
+        q_rows = np.empty((rows, N_BRANCHES, robot.n_dof))
+        valid_rows = np.empty((rows, N_BRANCHES), dtype=np.bool_)
+        aux_rows = np.empty((rows, N_BRANCHES, AUX_SIZE))
+        while True:
+            try:
+                start = pieces.popleft()
+            except IndexError:  # no piece left
+                return time.thread_time() - started if timed else 0.0
+            stop = min(start + size, n_cand)
+            rows = (stop - start) * n_poses
+            out = (q_rows[:rows], valid_rows[:rows], aux_rows[:rows])
+            q_all, valid, aux = family.solve_flat(flat[start * n_poses : stop * n_poses], out=out)
+            shape = (stop - start, n_poses, N_BRANCHES)
+            analyse_closed_form(
+                q_all.reshape(*shape, -1),
+                valid.reshape(shape),
+                aux.reshape(*shape, AUX_SIZE),
+                candidates[start:stop],
+                q_min,
+                q_max,
+                step,
+                *(array[start:stop] for array in paths),
+            )
+
+    n_threads = min(_SHARING.threads() if threads is None else threads, len(pieces))
+    if n_threads < 2:
+        work(timed=False)
+        return paths
+    start = time.perf_counter()
+    with ThreadPoolExecutor(n_threads - 1) as pool:  # its threads end with the block
+        running = [pool.submit(work) for _ in range(n_threads - 1)]
+        try:
+            cpu = work()
+        finally:
+            pieces.clear()  # on an exception here the helpers stop after their piece
+        cpu += sum(future.result() for future in running)
+    if threads is None:
+        _SHARING.note(cpu / (n_threads * (time.perf_counter() - start)))
+    return paths
+
+
+def path_threads() -> int:
+    """The cores this process may run on (``os.sched_getaffinity``): the threads the
+    closed-form path IK on all branches shares its work among while that pays."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
+
+
+EFFICIENT = 0.7
+"""Parallel efficiency (the threads' CPU time over threads × wall time) of a shared call of
+the path IK below which sharing does not pay: a thread waited for a core. Measured on two
+cores: about 0.95 with the second core free, about 0.3–0.4 at a load of 4."""
+
+FIRST_PAUSE = 4
+"""Calls of the path IK run on one thread after a shared call that did not pay; the pause
+doubles while sharing keeps not paying, up to :data:`LAST_PAUSE`."""
+LAST_PAUSE = 64
+
+
+class ThreadSharing:
+    """Whether the path IK shares its work among threads: while sharing pays.
+
+    Threads help only where a core is free. On a busy machine a thread waits for a core
+    and the caller waits for the thread: the call then takes longer than on one thread
+    (the corner case's search took 1.5× its one-thread wall time at a load of 4 on two
+    cores). So each shared call measures its parallel efficiency; below
+    :data:`EFFICIENT`, the next calls run on one thread (:data:`FIRST_PAUSE` calls, twice
+    as many after each further shared call that does not pay, at most
+    :data:`LAST_PAUSE`). The results are the same on any number of threads.
+    """
+
+    def __init__(self) -> None:
+        self.pause = 0  # the last pause, calls
+        self.left = 0  # calls still to run on one thread
+
+    def threads(self) -> int:
+        """Threads for the next call: one during a pause, else :func:`path_threads`."""
+        if self.left > 0:
+            self.left -= 1
+            return 1
+        return path_threads()
+
+    def note(self, efficiency: float) -> None:
+        """Record a shared call's parallel efficiency (in (0, 1])."""
+        if efficiency >= EFFICIENT:
+            self.pause = 0
+        else:
+            self.pause = min(LAST_PAUSE, 2 * self.pause if self.pause else FIRST_PAUSE)
+            self.left = self.pause
+
+
+_SHARING = ThreadSharing()
+"""The process's record of whether sharing the path IK among threads pays."""
+
+
+def _analysis_arrays(n_cand: int, n_k: int, n_poses: int, n: int) -> tuple[np.ndarray, ...]:
+    """Uninitialised outputs of :func:`~trackplan.robots._kernels.analyse_closed_form`."""
+    return (
+        np.empty((n_cand, n_k, n_poses, n)),
+        np.empty((n_cand, n_k, n_poses), dtype=np.bool_),
+        np.empty((n_cand, n_k, n_poses), dtype=np.bool_),
+        np.empty((n_cand, n_k, N_INT), dtype=np.int64),
+        np.empty((n_cand, n_k, N_FLOAT)),
+        np.empty((n_cand, n_k, n), dtype=np.int64),
+        np.empty((n_cand, n_k, n), dtype=np.int64),
     )
+
+
+def _usable(report: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Which analysed branches are usable: reachable everywhere, no switch, inside the
+    limits; shape (B, K), bool."""
     ok = (report[..., I_N_UNREACH] == 0) & (report[..., I_N_SWITCH] == 0)
-    ok &= values[..., F_MARGIN] >= 0.0
-    return switch, report, values, ok, windings, winding
+    return ok & (values[..., F_MARGIN] >= 0.0)
 
 
 def _candidate_branches(branch: int | np.ndarray | None, n_cand: int) -> np.ndarray:

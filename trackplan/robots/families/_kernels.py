@@ -254,7 +254,7 @@ def _opw_joints(
         q[5] = sg[5] * wrap(th6 + math.pi)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def opw_solve(
     g: np.ndarray,
     tail_inv: np.ndarray,
@@ -810,7 +810,7 @@ def _ur_assemble(
         _ur_joints(g, a, br, q[br], theta)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def ur_solve(
     g: np.ndarray,
     tail_inv: np.ndarray,

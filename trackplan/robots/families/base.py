@@ -82,11 +82,17 @@ class IKFamily(Protocol):
         ...
 
     def solve_flat(
-        self, T_base_tool: np.ndarray, *, with_aux: bool = True
+        self,
+        T_base_tool: np.ndarray,
+        *,
+        with_aux: bool = True,
+        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """All branches of a flat batch of tool poses (N, 4, 4).
 
         ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
+        ``out``: C-contiguous arrays (q, valid, aux) of the shapes below to write into
+        and return instead of new ones (with_aux is then ignored).
 
         Returns
         -------
@@ -155,16 +161,24 @@ class FusedClosedForm:
     _tail_inv: np.ndarray
 
     def solve_flat(
-        self, T_base_tool: np.ndarray, *, with_aux: bool = True
+        self,
+        T_base_tool: np.ndarray,
+        *,
+        with_aux: bool = True,
+        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """All eight branches of poses (N, 4, 4), m: q (N, 8, 6) rad, valid (N, 8) bool,
         aux (N, 8, AUX_SIZE); ``with_aux=False`` skips the branch quantities (aux is then
-        (1, 8, AUX_SIZE) scratch)."""
+        (1, 8, AUX_SIZE) scratch); ``out`` (q, valid, aux) of those shapes are written
+        instead of new arrays (the kernel releases the GIL: threads may solve at once)."""
         T = np.ascontiguousarray(T_base_tool, dtype=float)
         n_poses = T.shape[0]
-        q = np.empty((n_poses, N_BRANCHES, 6))
-        valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
-        aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
+        if out is not None:
+            q, valid, aux = out
+        else:
+            q = np.empty((n_poses, N_BRANCHES, 6))
+            valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
+            aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
         self._all_branches(self._geometry, self._tail_inv, T, q, valid, aux)
         return q, valid, aux
 

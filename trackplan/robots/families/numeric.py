@@ -38,7 +38,11 @@ class NumericFamily:
         return f"seed {branch}"
 
     def solve_flat(
-        self, T_base_tool: np.ndarray, *, with_aux: bool = True
+        self,
+        T_base_tool: np.ndarray,
+        *,
+        with_aux: bool = True,
+        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Not available: numeric IK needs seeds (use :mod:`trackplan.robots.ik_numeric`)."""
         raise CaseError(
