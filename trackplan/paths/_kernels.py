@@ -4,7 +4,9 @@
 The Python API is :class:`trackplan.paths.projection.PieceIndex`; the table layout is that
 of :class:`trackplan.paths.piece_table.PieceTable`. :func:`blend_parameter` is the curve
 parameter of a quintic blend at arc lengths
-(:meth:`trackplan.paths.geometry.QuinticBlend.parameter`).
+(:meth:`trackplan.paths.geometry.QuinticBlend.parameter`); :func:`piece_points` the piece,
+position and tangent of a path's lines and arcs at arc lengths
+(:func:`trackplan.paths.pieces.evaluate_points`).
 """
 
 from __future__ import annotations

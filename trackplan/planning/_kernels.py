@@ -10,9 +10,11 @@
   the results are the same to the bit.
 - :func:`task_frames`: the checker's tool points, velocities, speeds and tool axes in the
   definition frame, from the tool poses in one pass (numpy would make a strided copy, a
-  matrix product and a temporary per step). Each product is summed in the order of its
-  terms, without fused multiply-adds: machine-independent bits, which may differ from
-  numpy's BLAS products in the last bit.
+  matrix product and a temporary per step), and the tool's points between the samples
+  from the joints (FK by :func:`trackplan.robots._kernels.chain_block`, without building
+  their poses). Each product is summed in the order of its terms, without fused
+  multiply-adds: machine-independent bits, which may differ from numpy's BLAS products in
+  the last bit.
 """
 
 from __future__ import annotations
