@@ -11,6 +11,7 @@ from tests.conftest import CASES
 from trackplan.frames import tool_poses
 from trackplan.jointpath import _rotations
 from trackplan.robots.path_ik import branch_joints
+from trackplan.tool import SpinProfile, ToolOrientation
 
 
 def test_poses_of_a_tool_in_one_orientation_equal_those_of_every_point():
@@ -24,6 +25,24 @@ def test_poses_of_a_tool_in_one_orientation_equal_those_of_every_point():
     np.testing.assert_array_equal(every, np.broadcast_to(once, every.shape))
     expected = tool_poses(joint_path.placement, sample.position, every)
     np.testing.assert_allclose(joint_path.poses(s), expected, rtol=0, atol=1e-15)
+
+
+def test_a_held_rotation_is_computed_once_per_spec_and_spin():
+    """Plans of a case with a tool held in the part frame read one rotation; another spin
+    value has its own, that of a rotation computed at every point with that spin."""
+    case = trackplan.load_case(CASES / "paper-corner.yaml")
+    first = trackplan.plan_placement(case, case.bounds.example).joint_path
+    second = trackplan.plan_placement(case, case.bounds.example + 0.01).joint_path
+    s = np.linspace(0.0, first.length, 11)
+    sample = first.geometry.planned.sample(s)
+    held = _rotations(first.tool, sample.s, sample.tangent)
+    assert _rotations(second.tool, sample.s[::-1], sample.tangent[::-1]) is held
+    assert not held.flags.writeable
+    turned = ToolOrientation(case.task.tool, SpinProfile(np.array([0.3]), first.length))
+    other = _rotations(turned, sample.s, sample.tangent)
+    assert other is not held
+    every = turned.rotations(sample.s, sample.tangent)
+    np.testing.assert_array_equal(every, np.broadcast_to(other, every.shape))
 
 
 def test_a_seam_frame_tool_turns_with_the_path():

@@ -22,7 +22,7 @@ from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import PathIK, branch_joints_along, solve_path_ik
 from trackplan.status import Status
 from trackplan.stencils import stencil_derivatives, stencil_points
-from trackplan.tool import ToolFrame, ToolOrientation
+from trackplan.tool import ToolFrame, ToolOrientation, ToolSpec
 
 STENCIL_FRACTION = 0.1
 """Stencil spacing as a share of the grid step: small against the scale on which the
@@ -216,12 +216,26 @@ class JointPath:
         return stencil_derivatives(q, offset, spacing)
 
 
+_HELD_ROTATIONS: weakref.WeakKeyDictionary[ToolSpec, dict[float, np.ndarray]] = (
+    weakref.WeakKeyDictionary()
+)
+"""The one ``R_part_tool`` of a tool held in the part frame, per spec and spin value
+(read-only): every plan of a case with such a tool reads the same rotation."""
+
+
 def _rotations(tool: ToolOrientation, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:
     """``R_part_tool`` at arc lengths ``s`` (M,) with planned tangents (M, 3): shape
     (M, 3, 3), or one (3, 3) where the tool holds one orientation along the whole path
-    (part frame, constant spin): the rotation every row would repeat, computed once."""
+    (part frame, constant spin): the rotation every row would repeat, computed once per
+    spec and spin value (it depends on nothing else)."""
     if tool.spec.frame is ToolFrame.PART and len(tool.spin.coefficients) == 1 and len(s):
-        return tool.rotations(s[:1], tangent[:1])[0]
+        held = _HELD_ROTATIONS.setdefault(tool.spec, {})
+        spin = float(tool.spin.coefficients[0])
+        if spin not in held:
+            rotation = tool.rotations(s[:1], tangent[:1])[0]
+            rotation.flags.writeable = False
+            held[spin] = rotation
+        return held[spin]
     return tool.rotations(s, tangent)
 
 

@@ -96,10 +96,13 @@ def test_samples_are_at_their_arc_length(mixed_path):
 
 
 def test_points_are_the_samples_positions_and_tangents_to_the_bit(mixed_path):
-    """Lines, arcs, blends and fitted pieces; in order (slices) and shuffled (masks)."""
+    """Lines, arcs, blends and fitted pieces; in order and shuffled; on the junctions and
+    at NaN."""
     kinds = {piece.kind for piece in mixed_path.pieces}
     assert kinds == {"line", "arc", "blend"}
+    junctions = [piece.s_start for piece in mixed_path.pieces]
     s = np.linspace(-1e-10, mixed_path.length + 1e-10, 20_001)
+    s = np.sort(np.concatenate([s, junctions, [np.nan]]))
     shuffled = np.random.default_rng(5).permutation(s)
     for values in (s, shuffled):
         sample = mixed_path.sample(values)

@@ -123,19 +123,3 @@ def test_locate_in_blocks_equals_locate_at_once(monkeypatch):
     blocks = locate_on_nominal(nominal, points, velocity, 1e-3)
     for a, b in zip(whole, blocks, strict=True):
         np.testing.assert_array_equal(a, b)
-
-
-def test_periods_all_in_halves_give_the_midpoints_of_the_general_split():
-    """When no period needs more than its midpoint, the midpoints are those the general
-    split computes (to the bit); one long period makes the rest no different."""
-    rng = np.random.default_rng(3)
-    q = np.cumsum(rng.normal(scale=1e-3, size=(400, 6)), axis=0)
-    points = np.cumsum(rng.uniform(0.0, 1e-4, size=(400, 3)), axis=0)
-    q_mid, t_mid = tracking.between_samples(q, points, 1e-3)
-    assert q_mid.shape == (399, 6)
-    np.testing.assert_array_equal(t_mid, np.arange(399) + 0.5)
-    far = np.vstack([points, points[-1] + [0.01, 0.0, 0.0]])  # 10 mm: 40 parts
-    q_far, t_far = tracking.between_samples(np.vstack([q, q[-1] + 0.01]), far, 1e-3)
-    assert len(q_far) == 399 + 39
-    np.testing.assert_array_equal(q_far[:399], q_mid)
-    np.testing.assert_array_equal(t_far[:399], t_mid)

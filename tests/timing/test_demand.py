@@ -114,6 +114,23 @@ def test_vectorised_bounds_match_the_scalar_ones(puma):
     np.testing.assert_allclose(distances, np.where(np.array(expected) > 0, expected, np.inf))
 
 
+@pytest.mark.parametrize(("first", "stop"), [(0, 51), (0, 7), (12, 40), (50, 51)])
+def test_a_part_is_the_demand_of_its_rows(first, stop):
+    """A part reads its zone's magnitudes: the same as a demand built from its rows."""
+    s = np.linspace(0.0, 0.1, 51)
+    rng = np.random.default_rng(7)
+    demand = ZoneDemand(s, *rng.normal(size=(3, 51, 6)))
+    part = demand.part(first, stop)
+    built = ZoneDemand(s[first:stop], *(d[first:stop] for d in (demand.d1, demand.d2, demand.d3)))
+    for name in ("s", "d1", "d2", "d3", "peak_array"):
+        np.testing.assert_array_equal(getattr(part, name), getattr(built, name))
+    for got, expected in zip(part.absolute, built.absolute, strict=True):
+        np.testing.assert_array_equal(got, expected)
+    for backward in (0, 1):
+        np.testing.assert_array_equal(part.running_maxima(backward), built.running_maxima(backward))
+    np.testing.assert_array_equal(part.peaks(0.03, 0.05), built.peaks(0.03, 0.05))
+
+
 def test_stretch_peaks_are_the_maxima_over_the_stretch():
     s = np.linspace(0.0, 0.1, 51)
     rng = np.random.default_rng(5)

@@ -4,7 +4,9 @@
 The Python API is :class:`trackplan.paths.projection.PieceIndex`; the table layout is that
 of :class:`trackplan.paths.piece_table.PieceTable`. :func:`blend_parameter` is the curve
 parameter of a quintic blend at arc lengths
-(:meth:`trackplan.paths.geometry.QuinticBlend.parameter`).
+(:meth:`trackplan.paths.geometry.QuinticBlend.parameter`); :func:`piece_points` the piece,
+position and tangent of a path's lines and arcs at arc lengths
+(:func:`trackplan.paths.pieces.evaluate_points`).
 """
 
 from __future__ import annotations
@@ -465,3 +467,93 @@ def blend_parameter(
                 break
         out[m] = u
     return out
+
+
+LINE_KIND = 0
+ARC_KIND = 1
+OTHER_KIND = 2
+"""Piece kinds of :func:`piece_points`: its own arithmetic for lines and arcs; any other
+piece (a blend) is left to the caller."""
+
+
+@njit(cache=True)
+def piece_points(
+    s: np.ndarray,
+    s_start: np.ndarray,
+    length: np.ndarray,
+    kind: np.ndarray,
+    origin: np.ndarray,
+    first: np.ndarray,
+    second: np.ndarray,
+    radius: np.ndarray,
+    position: np.ndarray,
+    tangent: np.ndarray,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """Kernel: the piece of each arc length, and the position and unit tangent on lines and arcs.
+
+    The piece of ``s[m]`` is the last whose start is ≤ it (the first one below the first
+    start, the last one for NaN: numpy's ``searchsorted(side="right") - 1`` clipped); its
+    arc length ``σ`` is ``s[m] - s_start`` clipped to [0, length]. A line (``origin`` its
+    start, ``first`` its direction) gives ``origin + σ first`` and ``first``; an arc
+    (``origin`` its centre, ``first`` and ``second`` its e1 and e2, ``radius``) gives
+    ``origin + radius (cos φ e1 + sin φ e2)`` and ``cos φ e2 − sin φ e1``, φ = σ / radius:
+    the operations of :meth:`trackplan.paths.geometry.Line.point_tangent` and
+    :meth:`~trackplan.paths.geometry.Arc.point_tangent`, elementwise, so the same bits.
+    Rows on other pieces are not written.
+
+    Parameters
+    ----------
+    s
+        Arc lengths, shape (M,), m.
+    s_start, length
+        Start and length of each piece, shape (P,), m (``s_start`` increasing).
+    kind
+        :data:`LINE_KIND`, :data:`ARC_KIND` or :data:`OTHER_KIND` per piece, shape (P,).
+    origin, first, second
+        Shape (P, 3) each, as above (unused entries any value).
+    radius
+        Shape (P,), m.
+    position, tangent
+        Outputs, shape (M, 3) each.
+
+    Returns
+    -------
+    numpy.ndarray
+        The piece of each arc length, shape (M,), int.
+    """
+    n_pieces = s_start.size
+    index = np.empty(s.size, dtype=np.int64)
+    for m in range(s.size):
+        x = s[m]
+        if x != x:
+            k = n_pieces - 1
+        else:
+            lo, hi = 0, n_pieces
+            while lo < hi:  # the first start above x
+                mid = (lo + hi) // 2
+                if s_start[mid] <= x:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            k = max(lo - 1, 0)
+        index[m] = k
+        if kind[k] == OTHER_KIND:
+            continue
+        sigma = x - s_start[k]
+        if sigma < 0.0:
+            sigma = 0.0
+        elif sigma > length[k]:
+            sigma = length[k]
+        if kind[k] == LINE_KIND:
+            for j in range(3):
+                position[m, j] = origin[k, j] + sigma * first[k, j]
+                tangent[m, j] = first[k, j]
+        else:
+            phi = sigma / radius[k]
+            c = math.cos(phi)
+            n = math.sin(phi)
+            for j in range(3):
+                radial = c * first[k, j] + n * second[k, j]
+                position[m, j] = origin[k, j] + radius[k] * radial
+                tangent[m, j] = c * second[k, j] - n * first[k, j]
+    return index

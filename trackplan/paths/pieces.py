@@ -8,7 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.paths.geometry import Curve, CurveJet
+from trackplan.paths._kernels import ARC_KIND, LINE_KIND, OTHER_KIND, piece_points
+from trackplan.paths.geometry import Arc, Curve, CurveJet, Line
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,13 +86,58 @@ def evaluate_pieces(pieces: Sequence[Piece], s: np.ndarray) -> tuple[CurveJet, n
     return CurveJet(*fields), index
 
 
+@dataclass(frozen=True, eq=False)
+class PointTable:
+    """A chain of pieces laid out for :func:`~trackplan.paths._kernels.piece_points`.
+
+    Attributes
+    ----------
+    s_start, length
+        Start and length of each piece, shape (P,), m.
+    kind
+        Line, arc or other (a blend), shape (P,), int (the kernel's kinds).
+    origin, first, second
+        A line's start and direction; an arc's centre, e1 and e2; shape (P, 3) each.
+    radius
+        An arc's radius, shape (P,), m.
+    """
+
+    s_start: np.ndarray
+    length: np.ndarray
+    kind: np.ndarray
+    origin: np.ndarray
+    first: np.ndarray
+    second: np.ndarray
+    radius: np.ndarray
+
+    @classmethod
+    def from_pieces(cls, pieces: Sequence[Piece]) -> PointTable:
+        """The table of consecutive pieces, as made by :func:`chain`."""
+        n = len(pieces)
+        kind = np.full(n, OTHER_KIND, dtype=np.int64)
+        origin, first, second = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+        radius = np.ones(n)
+        for k, piece in enumerate(pieces):
+            curve = piece.curve
+            if isinstance(curve, Line):
+                kind[k], origin[k], first[k] = LINE_KIND, curve.start, curve.direction
+            elif isinstance(curve, Arc):
+                kind[k], origin[k], radius[k] = ARC_KIND, curve.center, curve.radius
+                first[k], second[k] = curve.e1, curve.e2
+        s_start = np.array([piece.s_start for piece in pieces])
+        length = np.array([piece.length for piece in pieces])
+        return cls(s_start, length, kind, origin, first, second, radius)
+
+
 def evaluate_points(
-    pieces: Sequence[Piece], s: np.ndarray
+    pieces: Sequence[Piece], s: np.ndarray, table: PointTable | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position and unit tangent of a chain of pieces at path arc lengths ``s``.
 
     The first two fields of :func:`evaluate_pieces`, with the same values, without the
-    curvature terms.
+    curvature terms: lines and arcs in one compiled pass
+    (:func:`~trackplan.paths._kernels.piece_points`), each blend's rows by its own
+    :meth:`~trackplan.paths.geometry.QuinticBlend.point_tangent`.
 
     Parameters
     ----------
@@ -99,6 +145,8 @@ def evaluate_points(
         Consecutive pieces, as made by :func:`chain`.
     s
         Arc lengths (M,), m, within [0, total length].
+    table
+        The pieces' :class:`PointTable`, when kept; default: built.
 
     Returns
     -------
@@ -109,15 +157,22 @@ def evaluate_points(
     piece
         Index of the piece of each sample, shape (M,).
     """
-    s = np.asarray(s, dtype=float)
-    index, rows = _piece_rows(pieces, s)
+    s = np.ascontiguousarray(s, dtype=float).ravel()
+    t = PointTable.from_pieces(pieces) if table is None else table
     position = np.empty((s.size, 3))
     tangent = np.empty((s.size, 3))
-    for piece, selected in zip(pieces, rows, strict=True):
-        sigma = np.clip(s[selected] - piece.s_start, 0.0, piece.length)
-        if sigma.size == 0:
-            continue
-        position[selected], tangent[selected] = piece.curve.point_tangent(sigma)
+    index = piece_points(
+        s, t.s_start, t.length, t.kind, t.origin, t.first, t.second, t.radius, position, tangent
+    )
+    other = np.flatnonzero(t.kind[index] == OTHER_KIND)  # rows on blends, in order
+    if other.size:
+        on = index[other]
+        order = np.argsort(on, kind="stable")
+        rows, on = other[order], on[order]
+        for group in np.split(rows, np.flatnonzero(np.diff(on)) + 1):
+            piece = pieces[int(index[group[0]])]
+            sigma = np.clip(s[group] - piece.s_start, 0.0, piece.length)
+            position[group], tangent[group] = piece.curve.point_tangent(sigma)
     return position, tangent, index
 
 

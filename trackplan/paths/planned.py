@@ -28,7 +28,7 @@ from trackplan.paths.blending import (
 from trackplan.paths.fitting import fit_polyline
 from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, Curve, Line, Primitive, turning_angle
 from trackplan.paths.nominal import NominalPath
-from trackplan.paths.pieces import Piece, chain, evaluate_pieces, evaluate_points
+from trackplan.paths.pieces import Piece, PointTable, chain, evaluate_pieces, evaluate_points
 from trackplan.paths.specs import PointsSpec
 
 #: Share of ρ that a blend of exact lines and arcs may use.
@@ -163,8 +163,13 @@ class Path:
             If a value lies outside [0, length] by more than 1e-9 m.
         """
         s = self._clipped(s)
-        position, tangent, _ = evaluate_points(self.pieces, s)
+        position, tangent, _ = evaluate_points(self.pieces, s, self._point_table)
         return s, position, tangent
+
+    @cached_property
+    def _point_table(self) -> PointTable:
+        """The pieces laid out for :meth:`points` (built once)."""
+        return PointTable.from_pieces(self.pieces)
 
     def _clipped(self, s: np.ndarray) -> np.ndarray:
         s = np.atleast_1d(np.asarray(s, dtype=float))

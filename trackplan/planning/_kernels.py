@@ -10,15 +10,19 @@
   the results are the same to the bit.
 - :func:`task_frames`: the checker's tool points, velocities, speeds and tool axes in the
   definition frame, from the tool poses in one pass (numpy would make a strided copy, a
-  matrix product and a temporary per step). Each product is summed in the order of its
-  terms, without fused multiply-adds: machine-independent bits, which may differ from
-  numpy's BLAS products in the last bit.
+  matrix product and a temporary per step), and the tool's points between the samples
+  from the joints (FK by :func:`trackplan.robots._kernels.chain_block`, without building
+  their poses). Each product is summed in the order of its terms, without fused
+  multiply-adds: machine-independent bits, which may differ from numpy's BLAS products in
+  the last bit.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from trackplan.robots._kernels import FK_BLOCK, chain_block
 
 
 @njit(cache=True)
@@ -190,15 +194,41 @@ def peak_use(
     return peak, row
 
 
+@njit(cache=True, inline="always")
+def _tool_point(T: np.ndarray, tail: np.ndarray, r: int, b: int) -> float:  # pragma: no cover
+    """Kernel: row r of the tool point of configuration b of a :func:`chain_block` block,
+    summed as :func:`~trackplan.robots._kernels.fk_flat` sums it."""
+    point = T[4 * r, b] * tail[0, 3] + T[4 * r + 1, b] * tail[1, 3] + T[4 * r + 2, b] * tail[2, 3]
+    return point + T[4 * r + 3, b]
+
+
 @njit(cache=True)
 def task_frames(
-    T_base_tool: np.ndarray, T_base_part: np.ndarray, sample_time: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover
-    """Kernel: the tool's points, velocities, speeds and x and z axes in the definition frame.
+    T_base_tool: np.ndarray,
+    T_base_part: np.ndarray,
+    sample_time: float,
+    chain: np.ndarray,
+    tail: np.ndarray,
+    q: np.ndarray,
+    chord_step: float,
+    max_parts: int,
+) -> tuple[
+    np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray
+]:  # pragma: no cover - compiled
+    """Kernel: the tool's points, velocities, speeds and x and z axes in the definition frame,
+    and its points between the samples.
 
     With ``R``, ``t`` the rotation and origin of ``T_base_part``: ``p = Rᵀ (T[:3, 3] - t)``,
     ``x = Rᵀ T[:3, 0]``, ``z = Rᵀ T[:3, 2]`` per pose, the velocity the backward difference
     of ``p`` over Ts (0 at the first sample) and the speed its length.
+
+    Between samples k and k + 1 the joints are interpolated linearly at the fractions j / m_k
+    (j = 1 … m_k − 1) of the period, m_k = ⌈|p_k+1 − p_k| / chord_step⌉ clipped to
+    [2, max_parts] (2 where the chord is NaN): the tool's points there are the FK of
+    ``q_k + (j / m_k)(q_k+1 − q_k)`` (:func:`trackplan.robots._kernels.chain_block`, the
+    arithmetic of :func:`~trackplan.robots._kernels.fk_flat` over blocks of the same
+    configurations) placed in the definition frame as above: the same bits as FK of the
+    interpolated joints and the points of their poses, without the poses.
 
     Parameters
     ----------
@@ -208,6 +238,15 @@ def task_frames(
         Placement of the definition frame, shape (4, 4).
     sample_time
         Ts, s.
+    chain, tail
+        The robot's kernel chain (n, 4, 4) and tail (4, 4)
+        (:attr:`trackplan.robots.model.Robot.kernel_chain`).
+    q
+        Joint positions at the samples, shape (N, n), rad (``T_base_tool`` is their FK).
+    chord_step
+        Largest chord between checked points, m (> 0).
+    max_parts
+        Most parts of one period.
 
     Returns
     -------
@@ -217,6 +256,10 @@ def task_frames(
         Shape (N,), m/s.
     x_axis, z_axis
         Shape (N, 3) each.
+    between
+        The tool's points between the samples, shape (K,  3), m (none when N < 2).
+    t_between
+        Their times in periods from the first sample, ``k + j / m_k``, shape (K,).
     """
     n = T_base_tool.shape[0]
     points = np.empty((n, 3))
@@ -240,4 +283,47 @@ def task_frames(
             velocity[k, j] = (points[k, j] - points[before, j]) / sample_time
         v0, v1, v2 = velocity[k, 0], velocity[k, 1], velocity[k, 2]
         speed[k] = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-    return points, velocity, speed, x_axis, z_axis
+
+    # the parts of each period, from its chord
+    n_periods = max(n - 1, 0)
+    parts = np.empty(n_periods, dtype=np.int64)
+    n_between = 0
+    for k in range(n_periods):
+        c0 = points[k + 1, 0] - points[k, 0]
+        c1 = points[k + 1, 1] - points[k, 1]
+        c2 = points[k + 1, 2] - points[k, 2]
+        m_k = np.ceil(np.sqrt(c0 * c0 + c1 * c1 + c2 * c2) / chord_step)
+        if m_k != m_k or m_k < 2.0:
+            m_k = 2.0
+        elif m_k > max_parts:
+            m_k = float(max_parts)
+        parts[k] = int(m_k)
+        n_between += parts[k] - 1
+    between = np.empty((n_between, 3))
+    t_between = np.empty(n_between)
+    n_dof = q.shape[1]
+    angle = np.zeros((n_dof, FK_BLOCK))
+    cos = np.empty((n_dof, FK_BLOCK))
+    sin = np.empty((n_dof, FK_BLOCK))
+    T_block = np.empty((12, FK_BLOCK))
+    k = 0  # the period of the next point and its index j in it
+    j = 1
+    for start in range(0, n_between, FK_BLOCK):
+        m = min(FK_BLOCK, n_between - start)
+        for b in range(m):
+            fraction = j / parts[k]
+            t_between[start + b] = k + fraction
+            for i in range(n_dof):
+                angle[i, b] = q[k, i] + fraction * (q[k + 1, i] - q[k, i])
+            j += 1
+            if j == parts[k]:
+                k += 1
+                j = 1
+        chain_block(chain, angle, m, cos, sin, T_block)
+        for b in range(m):  # the pose's point as fk_flat, then as the samples' above
+            d0 = _tool_point(T_block, tail, 0, b) - R[0, 3]
+            d1 = _tool_point(T_block, tail, 1, b) - R[1, 3]
+            d2 = _tool_point(T_block, tail, 2, b) - R[2, 3]
+            for c in range(3):
+                between[start + b, c] = d0 * R[0, c] + d1 * R[1, c] + d2 * R[2, c]
+    return points, velocity, speed, x_axis, z_axis, between, t_between

@@ -18,9 +18,13 @@ from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
 from trackplan.planning.result import CheckReport, Violation
 from trackplan.planning.tool_zones import nominal_rotations
-from trackplan.planning.tracking import between_samples, jump_allowance, locate_on_nominal
+from trackplan.planning.tracking import (
+    BETWEEN_STEP,
+    MAX_BETWEEN_PER_PERIOD,
+    jump_allowance,
+    locate_on_nominal,
+)
 from trackplan.robots.dynamics.rne import inverse_dynamics
-from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 from trackplan.tool import SpinMode, ToolFrame, ToolSpec
 
@@ -269,9 +273,21 @@ def _check_task(
     robot, q, sample_time = motion.robot, motion.q, motion.sample_time
     T_base_part = np.ascontiguousarray(ref.T_base_part, dtype=float)
     # the tool's points, velocities and speeds, and its x and z axes (all the tool checks
-    # read), in the definition frame: one compiled pass over the poses
-    p_part, velocity, speed, x_part, z_part = _kernels.task_frames(
-        motion.T_base_tool, T_base_part, sample_time
+    # read), in the definition frame; and its points between the samples, along the
+    # joint-space interpolation a controller follows (each period in parts of at most
+    # BETWEEN_STEP ρ of chord, at least two): one compiled pass over the poses and joints
+    chain, tail = robot.kernel_chain
+    q_read = np.ascontiguousarray(q).view()
+    q_read.flags.writeable = False  # one compiled version whoever made the samples
+    p_part, velocity, speed, x_part, z_part, p_between, t_between = _kernels.task_frames(
+        motion.T_base_tool,
+        T_base_part,
+        sample_time,
+        chain,
+        tail,
+        q_read,
+        BETWEEN_STEP * ref.tolerance,
+        MAX_BETWEEN_PER_PERIOD,
     )
     t = np.arange(len(q)) * sample_time
     violations: list[Violation] = []
@@ -286,12 +302,8 @@ def _check_task(
         violations.append(
             _violation("tracking", None, t, distance, distance / ref.tolerance, ref.tolerance)
         )
-    # ... and between the samples, along the joint-space interpolation a controller follows
-    q_between, t_between = between_samples(q, p_part, ref.tolerance)
-    if len(q_between):
-        T_between = forward_kinematics(robot, q_between)
-        T_between.flags.writeable = False  # the samples' poses' type: one compiled version
-        p_between = _kernels.task_frames(T_between, T_base_part, sample_time)[0]
+    # ... and between the samples
+    if len(p_between):
         d_between = ref.nominal.index.candidates(p_between, 0.0).nearest  # distances only
         worst = max(worst, float(d_between.max()))
         if d_between.max() > ref.tolerance * (1 + RELATIVE_SLACK) and not violations_of(

@@ -117,50 +117,16 @@ def jump_allowance(nominal: NominalPath, tolerance: float) -> np.ndarray:
 
 
 BETWEEN_STEP = 0.25
-"""Largest chord between checked points, as a fraction of ρ (see :func:`between_samples`)."""
+"""Largest chord between the tool points the checker takes inside one controller period, as
+a fraction of ρ.
+
+A controller interpolating the joint positions linearly at Ts moves the tool along a curve
+between two samples, not through the samples only. Each period k → k+1 is split into
+m_k = max(2, ceil(|p_k+1 − p_k| / (BETWEEN_STEP · ρ))) equal parts of q, and the tool's
+points at the interior ones are checked: at least the midpoint, and points no more than ρ/4
+of chord apart (a period that jumps across a corner is sampled densely enough to see it).
+The checker computes them with the samples' task frames in one compiled pass
+(:func:`trackplan.planning._kernels.task_frames`)."""
 
 MAX_BETWEEN_PER_PERIOD = 10_000
-"""Most points checked inside one controller period."""
-
-
-def between_samples(
-    q: np.ndarray, points: np.ndarray, tolerance: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Joint positions inside each controller period where the tool path must be checked.
-
-    A controller interpolating the joint positions linearly at Ts moves the tool along a
-    curve between two samples, not through the samples only. Each period k → k+1 is split
-    into m_k = max(2, ceil(|p_k+1 − p_k| / (BETWEEN_STEP · ρ))) equal parts of q, and the
-    interior points are returned: at least the midpoint, and points no more than ρ/4 of
-    chord apart (a period that jumps across a corner is sampled densely enough to see it).
-
-    Parameters
-    ----------
-    q
-        Joint positions at the samples, shape (N, n), rad.
-    points
-        Tool points at the samples, shape (N, 3), m.
-    tolerance
-        ρ, m.
-
-    Returns
-    -------
-    q_between
-        Shape (K, n), rad.
-    t_between
-        Their times in periods from the first sample (k + j/m_k), shape (K,).
-    """
-    if len(q) < 2:
-        return np.zeros((0, q.shape[1] if q.ndim == 2 else 0)), np.zeros(0)
-    chord = vector_norms(np.diff(points, axis=0))
-    if chord.max() <= 2 * BETWEEN_STEP * tolerance:  # (NaN: False) every period in halves
-        midpoints = q[:-1] + 0.5 * (q[1:] - q[:-1])  # as below with the fraction 1/2
-        return midpoints, np.arange(len(chord)) + 0.5
-    parts = np.ceil(chord / (BETWEEN_STEP * tolerance))
-    parts = np.clip(np.nan_to_num(parts, nan=2.0), 2, MAX_BETWEEN_PER_PERIOD).astype(int)
-    period = np.repeat(np.arange(len(parts)), parts - 1)  # (K,)
-    first = np.cumsum(parts - 1) - (parts - 1)  # index of each period's first interior point
-    j = np.arange(len(period)) - np.repeat(first, parts - 1) + 1
-    fraction = j / parts[period]
-    q_between = q[period] + fraction[:, None] * (q[period + 1] - q[period])
-    return q_between, period + fraction
+"""Most parts of one controller period (see :data:`BETWEEN_STEP`)."""

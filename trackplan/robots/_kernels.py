@@ -89,13 +89,73 @@ def sincos(x: float) -> tuple[float, float]:  # pragma: no cover - compiled
     return cos_x, sin_x
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def chain_block(
+    chain: np.ndarray,
+    angle: np.ndarray,
+    m: int,
+    cos: np.ndarray,
+    sin: np.ndarray,
+    T: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Kernel: ``T ← Π (C_i · Rz(θ_i))`` of a block of :data:`FK_BLOCK` configurations.
+
+    ``angle`` (n, FK_BLOCK) holds joint i of configuration b at ``[i, b]`` (the first ``m``
+    columns are used); ``cos`` and ``sin`` (n, FK_BLOCK) are scratch; ``T`` (12, FK_BLOCK)
+    receives row r, column c of configuration b's (3, 4) transform at ``[4 r + c, b]``.
+    The sines and cosines by :func:`sincos` (libm for a block with an angle beyond
+    :data:`REDUCTION_LIMIT`), each product ``T ← T · C · Rz(θ)`` over the block's
+    configurations in a flat loop that vectorises.
+    """
+    n_dof = angle.shape[0]
+    exotic = False
+    for i in range(n_dof):
+        for b in range(m):
+            if not abs(angle[i, b]) <= REDUCTION_LIMIT:
+                exotic = True
+    for i in range(n_dof):
+        x_i = angle[i]
+        cos_i = cos[i]
+        sin_i = sin[i]
+        for b in range(FK_BLOCK):
+            cos_i[b], sin_i[b] = sincos(x_i[b])
+        if exotic:
+            for b in range(m):
+                cos_i[b] = math.cos(x_i[b])
+                sin_i[b] = math.sin(x_i[b])
+    for e in range(12):
+        value = 1.0 if e == 0 or e == 5 or e == 10 else 0.0
+        for b in range(FK_BLOCK):
+            T[e, b] = value
+    for i in range(n_dof):
+        C = chain[i]
+        c00, c01, c02, c03 = C[0, 0], C[0, 1], C[0, 2], C[0, 3]
+        c10, c11, c12, c13 = C[1, 0], C[1, 1], C[1, 2], C[1, 3]
+        c20, c21, c22, c23 = C[2, 0], C[2, 1], C[2, 2], C[2, 3]
+        cos_i = cos[i]
+        sin_i = sin[i]
+        for r in range(3):
+            T0 = T[4 * r]
+            T1 = T[4 * r + 1]
+            T2 = T[4 * r + 2]
+            T3 = T[4 * r + 3]
+            for b in range(FK_BLOCK):
+                t0 = T0[b]
+                t1 = T1[b]
+                t2 = T2[b]
+                x = t0 * c00 + t1 * c10 + t2 * c20
+                y = t0 * c01 + t1 * c11 + t2 * c21
+                T3[b] += t0 * c03 + t1 * c13 + t2 * c23
+                T2[b] = t0 * c02 + t1 * c12 + t2 * c22
+                T0[b] = x * cos_i[b] + y * sin_i[b]
+                T1[b] = y * cos_i[b] - x * sin_i[b]
+
+
 @njit(cache=True, error_model="numpy")
 def fk_flat(chain: np.ndarray, tail: np.ndarray, q: np.ndarray) -> np.ndarray:  # pragma: no cover
     """Kernel: tool poses of a flat batch, q (N, n) → T (N, 4, 4).
 
-    Blocks of :data:`FK_BLOCK` poses: the sines and cosines of a joint (:func:`sincos`,
-    libm for angles beyond :data:`REDUCTION_LIMIT`) and each product ``T ← T · C · Rz(θ)``
-    of :func:`chain_step` run over the block's poses, rows of ``T`` one per entry.
+    Blocks of :data:`FK_BLOCK` poses (:func:`chain_block`), then the tail.
     """
     n_poses, n_dof = q.shape
     out = np.empty((n_poses, 4, 4))
@@ -105,49 +165,10 @@ def fk_flat(chain: np.ndarray, tail: np.ndarray, q: np.ndarray) -> np.ndarray:  
     T = np.empty((12, FK_BLOCK))  # T[4 r + c, b]: row r, column c of pose b's transform
     for start in range(0, n_poses, FK_BLOCK):
         m = min(FK_BLOCK, n_poses - start)
-        exotic = False
         for b in range(m):
             for i in range(n_dof):
-                x = q[start + b, i]
-                angle[i, b] = x
-                if not abs(x) <= REDUCTION_LIMIT:
-                    exotic = True
-        for i in range(n_dof):
-            x_i = angle[i]
-            cos_i = cos[i]
-            sin_i = sin[i]
-            for b in range(FK_BLOCK):
-                cos_i[b], sin_i[b] = sincos(x_i[b])
-            if exotic:
-                for b in range(m):
-                    cos_i[b] = math.cos(x_i[b])
-                    sin_i[b] = math.sin(x_i[b])
-        for e in range(12):
-            value = 1.0 if e == 0 or e == 5 or e == 10 else 0.0
-            for b in range(FK_BLOCK):
-                T[e, b] = value
-        for i in range(n_dof):
-            C = chain[i]
-            c00, c01, c02, c03 = C[0, 0], C[0, 1], C[0, 2], C[0, 3]
-            c10, c11, c12, c13 = C[1, 0], C[1, 1], C[1, 2], C[1, 3]
-            c20, c21, c22, c23 = C[2, 0], C[2, 1], C[2, 2], C[2, 3]
-            cos_i = cos[i]
-            sin_i = sin[i]
-            for r in range(3):
-                T0 = T[4 * r]
-                T1 = T[4 * r + 1]
-                T2 = T[4 * r + 2]
-                T3 = T[4 * r + 3]
-                for b in range(FK_BLOCK):
-                    t0 = T0[b]
-                    t1 = T1[b]
-                    t2 = T2[b]
-                    x = t0 * c00 + t1 * c10 + t2 * c20
-                    y = t0 * c01 + t1 * c11 + t2 * c21
-                    T3[b] += t0 * c03 + t1 * c13 + t2 * c23
-                    T2[b] = t0 * c02 + t1 * c12 + t2 * c22
-                    T0[b] = x * cos_i[b] + y * sin_i[b]
-                    T1[b] = y * cos_i[b] - x * sin_i[b]
+                angle[i, b] = q[start + b, i]
+        chain_block(chain, angle, m, cos, sin, T)
         for b in range(m):
             pose = out[start + b]
             for r in range(3):

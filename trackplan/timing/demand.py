@@ -55,7 +55,10 @@ class ZoneDemand:
     _maxima: list[np.ndarray | None] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        absolute = (np.abs(self.d1), np.abs(self.d2), np.abs(self.d3))
+        self._set_absolute((np.abs(self.d1), np.abs(self.d2), np.abs(self.d3)))
+
+    def _set_absolute(self, absolute: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+        """Keep |q'|, |q''|, |q'''| and their peaks per joint."""
         object.__setattr__(self, "_abs", absolute)
         object.__setattr__(self, "_peaks", tuple(d.max(axis=0) for d in absolute))
         object.__setattr__(self, "_peak_array", np.stack(self._peaks))
@@ -72,10 +75,14 @@ class ZoneDemand:
         return self._abs
 
     def part(self, first: int, stop: int) -> ZoneDemand:
-        """The grid points ``first … stop - 1``."""
-        return ZoneDemand(
-            self.s[first:stop], self.d1[first:stop], self.d2[first:stop], self.d3[first:stop]
-        )
+        """The grid points ``first … stop - 1`` (their magnitudes: views of this zone's)."""
+        part = object.__new__(ZoneDemand)  # the fields __init__ sets, without taking the
+        rows = slice(first, stop)  # magnitudes again
+        for name in ("s", "d1", "d2", "d3"):
+            object.__setattr__(part, name, getattr(self, name)[rows])
+        q1, q2, q3 = self._abs
+        part._set_absolute((q1[rows], q2[rows], q3[rows]))
+        return part
 
     def peaks(
         self, s_from: float | None = None, s_to: float | None = None
