@@ -17,7 +17,7 @@ turns them into
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 
 import numpy as np
 
@@ -43,22 +43,23 @@ class ZoneDemand:
         Grid, shape (G,), m, increasing.
     d1, d2, d3
         dq/ds, d²q/ds², d³q/ds³ at the grid, shape (G, n), rad/m, rad/m², rad/m³.
+    magnitudes
+        |d1|, |d2|, |d3| when already taken (a zone's part reads its zone's); default:
+        taken here.
     """
 
     s: np.ndarray
     d1: np.ndarray
     d2: np.ndarray
     d3: np.ndarray
+    magnitudes: InitVar[tuple[np.ndarray, np.ndarray, np.ndarray] | None] = None
     _abs: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
     _peaks: tuple[np.ndarray, np.ndarray, np.ndarray] = field(init=False, repr=False)
     _peak_array: np.ndarray = field(init=False, repr=False)
     _maxima: list[np.ndarray | None] = field(init=False, repr=False)
 
-    def __post_init__(self) -> None:
-        self._set_absolute((np.abs(self.d1), np.abs(self.d2), np.abs(self.d3)))
-
-    def _set_absolute(self, absolute: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
-        """Keep |q'|, |q''|, |q'''| and their peaks per joint."""
+    def __post_init__(self, magnitudes: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> None:
+        absolute = magnitudes or (np.abs(self.d1), np.abs(self.d2), np.abs(self.d3))
         object.__setattr__(self, "_abs", absolute)
         object.__setattr__(self, "_peaks", tuple(d.max(axis=0) for d in absolute))
         object.__setattr__(self, "_peak_array", np.stack(self._peaks))
@@ -76,13 +77,10 @@ class ZoneDemand:
 
     def part(self, first: int, stop: int) -> ZoneDemand:
         """The grid points ``first … stop - 1`` (their magnitudes: views of this zone's)."""
-        part = object.__new__(ZoneDemand)  # the fields __init__ sets, without taking the
-        rows = slice(first, stop)  # magnitudes again
-        for name in ("s", "d1", "d2", "d3"):
-            object.__setattr__(part, name, getattr(self, name)[rows])
+        rows = slice(first, stop)
         q1, q2, q3 = self._abs
-        part._set_absolute((q1[rows], q2[rows], q3[rows]))
-        return part
+        magnitudes = (q1[rows], q2[rows], q3[rows])
+        return ZoneDemand(self.s[rows], self.d1[rows], self.d2[rows], self.d3[rows], magnitudes)
 
     def peaks(
         self, s_from: float | None = None, s_to: float | None = None
