@@ -498,8 +498,8 @@ def path_figure(
     n_tool_frames
         Number of tool frames drawn along the path.
     kinematics
-        The run's :func:`plot_kinematics` with ``n_path_frames=n_tool_frames``, computed
-        here when not given.
+        The run's :func:`plot_kinematics` with ``n_path_frames=n_tool_frames``; without
+        it the robot at t = 0 and the tool frames are computed here.
     canvas
         The blank figure (:func:`blank_canvases`), made here when not given.
 
@@ -509,8 +509,6 @@ def path_figure(
         Two 3D axes.
     """
     trajectory = result.trajectory
-    if kinematics is None:
-        kinematics = plot_kinematics(result, case, n_path_frames=n_tool_frames)
     points_part, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
     figure, (ax_cell, ax_path) = canvas or _path_canvas()
@@ -546,7 +544,10 @@ def path_figure(
     )
     scene = [shell, points_part, points_base]
     if trajectory.n_samples:
-        chain = kinematics.chain_start
+        if kinematics is None:
+            chain = chain_points(case.robot, trajectory.q[0])
+        else:
+            chain = kinematics.chain_start
         ax_cell.plot(*chain.T, "o-", color="0.2", lw=3.0, ms=4, gid="robot", label="robot at t = 0")
         scene.append(chain)
     _set_equal(ax_cell, np.vstack(scene))
@@ -557,7 +558,11 @@ def path_figure(
     ax_path.plot(*points_base[-1], "s", color="0.2", ms=6, label="end", gid="end")
     extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
     if trajectory.n_samples:
-        T_tool = kinematics.path_frames
+        if kinematics is None:
+            idx = frame_indices(trajectory.n_samples, n_tool_frames)
+            T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+        else:
+            T_tool = kinematics.path_frames
         _plot_triads(ax_path, triad_lines(T_tool, 0.08 * extent), "tool-frames", "tool frames")
         bad = violation_samples(trajectory, result.check.violations)
         if bad.any():
