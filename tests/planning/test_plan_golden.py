@@ -1,7 +1,9 @@
 """Golden values: plans of every shipped case at fixed placements, recorded before the
 planning speed-up (one pose, IK, FK, derivative and RNE pass per plan), must not change
-beyond round-off: to 1e-9, except the tool axis error (an arccos near 1) and the jerk
-margins (third differences over Ts³), each to the resolution that round-off leaves them.
+beyond round-off: to :data:`TOLERANCE` (relative), except the tool axis error (an arccos
+near 1) and the jerk and acceleration figures (differences over Ts³ and Ts²), each to the
+resolution that round-off leaves them. Outcomes, sample counts and messages are compared
+exactly.
 
 The placements are each case's ``placement.example``, or for a case without one a
 placement drawn once with a seeded generator inside its bounds (the corner cell at the
@@ -43,12 +45,21 @@ PLACEMENTS: dict[str, list[float] | None] = {
 ORIENTATION_RESOLUTION = 1e-7
 """The tool axis error is an arccos of a cosine near 1, resolved to about sqrt(2 eps) ≈ 2e-8
 rad: below this a change of its last bits is round-off, rad."""
-JERK_RESOLUTION = 1e-6
-"""A jerk is a third difference of q over Ts³ (1e-9 s³ at 1 ms): the last bits of q, which
-an IK kernel's round-off moves, move a jerk margin by up to about 1e-7."""
+RATE_RESOLUTION = 1e-4
+"""Acceleration and jerk margins are second and third differences of q over Ts² and Ts³:
+the rounding that the law's root finding leaves in the timing of a sample is amplified by
+1/Ts² and 1/Ts³ (seen between installs: 2e-6 of a margin, 3.5e-5 of the sum of jerks). A
+hundredth of a percent of the limit is far above that and far below anything a margin
+guards."""
 SLOW = {"bracket-weld", "kuka-weld", "seam-weld-fixed", "seam-weld-free", "ur5-bead"}
 """Cases whose plan takes about a second or more."""
-TOLERANCE = 1e-9
+TOLERANCE = 1e-6
+"""Relative tolerance of every other figure. The time law finds its speed caps by root
+finding on rounded kernels, so a figure carries the rounding of the numpy, numba and BLAS
+it ran on: between the install that recorded them and numpy 2.4 with numba 0.68 they moved
+by up to 5e-8 (a velocity margin by 3e-9, an objective by 7e-9). One part in a million is
+far below what any figure guards (a tenth of a percent of a limit, a micrometre, a sample
+time) and far above that rounding."""
 
 
 def figures(name: str) -> dict[str, Any]:
@@ -82,12 +93,14 @@ def figures(name: str) -> dict[str, Any]:
 
 def _close(actual: Any, expected: Any, where: str) -> None:
     """Equal strings, or numbers equal to :data:`TOLERANCE` (relative or absolute); the
-    tool axis error and its margin to :data:`ORIENTATION_RESOLUTION`, jerk margins to
-    :data:`JERK_RESOLUTION`."""
+    tool axis error and its margin to :data:`ORIENTATION_RESOLUTION`, jerk and acceleration
+    margins (and the sum of jerks, relative) to :data:`RATE_RESOLUTION`."""
     if where.endswith("orientation_error"):
         assert actual == pytest.approx(expected, abs=ORIENTATION_RESOLUTION, nan_ok=True), where
-    elif ".joint_margins.jerk[" in where:
-        assert actual == pytest.approx(expected, abs=JERK_RESOLUTION), where
+    elif ".joint_margins.jerk[" in where or ".joint_margins.acceleration[" in where:
+        assert actual == pytest.approx(expected, abs=RATE_RESOLUTION), where
+    elif where.endswith(".qddd_abs_sum"):
+        assert actual == pytest.approx(expected, rel=RATE_RESOLUTION), where
     elif where.endswith("task_margins.orientation"):
         resolution = ORIENTATION_RESOLUTION / ORIENTATION_TOLERANCE
         assert actual == pytest.approx(expected, abs=resolution), where

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.tolerances import assert_ulp_close
 from trackplan.timing.demand import (
     ZoneDemand,
     _changes_within_limits,
@@ -245,7 +246,8 @@ def test_compiled_change_check_matches_numpy(puma, amplitude, rate, slope, v_fro
 
 def test_cruise_cap_is_numpys_least_root_and_its_joint(puma):
     """The scalar loop of cruise_cap against the numpy expression it replaces: the same
-    speed to the bit and the same binding joint and limit, zeros (no demand) included."""
+    speed to a few ULP (numpy's cbrt is a SIMD loop of its own) and the same binding joint
+    and limit, zeros (no demand) included."""
     from trackplan.timing.demand import cruise_cap, safe_ratio
 
     rng = np.random.default_rng(3)
@@ -263,4 +265,6 @@ def test_cruise_cap_is_numpys_least_root_and_its_joint(puma):
             j = int(np.argmin(values))
             if values[j] < expected:
                 expected, reason = float(values[j]), f"joint {j + 1} {kind}"
-        assert cruise_cap(puma, tuple(peaks), share) == (expected, reason)
+        speed, why = cruise_cap(puma, tuple(peaks), share)
+        assert_ulp_close(speed, expected)
+        assert why == reason

@@ -10,6 +10,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.tolerances import assert_ulp_close
 from trackplan.derivatives import backward_derivatives
 from trackplan.timing._kernels import rate_ratios
 from trackplan.timing.demand import ZoneDemand
@@ -75,7 +76,8 @@ def test_local_caps_are_the_numpy_expression(seed, n_rows, n_dof, zeros, odd):
         np.minimum(ratio[0].min(axis=1), np.sqrt(ratio[1]).min(axis=1)),
         np.cbrt(ratio[2]).min(axis=1),
     )
-    np.testing.assert_array_equal(demand.local_caps(robot, share), expected)
+    # the kernel's cbrt and numpy's SIMD cbrt round differently: a few ULP apart
+    assert_ulp_close(demand.local_caps(robot, share), expected)
 
 
 def _jerk_for_duration_80(delta: float, accel: float, jerk: float, duration: float) -> float:
