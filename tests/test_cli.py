@@ -76,6 +76,29 @@ def test_cases_lists_the_shipped_cases(capsys: pytest.CaptureFixture[str]) -> No
     assert "1.0385" in out and "68.2°" in out
 
 
+def test_cases_lists_each_seam_of_a_case_with_several(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, out, err = run(capsys, "cases")
+    assert (code, err) == (0, "")
+    lines = out.splitlines()
+    (row,) = [line for line in lines if "bracket-4-fillets.yaml" in line]
+    cells = [cell.strip() for cell in row.strip("│ ").split("│")]
+    # the case's own row: its 4 seams and their 5 segments, 0.5885 m in all
+    assert cells[:4] == ["bracket-4-fillets", "puma560", "4", "5"]
+    length = 0.1 + 0.1 + 2 * math.pi * 0.03 + 0.15 + 0.05
+    assert cells[4] == f"{length:.4f}"
+    below = lines[lines.index(row) + 1 : lines.index(row) + 5]
+    seams = [[cell.strip() for cell in line.strip("│ ").split("│")] for line in below]
+    assert [(s[0], s[3], s[4]) for s in seams] == [
+        ("· rib-left", "1", "0.1000"),
+        ("· rib-right", "1", "0.1000"),
+        ("· boss", "1", f"{2 * math.pi * 0.03:.4f}"),
+        ("· gusset", "2", "0.2000"),
+    ]
+    assert seams[3][5] == "90.0°"
+
+
 @pytest.mark.parametrize(
     ("args", "code"),
     [
