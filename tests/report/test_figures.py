@@ -200,7 +200,10 @@ def test_convergence_one_series_per_method_and_panel(history):
             np.testing.assert_allclose(line.get_ydata(), scale * table[key])
     colors = {line.get_gid(): line.get_color() for line in figure.axes[0].lines}
     assert len(set(colors.values())) == len(history)
-    assert figure.axes[0].get_yscale() == "log"
+    for ax, key in zip(figure.axes[:2], ("best", "mean"), strict=True):
+        values = np.concatenate([table[key] for table in history.values()])
+        wide = values.max() >= 10 * values.min()  # a decade or more: log
+        assert ax.get_yscale() == ("log" if wide else "linear")
     assert figure.axes[2].get_ylabel() == "feasible share [%]"
 
 
@@ -268,7 +271,7 @@ def test_convergence_minor_ticks_only_over_few_decades():
     wide = {"evaluations": evaluations, "generation": np.arange(1, 11)}
     wide |= {"feasible_share": np.linspace(0, 1, 10), "wall_time": evaluations / 100}
     wide |= {"best": np.geomspace(1e4, 1.0, 10), "mean": np.geomspace(1e6, 1.0, 10)}
-    narrow = dict(wide, best=np.linspace(1.2, 0.8, 10), mean=np.linspace(3.0, 1.0, 10))
+    narrow = dict(wide, best=np.geomspace(50.0, 1.0, 10), mean=np.geomspace(80.0, 1.0, 10))
     for table, minor in ((wide, False), (narrow, True)):
         figure = convergence_figure({"ga": table})
         for ax in figure.axes[:2]:
@@ -276,3 +279,42 @@ def test_convergence_minor_ticks_only_over_few_decades():
             low, high = ax.get_ylim()
             ticks = [v for v in ax.yaxis.get_minorticklocs() if low <= v <= high]
             assert bool(ticks) is minor
+
+
+def _tick_labels(ax, low, high):
+    """The (value, text) of every labelled y tick (major and minor) inside the view."""
+    ax.figure.canvas.draw()
+    ticks = []
+    for locations, labels in (
+        (ax.yaxis.get_majorticklocs(), ax.yaxis.get_majorticklabels()),
+        (ax.yaxis.get_minorticklocs(), ax.yaxis.get_minorticklabels()),
+    ):
+        for value, label in zip(locations, labels, strict=False):
+            if low <= value <= high and label.get_text():
+                ticks.append((float(value), label.get_text()))
+    return sorted(ticks)
+
+
+@pytest.mark.parametrize(
+    ("low", "high"),
+    [(0.7, 0.79), (0.72, 0.78), (0.66449, 0.6646), (0.6645, 0.9), (0.8, 1.2), (0.3, 5.0)],
+)
+def test_convergence_fitness_ticks_are_distinct_and_readable(low, high):
+    """Over a narrow range every labelled tick reads differently and says its own value
+    (formerly every label of 0.70-0.79 read 7e−01)."""
+    evaluations = np.arange(1, 31) * 100.0
+    table = {"evaluations": evaluations, "generation": np.arange(1, 31)}
+    table |= {"feasible_share": np.linspace(0, 1, 30), "wall_time": evaluations / 100}
+    table |= {"best": np.geomspace(high, low, 30), "mean": np.geomspace(high, low, 30)}
+    figure = convergence_figure({"multistart": table})
+    for ax in figure.axes[:2]:
+        ticks = _tick_labels(ax, *ax.get_ylim())
+        assert len(ticks) >= 3, ticks
+        texts = [text for _, text in ticks]
+        assert len(set(texts)) == len(texts), ticks
+        values = np.array([value for value, _ in ticks])
+        step = np.min(np.diff(values))
+        for value, text in ticks:
+            # the label is the tick's value to within half the spacing of the ticks
+            assert float(text.replace("−", "-")) == pytest.approx(value, abs=0.5 * step)
+        assert ax.get_yscale() == ("linear" if high < 10 * low else "log")

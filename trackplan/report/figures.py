@@ -719,6 +719,9 @@ def history_columns(
 MINOR_DECADES = 2.0
 """Log fitness axes spanning more decades than this get no minor ticks."""
 
+LOG_RATIO = 10.0
+"""Fitness axes whose largest value is less than this times their smallest are linear."""
+
 
 def convergence_figure(
     history: Mapping[str, Mapping[str, np.ndarray]], canvas: Canvas | None = None
@@ -727,9 +730,10 @@ def convergence_figure(
 
     Each generation is drawn at its cumulative number of placement evaluations, the
     budget all methods share (their population sizes differ). Fitness axes are
-    logarithmic when every value is positive (penalised candidates sit decades above
-    feasible ones), with labelled minor ticks when they span at most
-    :data:`MINOR_DECADES` decades and a tick per decade otherwise.
+    logarithmic when every value is positive and they span a decade or more (penalised
+    candidates sit decades above feasible ones), with labelled minor ticks when they span
+    at most :data:`MINOR_DECADES` decades and a tick per decade otherwise; within a decade
+    (:data:`LOG_RATIO`) they are linear, labelled with as many digits as the ticks need.
 
     Parameters
     ----------
@@ -746,7 +750,7 @@ def convergence_figure(
         Three axes (best, mean, feasible share), one line per method in each
         (``gid=method``).
     """
-    from matplotlib.ticker import LogFormatter, NullLocator
+    from matplotlib.ticker import LogFormatter, MaxNLocator, NullLocator, ScalarFormatter
 
     columns = history_columns(history)
     figure, (ax_best, ax_mean, ax_share) = canvas or _convergence_canvas()
@@ -774,7 +778,13 @@ def convergence_figure(
         (ax_mean, "mean", "mean fitness"),
     ):
         values = np.concatenate([c[key] for c in columns.values()])
-        if values.size and np.all(values > 0):
+        if values.size and np.all(values > 0) and values.max() < LOG_RATIO * values.min():
+            # within a decade a log axis has no decade to label and its minor labels all
+            # round to the same digit ("7e−01"): a linear axis with plain numbers, as many
+            # digits as the ticks need to differ
+            ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+            ax.yaxis.set_major_formatter(ScalarFormatter(useOffset=False))
+        elif values.size and np.all(values > 0):
             ax.set_yscale("log")
             # plain-text labels: the default ones are mathtext, whose parser costs more
             # than the rest of the figure
