@@ -134,6 +134,31 @@ def test_path_draws_the_reach_shell_and_frames(path, corner, corner_result):
     assert len(_by_gid(close_up, "violation")) == 1
 
 
+def test_path_base_and_part_frames_differ_in_colour_and_legend(path):
+    """The base and the part frame were both drawn in red, green and blue under one red
+    legend swatch each: their colours now differ axis by axis, and so do their legend
+    entries."""
+    from matplotlib.colors import to_hex
+
+    cell = path.axes[0]
+    colours = {}
+    for gid in ("base-frame", "part-frame"):
+        lines = _by_gid(cell, gid)
+        assert len(lines) == 3
+        colours[gid] = [to_hex(line.get_color()) for line in lines]
+    assert not set(colours["base-frame"]) & set(colours["part-frame"])
+    (legend,) = path.legends
+    entries = dict(
+        zip([t.get_text() for t in legend.get_texts()], legend.legend_handles, strict=True)
+    )
+    base = [label for label in entries if label.startswith("base frame")]
+    part = [label for label in entries if label.startswith("part frame")]
+    assert len(base) == len(part) == 1
+    base_swatch, part_swatch = entries[base[0]], entries[part[0]]
+    assert to_hex(base_swatch.get_color()) != to_hex(part_swatch.get_color())
+    assert base_swatch.get_linestyle() != part_swatch.get_linestyle()
+
+
 def test_path_axes_have_equal_aspect(path):
     for ax in path.axes:
         widths = [np.ptp(ax.get_xlim()), np.ptp(ax.get_ylim()), np.ptp(ax.get_zlim())]

@@ -108,3 +108,24 @@ def test_report_shows_torque_margins_and_energy(page, corner_result):
     assert "torque [N·m]" in page
     assert "copper loss" in page and energy.copper_loss_unit in page
     assert f"(joint {energy.peak_torque_joint})" in page
+
+
+def test_view_base_and_part_frames_differ_in_colour_and_legend(corner, corner_result):
+    """In the 3D view the two frames' axes were the same red, green and blue: each frame
+    now has its own colours and dash, and one legend entry of its own."""
+    from trackplan.report.robot_view import robot_view_spec
+
+    traces = robot_view_spec(corner_result, corner, n_frames=4)["data"]
+    frames = {}
+    for name in ("base frame", "part frame"):
+        axes = [t for t in traces if t.get("legendgroup") == name]
+        assert len(axes) == 3
+        frames[name] = axes
+        legend = [t for t in axes if t["showlegend"]]
+        assert len(legend) == 1 and legend[0]["name"].startswith(name)
+    base_colours = {t["line"]["color"] for t in frames["base frame"]}
+    part_colours = {t["line"]["color"] for t in frames["part frame"]}
+    assert len(base_colours) == len(part_colours) == 3
+    assert not base_colours & part_colours
+    assert {t["line"].get("dash", "solid") for t in frames["base frame"]} == {"solid"}
+    assert {t["line"].get("dash", "solid") for t in frames["part frame"]} == {"dash"}

@@ -21,6 +21,7 @@ from trackplan.frames import placement_transform
 from trackplan.planning.checker import RELATIVE_SLACK
 from trackplan.planning.result import LIMIT_KINDS, PlanResult
 from trackplan.report.scene import (
+    FRAME_STYLES,
     JOINT_QUANTITIES,
     chain_points,
     equal_limits,
@@ -341,10 +342,26 @@ def joints_figure(
     return figure
 
 
-def _plot_triads(ax: Axes3D, lines: np.ndarray, gid: str, label: str, lw: float = 1.2) -> None:
-    """Draw the output of :func:`triad_lines` (x red, y green, z blue)."""
-    for axis, color in enumerate(AXIS_COLORS):
-        ax.plot(*lines[axis].T, color=color, lw=lw, gid=gid, label=label if axis == 0 else None)
+def _plot_triads(
+    ax: Axes3D,
+    lines: np.ndarray,
+    gid: str,
+    label: str,
+    lw: float = 1.2,
+    colors: Sequence[str] = AXIS_COLORS,
+    ls: str = "-",
+) -> None:
+    """Draw the output of :func:`triad_lines` in ``colors`` (x, y, z; red, green, blue by
+    default)."""
+    for axis, color in enumerate(colors):
+        ax.plot(
+            *lines[axis].T,
+            color=color,
+            lw=lw,
+            ls=ls,
+            gid=gid,
+            label=label if axis == 0 else None,
+        )
 
 
 def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
@@ -527,10 +544,20 @@ def path_figure(
             else None,
         )
     triad_length = 0.25 * r_max
-    _plot_triads(
-        ax_cell, triad_lines(np.eye(4), triad_length), "base-frame", "base frame (x, y, z)", 2.0
-    )
-    _plot_triads(ax_cell, triad_lines(T_base_part, 0.5 * triad_length), "part-frame", "part frame")
+    for name, T, length, width in (
+        ("base frame", np.eye(4), triad_length, 2.0),
+        ("part frame", T_base_part, 0.5 * triad_length, 1.6),
+    ):
+        colors, style = FRAME_STYLES[name]
+        _plot_triads(
+            ax_cell,
+            triad_lines(T, length),
+            name.replace(" ", "-"),
+            f"{name} (x, y, z)",
+            width,
+            colors,
+            "--" if style == "dash" else "-",
+        )
     ax_cell.plot(
         *points_part.T,
         ls="--",

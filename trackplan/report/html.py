@@ -39,9 +39,10 @@ _PLOT_CAPTIONS = {
     "path.png": (
         "Path and placement",
         "Left: the path in its definition frame (dashed) and placed (solid) in the robot base "
-        "frame, with the base and part frames, the reach shell allowed for the placement origin "
-        "and the robot at t = 0. Right: the placed path close up with tool frames (x red, "
-        "y green, z blue) and the samples inside violation windows.",
+        "frame, with the base frame (dark, solid) and the part frame (light, dashed), the "
+        "reach shell allowed for the placement origin and the robot at t = 0. Right: the "
+        "placed path close up with tool frames (x red, y green, z blue) and the samples "
+        "inside violation windows.",
     ),
     "speed.png": (
         "Tool speed and tracking error",
