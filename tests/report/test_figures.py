@@ -194,6 +194,71 @@ def test_speed_figure_bounds_and_series(corner, corner_result):
     assert not _by_gid(ax_speed, "violation") and not _by_gid(ax_error, "violation")
 
 
+def _overlapping_texts(figure):
+    """Pairs of visible, non-empty texts of ``figure`` (axes texts, annotations, legend
+    entries) whose bounding boxes intersect."""
+    from matplotlib.text import Text
+
+    renderer = figure.canvas.get_renderer()
+    figure.canvas.draw()
+    texts = [t for t in figure.findobj(Text) if t.get_visible() and t.get_text().strip()]
+    # tick labels and axis labels are matplotlib's own layout: only what the plot adds
+    ticks = set()
+    for ax in figure.axes:
+        ticks.update(ax.get_xticklabels() + ax.get_yticklabels())
+        ticks.update([ax.xaxis.label, ax.yaxis.label, ax.xaxis.offsetText, ax.yaxis.offsetText])
+        ticks.update([ax.title, ax._left_title, ax._right_title])
+    texts = [text for text in texts if text not in ticks and text is not figure._suptitle]
+    boxes = [text.get_window_extent(renderer) for text in texts]
+    return [
+        (texts[i].get_text(), texts[j].get_text())
+        for i, j in itertools.combinations(range(len(texts)), 2)
+        if boxes[i].overlaps(boxes[j])
+    ]
+
+
+def test_speed_figure_slowdown_labels_do_not_overlap(corner, corner_result):
+    """Many slow-downs close together: every one is numbered on the plot, the numbers of
+    neighbours too close to label apart share one label ("3–5"), each reason is given
+    once in the legend with the numbers it applies to, and no two texts overlap (the
+    reasons were written in full at every slow-down, on top of each other)."""
+    from trackplan.timing import SlowDown
+
+    length = float(corner_result.trajectory.s[-1])
+    rated = corner.task.rated_speed
+    starts = np.concatenate([np.linspace(0.30, 0.33, 6), np.linspace(0.6, 0.9, 8)]) * length
+    reasons = [
+        "joint 4 velocity",
+        "too short to reach the rated speed under the joint acceleration and jerk limits",
+    ]
+    slowdowns = tuple(
+        SlowDown(s0, s0 + 0.002, 0.7 * rated, rated, reasons[k % 2]) for k, s0 in enumerate(starts)
+    )
+    figure = speed_figure(dataclasses.replace(corner_result, slowdowns=slowdowns), corner)
+    assert _overlapping_texts(figure) == []
+    ax_speed = figure.axes[0]
+    labels = [t.get_text() for t in ax_speed.texts if t.get_gid() == "slowdown-label"]
+    numbered = []
+    for label in labels:
+        first, _, last = label.partition("–")
+        numbered += list(range(int(first), int(last or first) + 1))
+    assert numbered == list(range(1, len(slowdowns) + 1))
+    assert len(labels) < len(slowdowns)  # the six within 3 % of the path share labels
+    x_low, x_high = ax_speed.get_window_extent().x0, ax_speed.get_window_extent().x1
+    renderer = figure.canvas.get_renderer()
+    for text in ax_speed.texts:
+        box = text.get_window_extent(renderer)
+        assert x_low - 1 <= box.x0 and box.x1 <= x_high + 1
+    figure_box = figure.bbox
+    for text in ax_speed.get_legend().get_texts():
+        box = text.get_window_extent(renderer)
+        assert box.x1 <= figure_box.x1 and box.y0 >= figure_box.y0, text.get_text()
+    legend = " ".join(t.get_text() for t in ax_speed.get_legend().get_texts())
+    legend = " ".join(legend.split())
+    for reason in reasons:
+        assert legend.count(reason) == 1
+
+
 def test_speed_figure_marks_a_reported_speed_violation(corner, corner_result):
     t = corner_result.trajectory.t
     k = int(np.argmax(corner_result.trajectory.speed))

@@ -670,30 +670,11 @@ def speed_figure(
         label=f"corner speed cap vₜᵐᵃˣ = {1e3 * task.corner_speed:.4g} mm/s",
         gid="corner-speed",
     )
-    if trajectory.n_samples:
-        for k, slowdown in enumerate(result.slowdowns):
-            t0, t1 = np.interp([slowdown.s_start, slowdown.s_end], trajectory.s, t)
-            ax_speed.axvspan(
-                t0,
-                t1,
-                color="tab:orange",
-                alpha=0.15,
-                lw=0,
-                gid="slowdown",
-                label="slow-down below vᵣ" if k == 0 else None,
-            )
-            ax_speed.annotate(
-                slowdown.limit,
-                (0.5 * (t0 + t1), 1e3 * slowdown.speed),
-                textcoords="offset points",
-                xytext=(0, -14),
-                ha="center",
-                fontsize=7,
-                color="tab:orange",
-            )
     ax_speed.set_ylabel("tool speed [mm/s]")
     top = max(task.rated_speed, task.corner_speed, float(np.max(trajectory.speed, initial=0.0)))
     ax_speed.set_ylim(0.0, 1.15e3 * top)
+    if trajectory.n_samples and result.slowdowns:
+        _mark_slowdowns(ax_speed, result, t)
 
     error = tracking_error(result, case) if kinematics is None else kinematics.tracking_error
     ax_error.plot(
@@ -722,6 +703,115 @@ def speed_figure(
     note = "" if trajectory.n_samples else f" — no trajectory: {result.message}"
     figure.suptitle(f"{_status_line(result)}: tool speed and tracking error{note}", fontsize=10)
     return figure
+
+
+SLOWDOWN_COLOR = "tab:orange"
+SLOWDOWN_REASONS = 6
+"""Most distinct slow-down reasons listed in the legend of ``speed.png``; the rest are in
+the report's slow-down table."""
+
+
+def _mark_slowdowns(ax: Axes, result: PlanResult, t: np.ndarray) -> None:
+    """Shade the slow-downs of ``result`` on the speed axes ``ax`` and number them (1, 2, …
+    in the order of ``result.slowdowns``, as the report's table and the summary list them).
+
+    The numbers stand in one row at the top of the axes, each at the start of its slow-down
+    (``gid="slowdown-label"``); slow-downs too close to be labelled apart share a label
+    ("3–5"). The reason of each slow-down is given once per distinct reason in the legend,
+    after the numbers it applies to. Labels are laid out from their measured widths, so
+    none overlaps another or leaves the axes.
+    """
+    from matplotlib.patches import Patch
+    from matplotlib.transforms import blended_transform_factory
+
+    trajectory = result.trajectory
+    spans = [
+        np.interp([slowdown.s_start, slowdown.s_end], trajectory.s, t)
+        for slowdown in result.slowdowns
+    ]
+    for k, (t0, t1) in enumerate(spans):
+        ax.axvspan(
+            t0,
+            t1,
+            color=SLOWDOWN_COLOR,
+            alpha=0.15,
+            lw=0,
+            gid="slowdown",
+            label="slow-down below vᵣ (numbered)" if k == 0 else None,
+        )
+    figure = ax.figure
+    renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    to_pixels = ax.transData.transform
+    box = ax.get_window_extent(renderer)
+    gap = 4.0 * figure.dpi / 72.0  # 4 pt between labels
+
+    def label_text(first: int, last: int) -> str:
+        return str(first + 1) if first == last else f"{first + 1}–{last + 1}"
+
+    def width(text: str) -> float:
+        probe = ax.text(0.0, 0.0, text, fontsize=7)
+        extent = probe.get_window_extent(renderer).width
+        probe.remove()
+        return float(extent)
+
+    # left to right: a label starts at its first slow-down unless the previous label
+    # reaches there, which then takes this slow-down too
+    labels: list[list] = []  # [first, last, left px, width px]
+    for k, (t0, _) in enumerate(spans):
+        x = float(to_pixels((t0, 0.0))[0])
+        if labels and x < labels[-1][2] + labels[-1][3] + gap:
+            labels[-1][1] = k
+            labels[-1][3] = width(label_text(labels[-1][0], k))
+        else:
+            labels.append([k, k, max(x, box.x0), width(label_text(k, k))])
+    # right to left: labels that would leave the axes move left, and push their
+    # neighbours left as far as needed
+    limit = box.x1
+    for label in reversed(labels):
+        label[2] = min(label[2], limit - label[3])
+        limit = label[2] - gap
+    transform = blended_transform_factory(figure.dpi_scale_trans, ax.transAxes)
+    for first, last, left, _ in labels:
+        ax.text(
+            left / figure.dpi,
+            0.97,
+            label_text(first, last),
+            transform=transform,
+            ha="left",
+            va="top",
+            fontsize=7,
+            color="0.15",
+            gid="slowdown-label",
+        )
+    reasons: dict[str, list[int]] = {}
+    for k, slowdown in enumerate(result.slowdowns):
+        reasons.setdefault(slowdown.limit, []).append(k + 1)
+    listed = list(reasons.items())[:SLOWDOWN_REASONS]
+    for reason, numbers in listed:
+        ax.add_artist(Patch(visible=False, label=_wrap(f"{_ranges(numbers)}: {reason}")))
+    if len(reasons) > len(listed):
+        ax.add_artist(
+            Patch(visible=False, label=f"{len(reasons) - len(listed)} more reasons: see report")
+        )
+
+
+def _ranges(numbers: Sequence[int]) -> str:
+    """Sorted integers as runs: 1, 2, 3, 5 → "1–3, 5"."""
+    runs: list[list[int]] = []
+    for n in numbers:
+        if runs and n == runs[-1][1] + 1:
+            runs[-1][1] = n
+        else:
+            runs.append([n, n])
+    return ", ".join(str(a) if a == b else f"{a}–{b}" for a, b in runs)
+
+
+def _wrap(text: str, width: int = 36) -> str:
+    """``text`` in lines of at most ``width`` characters (the legend column of
+    ``speed.png`` holds about 40)."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)) or text
 
 
 def history_columns(

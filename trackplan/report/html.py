@@ -47,8 +47,9 @@ _PLOT_CAPTIONS = {
     "speed.png": (
         "Tool speed and tracking error",
         "Top: Cartesian tool speed against the rated speed and the corner speed cap, slow-downs "
-        "shaded. Bottom: distance of the tool point from the nominal path (sharp corners kept) "
-        "against the tolerance ρ.",
+        "shaded and numbered as in the slow-down table (neighbours too close to label apart "
+        "share a label, 3–5), their reasons in the legend. Bottom: distance of the tool point "
+        "from the nominal path (sharp corners kept) against the tolerance ρ.",
     ),
     "clearance.png": (
         "Clearance",
@@ -373,16 +374,17 @@ def _slowdowns_table(result: PlanResult) -> str:
         return "<h3>Slow-downs</h3><p>None: every straight piece runs at the rated speed.</p>"
     rows: list[list[Cell]] = [
         [
+            str(k + 1),  # the number speed.png labels it with
             _num(s.s_start, unit="m"),
             _num(s.s_end, unit="m"),
             _num(s.speed, scale=1e3, unit="mm/s"),
             _num(s.rated_speed, scale=1e3, unit="mm/s"),
             (_esc(s.limit), "text"),
         ]
-        for s in result.slowdowns
+        for k, s in enumerate(result.slowdowns)
     ]
     return "<h3>Slow-downs</h3>" + _grid(
-        ["from s", "to s", "speed", "rated", "forced by"], rows, False
+        ["#", "from s", "to s", "speed", "rated", "forced by"], rows
     )
 
 
