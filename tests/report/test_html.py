@@ -129,3 +129,80 @@ def test_view_base_and_part_frames_differ_in_colour_and_legend(corner, corner_re
     assert not base_colours & part_colours
     assert {t["line"].get("dash", "solid") for t in frames["base frame"]} == {"solid"}
     assert {t["line"].get("dash", "solid") for t in frames["part frame"]} == {"dash"}
+
+
+def _table_after(page: str, heading: str) -> list[list[str]]:
+    """The rows (header row first) of the first table after ``heading``, cell texts."""
+    start = page.index(heading)
+    table = page[page.index("<table", start) : page.index("</table>", start)]
+    rows = re.findall(r"<tr>(.*?)</tr>", table)
+    return [
+        [re.sub(r"<[^>]+>", "", c) for c in re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", row)]
+        for row in rows
+    ]
+
+
+def test_placement_search_tables_have_named_columns(corner, corner_result):
+    """The search's figures were printed as raw dicts ("name = puma560, joints = 6, …",
+    "placement = x = 0.15, y = 0, …"): they are tables with named columns, units in the
+    headers, and the robot block, already in the Case section, is not repeated."""
+    from trackplan.report.html import report_page
+
+    info = {
+        "robot": {"name": "puma560", "joints": 6, "parameters": {"a1": -0.0, "a2": 0.0203}},
+        "optimizer": {
+            "method": "multistart",
+            "seed": 0,
+            "evaluations": 3464,
+            "generations": 70,
+            "stop_reason": "converged",
+            "runs": 1,
+            "wall_time_s": 141.606351361,
+            "status": "feasible",
+            "message": "feasible placement found in 3464 evaluations",
+            "fitness": 0.7896407537987621,
+            "rejected_candidates": [[0.1, 0.2, 0.3, 0.0, 0.1, 0.2]],
+        },
+        "initial": {
+            "placement": {"x": 0.150333, "y": 0.0, "z": 0.0, "roll": 0.0, "pitch": 0.0, "yaw": 0.0},
+            "feasible": True,
+            "status": "feasible",
+            "message": "feasible: every limit met",
+            "objective": 1.5098382877706558,
+            "violations": [],
+        },
+    }
+    page = report_page(corner_result, corner, [], "", None, info)
+    section = page[page.index('<section id="result">') :]
+    for raw in ("name = puma560", "placement = x =", "rejected_candidates", "wall_time_s", "{"):
+        assert raw not in section, raw
+    search = _table_after(section, "<h3>Placement search</h3>")
+    assert search[0] == [
+        "method",
+        "seed",
+        "runs",
+        "generations",
+        "evaluations",
+        "wall time [s]",
+        "best fitness",
+        "stopped",
+    ]
+    assert search[1] == ["multistart", "0", "1", "70", "3464", "141.6", "0.789641", "converged"]
+    placements = _table_after(section, "<h4>Placements</h4>")
+    assert placements[0] == [
+        "placement",
+        "x [m]",
+        "y [m]",
+        "z [m]",
+        "roll [rad]",
+        "pitch [rad]",
+        "yaw [rad]",
+        "verdict",
+        "J",
+    ]
+    before, after, rejected = placements[1:]
+    assert before[0].startswith("before") and before[1:3] == ["0.1503", "0"]
+    assert before[7:] == ["feasible", "1.50984"]
+    assert after[0].startswith("after") and after[7] == corner_result.status.value
+    assert after[1] == f"{corner_result.placement[0]:.4g}"
+    assert rejected[0].startswith("rejected") and rejected[1:4] == ["0.1", "0.2", "0.3"]

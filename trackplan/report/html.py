@@ -405,6 +405,8 @@ def _references_table(result: PlanResult) -> str:
 
 
 def _format_value(value: object) -> str:
+    if isinstance(value, bool):
+        return "yes" if value else "no"
     if isinstance(value, float | np.floating):
         return _num(float(value), 6)
     if isinstance(value, np.ndarray | list | tuple):
@@ -415,19 +417,102 @@ def _format_value(value: object) -> str:
             + (", …)" if len(items) > 12 else ")")
         )
     if isinstance(value, Mapping):
-        return ", ".join(f"{_esc(k)} = {_format_value(v)}" for k, v in value.items())
+        return _key_values((str(k), _format_value(v)) for k, v in value.items())
     return _esc(value)
+
+
+PLACEMENT_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
+PLACEMENT_HEADER = ["x [m]", "y [m]", "z [m]", "roll [rad]", "pitch [rad]", "yaw [rad]"]
+"""Columns of a placement X in the report's tables."""
+
+_SEARCH_KEYS = ("optimizer", "initial", "robot", "status", "plan_status", "interrupted")
+"""Keys of ``optimizer_info`` (the ``result.json`` blocks of a run) that the placement
+search section lays out as tables, or leaves out (``robot``: in the Case section)."""
+
+
+def _search_tables(info: Mapping[str, object], result: PlanResult) -> str:
+    """The search (method, budget, time, stop) and the placements before, after and
+    rejected, as tables with named columns, from the ``optimizer`` and ``initial`` blocks
+    of ``result.json`` (:func:`trackplan.io.history.optimizer_summary`)."""
+    parts = []
+    optimizer = info.get("optimizer")
+    if isinstance(optimizer, Mapping):
+        header = [
+            "method",
+            "seed",
+            "runs",
+            "generations",
+            "evaluations",
+            "wall time [s]",
+            "best fitness",
+            "stopped",
+        ]
+        row: list[Cell] = [
+            _esc(optimizer.get("method", "–")),
+            *(
+                _esc(optimizer.get(key, "–"))
+                for key in ("seed", "runs", "generations", "evaluations")
+            ),
+            _num(optimizer.get("wall_time_s")),
+            _num(optimizer.get("fitness"), 6),
+            (_esc(optimizer.get("stop_reason", "–")), "text"),
+        ]
+        parts.append(_grid(header, [row]))
+    interrupted = info.get("interrupted")
+    if isinstance(interrupted, Mapping) and "message" in interrupted:
+        parts.append(f'<p class="bad">{_esc(interrupted["message"])}</p>')
+    rows: list[list[Cell]] = []
+    initial = info.get("initial")
+    if isinstance(initial, Mapping) and isinstance(initial.get("placement"), Mapping):
+        placement = initial["placement"]
+        verdict = initial.get("status", "feasible" if initial.get("feasible") else "infeasible")
+        rows.append(
+            [
+                "before (centre of the bounds)",
+                *(_num(placement.get(key)) for key in PLACEMENT_KEYS),
+                (_esc(verdict), "text"),
+                _num(initial.get("objective"), 6),
+            ]
+        )
+    rows.append(
+        [
+            "after (best found)",
+            *(_num(v) for v in result.placement),
+            (_esc(result.status.value), "text"),
+            _num(result.objective, 6),
+        ]
+    )
+    rejected = optimizer.get("rejected_candidates", []) if isinstance(optimizer, Mapping) else []
+    for k, X in enumerate(rejected or []):  # type: ignore[union-attr]
+        rows.append(
+            [
+                f"rejected {k + 1} (failed the final check)",
+                *(_num(v) for v in X),
+                ("rejected", "text"),
+                "–",
+            ]
+        )
+    parts.append(
+        "<h4>Placements</h4>" + _grid(["placement", *PLACEMENT_HEADER, "verdict", "J"], rows)
+    )
+    return "".join(parts)
 
 
 def _optimizer_section(
     optimizer_info: Mapping[str, object] | None,
     history: Mapping[str, Mapping[str, np.ndarray]] | None,
+    result: PlanResult,
 ) -> str:
-    if not optimizer_info and not history:
+    info = optimizer_info or {}
+    searched = "optimizer" in info or "initial" in info
+    others = [(str(k), v) for k, v in info.items() if k not in _SEARCH_KEYS]
+    if not searched and not others and not history:
         return ""
     parts = ["<h3>Placement search</h3>"]
-    if optimizer_info:
-        parts.append(_key_values((str(k), _format_value(v)) for k, v in optimizer_info.items()))
+    if searched:
+        parts.append(_search_tables(info, result))
+    if others:
+        parts.append(_key_values((k, _format_value(v)) for k, v in others))
     if history:
         rows = [
             [
@@ -437,7 +522,7 @@ def _optimizer_section(
                 _num(c["best"][-1], 6),
                 _num(c["mean"][-1], 4),
                 _percent(c["feasible_share"][-1]),
-                _num(c["wall_time"][-1], 4, unit="s"),
+                _num(c["wall_time"][-1], 4),
             ]
             for method, c in history_columns(history).items()
         ]
@@ -448,9 +533,9 @@ def _optimizer_section(
             "best",
             "last mean",
             "last feasible share",
-            "wall time",
+            "wall time [s]",
         ]
-        parts.append(_grid(header, rows))
+        parts.append("<h4>History</h4>" + _grid(header, rows))
     return "".join(parts)
 
 
@@ -561,7 +646,7 @@ def report_page(
             "</div><div>",
             _references_table(result),
             _slowdowns_table(result),
-            _optimizer_section(optimizer_info, history),
+            _optimizer_section(optimizer_info, history, result),
             "</div></div>",
             _margins_table(result, case),
             _violations_table(result),
