@@ -184,3 +184,47 @@ def test_python_dash_m_reports_bad_input(tmp_path: Path) -> None:
     )
     assert result.returncode == 2
     assert result.stderr == f"{tmp_path / 'missing.yaml'}: case file not found\n"
+
+
+def test_plan_summary_gives_the_top_speed_when_no_sample_runs_at_the_rated_speed() -> None:
+    """A plan whose speed curve cruises just below the rated speed (the continuous curve of
+    a free spin plans at 99.9 % of its caps) printed "rated speed on 0.0 % of the path":
+    true to the 0.01 % but meaningless. When the share would read 0.0 % it prints the top
+    speed and its share of the rated speed instead; a plan that runs at the rated speed
+    keeps the share of the path."""
+    import dataclasses
+    import io
+
+    from rich.console import Console
+
+    from tests.report.conftest import corner_case, plan_corner
+    from trackplan.cli.summaries import print_plan
+    from trackplan.robots.builtin import puma560
+
+    case = corner_case(puma560())
+    result = plan_corner(case)
+    below = dataclasses.replace(
+        result,
+        rated_speed_fraction=0.0,
+        trajectory=dataclasses.replace(result.trajectory, speed=0.999 * result.trajectory.speed),
+    )
+    top = 0.999 * float(result.trajectory.speed.max())
+    for plan, expected, absent in (
+        (
+            result,
+            f"rated speed on {100 * result.rated_speed_fraction:.1f} % of the path",
+            "top speed",
+        ),
+        (
+            below,
+            f"top speed = {top:.4f} m/s ({100 * top / case.task.rated_speed:.1f} % of the "
+            "rated speed)",
+            "rated speed on",
+        ),
+    ):
+        out = io.StringIO()
+        print_plan(
+            Console(file=out, width=400), plan, Path("runs/x"), rated_speed=case.task.rated_speed
+        )
+        assert expected in out.getvalue()
+        assert absent not in out.getvalue()

@@ -206,3 +206,31 @@ def test_placement_search_tables_have_named_columns(corner, corner_result):
     assert after[0].startswith("after") and after[7] == corner_result.status.value
     assert after[1] == f"{corner_result.placement[0]:.4g}"
     assert rejected[0].startswith("rejected") and rejected[1:4] == ["0.1", "0.2", "0.3"]
+
+
+def test_key_figures_give_the_top_speed_when_no_sample_runs_at_the_rated_speed(
+    corner, corner_result
+):
+    """ "rated speed fraction 0.0 %" for a speed curve that cruises at 99.9 % of the rated
+    speed said nothing: the key figures give the top speed against the rated speed."""
+    import dataclasses
+
+    from trackplan.report.html import report_page
+
+    trajectory = dataclasses.replace(
+        corner_result.trajectory, speed=0.999 * corner_result.trajectory.speed
+    )
+    below = dataclasses.replace(corner_result, rated_speed_fraction=0.0, trajectory=trajectory)
+    figures = dict(
+        row[:2] for row in _table_after(report_page(below, corner, [], ""), "<h3>Key figures</h3>")
+    )
+    assert "rated speed fraction" not in figures
+    top = 1e3 * float(trajectory.speed.max())
+    share = 100 * top / (1e3 * corner.task.rated_speed)
+    assert figures["top speed"] == f"{top:.4g} mm/s ({share:.1f} % of v_r)"
+    figures = dict(
+        row[:2]
+        for row in _table_after(report_page(corner_result, corner, [], ""), "<h3>Key figures</h3>")
+    )
+    assert figures["rated speed fraction"] == f"{100 * corner_result.rated_speed_fraction:.1f} %"
+    assert "top speed" not in figures

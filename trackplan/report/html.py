@@ -280,7 +280,7 @@ def _figures_table(result: PlanResult, case: Case) -> str:
             f"{_num(ideal, unit='s')}; duration is "
             f"{_num(result.duration / ideal if ideal else float('nan'))} × that",
         ),
-        ("rated speed fraction", _percent(result.rated_speed_fraction)),
+        _rated_speed_row(result, task.rated_speed),
         ("min corner speed", _num(result.min_corner_speed, scale=1e3, unit="mm/s")),
         (
             "max tracking error",
@@ -305,6 +305,17 @@ def _figures_table(result: PlanResult, case: Case) -> str:
         ),
     ]
     return _key_values(rows)
+
+
+def _rated_speed_row(result: PlanResult, rated_speed: float) -> tuple[str, str]:
+    """The share of the path run at the rated speed, or the top speed when that share
+    would read 0.0 % (a curve cruising just below the rated speed; ``docs/results.md``)."""
+    share = _percent(result.rated_speed_fraction)
+    if share != "0.0 %":
+        return "rated speed fraction", share
+    top = float(np.max(result.trajectory.speed, initial=0.0))
+    of_rated = f" ({_percent(top / rated_speed)} of v_r)" if rated_speed > 0 else ""
+    return "top speed", _num(top, scale=1e3, unit="mm/s") + of_rated
 
 
 def _energy_rows(result: PlanResult) -> list[tuple[str, str]]:
