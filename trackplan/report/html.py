@@ -76,6 +76,7 @@ body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans
 h1 { margin: 1.2rem 0 0.3rem; font-size: 1.6rem; }
 h2 { border-bottom: 2px solid #ddd; padding-bottom: 0.2rem; margin-top: 2.2rem; }
 h3 { margin: 1.2rem 0 0.4rem; font-size: 1.05rem; }
+h4 { margin: 0.9rem 0 0.3rem; font-size: 0.95rem; }
 nav a { margin-right: 1rem; }
 .verdict { display: inline-block; padding: 0.2rem 0.7rem; border-radius: 4px; font-weight: 600; }
 .ok { background: #e3f4e1; color: #1d6b16; }
@@ -666,10 +667,17 @@ def report_page(
             view,
         ]
     )
+    return html_page(f"trackplan report: {case.name}", body)
+
+
+def html_page(title: str, body: str) -> str:
+    """A self-contained page in the report's look: ``title`` (text) and ``body`` (HTML)
+    with the report's style sheet. ``report.html``, a cycle's report and ``map.html`` are
+    all built with it."""
     return (
         '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>trackplan report: {_esc(case.name)}</title><style>{_CSS}</style></head>"
+        f"<title>{_esc(title)}</title><style>{_CSS}</style></head>"
         f"<body>{body}</body></html>\n"
     )
 
