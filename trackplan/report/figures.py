@@ -741,6 +741,7 @@ def _mark_slowdowns(ax: Axes, result: PlanResult, t: np.ndarray) -> None:
         )
     figure = ax.figure
     renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    ax.get_xlim()  # settles the autoscaled time axis before positions are measured
     to_pixels = ax.transData.transform
     box = ax.get_window_extent(renderer)
     gap = 4.0 * figure.dpi / 72.0  # 4 pt between labels
