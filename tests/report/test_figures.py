@@ -195,20 +195,14 @@ def test_speed_figure_bounds_and_series(corner, corner_result):
 
 
 def _overlapping_texts(figure):
-    """Pairs of visible, non-empty texts of ``figure`` (axes texts, annotations, legend
-    entries) whose bounding boxes intersect."""
-    from matplotlib.text import Text
-
+    """Pairs of the texts a plot adds (axes texts and annotations, legend entries) whose
+    bounding boxes intersect."""
     renderer = figure.canvas.get_renderer()
     figure.canvas.draw()
-    texts = [t for t in figure.findobj(Text) if t.get_visible() and t.get_text().strip()]
-    # tick labels and axis labels are matplotlib's own layout: only what the plot adds
-    ticks = set()
-    for ax in figure.axes:
-        ticks.update(ax.get_xticklabels() + ax.get_yticklabels())
-        ticks.update([ax.xaxis.label, ax.yaxis.label, ax.xaxis.offsetText, ax.yaxis.offsetText])
-        ticks.update([ax.title, ax._left_title, ax._right_title])
-    texts = [text for text in texts if text not in ticks and text is not figure._suptitle]
+    texts = [text for ax in figure.axes for text in ax.texts]
+    legends = [ax.get_legend() for ax in figure.axes] + list(figure.legends)
+    texts += [text for legend in legends if legend is not None for text in legend.get_texts()]
+    texts = [text for text in texts if text.get_visible() and text.get_text().strip()]
     boxes = [text.get_window_extent(renderer) for text in texts]
     return [
         (texts[i].get_text(), texts[j].get_text())
