@@ -76,6 +76,29 @@ def test_cases_lists_the_shipped_cases(capsys: pytest.CaptureFixture[str]) -> No
     assert "1.0385" in out and "68.2°" in out
 
 
+def test_cases_lists_each_seam_of_a_case_with_several(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, out, err = run(capsys, "cases")
+    assert (code, err) == (0, "")
+    lines = out.splitlines()
+    (row,) = [line for line in lines if "bracket-4-fillets.yaml" in line]
+    cells = [cell.strip() for cell in row.strip("│ ").split("│")]
+    # the case's own row: its 4 seams and their 5 segments, 0.5885 m in all
+    assert cells[:4] == ["bracket-4-fillets", "puma560", "4", "5"]
+    length = 0.1 + 0.1 + 2 * math.pi * 0.03 + 0.15 + 0.05
+    assert cells[4] == f"{length:.4f}"
+    below = lines[lines.index(row) + 1 : lines.index(row) + 5]
+    seams = [[cell.strip() for cell in line.strip("│ ").split("│")] for line in below]
+    assert [(s[0], s[3], s[4]) for s in seams] == [
+        ("· rib-left", "1", "0.1000"),
+        ("· rib-right", "1", "0.1000"),
+        ("· boss", "1", f"{2 * math.pi * 0.03:.4f}"),
+        ("· gusset", "2", "0.2000"),
+    ]
+    assert seams[3][5] == "90.0°"
+
+
 @pytest.mark.parametrize(
     ("args", "code"),
     [
@@ -161,3 +184,47 @@ def test_python_dash_m_reports_bad_input(tmp_path: Path) -> None:
     )
     assert result.returncode == 2
     assert result.stderr == f"{tmp_path / 'missing.yaml'}: case file not found\n"
+
+
+def test_plan_summary_gives_the_top_speed_when_no_sample_runs_at_the_rated_speed() -> None:
+    """A plan whose speed curve cruises just below the rated speed (the continuous curve of
+    a free spin plans at 99.9 % of its caps) printed "rated speed on 0.0 % of the path":
+    true to the 0.01 % but meaningless. When the share would read 0.0 % it prints the top
+    speed and its share of the rated speed instead; a plan that runs at the rated speed
+    keeps the share of the path."""
+    import dataclasses
+    import io
+
+    from rich.console import Console
+
+    from tests.report.conftest import corner_case, plan_corner
+    from trackplan.cli.summaries import print_plan
+    from trackplan.robots.builtin import puma560
+
+    case = corner_case(puma560())
+    result = plan_corner(case)
+    below = dataclasses.replace(
+        result,
+        rated_speed_fraction=0.0,
+        trajectory=dataclasses.replace(result.trajectory, speed=0.999 * result.trajectory.speed),
+    )
+    top = 0.999 * float(result.trajectory.speed.max())
+    for plan, expected, absent in (
+        (
+            result,
+            f"rated speed on {100 * result.rated_speed_fraction:.1f} % of the path",
+            "top speed",
+        ),
+        (
+            below,
+            f"top speed = {top:.4f} m/s ({100 * top / case.task.rated_speed:.1f} % of the "
+            "rated speed)",
+            "rated speed on",
+        ),
+    ):
+        out = io.StringIO()
+        print_plan(
+            Console(file=out, width=400), plan, Path("runs/x"), rated_speed=case.task.rated_speed
+        )
+        assert expected in out.getvalue()
+        assert absent not in out.getvalue()

@@ -134,6 +134,31 @@ def test_path_draws_the_reach_shell_and_frames(path, corner, corner_result):
     assert len(_by_gid(close_up, "violation")) == 1
 
 
+def test_path_base_and_part_frames_differ_in_colour_and_legend(path):
+    """The base and the part frame were both drawn in red, green and blue under one red
+    legend swatch each: their colours now differ axis by axis, and so do their legend
+    entries."""
+    from matplotlib.colors import to_hex
+
+    cell = path.axes[0]
+    colours = {}
+    for gid in ("base-frame", "part-frame"):
+        lines = _by_gid(cell, gid)
+        assert len(lines) == 3
+        colours[gid] = [to_hex(line.get_color()) for line in lines]
+    assert not set(colours["base-frame"]) & set(colours["part-frame"])
+    (legend,) = path.legends
+    entries = dict(
+        zip([t.get_text() for t in legend.get_texts()], legend.legend_handles, strict=True)
+    )
+    base = [label for label in entries if label.startswith("base frame")]
+    part = [label for label in entries if label.startswith("part frame")]
+    assert len(base) == len(part) == 1
+    base_swatch, part_swatch = entries[base[0]], entries[part[0]]
+    assert to_hex(base_swatch.get_color()) != to_hex(part_swatch.get_color())
+    assert base_swatch.get_linestyle() != part_swatch.get_linestyle()
+
+
 def test_path_axes_have_equal_aspect(path):
     for ax in path.axes:
         widths = [np.ptp(ax.get_xlim()), np.ptp(ax.get_ylim()), np.ptp(ax.get_zlim())]
@@ -169,6 +194,65 @@ def test_speed_figure_bounds_and_series(corner, corner_result):
     assert not _by_gid(ax_speed, "violation") and not _by_gid(ax_error, "violation")
 
 
+def _overlapping_texts(figure):
+    """Pairs of the texts a plot adds (axes texts and annotations, legend entries) whose
+    bounding boxes intersect."""
+    renderer = figure.canvas.get_renderer()
+    figure.canvas.draw()
+    texts = [text for ax in figure.axes for text in ax.texts]
+    legends = [ax.get_legend() for ax in figure.axes] + list(figure.legends)
+    texts += [text for legend in legends if legend is not None for text in legend.get_texts()]
+    texts = [text for text in texts if text.get_visible() and text.get_text().strip()]
+    boxes = [text.get_window_extent(renderer) for text in texts]
+    return [
+        (texts[i].get_text(), texts[j].get_text())
+        for i, j in itertools.combinations(range(len(texts)), 2)
+        if boxes[i].overlaps(boxes[j])
+    ]
+
+
+def test_speed_figure_slowdown_labels_do_not_overlap(corner, corner_result):
+    """Many slow-downs close together: every one is numbered on the plot, the numbers of
+    neighbours too close to label apart share one label ("3–5"), each reason is given
+    once in the legend with the numbers it applies to, and no two texts overlap (the
+    reasons were written in full at every slow-down, on top of each other)."""
+    from trackplan.timing import SlowDown
+
+    length = float(corner_result.trajectory.s[-1])
+    rated = corner.task.rated_speed
+    starts = np.concatenate([np.linspace(0.30, 0.33, 6), np.linspace(0.6, 0.9, 8)]) * length
+    reasons = [
+        "joint 4 velocity",
+        "too short to reach the rated speed under the joint acceleration and jerk limits",
+    ]
+    slowdowns = tuple(
+        SlowDown(s0, s0 + 0.002, 0.7 * rated, rated, reasons[k % 2]) for k, s0 in enumerate(starts)
+    )
+    figure = speed_figure(dataclasses.replace(corner_result, slowdowns=slowdowns), corner)
+    assert _overlapping_texts(figure) == []
+    ax_speed = figure.axes[0]
+    labels = [t.get_text() for t in ax_speed.texts if t.get_gid() == "slowdown-label"]
+    numbered = []
+    for label in labels:
+        first, _, last = label.partition("–")
+        numbered += list(range(int(first), int(last or first) + 1))
+    assert numbered == list(range(1, len(slowdowns) + 1))
+    assert len(labels) < len(slowdowns)  # the six within 3 % of the path share labels
+    x_low, x_high = ax_speed.get_window_extent().x0, ax_speed.get_window_extent().x1
+    renderer = figure.canvas.get_renderer()
+    for text in ax_speed.texts:
+        box = text.get_window_extent(renderer)
+        assert x_low - 1 <= box.x0 and box.x1 <= x_high + 1
+    figure_box = figure.bbox
+    for text in ax_speed.get_legend().get_texts():
+        box = text.get_window_extent(renderer)
+        assert box.x1 <= figure_box.x1 and box.y0 >= figure_box.y0, text.get_text()
+    legend = " ".join(t.get_text() for t in ax_speed.get_legend().get_texts())
+    legend = " ".join(legend.split())
+    for reason in reasons:
+        assert legend.count(reason) == 1
+
+
 def test_speed_figure_marks_a_reported_speed_violation(corner, corner_result):
     t = corner_result.trajectory.t
     k = int(np.argmax(corner_result.trajectory.speed))
@@ -200,7 +284,10 @@ def test_convergence_one_series_per_method_and_panel(history):
             np.testing.assert_allclose(line.get_ydata(), scale * table[key])
     colors = {line.get_gid(): line.get_color() for line in figure.axes[0].lines}
     assert len(set(colors.values())) == len(history)
-    assert figure.axes[0].get_yscale() == "log"
+    for ax, key in zip(figure.axes[:2], ("best", "mean"), strict=True):
+        values = np.concatenate([table[key] for table in history.values()])
+        wide = values.max() >= 10 * values.min()  # a decade or more: log
+        assert ax.get_yscale() == ("log" if wide else "linear")
     assert figure.axes[2].get_ylabel() == "feasible share [%]"
 
 
@@ -268,7 +355,7 @@ def test_convergence_minor_ticks_only_over_few_decades():
     wide = {"evaluations": evaluations, "generation": np.arange(1, 11)}
     wide |= {"feasible_share": np.linspace(0, 1, 10), "wall_time": evaluations / 100}
     wide |= {"best": np.geomspace(1e4, 1.0, 10), "mean": np.geomspace(1e6, 1.0, 10)}
-    narrow = dict(wide, best=np.linspace(1.2, 0.8, 10), mean=np.linspace(3.0, 1.0, 10))
+    narrow = dict(wide, best=np.geomspace(50.0, 1.0, 10), mean=np.geomspace(80.0, 1.0, 10))
     for table, minor in ((wide, False), (narrow, True)):
         figure = convergence_figure({"ga": table})
         for ax in figure.axes[:2]:
@@ -276,3 +363,42 @@ def test_convergence_minor_ticks_only_over_few_decades():
             low, high = ax.get_ylim()
             ticks = [v for v in ax.yaxis.get_minorticklocs() if low <= v <= high]
             assert bool(ticks) is minor
+
+
+def _tick_labels(ax, low, high):
+    """The (value, text) of every labelled y tick (major and minor) inside the view."""
+    ax.figure.canvas.draw()
+    ticks = []
+    for locations, labels in (
+        (ax.yaxis.get_majorticklocs(), ax.yaxis.get_majorticklabels()),
+        (ax.yaxis.get_minorticklocs(), ax.yaxis.get_minorticklabels()),
+    ):
+        for value, label in zip(locations, labels, strict=False):
+            if low <= value <= high and label.get_text():
+                ticks.append((float(value), label.get_text()))
+    return sorted(ticks)
+
+
+@pytest.mark.parametrize(
+    ("low", "high"),
+    [(0.7, 0.79), (0.72, 0.78), (0.66449, 0.6646), (0.6645, 0.9), (0.8, 1.2), (0.3, 5.0)],
+)
+def test_convergence_fitness_ticks_are_distinct_and_readable(low, high):
+    """Over a narrow range every labelled tick reads differently and says its own value
+    (formerly every label of 0.70-0.79 read 7e−01)."""
+    evaluations = np.arange(1, 31) * 100.0
+    table = {"evaluations": evaluations, "generation": np.arange(1, 31)}
+    table |= {"feasible_share": np.linspace(0, 1, 30), "wall_time": evaluations / 100}
+    table |= {"best": np.geomspace(high, low, 30), "mean": np.geomspace(high, low, 30)}
+    figure = convergence_figure({"multistart": table})
+    for ax in figure.axes[:2]:
+        ticks = _tick_labels(ax, *ax.get_ylim())
+        assert len(ticks) >= 3, ticks
+        texts = [text for _, text in ticks]
+        assert len(set(texts)) == len(texts), ticks
+        values = np.array([value for value, _ in ticks])
+        step = np.min(np.diff(values))
+        for value, text in ticks:
+            # the label is the tick's value to within half the spacing of the ticks
+            assert float(text.replace("−", "-")) == pytest.approx(value, abs=0.5 * step)
+        assert ax.get_yscale() == ("linear" if high < 10 * low else "log")

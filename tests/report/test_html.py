@@ -108,3 +108,129 @@ def test_report_shows_torque_margins_and_energy(page, corner_result):
     assert "torque [N·m]" in page
     assert "copper loss" in page and energy.copper_loss_unit in page
     assert f"(joint {energy.peak_torque_joint})" in page
+
+
+def test_view_base_and_part_frames_differ_in_colour_and_legend(corner, corner_result):
+    """In the 3D view the two frames' axes were the same red, green and blue: each frame
+    now has its own colours and dash, and one legend entry of its own."""
+    from trackplan.report.robot_view import robot_view_spec
+
+    traces = robot_view_spec(corner_result, corner, n_frames=4)["data"]
+    frames = {}
+    for name in ("base frame", "part frame"):
+        axes = [t for t in traces if t.get("legendgroup") == name]
+        assert len(axes) == 3
+        frames[name] = axes
+        legend = [t for t in axes if t["showlegend"]]
+        assert len(legend) == 1 and legend[0]["name"].startswith(name)
+    base_colours = {t["line"]["color"] for t in frames["base frame"]}
+    part_colours = {t["line"]["color"] for t in frames["part frame"]}
+    assert len(base_colours) == len(part_colours) == 3
+    assert not base_colours & part_colours
+    assert {t["line"].get("dash", "solid") for t in frames["base frame"]} == {"solid"}
+    assert {t["line"].get("dash", "solid") for t in frames["part frame"]} == {"dash"}
+
+
+def _table_after(page: str, heading: str) -> list[list[str]]:
+    """The rows (header row first) of the first table after ``heading``, cell texts."""
+    start = page.index(heading)
+    table = page[page.index("<table", start) : page.index("</table>", start)]
+    rows = re.findall(r"<tr>(.*?)</tr>", table)
+    return [
+        [re.sub(r"<[^>]+>", "", c) for c in re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", row)]
+        for row in rows
+    ]
+
+
+def test_placement_search_tables_have_named_columns(corner, corner_result):
+    """The search's figures were printed as raw dicts ("name = puma560, joints = 6, …",
+    "placement = x = 0.15, y = 0, …"): they are tables with named columns, units in the
+    headers, and the robot block, already in the Case section, is not repeated."""
+    from trackplan.report.html import report_page
+
+    info = {
+        "robot": {"name": "puma560", "joints": 6, "parameters": {"a1": -0.0, "a2": 0.0203}},
+        "optimizer": {
+            "method": "multistart",
+            "seed": 0,
+            "evaluations": 3464,
+            "generations": 70,
+            "stop_reason": "converged",
+            "runs": 1,
+            "wall_time_s": 141.606351361,
+            "status": "feasible",
+            "message": "feasible placement found in 3464 evaluations",
+            "fitness": 0.7896407537987621,
+            "rejected_candidates": [[0.1, 0.2, 0.3, 0.0, 0.1, 0.2]],
+        },
+        "initial": {
+            "placement": {"x": 0.150333, "y": 0.0, "z": 0.0, "roll": 0.0, "pitch": 0.0, "yaw": 0.0},
+            "feasible": True,
+            "status": "feasible",
+            "message": "feasible: every limit met",
+            "objective": 1.5098382877706558,
+            "violations": [],
+        },
+    }
+    page = report_page(corner_result, corner, [], "", None, info)
+    section = page[page.index('<section id="result">') :]
+    for raw in ("name = puma560", "placement = x =", "rejected_candidates", "wall_time_s", "{"):
+        assert raw not in section, raw
+    search = _table_after(section, "<h3>Placement search</h3>")
+    assert search[0] == [
+        "method",
+        "seed",
+        "runs",
+        "generations",
+        "evaluations",
+        "wall time [s]",
+        "best fitness",
+        "stopped",
+    ]
+    assert search[1] == ["multistart", "0", "1", "70", "3464", "141.6", "0.789641", "converged"]
+    placements = _table_after(section, "<h4>Placements</h4>")
+    assert placements[0] == [
+        "placement",
+        "x [m]",
+        "y [m]",
+        "z [m]",
+        "roll [rad]",
+        "pitch [rad]",
+        "yaw [rad]",
+        "verdict",
+        "J",
+    ]
+    before, after, rejected = placements[1:]
+    assert before[0].startswith("before") and before[1:3] == ["0.1503", "0"]
+    assert before[7:] == ["feasible", "1.50984"]
+    assert after[0].startswith("after") and after[7] == corner_result.status.value
+    assert after[1] == f"{corner_result.placement[0]:.4g}"
+    assert rejected[0].startswith("rejected") and rejected[1:4] == ["0.1", "0.2", "0.3"]
+
+
+def test_key_figures_give_the_top_speed_when_no_sample_runs_at_the_rated_speed(
+    corner, corner_result
+):
+    """ "rated speed fraction 0.0 %" for a speed curve that cruises at 99.9 % of the rated
+    speed said nothing: the key figures give the top speed against the rated speed."""
+    import dataclasses
+
+    from trackplan.report.html import report_page
+
+    trajectory = dataclasses.replace(
+        corner_result.trajectory, speed=0.999 * corner_result.trajectory.speed
+    )
+    below = dataclasses.replace(corner_result, rated_speed_fraction=0.0, trajectory=trajectory)
+    figures = dict(
+        row[:2] for row in _table_after(report_page(below, corner, [], ""), "<h3>Key figures</h3>")
+    )
+    assert "rated speed fraction" not in figures
+    top = 1e3 * float(trajectory.speed.max())
+    share = 100 * top / (1e3 * corner.task.rated_speed)
+    assert figures["top speed"] == f"{top:.4g} mm/s ({share:.1f} % of v_r)"
+    figures = dict(
+        row[:2]
+        for row in _table_after(report_page(corner_result, corner, [], ""), "<h3>Key figures</h3>")
+    )
+    assert figures["rated speed fraction"] == f"{100 * corner_result.rated_speed_fraction:.1f} %"
+    assert "top speed" not in figures

@@ -107,7 +107,8 @@ def _show_value(value: object) -> str:
 
 @app.command()
 def cases() -> ExitCode:
-    """List the cases shipped in the repository's cases/ folder."""
+    """List the cases shipped in the repository's cases/ folder; a case with several seams
+    gets a row per seam below its own."""
     from rich.markup import escape
     from rich.table import Table
 
@@ -120,21 +121,39 @@ def cases() -> ExitCode:
         error(f"no shipped cases found in {folder}")
         return ExitCode.OK
     table = Table(title=f"Cases in {folder}")
-    for column in ("case", "robot", "segments", "length m", "corners", "file"):
-        table.add_column(column, justify="right" if column in ("segments", "length m") else "left")
+    numbers = ("seams", "segments", "length m")
+    for column in ("case", "robot", *numbers, "corners", "file"):
+        table.add_column(column, justify="right" if column in numbers else "left")
     loaded = load_each(files)
     for file, case in loaded:
         if case is None:
-            table.add_row(escape(file.stem), "", "", "", "invalid", escape(file.name))
+            table.add_row(escape(file.stem), "", "", "", "", "invalid", escape(file.name))
             continue
-        path = NominalPath.from_specs(case.start, case.segments)
+        seams = [(seam, NominalPath.from_specs(seam.start, seam.segments)) for seam in case.seams]
+
+        def corners(path: NominalPath) -> str:
+            return ", ".join(f"{angle:.1f}°" for _, angle in segment_corners(path)) or "none"
+
+        several = case.cycle is not None
         table.add_row(
             escape(case.name),
             escape(case.robot.name),
-            str(len(case.segments)),
-            f"{path.length:.4f}",
-            ", ".join(f"{angle:.1f}°" for _, angle in segment_corners(path)) or "none",
+            str(len(seams)),
+            str(sum(len(seam.segments) for seam, _ in seams)),
+            f"{sum(path.length for _, path in seams):.4f}",
+            "per seam below" if several else corners(seams[0][1]),
             escape(file.name),
         )
+        if several:
+            for seam, path in seams:
+                table.add_row(
+                    f"· {escape(seam.name)}",
+                    "",
+                    "",
+                    str(len(seam.segments)),
+                    f"{path.length:.4f}",
+                    corners(path),
+                    "",
+                )
     console().print(table)
     return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT

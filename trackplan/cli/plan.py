@@ -89,7 +89,7 @@ def plan(
         references = reference_durations(result.joint_path, loaded.task)
         result = replace(result, references={**result.references, **references})
     write_run(out, result, loaded, report=report)
-    print_plan(console(), result, out)
+    print_plan(console(), result, out, rated_speed=loaded.task.rated_speed)
     return ExitCode.OK if result.feasible else ExitCode.INFEASIBLE
 
 

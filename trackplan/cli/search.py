@@ -295,7 +295,7 @@ def _search_and_write(  # type: ignore[no-untyped-def]
         interrupted = result.stop_reason == "interrupted" or signals.first is not None
         marks = _interrupted_marks(result, signals) if interrupted else None
         write_search_run(out, result, case, report=report, extra=marks, plot_worker=worker)
-    print_search(console(), result, out)
+    print_search(console(), result, out, rated_speed=case.task.rated_speed)
     if interrupted:
         return ExitCode(signals.exit_code)
     return ExitCode.OK if result.success else ExitCode.INFEASIBLE

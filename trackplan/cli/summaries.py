@@ -128,8 +128,11 @@ def print_check(
     console.print("feasible" if report.success else f"infeasible: {count}")
 
 
-def print_plan(console: Console, result: PlanResult, out: Path) -> None:
-    """A few lines on what a plan achieved and where its files are."""
+def print_plan(
+    console: Console, result: PlanResult, out: Path, *, rated_speed: float | None = None
+) -> None:
+    """A few lines on what a plan achieved and where its files are; ``rated_speed`` (m/s,
+    the case's) for :func:`rated_speed_text`."""
     violations = result.check.violations
     if result.feasible:
         console.print(f"{escape(result.case_name)}: {escape(result.message)}")
@@ -146,7 +149,7 @@ def print_plan(console: Console, result: PlanResult, out: Path) -> None:
     if result.trajectory.n_samples:
         console.print(
             f"  J = {result.objective:.4f}  duration = {result.duration:.3f} s  "
-            f"rated speed on {100 * result.rated_speed_fraction:.1f} % of the path  "
+            f"{rated_speed_text(result, rated_speed)}  "
             f"min corner speed = {result.min_corner_speed:.4f} m/s  "
             f"max tracking error = {result.check.max_tracking_error * 1e3:.4f} mm  "
             f"branch {result.branch}"
@@ -181,8 +184,25 @@ def print_plan(console: Console, result: PlanResult, out: Path) -> None:
     console.print(f"  results in {escape(str(out))}/")
 
 
-def print_search(console: Console, result, out: Path) -> None:  # type: ignore[no-untyped-def]
-    """The search summary, then the final plan's summary."""
+def rated_speed_text(result: PlanResult, rated_speed: float | None = None) -> str:
+    """How much of the path runs at the rated speed (``docs/results.md``): the share of
+    its length, or, when that share would read 0.0 %, the top tool speed and its share of
+    the rated speed (``rated_speed``, m/s): a curve cruising at 99.9 % of the rated speed,
+    or the paper's law with its sampling noise, would read 0.0 % of the path."""
+    share = f"{100 * result.rated_speed_fraction:.1f}"
+    if share != "0.0":
+        return f"rated speed on {share} % of the path"
+    top = float(np.max(result.trajectory.speed, initial=0.0))
+    if rated_speed is None or rated_speed <= 0:
+        return f"top speed = {top:.4f} m/s"
+    return f"top speed = {top:.4f} m/s ({100 * top / rated_speed:.1f} % of the rated speed)"
+
+
+def print_search(  # type: ignore[no-untyped-def]
+    console: Console, result, out: Path, *, rated_speed: float | None = None
+) -> None:
+    """The search summary, then the final plan's summary (``rated_speed``: the case's,
+    m/s)."""
     initial = result.initial
     before = (
         f"J = {initial.objective:.4f}"
@@ -203,7 +223,7 @@ def print_search(console: Console, result, out: Path) -> None:  # type: ignore[n
         "the closest one is planned below"
     )
     console.print(f"  after  (X = {_vector(result.X)}): {after}")
-    print_plan(console, result.final, out)
+    print_plan(console, result.final, out, rated_speed=rated_speed)
 
 
 def _vector(values: np.ndarray) -> str:

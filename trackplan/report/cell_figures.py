@@ -119,26 +119,49 @@ def clearance_figure(result: PlanResult) -> Figure:
 
 
 def write_map_report(pmap: PlacementMap, out_dir: Path) -> list[Path]:
-    """Write ``map.png`` and ``map.html`` (the map as a report panel) into ``out_dir``."""
+    """Write ``map.png`` and ``map.html`` into ``out_dir``: the map in the report's look
+    (:func:`~trackplan.report.html.html_page`), its grid, height, orientation, the share of
+    each class and the least J in tables, the plot as a captioned figure."""
+    from trackplan.report.html import PLACEMENT_HEADER, _grid, _num, html_page
+
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     png = out_dir / MAP_FILE
     map_figure(pmap).savefig(png, dpi=DPI)
-    counts = ", ".join(
-        f"{name} {100 * np.mean(pmap.reason == code):.0f} %" for code, name in enumerate(REASONS)
-    )
     data = base64.b64encode(png.read_bytes()).decode("ascii")
     best = np.nanmin(pmap.objective) if np.isfinite(pmap.objective).any() else float("nan")
-    page = (
-        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        f"<title>trackplan placement map: {html.escape(pmap.case_name)}</title></head><body>"
-        f'<section id="placement-map"><h2>Placement map: {html.escape(pmap.case_name)}</h2>'
-        f"<p>{len(pmap.x)} × {len(pmap.y)} placements at z = {pmap.z:.4f} m, "
-        f"rpy = {html.escape(str(np.round(pmap.rpy, 4).tolist()))} rad: {counts}; "
-        f"least J on the grid {best:.4f}.</p>"
+    name = html.escape(pmap.case_name)
+    grid = _grid(
+        ["grid", "x range [m]", "y range [m]", *PLACEMENT_HEADER[2:], "least J"],
+        [
+            [
+                f"{len(pmap.x)} × {len(pmap.y)}",
+                f"{_num(pmap.x[0])} – {_num(pmap.x[-1])}",
+                f"{_num(pmap.y[0])} – {_num(pmap.y[-1])}",
+                _num(pmap.z),
+                *(_num(v) for v in pmap.rpy),
+                _num(best, 6),
+            ]
+        ],
+    )
+    shares = _grid(
+        list(REASONS),
+        [[(f"{100 * np.mean(pmap.reason == code):.0f} %", "") for code in range(len(REASONS))]],
+        row_header=False,
+    )
+    body = (
+        f"<h1>Placement map: {name}</h1>"
+        '<section id="placement-map"><h2>Placements</h2>'
+        '<p class="muted">Every placement of the grid at the height and orientation below, '
+        "classified by the first reason it fails, or feasible and coloured by its J "
+        "(docs/cell.md).</p>"
+        f"{grid}<h3>Share of the grid</h3>{shares}"
+        f'<figure id="plot-map"><h3>Map</h3>'
         f'<img alt="placement map" src="data:image/png;base64,{data}">'
-        "</section></body></html>\n"
+        "<figcaption>x–y grid of placement origins in the robot base frame: infeasible "
+        "points by reason, feasible ones coloured by J; the robot base and the reference "
+        f"placement are marked. (file: {MAP_FILE})</figcaption></figure></section>"
     )
     page_file = out_dir / MAP_REPORT_FILE
-    page_file.write_text(page, encoding="utf-8")
+    page_file.write_text(html_page(f"trackplan placement map: {pmap.case_name}", body), "utf-8")
     return [png, page_file]

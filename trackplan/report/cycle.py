@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from trackplan.case import Case
 from trackplan.planning.cycle import AIR, APPROACH, RETRACT, CycleResult
 from trackplan.report.figures import _new_figure
-from trackplan.report.html import _CSS, _esc, _grid
+from trackplan.report.html import _esc, _grid, html_page
 from trackplan.run_files import REPORT_FILE
 
 if TYPE_CHECKING:
@@ -172,11 +172,7 @@ def write_cycle_report(
         + (f"<h2>Violations</h2><ul>{violations}</ul>" if violations else "")
         + "</section>"
     )
-    page = (
-        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        f"<title>trackplan report: {_esc(case.name)}</title><style>{_CSS}</style></head>"
-        f"<body>{body}</body></html>\n"
-    )
+    page = html_page(f"trackplan report: {case.name}", body)
     report = out_dir / REPORT_FILE
     report.write_text(page, encoding="utf-8")
     written.append(report)

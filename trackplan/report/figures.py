@@ -21,6 +21,7 @@ from trackplan.frames import placement_transform
 from trackplan.planning.checker import RELATIVE_SLACK
 from trackplan.planning.result import LIMIT_KINDS, PlanResult
 from trackplan.report.scene import (
+    FRAME_STYLES,
     JOINT_QUANTITIES,
     chain_points,
     equal_limits,
@@ -341,10 +342,26 @@ def joints_figure(
     return figure
 
 
-def _plot_triads(ax: Axes3D, lines: np.ndarray, gid: str, label: str, lw: float = 1.2) -> None:
-    """Draw the output of :func:`triad_lines` (x red, y green, z blue)."""
-    for axis, color in enumerate(AXIS_COLORS):
-        ax.plot(*lines[axis].T, color=color, lw=lw, gid=gid, label=label if axis == 0 else None)
+def _plot_triads(
+    ax: Axes3D,
+    lines: np.ndarray,
+    gid: str,
+    label: str,
+    lw: float = 1.2,
+    colors: Sequence[str] = AXIS_COLORS,
+    ls: str = "-",
+) -> None:
+    """Draw the output of :func:`triad_lines` in ``colors`` (x, y, z; red, green, blue by
+    default)."""
+    for axis, color in enumerate(colors):
+        ax.plot(
+            *lines[axis].T,
+            color=color,
+            lw=lw,
+            ls=ls,
+            gid=gid,
+            label=label if axis == 0 else None,
+        )
 
 
 def _set_equal(ax: Axes3D, points: np.ndarray) -> None:
@@ -527,10 +544,20 @@ def path_figure(
             else None,
         )
     triad_length = 0.25 * r_max
-    _plot_triads(
-        ax_cell, triad_lines(np.eye(4), triad_length), "base-frame", "base frame (x, y, z)", 2.0
-    )
-    _plot_triads(ax_cell, triad_lines(T_base_part, 0.5 * triad_length), "part-frame", "part frame")
+    for name, T, length, width in (
+        ("base frame", np.eye(4), triad_length, 2.0),
+        ("part frame", T_base_part, 0.5 * triad_length, 1.6),
+    ):
+        colors, style = FRAME_STYLES[name]
+        _plot_triads(
+            ax_cell,
+            triad_lines(T, length),
+            name.replace(" ", "-"),
+            f"{name} (x, y, z)",
+            width,
+            colors,
+            "--" if style == "dash" else "-",
+        )
     ax_cell.plot(
         *points_part.T,
         ls="--",
@@ -643,30 +670,11 @@ def speed_figure(
         label=f"corner speed cap vₜᵐᵃˣ = {1e3 * task.corner_speed:.4g} mm/s",
         gid="corner-speed",
     )
-    if trajectory.n_samples:
-        for k, slowdown in enumerate(result.slowdowns):
-            t0, t1 = np.interp([slowdown.s_start, slowdown.s_end], trajectory.s, t)
-            ax_speed.axvspan(
-                t0,
-                t1,
-                color="tab:orange",
-                alpha=0.15,
-                lw=0,
-                gid="slowdown",
-                label="slow-down below vᵣ" if k == 0 else None,
-            )
-            ax_speed.annotate(
-                slowdown.limit,
-                (0.5 * (t0 + t1), 1e3 * slowdown.speed),
-                textcoords="offset points",
-                xytext=(0, -14),
-                ha="center",
-                fontsize=7,
-                color="tab:orange",
-            )
     ax_speed.set_ylabel("tool speed [mm/s]")
     top = max(task.rated_speed, task.corner_speed, float(np.max(trajectory.speed, initial=0.0)))
     ax_speed.set_ylim(0.0, 1.15e3 * top)
+    if trajectory.n_samples and result.slowdowns:
+        _mark_slowdowns(ax_speed, result, t)
 
     error = tracking_error(result, case) if kinematics is None else kinematics.tracking_error
     ax_error.plot(
@@ -697,6 +705,116 @@ def speed_figure(
     return figure
 
 
+SLOWDOWN_COLOR = "tab:orange"
+SLOWDOWN_REASONS = 6
+"""Most distinct slow-down reasons listed in the legend of ``speed.png``; the rest are in
+the report's slow-down table."""
+
+
+def _mark_slowdowns(ax: Axes, result: PlanResult, t: np.ndarray) -> None:
+    """Shade the slow-downs of ``result`` on the speed axes ``ax`` and number them (1, 2, …
+    in the order of ``result.slowdowns``, as the report's table and the summary list them).
+
+    The numbers stand in one row at the top of the axes, each at the start of its slow-down
+    (``gid="slowdown-label"``); slow-downs too close to be labelled apart share a label
+    ("3–5"). The reason of each slow-down is given once per distinct reason in the legend,
+    after the numbers it applies to. Labels are laid out from their measured widths, so
+    none overlaps another or leaves the axes.
+    """
+    from matplotlib.patches import Patch
+    from matplotlib.transforms import blended_transform_factory
+
+    trajectory = result.trajectory
+    spans = [
+        np.interp([slowdown.s_start, slowdown.s_end], trajectory.s, t)
+        for slowdown in result.slowdowns
+    ]
+    for k, (t0, t1) in enumerate(spans):
+        ax.axvspan(
+            t0,
+            t1,
+            color=SLOWDOWN_COLOR,
+            alpha=0.15,
+            lw=0,
+            gid="slowdown",
+            label="slow-down below vᵣ (numbered)" if k == 0 else None,
+        )
+    figure = ax.figure
+    renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    ax.get_xlim()  # settles the autoscaled time axis before positions are measured
+    to_pixels = ax.transData.transform
+    box = ax.get_window_extent(renderer)
+    gap = 4.0 * figure.dpi / 72.0  # 4 pt between labels
+
+    def label_text(first: int, last: int) -> str:
+        return str(first + 1) if first == last else f"{first + 1}–{last + 1}"
+
+    def width(text: str) -> float:
+        probe = ax.text(0.0, 0.0, text, fontsize=7)
+        extent = probe.get_window_extent(renderer).width
+        probe.remove()
+        return float(extent)
+
+    # left to right: a label starts at its first slow-down unless the previous label
+    # reaches there, which then takes this slow-down too
+    labels: list[list] = []  # [first, last, left px, width px]
+    for k, (t0, _) in enumerate(spans):
+        x = float(to_pixels((t0, 0.0))[0])
+        if labels and x < labels[-1][2] + labels[-1][3] + gap:
+            labels[-1][1] = k
+            labels[-1][3] = width(label_text(labels[-1][0], k))
+        else:
+            labels.append([k, k, max(x, box.x0), width(label_text(k, k))])
+    # right to left: labels that would leave the axes move left, and push their
+    # neighbours left as far as needed
+    limit = box.x1
+    for label in reversed(labels):
+        label[2] = min(label[2], limit - label[3])
+        limit = label[2] - gap
+    transform = blended_transform_factory(figure.dpi_scale_trans, ax.transAxes)
+    for first, last, left, _ in labels:
+        ax.text(
+            left / figure.dpi,
+            0.97,
+            label_text(first, last),
+            transform=transform,
+            ha="left",
+            va="top",
+            fontsize=7,
+            color="0.15",
+            gid="slowdown-label",
+        )
+    reasons: dict[str, list[int]] = {}
+    for k, slowdown in enumerate(result.slowdowns):
+        reasons.setdefault(slowdown.limit, []).append(k + 1)
+    listed = list(reasons.items())[:SLOWDOWN_REASONS]
+    for reason, numbers in listed:
+        ax.add_artist(Patch(visible=False, label=_wrap(f"{_ranges(numbers)}: {reason}")))
+    if len(reasons) > len(listed):
+        ax.add_artist(
+            Patch(visible=False, label=f"{len(reasons) - len(listed)} more reasons: see report")
+        )
+
+
+def _ranges(numbers: Sequence[int]) -> str:
+    """Sorted integers as runs: 1, 2, 3, 5 → "1–3, 5"."""
+    runs: list[list[int]] = []
+    for n in numbers:
+        if runs and n == runs[-1][1] + 1:
+            runs[-1][1] = n
+        else:
+            runs.append([n, n])
+    return ", ".join(str(a) if a == b else f"{a}–{b}" for a, b in runs)
+
+
+def _wrap(text: str, width: int = 36) -> str:
+    """``text`` in lines of at most ``width`` characters (the legend column of
+    ``speed.png`` holds about 40)."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)) or text
+
+
 def history_columns(
     history: Mapping[str, Mapping[str, np.ndarray]],
 ) -> dict[str, dict[str, np.ndarray]]:
@@ -719,6 +837,9 @@ def history_columns(
 MINOR_DECADES = 2.0
 """Log fitness axes spanning more decades than this get no minor ticks."""
 
+LOG_RATIO = 10.0
+"""Fitness axes whose largest value is less than this times their smallest are linear."""
+
 
 def convergence_figure(
     history: Mapping[str, Mapping[str, np.ndarray]], canvas: Canvas | None = None
@@ -727,9 +848,10 @@ def convergence_figure(
 
     Each generation is drawn at its cumulative number of placement evaluations, the
     budget all methods share (their population sizes differ). Fitness axes are
-    logarithmic when every value is positive (penalised candidates sit decades above
-    feasible ones), with labelled minor ticks when they span at most
-    :data:`MINOR_DECADES` decades and a tick per decade otherwise.
+    logarithmic when every value is positive and they span a decade or more (penalised
+    candidates sit decades above feasible ones), with labelled minor ticks when they span
+    at most :data:`MINOR_DECADES` decades and a tick per decade otherwise; within a decade
+    (:data:`LOG_RATIO`) they are linear, labelled with as many digits as the ticks need.
 
     Parameters
     ----------
@@ -746,7 +868,7 @@ def convergence_figure(
         Three axes (best, mean, feasible share), one line per method in each
         (``gid=method``).
     """
-    from matplotlib.ticker import LogFormatter, NullLocator
+    from matplotlib.ticker import LogFormatter, MaxNLocator, NullLocator, ScalarFormatter
 
     columns = history_columns(history)
     figure, (ax_best, ax_mean, ax_share) = canvas or _convergence_canvas()
@@ -774,7 +896,13 @@ def convergence_figure(
         (ax_mean, "mean", "mean fitness"),
     ):
         values = np.concatenate([c[key] for c in columns.values()])
-        if values.size and np.all(values > 0):
+        if values.size and np.all(values > 0) and values.max() < LOG_RATIO * values.min():
+            # within a decade a log axis has no decade to label and its minor labels all
+            # round to the same digit ("7e−01"): a linear axis with plain numbers, as many
+            # digits as the ticks need to differ
+            ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+            ax.yaxis.set_major_formatter(ScalarFormatter(useOffset=False))
+        elif values.size and np.all(values > 0):
             ax.set_yscale("log")
             # plain-text labels: the default ones are mathtext, whose parser costs more
             # than the rest of the figure

@@ -39,15 +39,17 @@ _PLOT_CAPTIONS = {
     "path.png": (
         "Path and placement",
         "Left: the path in its definition frame (dashed) and placed (solid) in the robot base "
-        "frame, with the base and part frames, the reach shell allowed for the placement origin "
-        "and the robot at t = 0. Right: the placed path close up with tool frames (x red, "
-        "y green, z blue) and the samples inside violation windows.",
+        "frame, with the base frame (dark, solid) and the part frame (light, dashed), the "
+        "reach shell allowed for the placement origin and the robot at t = 0. Right: the "
+        "placed path close up with tool frames (x red, y green, z blue) and the samples "
+        "inside violation windows.",
     ),
     "speed.png": (
         "Tool speed and tracking error",
         "Top: Cartesian tool speed against the rated speed and the corner speed cap, slow-downs "
-        "shaded. Bottom: distance of the tool point from the nominal path (sharp corners kept) "
-        "against the tolerance ρ.",
+        "shaded and numbered as in the slow-down table (neighbours too close to label apart "
+        "share a label, 3–5), their reasons in the legend. Bottom: distance of the tool point "
+        "from the nominal path (sharp corners kept) against the tolerance ρ.",
     ),
     "clearance.png": (
         "Clearance",
@@ -74,6 +76,7 @@ body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans
 h1 { margin: 1.2rem 0 0.3rem; font-size: 1.6rem; }
 h2 { border-bottom: 2px solid #ddd; padding-bottom: 0.2rem; margin-top: 2.2rem; }
 h3 { margin: 1.2rem 0 0.4rem; font-size: 1.05rem; }
+h4 { margin: 0.9rem 0 0.3rem; font-size: 0.95rem; }
 nav a { margin-right: 1rem; }
 .verdict { display: inline-block; padding: 0.2rem 0.7rem; border-radius: 4px; font-weight: 600; }
 .ok { background: #e3f4e1; color: #1d6b16; }
@@ -278,7 +281,7 @@ def _figures_table(result: PlanResult, case: Case) -> str:
             f"{_num(ideal, unit='s')}; duration is "
             f"{_num(result.duration / ideal if ideal else float('nan'))} × that",
         ),
-        ("rated speed fraction", _percent(result.rated_speed_fraction)),
+        _rated_speed_row(result, task.rated_speed),
         ("min corner speed", _num(result.min_corner_speed, scale=1e3, unit="mm/s")),
         (
             "max tracking error",
@@ -303,6 +306,17 @@ def _figures_table(result: PlanResult, case: Case) -> str:
         ),
     ]
     return _key_values(rows)
+
+
+def _rated_speed_row(result: PlanResult, rated_speed: float) -> tuple[str, str]:
+    """The share of the path run at the rated speed, or the top speed when that share
+    would read 0.0 % (a curve cruising just below the rated speed; ``docs/results.md``)."""
+    share = _percent(result.rated_speed_fraction)
+    if share != "0.0 %":
+        return "rated speed fraction", share
+    top = float(np.max(result.trajectory.speed, initial=0.0))
+    of_rated = f" ({_percent(top / rated_speed)} of v_r)" if rated_speed > 0 else ""
+    return "top speed", _num(top, scale=1e3, unit="mm/s") + of_rated
 
 
 def _energy_rows(result: PlanResult) -> list[tuple[str, str]]:
@@ -372,16 +386,17 @@ def _slowdowns_table(result: PlanResult) -> str:
         return "<h3>Slow-downs</h3><p>None: every straight piece runs at the rated speed.</p>"
     rows: list[list[Cell]] = [
         [
+            str(k + 1),  # the number speed.png labels it with
             _num(s.s_start, unit="m"),
             _num(s.s_end, unit="m"),
             _num(s.speed, scale=1e3, unit="mm/s"),
             _num(s.rated_speed, scale=1e3, unit="mm/s"),
             (_esc(s.limit), "text"),
         ]
-        for s in result.slowdowns
+        for k, s in enumerate(result.slowdowns)
     ]
     return "<h3>Slow-downs</h3>" + _grid(
-        ["from s", "to s", "speed", "rated", "forced by"], rows, False
+        ["#", "from s", "to s", "speed", "rated", "forced by"], rows
     )
 
 
@@ -402,6 +417,8 @@ def _references_table(result: PlanResult) -> str:
 
 
 def _format_value(value: object) -> str:
+    if isinstance(value, bool):
+        return "yes" if value else "no"
     if isinstance(value, float | np.floating):
         return _num(float(value), 6)
     if isinstance(value, np.ndarray | list | tuple):
@@ -412,19 +429,102 @@ def _format_value(value: object) -> str:
             + (", …)" if len(items) > 12 else ")")
         )
     if isinstance(value, Mapping):
-        return ", ".join(f"{_esc(k)} = {_format_value(v)}" for k, v in value.items())
+        return _key_values((str(k), _format_value(v)) for k, v in value.items())
     return _esc(value)
+
+
+PLACEMENT_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
+PLACEMENT_HEADER = ["x [m]", "y [m]", "z [m]", "roll [rad]", "pitch [rad]", "yaw [rad]"]
+"""Columns of a placement X in the report's tables."""
+
+_SEARCH_KEYS = ("optimizer", "initial", "robot", "status", "plan_status", "interrupted")
+"""Keys of ``optimizer_info`` (the ``result.json`` blocks of a run) that the placement
+search section lays out as tables, or leaves out (``robot``: in the Case section)."""
+
+
+def _search_tables(info: Mapping[str, object], result: PlanResult) -> str:
+    """The search (method, budget, time, stop) and the placements before, after and
+    rejected, as tables with named columns, from the ``optimizer`` and ``initial`` blocks
+    of ``result.json`` (:func:`trackplan.io.history.optimizer_summary`)."""
+    parts = []
+    optimizer = info.get("optimizer")
+    if isinstance(optimizer, Mapping):
+        header = [
+            "method",
+            "seed",
+            "runs",
+            "generations",
+            "evaluations",
+            "wall time [s]",
+            "best fitness",
+            "stopped",
+        ]
+        row: list[Cell] = [
+            _esc(optimizer.get("method", "–")),
+            *(
+                _esc(optimizer.get(key, "–"))
+                for key in ("seed", "runs", "generations", "evaluations")
+            ),
+            _num(optimizer.get("wall_time_s")),
+            _num(optimizer.get("fitness"), 6),
+            (_esc(optimizer.get("stop_reason", "–")), "text"),
+        ]
+        parts.append(_grid(header, [row]))
+    interrupted = info.get("interrupted")
+    if isinstance(interrupted, Mapping) and "message" in interrupted:
+        parts.append(f'<p class="bad">{_esc(interrupted["message"])}</p>')
+    rows: list[list[Cell]] = []
+    initial = info.get("initial")
+    if isinstance(initial, Mapping) and isinstance(initial.get("placement"), Mapping):
+        placement = initial["placement"]
+        verdict = initial.get("status", "feasible" if initial.get("feasible") else "infeasible")
+        rows.append(
+            [
+                "before (centre of the bounds)",
+                *(_num(placement.get(key)) for key in PLACEMENT_KEYS),
+                (_esc(verdict), "text"),
+                _num(initial.get("objective"), 6),
+            ]
+        )
+    rows.append(
+        [
+            "after (best found)",
+            *(_num(v) for v in result.placement),
+            (_esc(result.status.value), "text"),
+            _num(result.objective, 6),
+        ]
+    )
+    rejected = optimizer.get("rejected_candidates", []) if isinstance(optimizer, Mapping) else []
+    for k, X in enumerate(rejected or []):  # type: ignore[union-attr]
+        rows.append(
+            [
+                f"rejected {k + 1} (failed the final check)",
+                *(_num(v) for v in X),
+                ("rejected", "text"),
+                "–",
+            ]
+        )
+    parts.append(
+        "<h4>Placements</h4>" + _grid(["placement", *PLACEMENT_HEADER, "verdict", "J"], rows)
+    )
+    return "".join(parts)
 
 
 def _optimizer_section(
     optimizer_info: Mapping[str, object] | None,
     history: Mapping[str, Mapping[str, np.ndarray]] | None,
+    result: PlanResult,
 ) -> str:
-    if not optimizer_info and not history:
+    info = optimizer_info or {}
+    searched = "optimizer" in info or "initial" in info
+    others = [(str(k), v) for k, v in info.items() if k not in _SEARCH_KEYS]
+    if not searched and not others and not history:
         return ""
     parts = ["<h3>Placement search</h3>"]
-    if optimizer_info:
-        parts.append(_key_values((str(k), _format_value(v)) for k, v in optimizer_info.items()))
+    if searched:
+        parts.append(_search_tables(info, result))
+    if others:
+        parts.append(_key_values((k, _format_value(v)) for k, v in others))
     if history:
         rows = [
             [
@@ -434,7 +534,7 @@ def _optimizer_section(
                 _num(c["best"][-1], 6),
                 _num(c["mean"][-1], 4),
                 _percent(c["feasible_share"][-1]),
-                _num(c["wall_time"][-1], 4, unit="s"),
+                _num(c["wall_time"][-1], 4),
             ]
             for method, c in history_columns(history).items()
         ]
@@ -445,9 +545,9 @@ def _optimizer_section(
             "best",
             "last mean",
             "last feasible share",
-            "wall time",
+            "wall time [s]",
         ]
-        parts.append(_grid(header, rows))
+        parts.append("<h4>History</h4>" + _grid(header, rows))
     return "".join(parts)
 
 
@@ -558,7 +658,7 @@ def report_page(
             "</div><div>",
             _references_table(result),
             _slowdowns_table(result),
-            _optimizer_section(optimizer_info, history),
+            _optimizer_section(optimizer_info, history, result),
             "</div></div>",
             _margins_table(result, case),
             _violations_table(result),
@@ -567,10 +667,17 @@ def report_page(
             view,
         ]
     )
+    return html_page(f"trackplan report: {case.name}", body)
+
+
+def html_page(title: str, body: str) -> str:
+    """A self-contained page in the report's look: ``title`` (text) and ``body`` (HTML)
+    with the report's style sheet. ``report.html``, a cycle's report and ``map.html`` are
+    all built with it."""
     return (
         '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>trackplan report: {_esc(case.name)}</title><style>{_CSS}</style></head>"
+        f"<title>{_esc(title)}</title><style>{_CSS}</style></head>"
         f"<body>{body}</body></html>\n"
     )
 

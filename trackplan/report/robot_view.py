@@ -24,6 +24,7 @@ from trackplan.case import Case
 from trackplan.frames import placement_transform
 from trackplan.planning.result import PlanResult
 from trackplan.report.scene import (
+    FRAME_STYLES,
     chain_points,
     equal_limits,
     frame_indices,
@@ -48,7 +49,6 @@ NOMINAL_TRACE = "nominal path"
 CAPSULES_TRACE = "link capsules"
 CLOSEST_TRACE = "closest approach"
 DECIMALS = 5  # 10 µm: keeps the page small, far below anything visible
-_AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")
 
 
 def _xyz(points: np.ndarray, decimals: int = DECIMALS) -> dict[str, list[float | None]]:
@@ -279,17 +279,19 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
     ]
     for label, T in (("base frame", np.eye(4)), ("part frame", T_base_part)):
         lines = triad_lines(T, axis_length if label == "base frame" else 0.6 * axis_length)
-        for axis, color in enumerate(_AXIS_COLORS):
+        colors, dash = FRAME_STYLES[label]
+        for axis, color in enumerate(colors):
             static.append(
                 {
                     "type": "scatter3d",
                     **_xyz(lines[axis]),
                     "mode": "lines",
-                    "name": label,
+                    "name": f"{label} (x, y, z)",
                     "legendgroup": label,
                     "showlegend": axis == 0,
-                    "line": {"color": color, "width": 5},
-                    "hoverinfo": "skip",
+                    "line": {"color": color, "width": 5, "dash": dash},
+                    "hovertext": f"{label} {'xyz'[axis]}",
+                    "hoverinfo": "text",
                 }
             )
     builders = [robot_trace, trail_trace]

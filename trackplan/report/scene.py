@@ -189,6 +189,16 @@ def sphere_wireframe(radius: float, n_meridians: int = 12, n_parallels: int = 7)
     return radius * np.vstack([np.vstack([c, gap]) for c in circles])[:-1]
 
 
+FRAME_STYLES = {
+    "base frame": (("#8b0000", "#006400", "#00008b"), "solid"),
+    "part frame": (("#ff8c69", "#66cd66", "#6ca6ff"), "dash"),
+}
+"""Colours of the x, y and z axes (dark and light red, green, blue) and the line style of
+the robot's base frame and of the part (path definition) frame, in every view: the two
+frames are told apart by colour, style and legend entry. Tool frames keep the plain
+red, green and blue."""
+
+
 def triad_lines(T: np.ndarray, length: float) -> np.ndarray:
     """Axes of frames as NaN-separated line pieces, one polyline per axis.
 
