@@ -60,10 +60,15 @@ def test_a_placement_the_search_counts_feasible_passes_the_final_check(numeric_k
     assert plan.check.task_margins["speed"] == 0.0
 
 
+KR6_FEASIBLE = np.array([0.3147, -0.0547, 0.0967, 0.046, -0.1904, -0.014])
+"""A placement of the KUKA weld case the search found feasible."""
+
+
 def _straight_at(case, geometry, X, speed):
     """Joints moving the tool along the first (straight) piece at a constant speed, m/s."""
     tool = ToolOrientation.choose(case.task.tool, geometry)
     joint_path = JointPath.solve(case.robot, geometry, X, tool)
+    assert joint_path.success, joint_path.message
     Ts = case.task.sample_time
     n = 200
     s = np.arange(n) * speed * Ts
@@ -74,7 +79,7 @@ def _straight_at(case, geometry, X, speed):
 def test_an_over_speed_just_past_the_slack_is_rejected_by_margin_and_violation(side):
     case = load_case(CASES / "kuka-weld.yaml")
     geometry = PathGeometry.from_case(case)
-    X = np.array([0.45, 0.0, 0.05, 0.0, 0.0, 0.0])
+    X = KR6_FEASIBLE
     Ts = case.task.sample_time
     rated = case.task.rated_speed
     allowed = speed_slack(Ts) + RELATIVE_SLACK * rated
@@ -96,7 +101,7 @@ def test_an_over_speed_just_past_the_slack_is_rejected_by_margin_and_violation(s
 def test_an_over_speed_names_the_cap_that_applies_and_why():
     case = load_case(CASES / "kuka-weld.yaml")
     geometry = PathGeometry.from_case(case)
-    X = np.array([0.45, 0.0, 0.05, 0.0, 0.0, 0.0])
+    X = KR6_FEASIBLE
     Ts = case.task.sample_time
     rated, corner = case.task.rated_speed, case.task.corner_speed
     assert corner < rated

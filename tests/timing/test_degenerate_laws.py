@@ -3,11 +3,14 @@ a ZeroDivisionError or NaN samples (docs/timing.md, "When no speed helps")."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from tests.conftest import CASES
 from trackplan.cli import ExitCode, main
+from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
 from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
@@ -97,3 +100,35 @@ def test_an_air_move_of_no_length_is_finite(apart):
     move = plan_air_move(q0, q0 + apart, np.ones(6), np.ones(6), np.ones(6), 0.004)
     assert np.all(np.isfinite(move.q))
     assert move.q[0] == pytest.approx(q0, abs=0) and move.q[-1] == pytest.approx(q0 + apart, abs=0)
+
+
+KR6_FEASIBLE = np.array([0.3147, -0.0547, 0.0967, 0.046, -0.1904, -0.014])
+"""A placement of the KUKA weld case the search found feasible."""
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("rated_speed", 0.0),
+        ("corner_speed", 0.0),
+        ("corner_speed", float("nan")),
+        ("sample_time", 0.0),
+        ("tolerance", -1e-3),
+    ],
+)
+def test_a_task_built_in_code_with_no_speed_is_bad_input(name, value):
+    """The case loader refuses these in files; a Task built in code is refused the same way
+    (before: a zero corner speed planned a standstill, a NaN one passed every check)."""
+    case = load_case(CASES / "kuka-weld.yaml")
+    bad = replace(case, task=replace(case.task, **{name: value}))
+    with pytest.raises(CaseError, match=rf"task\.{name}: must be a finite number > 0"):
+        plan_placement(bad, KR6_FEASIBLE)
+
+
+def test_a_tiny_task_speed_is_not_blamed_on_a_singularity():
+    case = load_case(CASES / "kuka-weld.yaml")
+    slow = replace(case, task=replace(case.task, rated_speed=1e-9))
+    result = plan_placement(slow, KR6_FEASIBLE)
+    assert result.status is Status.LIMITS_VIOLATED
+    assert "rated speed holds the speed to 1e-09 m/s" in result.message
+    assert "singularity" not in result.message

@@ -143,10 +143,11 @@ def plan_smooth_time_law(
         n_steps = max(1, int(np.ceil(profile.duration / sample_time - 1e-9)))
         if n_steps > MAX_SAMPLES:
             slowest = min((p for p in plans if p.kind != "stop"), key=lambda p: p.plateau)
+            hint = " (a singularity near the path?)" if slowest.reason.startswith("joint") else ""
             message = (
                 f"the time law would need {profile.duration:.4g} s: {slowest.reason} holds the "
                 f"speed to {slowest.plateau:.3g} m/s at s = {slowest.s_start:.4f}.."
-                f"{slowest.s_end:.4f} m (a singularity near the path?)"
+                f"{slowest.s_end:.4f} m{hint}"
             )
             return unsampled(
                 Timing.SMOOTH, Status.LIMITS_VIOLATED, message, sample_time, robot.n_dof
@@ -179,7 +180,8 @@ def _standstill_message(halted: list[ZonePlan], length: float, failing: str) -> 
             f"{failing}, and slowing {where} down to a standstill does not bring it under: "
             "no speed meets it (the joint path jumps there: a singularity on the path?)"
         )
-    return f"{first.reason} leaves no speed at {where} (a singularity on the path?)"
+    hint = " (a singularity on the path?)" if first.reason.startswith("joint") else ""
+    return f"{first.reason} leaves no speed at {where}{hint}"
 
 
 ORDER_KINDS = {1: "velocity", 2: "acceleration", 3: "jerk"}
