@@ -99,17 +99,26 @@ def test_an_over_speed_just_past_the_slack_is_rejected_by_margin_and_violation(s
 
 
 def test_an_over_speed_names_the_cap_that_applies_and_why():
+    """Over the rated speed on the first straight, then slowly into the arc: the cap that
+    applies is the rated speed, not the lowest cap of the trajectory (the corner speed)."""
     case = load_case(CASES / "kuka-weld.yaml")
     geometry = PathGeometry.from_case(case)
     X = KR6_FEASIBLE
     Ts = case.task.sample_time
     rated, corner = case.task.rated_speed, case.task.corner_speed
     assert corner < rated
-    # a straight run at 1.1 × the rated speed: the rated speed is exceeded, not the corner's
-    q = _straight_at(case, geometry, X, 1.1 * rated)
+    (_, straight_end, kind), (_, _, next_kind) = geometry.zones()[:2]
+    assert (kind, next_kind) == ("straight", "curved")
+    fast = np.arange(0.0, straight_end, 1.1 * rated * Ts)
+    slow = fast[-1] + np.arange(1, 300) * 0.5 * corner * Ts
+    tool = ToolOrientation.choose(case.task.tool, geometry)
+    joint_path = JointPath.solve(case.robot, geometry, X, tool)
+    q = joint_path.joints(np.concatenate([fast, slow]))
     report = check_trajectory(case.robot, q, Ts, tracking_reference(case, geometry, X))
     (violation,) = [v for v in report.violations if v.limit == "speed"]
     assert violation.bound == rated
-    assert f"rated speed {rated:g} m/s" in violation.message
-    assert "straight" in violation.message
+    assert (
+        f"exceeds the rated speed {rated:g} m/s (the cap on straight pieces)" in violation.message
+    )
     assert f"{corner:g}" not in violation.message
+    assert violation.t_last < len(fast) * Ts  # the straight only
