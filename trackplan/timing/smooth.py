@@ -184,7 +184,7 @@ def _standstill_message(halted: list[ZonePlan], length: float, failing: str) -> 
     return f"{first.reason} leaves no speed at {where}{hint}"
 
 
-ORDER_KINDS = {1: "velocity", 2: "acceleration", 3: "jerk"}
+_ORDER_KINDS = {1: "velocity", 2: "acceleration", 3: "jerk"}
 
 
 def _failing_limit(
@@ -197,13 +197,14 @@ def _failing_limit(
     row, kind = int(sample[k]), int(order[k])
     where = f"at s = {s[row]:.4f} m"
     robot = motion.robot
-    if kind in ORDER_KINDS:
+    if kind in _ORDER_KINDS:  # the rates: which joint, and its use of the full limit
         values = (motion.qd, motion.qdd, motion.qddd)[kind - 1][row : row + 4]
         limit = (robot.v_max, robot.a_max, robot.j_max)[kind - 1]
         use = np.abs(values) / limit  # (rows, n)
         joint = int(np.argmax(use.max(axis=0)))
-        if use[:, joint].max() >= ratio[k] * (1.0 - LIMIT_MARGIN) * (1.0 - 1e-9):
-            return f"joint {joint + 1} {ORDER_KINDS[kind]} is {ratio[k]:.3g} × its limit {where}"
+        peak = float(use[:, joint].max())
+        if peak >= ratio[k] * (1.0 - LIMIT_MARGIN) * (1.0 - 1e-9):  # the check's sample
+            return f"joint {joint + 1} {_ORDER_KINDS[kind]} is {peak:.3g} × its limit {where}"
     return f"a joint limit is {ratio[k]:.3g} × exceeded {where}"
 
 
