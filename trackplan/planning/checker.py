@@ -51,7 +51,9 @@ RELATIVE_SLACK = 1e-9
 IK_POSITION_TOLERANCE = NEWTON_TOLERANCE
 """Largest distance between a sample's tool point (FK of its joints) and the path point the
 joints were solved for, m: the numeric IK's Newton tolerance
-(:data:`trackplan.robots.path_ik._NEWTON_TOL`); closed-form IK is exact to round-off."""
+(:data:`trackplan.robots.path_ik._NEWTON_TOL`), also the default of the paper law's
+resolved-rate IK (:func:`trackplan.robots.resolved_rate.solve_path_resolved_rate`);
+closed-form IK is exact to round-off."""
 
 
 def speed_slack(sample_time: float) -> float:
