@@ -187,6 +187,7 @@ def write_cycle_run(
             "fitness": float(search.fitness),
             "unreachable_seams": list(search.unreachable),
             "rejected_candidates": [list(map(float, X)) for X in search.rejected],
+            "on_bounds": [hit.as_dict() for hit in search.on_bounds],
         }
     blocks.update(extra or {})
     written: dict = {}

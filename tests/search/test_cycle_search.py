@@ -84,6 +84,11 @@ def test_a_seam_unreachable_everywhere_makes_optimize_exit_3_naming_it(
     result = json.loads((tmp_path / "run" / "result.json").read_text(encoding="utf-8"))
     assert result["optimizer"]["unreachable_seams"] == ["far-away"]
     assert result["feasible"] is False
+    # the placement's variables on a bound of the box (z's range is 2 cm wide)
+    X = [result["placement"][k] for k in ("x", "y", "z", "roll", "pitch", "yaw")]
+    hits = cycle_space(load_case(file)).bound_hits(np.array(X))
+    assert result["optimizer"]["on_bounds"] == [hit.as_dict() for hit in hits]
+    assert ("note: the placement lies on a bound" in out) == bool(hits)
 
 
 @pytest.mark.slow

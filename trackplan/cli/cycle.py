@@ -78,6 +78,11 @@ def optimize_cycle_command(case: Case, out: Path, *, report: bool, **options: ob
         f"{escape(result.message)} ({result.evaluations} evaluations, "
         f"{result.wall_time_s:.2f} s, seed {result.seed})"
     )
+    from trackplan.search.space import bounds_note
+
+    note = bounds_note(result.on_bounds)
+    if note:
+        text.print(f"  note: {escape(note)}")
     print_cycle(text, result.final, out)
     if interrupted:
         return ExitCode(signals.exit_code)

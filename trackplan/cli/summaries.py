@@ -223,6 +223,11 @@ def print_search(  # type: ignore[no-untyped-def]
         "the closest one is planned below"
     )
     console.print(f"  after  (X = {_vector(result.X)}): {after}")
+    from trackplan.search.space import bounds_note
+
+    note = bounds_note(result.on_bounds)
+    if note:
+        console.print(f"  note: {escape(note)}")
     print_plan(console, result.final, out, rated_speed=rated_speed)
 
 

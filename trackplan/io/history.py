@@ -75,7 +75,7 @@ def optimizer_summary(result: OptimizeResult, joint_names: tuple[str, ...]) -> d
     -------
     dict
         ``{"optimizer": {method, seed, evaluations, generations, stop_reason,
-        wall_time_s, ...}, "initial": {placement, feasible, status, message, objective,
+        wall_time_s, ..., on_bounds}, "initial": {placement, feasible, status, message, objective,
         violations}}`` in plain JSON types.
     """
     initial = result_summary(result.initial, joint_names)
@@ -92,6 +92,7 @@ def optimizer_summary(result: OptimizeResult, joint_names: tuple[str, ...]) -> d
             "message": result.message,
             "fitness": float(result.fitness),
             "rejected_candidates": [list(map(float, X)) for X in result.rejected],
+            "on_bounds": [hit.as_dict() for hit in result.on_bounds],
         },
         "initial": {
             key: initial[key]

@@ -26,6 +26,7 @@ from trackplan.planning.tracking import (
 )
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.model import Robot
+from trackplan.robots.path_ik import _NEWTON_TOL as NEWTON_TOLERANCE
 from trackplan.tool import SpinMode, ToolFrame, ToolSpec
 
 if TYPE_CHECKING:
@@ -47,8 +48,38 @@ UNITS = {
 }
 RELATIVE_SLACK = 1e-9
 """Values within this relative amount of a limit count as meeting it (float round-off)."""
-SPEED_SLACK = 1e-6
-"""The same for the Cartesian speed caps (the speed is a difference of FK positions)."""
+IK_POSITION_TOLERANCE = NEWTON_TOLERANCE
+"""Largest distance between a sample's tool point (FK of its joints) and the path point the
+joints were solved for, m: the numeric IK's Newton tolerance
+(:data:`trackplan.robots.path_ik._NEWTON_TOL`), also the default of the paper law's
+resolved-rate IK (:func:`trackplan.robots.resolved_rate.solve_path_resolved_rate`);
+closed-form IK is exact to round-off."""
+
+
+def speed_slack(sample_time: float) -> float:
+    """Speed above a cap that still counts as meeting it, m/s: ``2 ε / Ts``.
+
+    The checker's speed is the backward difference ``|p_k − p_(k−1)| / Ts`` of two tool
+    points, each within ε = :data:`IK_POSITION_TOLERANCE` of the point of the path the time
+    law planned there, so it differs from the planned speed by at most ``2 ε / Ts``
+    (5e-8 m/s at Ts = 4 ms). The time laws plan the path at most at each cap, so a plan
+    counted feasible by the search (in smooth timing, every geometrically feasible
+    placement) passes this check; a sampled speed above ``cap + 2 ε / Ts`` (plus
+    :data:`RELATIVE_SLACK` of the cap for round-off) is a planned excess and a violation.
+
+    Parameters
+    ----------
+    sample_time
+        Ts, s.
+
+    Returns
+    -------
+    float
+        m/s.
+    """
+    return 2.0 * IK_POSITION_TOLERANCE / sample_time
+
+
 ORIENTATION_TOLERANCE = 1e-3
 """Largest tool orientation error accepted, rad."""
 
@@ -328,17 +359,55 @@ def _check_task(
     # a backward difference is the mean speed over the last period: where that period
     # straddles the end of a corner, the mean may reach the higher of the two caps
     cap[1:] = np.maximum(cap[1:], cap[:-1])
-    # speed is a task bound: ppm-level round-off counts as meeting it
-    margins["speed"] = float(_met(1.0 - (speed / cap).max(), SPEED_SLACK))
-    if margins["speed"] < 0:
-        violations.append(
-            _violation("speed", None, t, speed, speed / cap * (1 - 1e-6), float(cap.min()))
-        )
+    corner = in_corner.copy()
+    corner[1:] |= in_corner[:-1]  # either end of the period in a corner …
+    corner &= cap == ref.corner_speed  # … and the corner speed its cap
+    margins["speed"], over_speed = _speed_verdict(speed, cap, corner, t, sample_time)
+    violations.extend(over_speed)
 
     coverage = _coverage_violations(ref, t, s_nominal, piece, speed, sample_time)
     margins["coverage"] = 1.0 if not coverage else -1.0
     violations.extend(coverage)
     return (margins, violations), worst, orientation_error
+
+
+def _speed_verdict(
+    speed: np.ndarray, cap: np.ndarray, in_corner: np.ndarray, t: np.ndarray, sample_time: float
+) -> tuple[float, list[Violation]]:
+    """The speed margin and violation, one verdict: a sample is over its cap when it exceeds
+    it by more than :func:`speed_slack` plus :data:`RELATIVE_SLACK` of the cap; the margin
+    ``1 − max(speed / cap)`` is negative exactly then (0 when within the slack).
+
+    Parameters
+    ----------
+    speed, cap
+        Tool speed (backward differences) and the cap at each sample, shape (N,), m/s.
+    in_corner
+        Whether the corner speed is the cap at each sample (an arc or a corner blend),
+        shape (N,), bool; elsewhere the rated speed is (a straight piece).
+    t
+        Sample times, shape (N,), s.
+    sample_time
+        Ts, s.
+    """
+    over = speed - cap > speed_slack(sample_time) + RELATIVE_SLACK * cap
+    margin = 1.0 - float((speed / cap).max())
+    if not over.any():
+        return max(margin, 0.0), []
+    ratio = np.where(over, speed / cap, 0.0)
+    found = _violation("speed", None, t, speed, ratio, float(cap[np.argmax(ratio)]))
+    worst = int(np.argmax(ratio))
+    value, bound = float(speed[worst]), float(cap[worst])
+    if in_corner[worst]:
+        which = f"the corner speed {bound:g} m/s (the cap on arcs and corner blends)"
+    else:
+        which = f"the rated speed {bound:g} m/s (the cap on straight pieces)"
+    message = (
+        f"speed {value:.6g} m/s exceeds {which} by {value - bound:.3g} m/s at "
+        f"t = {t[worst]:.3f} s ({_count(int(over.sum()), 'sample')} from "
+        f"t = {found.t_first:.3f} to {found.t_last:.3f} s)"
+    )
+    return min(margin, -RELATIVE_SLACK), [replace(found, message=message)]
 
 
 def violations_of(violations: list[Violation], limit: str) -> list[Violation]:

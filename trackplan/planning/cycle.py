@@ -48,6 +48,7 @@ from trackplan.planning.checker import check_trajectory
 from trackplan.planning.objective import joint_travel
 from trackplan.planning.plan import (
     cell_geometry,
+    check_task_values,
     make_trajectory,
     plan_placement,
     tracking_reference,
@@ -445,6 +446,8 @@ def plan_cycle(
     X = as_placement(X)
     cycle = case.cycle
     seams = case.seams
+    for index, seam in enumerate(seams):
+        check_task_values(seam.task, "task" if cycle is None else f"paths[{index}].task")
     m = len(seams)
     mode = "given" if cycle is None else cycle.sequence
     approach = 0.0 if cycle is None else cycle.approach

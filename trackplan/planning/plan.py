@@ -7,12 +7,13 @@ depends on which law runs.
 
 from __future__ import annotations
 
+import math
 import weakref
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.case import Case
+from trackplan.case import Case, Task
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform, vector_norms
 from trackplan.jointpath import JointPath
@@ -195,6 +196,7 @@ def plan_placement(
             key="paths",
         )
     X = as_placement(X)
+    check_task_values(case.task)
     law = time_law(timing or case.task.timing)
     if geometry is None or geometry.mode != law.path_mode:
         geometry = case_geometry(case, law.path_mode)
@@ -207,6 +209,31 @@ def plan_placement(
     if not timed.s.size:
         return _unplanned(case, joint_path, law.timing, timed.status, timed.message)
     return _checked(case, joint_path, timed)
+
+
+def check_task_values(task: Task, key: str = "task") -> None:
+    """Refuse a task no time law can run (a Task built in code; the case loader checks
+    files the same way): speeds, tolerance and sample time must be finite and > 0.
+
+    Raises
+    ------
+    CaseError
+        Naming the value, e.g. ``task.rated_speed: must be a finite number > 0 (m/s),
+        got 0.0``.
+    """
+    for name, unit in (
+        ("rated_speed", "m/s"),
+        ("corner_speed", "m/s"),
+        ("tolerance", "m"),
+        ("sample_time", "s"),
+    ):
+        value = getattr(task, name)
+        if not (
+            isinstance(value, int | float | np.floating) and math.isfinite(value) and value > 0
+        ):
+            raise CaseError(
+                f"must be a finite number > 0 ({unit}), got {value!r}", key=f"{key}.{name}"
+            )
 
 
 def _twist_note(joint_path: JointPath) -> str:
@@ -360,6 +387,7 @@ def check_case_trajectory(
             "trackplan.planning.cycle.check_cycle_trajectory (docs/seams.md)",
             key="paths",
         )
+    check_task_values(case.task)
     law = time_law(timing or case.task.timing)
     geometry = case_geometry(case, law.path_mode)
     reference = tracking_reference(case, geometry, as_placement(X))

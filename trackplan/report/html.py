@@ -649,6 +649,7 @@ def report_page(
         [
             f"<h1>{_esc(case.name)}: {verdict}</h1>",
             f"<p>{_verdict_badge(result)} {_esc(result.message)}</p>",
+            _bounds_line(optimizer_info),
             '<nav><a href="#case">Case</a><a href="#result">Result</a><a href="#plots">Plots</a>'
             '<a href="#view">3D view</a></nav>',
             _case_section(result, case),
@@ -680,6 +681,19 @@ def html_page(title: str, body: str) -> str:
         f"<title>{_esc(title)}</title><style>{_CSS}</style></head>"
         f"<body>{body}</body></html>\n"
     )
+
+
+def _bounds_line(optimizer_info: Mapping[str, object] | None) -> str:
+    """A line under the verdict when the search's placement lies on a bound of its box
+    (``optimizer.on_bounds`` of result.json); '' otherwise."""
+    search = (optimizer_info or {}).get("optimizer")
+    hits = search.get("on_bounds") if isinstance(search, Mapping) else None
+    if not hits:
+        return ""
+    from trackplan.search.space import BoundHit, bounds_note
+
+    note = bounds_note([BoundHit(**hit) for hit in hits])
+    return f'<p id="on-bounds">Note: {_esc(note)}</p>'
 
 
 def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]

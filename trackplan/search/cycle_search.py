@@ -58,7 +58,7 @@ from trackplan.search.fitness import (
 )
 from trackplan.search.optimize import GenerationRecord, SearchHistory, run_search, run_seeds
 from trackplan.search.problem import PlacementProblem
-from trackplan.search.space import N_VAR, SearchSpace
+from trackplan.search.space import N_VAR, BoundHit, SearchSpace
 from trackplan.status import Status
 from trackplan.timing import time_law
 from trackplan.timing.airmove import air_time_estimate
@@ -357,6 +357,9 @@ class CycleSearchResult:
         Seams no evaluated placement reached, by name.
     rejected
         Candidates screened feasible whose full cycle failed the check, shape (R, 6).
+    on_bounds
+        The variables of X on a bound of the search box
+        (:meth:`~trackplan.search.space.SearchSpace.bound_hits`).
     """
 
     success: bool
@@ -376,6 +379,7 @@ class CycleSearchResult:
     runs: int = 1
     unreachable: tuple[str, ...] = ()
     rejected: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    on_bounds: tuple[BoundHit, ...] = ()
     spins: tuple[SeamSpin, ...] = ()
 
 
@@ -457,6 +461,7 @@ def optimize_cycle(
         unreachable=unreachable,
         rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),
         spins=fitness.seam_spins(chosen),
+        on_bounds=space.bound_hits(final.placement),
     )
 
 

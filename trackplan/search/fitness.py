@@ -5,7 +5,9 @@ time law: J sums |Δq| along the joint path whatever the speed. So a whole popul
 screened at once on a coarse arc-length grid of the planned path: one batched IK call
 solves every candidate on all eight branches, and per candidate the feasible branch with
 the smallest J is chosen. The smooth time law always meets the rate limits by slowing
-down, so in smooth timing a geometrically feasible candidate is feasible; the time law
+down, and the speed caps up to the IK's error, which the checker's speed slack allows
+(:func:`trackplan.planning.checker.speed_slack`), so in smooth timing a geometrically
+feasible candidate is feasible; the time law
 runs only where the duration matters (``objective.time_weight > 0``) and the candidate
 can still beat the incumbent. In paper timing (Section 3.1 as written) every screened
 candidate is planned and checked, since that time law does not respect the limits.

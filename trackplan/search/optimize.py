@@ -37,7 +37,7 @@ from trackplan.search.algorithms import (
 )
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.problem import PlacementProblem
-from trackplan.search.space import SearchSpace
+from trackplan.search.space import BoundHit, SearchSpace
 from trackplan.status import Status
 from trackplan.timing import time_law
 
@@ -161,6 +161,10 @@ class OptimizeResult:
         The seed.
     rejected
         Candidates screened feasible that the final check rejected, best first, shape (R, 6).
+    on_bounds
+        The variables of X that lie on a bound of the search box
+        (:meth:`~trackplan.search.space.SearchSpace.bound_hits`): the optimum may lie
+        beyond it.
     """
 
     success: bool
@@ -181,6 +185,7 @@ class OptimizeResult:
     seed: int
     runs: int = 1
     rejected: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    on_bounds: tuple[BoundHit, ...] = ()
 
 
 ProgressCallback = Callable[[GenerationRecord], None]
@@ -331,6 +336,7 @@ def optimize_placement(
         seed=seed,
         runs=runs,
         rejected=np.asarray(rejected, dtype=float).reshape(-1, 6),
+        on_bounds=space.bound_hits(final.placement),
     )
 
 

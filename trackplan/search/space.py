@@ -26,6 +26,64 @@ _INSIDE = 1e-12
 """Relative amount by which projections land inside the reach radii (round-off)."""
 _GRID_NODES = 41
 """Grid nodes per axis of the fallback search for the admissible point nearest the centre."""
+BOUND_SHARE = 1e-3
+"""A placement variable lies on a bound of the box when it is within this share of the box's
+width (``upper - lower``) of it: 3 mrad of the default ±1.57 rad roll and pitch, 0.35 mm of
+a 0.35 m range of x. The searches clip candidates to the box, so an optimum pressed against
+a bound sits on it to round-off; one this close is held there by the bound, not by the
+task."""
+_UNITS = ("m", "m", "m", "rad", "rad", "rad")
+
+
+@dataclass(frozen=True)
+class BoundHit:
+    """A placement variable on a bound of the search box.
+
+    Attributes
+    ----------
+    variable
+        ``x``, ``y``, ``z``, ``roll``, ``pitch`` or ``yaw``.
+    side
+        ``lower`` or ``upper``.
+    value, bound
+        The variable and the bound it lies on, m or rad.
+    """
+
+    variable: str
+    side: str
+    value: float
+    bound: float
+
+    def describe(self) -> str:
+        """``roll = 1.5700 rad is on its upper bound 1.57 rad``."""
+        unit = _UNITS[PLACEMENT_KEYS.index(self.variable)]
+        return (
+            f"{self.variable} = {self.value:.4f} {unit} is on its {self.side} bound "
+            f"{self.bound:g} {unit}"
+        )
+
+    def as_dict(self) -> dict[str, str | float]:
+        """``{"variable", "side", "value", "bound"}`` in plain JSON types."""
+        return {
+            "variable": self.variable,
+            "side": self.side,
+            "value": float(self.value),
+            "bound": float(self.bound),
+        }
+
+
+def bounds_note(hits: tuple[BoundHit, ...] | list[BoundHit]) -> str:
+    """One line on the placement variables on a bound of the box ('' when none): which,
+    which bound, and what to do about it."""
+    if not hits:
+        return ""
+    keys = ", ".join(f"placement.{hit.variable}" for hit in hits)
+    return (
+        f"the placement lies on a bound of the search box: "
+        f"{'; '.join(h.describe() for h in hits)} "
+        f"(within {BOUND_SHARE:.1%} of the range); the optimum may lie beyond it: widen "
+        f"{keys} if the range is not a hard limit"
+    )
 
 
 def box_distance_range(lower: np.ndarray, upper: np.ndarray) -> tuple[float, float]:
@@ -252,11 +310,40 @@ class SearchSpace:
 
     def describe(self, X: np.ndarray) -> str:
         """``x = 0.1 m, ..., yaw = -0.2 rad`` for one placement, shape (6,)."""
-        units = ("m", "m", "m", "rad", "rad", "rad")
         return ", ".join(
             f"{key} = {value:.4f} {unit}"
-            for key, value, unit in zip(PLACEMENT_KEYS, X, units, strict=True)
+            for key, value, unit in zip(PLACEMENT_KEYS, X, _UNITS, strict=True)
         )
+
+    def bound_hits(self, X: np.ndarray) -> tuple[BoundHit, ...]:
+        """The placement variables of X that lie on a bound of the box.
+
+        On a bound means within :data:`BOUND_SHARE` of the box's width of it; a variable
+        the box fixes (``lower == upper``) is never reported.
+
+        Parameters
+        ----------
+        X
+            A placement, shape (6,) or (6 + k,) (the spin variables are not reported),
+            metres and radians.
+
+        Returns
+        -------
+        tuple of BoundHit
+            In the order x, y, z, roll, pitch, yaw.
+        """
+        X = np.asarray(X, dtype=float)[:N_VAR]
+        lower, upper = self.lower[:N_VAR], self.upper[:N_VAR]
+        near = BOUND_SHARE * (upper - lower)
+        hits = []
+        for i, key in enumerate(PLACEMENT_KEYS):
+            if not upper[i] > lower[i]:
+                continue
+            if X[i] - lower[i] <= near[i]:
+                hits.append(BoundHit(key, "lower", float(X[i]), float(lower[i])))
+            elif upper[i] - X[i] <= near[i]:
+                hits.append(BoundHit(key, "upper", float(X[i]), float(upper[i])))
+        return tuple(hits)
 
 
 def _nearest_in_shell(

@@ -683,7 +683,8 @@ def _sample(
     stretches: list[_Stretch], speeds: list[np.ndarray], sample_time: float
 ) -> np.ndarray | None:
     """Arc length at Ts along the curve, from rest to rest, shape (N,), m (None when the
-    curve stops inside a stretch or would last :data:`MAX_DURATION` or more).
+    curve stops inside a stretch, has no length, or would last :data:`MAX_DURATION` or
+    more).
 
     Node times from constant acceleration between nodes (constant jerk next to a rest).
     The fraction of a period left at the end is spread over the whole curve: every step
@@ -696,7 +697,7 @@ def _sample(
     """
     steps = [_node_steps(stretch, v) for stretch, v in zip(stretches, speeds, strict=True)]
     duration = float(sum(step.sum() for step in steps))
-    if not duration < MAX_DURATION:
+    if not 0.0 < duration < MAX_DURATION:  # no length to time, or too slow
         return None
     n_steps = max(1, int(np.ceil(duration / sample_time - 1e-9)))
     # every step a little longer: slower (by less than a period over the duration), and

@@ -128,16 +128,26 @@ def plan_smooth_time_law(
     zones, demands = _slow_down_windows(robot, zones, demands, task.rated_speed, task.corner_speed)
     planner = _ZonePlanner(robot, zones, demands, task.rated_speed, task.corner_speed)
     length = zones[-1][1]
+    failing = ""  # the limit the last rebuild was for
     for iteration in range(1, MAX_ITERATIONS + 1):
         plans = planner.plan()
+        halted = [
+            p for p in plans if p.kind != "stop" and p.s_end > p.s_start and not p.plateau > 0.0
+        ]
+        if halted or not length > 0.0:
+            message = _standstill_message(halted, length, failing)
+            return unsampled(
+                Timing.SMOOTH, Status.LIMITS_VIOLATED, message, sample_time, robot.n_dof
+            )
         profile = planner.profile(plans, length, sample_time)
         n_steps = max(1, int(np.ceil(profile.duration / sample_time - 1e-9)))
         if n_steps > MAX_SAMPLES:
             slowest = min((p for p in plans if p.kind != "stop"), key=lambda p: p.plateau)
+            hint = " (a singularity near the path?)" if slowest.reason.startswith("joint") else ""
             message = (
                 f"the time law would need {profile.duration:.4g} s: {slowest.reason} holds the "
                 f"speed to {slowest.plateau:.3g} m/s at s = {slowest.s_start:.4f}.."
-                f"{slowest.s_end:.4f} m (a singularity near the path?)"
+                f"{slowest.s_end:.4f} m{hint}"
             )
             return unsampled(
                 Timing.SMOOTH, Status.LIMITS_VIOLATED, message, sample_time, robot.n_dof
@@ -151,9 +161,51 @@ def plan_smooth_time_law(
         if not worst[0].size:
             law = _sampled(plans, task, s, motion, iteration, converged=True)
             return _or_curve(law, plans, profile.duration, joint_path, task, checks)
+        failing = _failing_limit(worst, motion, s)
         planner.tighten(worst, s, t / time_scale, profile)
     law = _sampled(plans, task, s, motion, MAX_ITERATIONS, converged=False)
     return _or_curve(law, plans, profile.duration, joint_path, task, checks)
+
+
+def _standstill_message(halted: list[ZonePlan], length: float, failing: str) -> str:
+    """Why the law cannot move: a window whose speed the joint limits (or the rebuilds for
+    ``failing``, the limit a sample kept breaking) brought down to 0, or a path of no length.
+    """
+    if not halted:
+        return f"the path has no length to time ({length:.3g} m)"
+    first = halted[0]
+    where = f"s = {first.s_start:.4f}..{first.s_end:.4f} m"
+    if failing:
+        return (
+            f"{failing}, and slowing {where} down to a standstill does not bring it under: "
+            "no speed meets it (the joint path jumps there: a singularity on the path?)"
+        )
+    hint = " (a singularity on the path?)" if first.reason.startswith("joint") else ""
+    return f"{first.reason} leaves no speed at {where}{hint}"
+
+
+_ORDER_KINDS = {1: "velocity", 2: "acceleration", 3: "jerk"}
+
+
+def _failing_limit(
+    worst: tuple[np.ndarray, np.ndarray, np.ndarray], motion: SampledMotion, s: np.ndarray
+) -> str:
+    """The worst failing sample of a sample check, in words: ``joint 1 acceleration is 4.8 ×
+    its limit at s = 0.0020 m`` (``a joint limit …`` for a check other than the rates)."""
+    sample, order, ratio = worst
+    k = int(np.argmax(ratio))
+    row, kind = int(sample[k]), int(order[k])
+    where = f"at s = {s[row]:.4f} m"
+    robot = motion.robot
+    if kind in _ORDER_KINDS:  # the rates: which joint, and its use of the full limit
+        values = (motion.qd, motion.qdd, motion.qddd)[kind - 1][row : row + 4]
+        limit = (robot.v_max, robot.a_max, robot.j_max)[kind - 1]
+        use = np.abs(values) / limit  # (rows, n)
+        joint = int(np.argmax(use.max(axis=0)))
+        peak = float(use[:, joint].max())
+        if peak >= ratio[k] * (1.0 - LIMIT_MARGIN) * (1.0 - 1e-9):  # the check's sample
+            return f"joint {joint + 1} {_ORDER_KINDS[kind]} is {peak:.3g} × its limit {where}"
+    return f"a joint limit is {ratio[k]:.3g} × exceeded {where}"
 
 
 CURVE_SHARE = 0.03
