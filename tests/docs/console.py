@@ -4,8 +4,8 @@ A ``console`` block holds commands (lines starting with ``$ ``) each followed by
 it prints. A command may end with a shell comment ``# exit N`` giving its exit code
 (default 0). Each shown output line must equal a line of the real output (trailing spaces
 aside), in the same order; a shown line ending in ``...`` must be the beginning of one; a
-line ``...`` stands for output that is left out. Numbers are compared as printed, so they
-match within the precision the documentation states.
+line ``...`` stands for output that is left out. Numbers agree within one unit of the last
+digit the documentation prints (``figures.agree``); the words around them exactly.
 """
 
 from __future__ import annotations
@@ -17,6 +17,8 @@ import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+
+from tests.docs import figures
 
 REPO = Path(__file__).resolve().parents[2]
 BLOCK = re.compile(r"^```console\n(.*?)^```", re.M | re.S)
@@ -78,14 +80,42 @@ def mismatch(shown: tuple[str, ...], output: str) -> str | None:
     for expected in shown:
         if expected in ("...", ""):
             continue
-        prefix = expected.endswith("...")
-        want = expected[:-3] if prefix else expected
-        while at < len(lines) and not (lines[at].startswith(want) if prefix else lines[at] == want):
+        while at < len(lines) and figures.agree_line(expected, lines[at]) is not None:
             at += 1
         if at == len(lines):
             return f"line not printed (in this order): {expected!r}"
         at += 1
     return None
+
+
+def refreshed(shown: tuple[str, ...], output: str) -> tuple[list[str], list[str]]:
+    """``shown`` with each line replaced by the printed line of the same words, in order
+    (its figures as printed now), and the shown lines no printed line has the words of.
+
+    Of the printed lines with the same words, a shown line stands for the one whose figures
+    are nearest: fewest integers (a joint, a count) that differ, then fewest other numbers
+    out of tolerance, then the first."""
+    lines = [line.rstrip() for line in output.splitlines()]
+    fresh: list[str] = []
+    lost: list[str] = []
+    at = 0
+    for expected in shown:
+        if expected in ("...", ""):
+            fresh.append(expected)
+            continue
+        candidates = [
+            (figures.distance(expected, lines[i]), i, new)
+            for i in range(at, len(lines))
+            if (new := figures.restate(expected, lines[i])) is not None
+        ]
+        if not candidates:
+            lost.append(expected)
+            fresh.append(expected)
+            continue
+        _, i, new = min(candidates)
+        fresh.append(expected if figures.agree_line(expected, lines[i]) is None else new)
+        at = i + 1
+    return fresh, lost
 
 
 def workspace(tmp: Path) -> Path:

@@ -40,3 +40,43 @@ def test_paths_page_paper_corner_table():
     assert f"{planned.length:.5f} m long (nominal {nominal.length:.5f} m)" in text
     arc = next(p for p in build_path(nominal, rho, mode="paper").pieces if p.kind == "arc")
     assert f"arc {arc.length * 1e3:.3f} mm" in text
+
+
+def _zones(case_name: str, normal: tuple[float, float, float] | None = None) -> np.ndarray:
+    from trackplan import load_case
+    from trackplan.paths.path_geometry import PathGeometry
+    from trackplan.planning.tool_zones import transition_zones
+    from trackplan.tool import ToolFrame, ToolSpec
+
+    case = load_case(console.REPO / "cases" / f"{case_name}.yaml")
+    spec = case.task.tool
+    if normal is not None:
+        spec = ToolSpec(frame=ToolFrame.SEAM, normal=np.array(normal))
+    return transition_zones(spec, PathGeometry.from_case(case), case.task.tolerance)
+
+
+def test_tool_page_transition_zones():
+    """docs/tool.md: the transition zones of its examples (geometry only, no search)."""
+    text = _text("tool.md")
+    ((s0, s1, bound),) = _zones("seam-weld-fixed")
+    assert f"nominal s from {s0:.3f} to {s1:.3f} m), bound {bound:.3f} rad" in text
+    assert f"({np.degrees(bound):.1f}°)" in text
+    ((s0, s1, bound),) = _zones("paper-corner", (0.0, 1.0, 0.3))
+    assert (
+        f"has one zone of {(s1 - s0) * 1e3:.0f} mm around the corner, bound {bound:.2f} rad" in text
+    )
+    assert len(_zones("paper-corner", (0.0, 1.0, 0.0))) == 0
+    ((s0, s1, bound),) = _zones("bracket-two-faces")
+    assert f"from nominal s = {s0:.3f} to {s1:.3f} m with bound {bound:.2f} rad" in text
+
+
+def test_tool_page_two_faces_blend():
+    """docs/tool.md: the blend of the two-faces bracket and the window around it."""
+    from trackplan import load_case
+    from trackplan.paths.path_geometry import PathGeometry
+
+    text = _text("tool.md")
+    pieces = PathGeometry.from_case(load_case(console.REPO / "cases/bracket-two-faces.yaml"))
+    (blend,) = [piece for piece in pieces.planned.pieces if piece.kind == "blend"]
+    assert f"the blend piece ({blend.length * 1e3:.0f} mm) widened by 5 mm" in text
+    assert f"a {blend.length * 1e3 + 10:.0f} mm window" in text

@@ -1,0 +1,224 @@
+"""Every figure the pages state outside ``console`` blocks, with the command that prints it.
+
+``make docs`` rewrites them from fresh runs (``tests/docs/regenerate.py``);
+``tests/docs/test_stated.py`` fails when one no longer agrees with what the code prints
+(``figures.agree``: within one unit of the last digit the page prints). Measured timings
+(CPU and wall seconds, rates) are measurements of one machine, stated as such with their
+command, and are not listed here.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from tests.docs.figures import Block, Done, Picture, Stated, Workspace, printed, summary_csv
+
+# the commands, as written once so that figures from the same run share it
+WALK_OPTIMIZE = "trackplan optimize cases/bracket-weld.yaml --out runs/bracket"
+"""The README walk-through's search (also writes the report of the screenshots)."""
+STUDY = "trackplan batch studies/robot-selection.yaml --out runs/robot-selection --no-report"
+CORNER = "trackplan optimize cases/paper-corner.yaml --out runs/corner-travel --no-report"
+CORNER_CELL = "trackplan optimize cases/paper-corner-cell.yaml --out runs/corner-cell --no-report"
+TWO_FACES = "trackplan optimize cases/bracket-two-faces.yaml --out runs/two-faces --no-report"
+TWO_FACES_PLAN = (
+    "trackplan plan cases/bracket-two-faces.yaml --out runs/two-faces-example --no-report"
+)
+TWO_FACES_CHECK = "trackplan check cases/bracket-two-faces.yaml runs/two-faces-example"
+CIRCLE_FREE_PLAN = (
+    "trackplan plan cases/paper-circle-seam-free.yaml --out runs/circle-seam-free --no-report"
+)
+CIRCLE_FREE = (
+    "trackplan optimize cases/paper-circle-seam-free.yaml --budget 600 --restarts 1"
+    " --out runs/circle-seam-free-search --no-report"
+)
+CIRCLE_PAPER = (
+    "trackplan plan cases/paper-circle.yaml --placement 0.3922 0.4626 0.1924 -0.799 0.8431 "
+    "-0.9053 --out runs/paper-circle-smooth --no-report"
+)
+"""As docs/paper.md runs it: the paper's constant tool at its example placement."""
+SEAM_WELD = "trackplan optimize cases/seam-weld-{}.yaml --out runs/seam-weld-{} --no-report"
+
+
+def corner_map(workspace: Workspace) -> Path:
+    """docs/cell-map.png: the cell case's placement map at the height and orientation of the
+    unconstrained optimum (as docs/cell.md's `trackplan map` command)."""
+    _, _, z, roll, pitch, yaw = placement(workspace.ok(CORNER))
+    done = workspace.ok(
+        f"trackplan map cases/paper-corner-cell.yaml --rpy {roll} {pitch} {yaw} --z {z} "
+        "--out runs/corner-cell-map"
+    )
+    return done.out() / "map.png"
+
+
+PICTURES: tuple[Picture, ...] = (Picture("cell-map.png", corner_map),)
+
+
+def _json(done: Done) -> dict:  # type: ignore[type-arg]
+    return json.loads((done.out() / "result.json").read_text(encoding="utf-8"))
+
+
+def placement(done: Done, decimals: int = 4) -> tuple[str, ...]:
+    """x, y, z, roll, pitch, yaw of the run's placement, as the pages print them."""
+    x = _json(done)["placement"]
+    return tuple(f"{x[k]:.{decimals}f}" for k in ("x", "y", "z", "roll", "pitch", "yaw"))
+
+
+J_DURATION = r"J = (\S+)  duration = (\S+) s"
+
+
+def j_duration(done: Done) -> tuple[str, ...]:
+    """J and the duration as the run's summary line prints them."""
+    return printed(J_DURATION)(done)
+
+
+STUDY_ARMS = (
+    ("kuka_kr6_r700_sixx", "KR6 R700 sixx"),
+    ("abb_irb1600", "IRB 1600"),
+    ("ur10e", "UR10e"),
+)
+
+
+def study_table(done: Done) -> str:
+    """The README's table of the robot-selection study: J per part and arm, the arm with the
+    least J and its cycle time."""
+    rows = summary_csv(done)
+    feasible = [row for row in rows if row["status"] == "feasible"]
+    lines = [
+        f"It writes a run folder per job, `summary.csv` and `summary.html` ({len(rows)} jobs, "
+        + ("all feasible" if len(feasible) == len(rows) else f"{len(feasible)} feasible")
+        + "):",
+        "",
+        "| part | " + " | ".join(f"{name} J" for _, name in STUDY_ARMS) + " | best robot"
+        " | cycle time s |",
+        "| --- | " + " | ".join("---:" for _ in STUDY_ARMS) + " | --- | ---: |",
+    ]
+    for part in sorted({row["case"] for row in rows}):
+        mine = {row["robot"]: row for row in feasible if row["case"] == part}
+        cells = [f"{float(mine[key]['J']):.4f}" if key in mine else "–" for key, _ in STUDY_ARMS]
+        best = min(mine.values(), key=lambda row: float(row["J"]), default=None)
+        cycle = "–" if best is None else f"{float(best['cycle_time_s']):.2f}"
+        tail = f"{'none' if best is None else best['robot']} | {cycle}"
+        lines.append(f"| {part} | " + " | ".join(cells) + f" | {tail} |")
+    return "\n".join(lines) + "\n"
+
+
+def best_per_part(done: Done) -> str:
+    """docs/studies.md's table of the arm with the least J per part."""
+    rows = summary_csv(done)
+    lines = [
+        "| part | best robot | J rad | cycle time s | feasible robots |",
+        "| --- | --- | ---: | ---: | ---: |",
+    ]
+    for part in sorted({row["case"] for row in rows}):
+        mine = [row for row in rows if row["case"] == part]
+        feasible = [row for row in mine if row["status"] == "feasible"]
+        best = min(feasible, key=lambda row: float(row["J"]), default=None)
+        figures = (
+            "none | – | –"
+            if best is None
+            else f"{best['robot']} | {float(best['J']):.4f} | {float(best['cycle_time_s']):.2f}"
+        )
+        lines.append(f"| {part} | {figures} | {len(feasible)}/{len(mine)} |")
+    return "\n".join(lines) + "\n"
+
+
+def j_per_arm(done: Done) -> str:
+    """docs/studies.md's table of J per part and arm."""
+    table = study_table(done).splitlines()[2:]
+    rows = [" | ".join(line.split(" | ")[: 1 + len(STUDY_ARMS)]) + " |" for line in table]
+    return "\n".join(row.replace(" J |", " |") for row in rows) + "\n"
+
+
+BLOCKS: tuple[Block, ...] = (
+    Block("README.md", "study table", STUDY, study_table),
+    Block("docs/studies.md", "best robot per part", STUDY, best_per_part),
+    Block("docs/studies.md", "J per arm", STUDY, j_per_arm),
+)
+
+
+STATED: tuple[Stated, ...] = (
+    # README.md: what the walk-through's numbers say
+    Stated(
+        "README.md",
+        "the torch stays within {} mm of the seam (tolerance 0.5 mm). J = {} is the weighted",
+        (WALK_OPTIMIZE,),
+        lambda run: (
+            printed(r"max tracking error = (\S+) mm")(run)[0],
+            printed(r"J = (\S+)  duration")(run)[0],
+        ),
+    ),
+    Stated(
+        "README.md",
+        "runs at exactly the rated 20 mm/s on **{} % of the path's length**",
+        (WALK_OPTIMIZE,),
+        printed(r"rated speed on (\S+) % of the path"),
+    ),
+    # docs/cell.md: the unconstrained optimum, where it collides, the optimum in the cell
+    Stated(
+        "docs/cell.md",
+        "without the cell, X = ({}, {}, {}, {}, {}, {}) (J = {},",
+        (CORNER,),
+        lambda run: (*placement(run), printed(r"J = (\S+)  duration")(run)[0]),
+    ),
+    Stated(
+        "docs/cell.md",
+        "$ trackplan plan cases/paper-corner-cell.yaml --placement {} {} {} {} {} {} ",
+        (CORNER,),
+        placement,
+        minus="-",
+    ),
+    Stated(
+        "docs/cell.md",
+        "(`trackplan map cases/paper-corner-cell.yaml --rpy {} {} {} --z {}`)",
+        (CORNER,),
+        lambda run: (*placement(run)[3:], placement(run)[2]),
+        minus="-",
+    ),
+    Stated(
+        "docs/cell.md",
+        "finds X = ({}, {}, {}, {}, {}, {}), feasible with J = {} and the clearance kept "
+        "everywhere by the exact check (least distance {} mm,",
+        (CORNER_CELL,),
+        lambda run: (
+            *placement(run),
+            printed(r"J = (\S+)  duration")(run)[0],
+            printed(r"min clearance = (\S+) mm")(run)[0],
+        ),
+    ),
+    # docs/tool.md
+    Stated(
+        "docs/tool.md",
+        "finds J = {}, {} s, feasible; `trackplan plan` at the case's example placement (the "
+        "inner spin search picks {} rad) gives J = {}, {} s, and `trackplan check` verifies "
+        "it (largest tool axis deviation {} rad,",
+        (TWO_FACES, TWO_FACES_PLAN, TWO_FACES_CHECK),
+        lambda search, plan, _check: (
+            *j_duration(search),
+            f"{_json(plan)['spin']['value']:.2f}",
+            *j_duration(plan),
+            f"{_json(plan)['max_orientation_error']:.3f}",
+        ),
+    ),
+    Stated(
+        "docs/tool.md",
+        "and plans feasibly: J = {}, {} s;",
+        (CIRCLE_FREE_PLAN,),
+        j_duration,
+    ),
+    Stated(
+        "docs/tool.md",
+        "(GA, seed 0) finds J = {}, {} s — below the {} of the paper's constant tool",
+        (CIRCLE_FREE, CIRCLE_PAPER),
+        lambda search, paper: (*j_duration(search), f"{float(j_duration(paper)[0]):.2f}"),
+    ),
+    *(
+        Stated(
+            "docs/tool.md",
+            f"| seam-weld-{spin} | {label} | yes | {{}} | {{}} s | {{}} |",
+            (SEAM_WELD.format(spin, spin),),
+            lambda run: (*j_duration(run), printed(r"found in (\d+) evaluations")(run)[0]),
+        )
+        for spin, label in (("fixed", "fixed (0)"), ("free", "free"))
+    ),
+)
