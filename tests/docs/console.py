@@ -113,7 +113,7 @@ def refreshed(shown: tuple[str, ...], output: str) -> tuple[list[str], list[str]
             fresh.append(expected)
             continue
         _, i, new = min(candidates)
-        fresh.append(expected if figures.agree_line(expected, lines[i]) is None else new)
+        fresh.append(new)
         at = i + 1
     return fresh, lost
 

@@ -5,11 +5,11 @@ In order: the figures in prose and the generated blocks (``tests/docs/stated.py`
 output lines of every ``console`` block of the README and docs/*.md (their commands as the
 pages now write them); the pictures commands draw (``stated.PICTURES``) and the walk-through's
 screenshots (``tests/docs/screenshots.py``, skipped with the reason when Chromium is
-missing). A figure is rewritten only when it no longer agrees with the fresh run
-(``figures.agree``), a picture replaced only when it differs. Every command runs once, in one
-scratch folder. Prints what changed; exits 1 when a figure cannot be placed (its words
-changed: edit the page or ``tests/docs/stated.py``) or a command does not exit as the page
-says.
+missing). Figures are written exactly as the commands print them now (the tests allow one
+unit of the last digit, ``figures.agree``); a picture is replaced only when it differs.
+Every command runs once, in one scratch folder. Prints what changed; exits 1 when a figure
+cannot be placed (its words changed: edit the page or ``tests/docs/stated.py``) or a
+command does not exit as the page says.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def restate_figures(text: str, figure: Stated, workspace: Workspace, log: list[s
     out = text
     for group in range(len(fresh), 0, -1):
         old, new = match.group(group), fresh[group - 1]
-        if agree(old, new) is not None:
+        if old != new:
             log.append(f"{figure.page}: {old} -> {new}   ({'; '.join(figure.commands)})")
             out = out[: match.start(group)] + new + out[match.end(group) :]
     return out
@@ -46,10 +46,10 @@ def render_block(text: str, block: Block, workspace: Workspace, log: list[str]) 
     """``text`` with ``block``'s generated text rendered from a fresh run."""
     start, end = block.span(text)
     fresh = block.render(workspace.ok(block.command))
-    problem = agree(text[start:end], fresh)
-    if problem is None:
+    if text[start:end] == fresh:
         return text
-    log.append(f"{block.page}: {block.name} rewritten ({problem})   ({block.command})")
+    problem = agree(text[start:end], fresh) or "within the tolerance"
+    log.append(f"{block.page}: {block.name} rewritten ({problem[:160]}...)   ({block.command})")
     return text[:start] + fresh + text[end:]
 
 
@@ -73,7 +73,7 @@ def refresh_console(text: str, page: str, workspace: Workspace, log: list[str]) 
             fresh, lost = console.refreshed(command.shown, done.stdout)
             problems.extend(f"{page}: `{command.line}` no longer prints {line!r}" for line in lost)
             for i, (old, new) in enumerate(zip(command.shown, fresh, strict=True)):
-                if old != new and agree(old, new) is not None:
+                if old != new:
                     log.append(f"{page}: {old}\n    -> {new}")
                     lines[at + 1 + i] = new
         return "```console\n" + "".join(line + "\n" for line in lines) + "```"
