@@ -195,9 +195,10 @@ class Workspace:
         return self.done[line]
 
     def ok(self, line: str) -> Done:
-        """``run``, for a command that must succeed (exit code 0)."""
+        """``run``, for a command that must exit as its ``# exit N`` comment says (else 0)."""
         done = self.run(line)
-        if done.returncode != 0:
+        said = re.search(r"#\s*exit\s+(\d+)\s*$", line)
+        if done.returncode != (int(said.group(1)) if said else 0):
             raise RuntimeError(
                 f"`{line}` exited {done.returncode}:\n{done.stdout[-2000:]}{done.stderr[-2000:]}"
             )

@@ -12,6 +12,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 import textwrap
 from pathlib import Path
 
@@ -51,7 +52,48 @@ CORNER_FRONT = (
 CORNER_PAPER = "trackplan plan cases/paper-corner.yaml --out runs/corner-paper --no-report"
 """The corner case at the paper's placement (the case's ``placement.example``)."""
 PAYLOAD = "trackplan optimize cases/puma-payload.yaml --out runs/puma-payload-search --no-report"
+BRACKET4 = "trackplan optimize cases/bracket-4-fillets.yaml --out runs/bracket4"
+"""As the README and docs/seams.md run it."""
+_LINE_X = "--placement -0.2230 0.1029 0.1829 0.0312 -0.4124 0.5020"
+LINE_PAPER = (
+    f"trackplan plan cases/paper-line.yaml --timing paper {_LINE_X} --out runs/paper-line-moved"
+    " --no-report   # exit 3"
+)
+LINE_SMOOTH = (
+    f"trackplan plan cases/paper-line.yaml {_LINE_X} --out runs/paper-line-smooth --no-report"
+)
+_CORNER_X = "--placement 0.0902 0.2090 0.2020 0.3263 0.3016 -0.2522"
+CORNER_PAPER_TIMING = (
+    f"trackplan plan cases/paper-corner.yaml --timing paper {_CORNER_X} --out runs/paper-corner"
+    " --no-report   # exit 3"
+)
+CORNER_SMOOTH = (
+    f"trackplan plan cases/paper-corner.yaml {_CORNER_X} --out runs/paper-corner-smooth --no-report"
+)
+_CIRCLE_X = "--placement 0.3922 0.4626 0.1924 -0.799 0.8431 -0.9053"
+CIRCLE_PAPER_TIMING = (
+    f"trackplan plan cases/paper-circle.yaml --timing paper {_CIRCLE_X} --out runs/paper-circle"
+    " --no-report   # exit 3"
+)
+"""docs/paper.md's console commands, as written there (their runs are shared)."""
 SEAM_WELD = "trackplan optimize cases/seam-weld-{}.yaml --out runs/seam-weld-{} --no-report"
+
+
+def worst_gusset(done: Done) -> tuple[str, ...]:
+    """The worst tracking error of the shipped bracket's seams, which docs/seams.md places at
+    the gusset."""
+    errors = {
+        name: float(err)
+        for name, err in re.findall(
+            r"^  ([\w-]+): \S+ s, max tracking error (\S+) mm", done.stdout, re.M
+        )
+    }
+    worst = max(errors, key=errors.__getitem__)
+    if worst != "gusset":
+        raise LookupError(
+            f"docs/seams.md: the worst tracking error is now on {worst}: edit the page"
+        )
+    return (f"{errors[worst]:.2f}",)
 
 
 def energy_row(done: Done) -> tuple[str, ...]:
@@ -351,6 +393,99 @@ STATED: tuple[Stated, ...] = (
             f"{_json(run)['objective']:.3f}",
             f"{_json(run)['duration']:.2f}",
         ),
+    ),
+    # docs/seams.md: the shipped bracket's cycle
+    Stated(
+        "docs/seams.md",
+        "| sequence at X = ({}, {}, {}, {}, {}, {}) | cycle time |",
+        (BRACKET4,),
+        printed(r"placement X = \((\S+), (\S+), (\S+), (\S+), (\S+), (\S+)\)"),
+    ),
+    Stated(
+        "docs/seams.md",
+        "| optimised: boss →, gusset ←, rib-right →, rib-left ← | {} s | {} s | {} s | {} |",
+        (BRACKET4,),
+        printed(
+            r"cycle time = (\S+) s \(welding (\S+) s, approach, retract and air (\S+) s\)"
+            r"  J = (\S+)"
+        ),
+    ),
+    Stated(
+        "docs/seams.md",
+        "each seam's tracking (worst {} mm of 0.5 mm, at the gusset's sharp corner blend)",
+        (BRACKET4,),
+        worst_gusset,
+    ),
+    Stated(
+        "docs/seams.md",
+        "and the clearance (least {} mm, the forearm to the plate, of {} mm required)",
+        (BRACKET4,),
+        printed(r"min clearance = (\S+) mm \(link 3 – plate at t = \S+ s; required (\S+?)\.0 mm\)"),
+    ),
+    # docs/paper.md: what its console blocks print, restated in its tables and prose
+    Stated(
+        "docs/paper.md",
+        "| status | limits violated | feasible | | duration | {} s | {} s | "
+        "| J (Eq. 8) | {} | {} |",
+        (LINE_PAPER, LINE_SMOOTH),
+        lambda paper, smooth: (
+            j_duration(paper)[1],
+            j_duration(smooth)[1],
+            j_duration(paper)[0],
+            j_duration(smooth)[0],
+        ),
+    ),
+    Stated(
+        "docs/paper.md",
+        "| duration | {} s | {} s | | J (Eq. 8) | **{}** (paper: 0.9433) | {} |",
+        (CORNER_PAPER_TIMING, CORNER_SMOOTH),
+        lambda paper, smooth: (
+            j_duration(paper)[1],
+            j_duration(smooth)[1],
+            j_duration(paper)[0],
+            j_duration(smooth)[0],
+        ),
+    ),
+    Stated(
+        "docs/paper.md",
+        "(Eq. 10 arc: β = 68.2°, r = 4.55 mm, 8.9 mm long) | {} mm (G2 blend) |",
+        (CORNER_SMOOTH,),
+        printed(r"max tracking error = (\S+) mm"),
+    ),
+    Stated(
+        "docs/paper.md",
+        "J = {} at the published X (paper timing, limits violated), {} in smooth timing "
+        "(feasible); the search finds {} |",
+        (CORNER_PAPER_TIMING, CORNER_SMOOTH, CORNER),
+        lambda paper, smooth, search: (
+            j_duration(paper)[0],
+            j_duration(smooth)[0],
+            f"{float(j_duration(search)[0]):.2f}",
+        ),
+    ),
+    Stated(
+        "docs/paper.md",
+        "({} in paper timing, {} in smooth timing at this X)",
+        (CORNER_PAPER_TIMING, CORNER_SMOOTH),
+        lambda paper, smooth: (j_duration(paper)[0], j_duration(smooth)[0]),
+    ),
+    Stated(
+        "docs/paper.md",
+        "The arc runs N = 60 periods at {} m/s",
+        (CORNER_PAPER_TIMING,),
+        printed(r"min corner speed = (\S+) m/s"),
+    ),
+    Stated(
+        "docs/paper.md",
+        "({} s), tracking error 33 nm.",
+        (CIRCLE_PAPER_TIMING,),
+        lambda run: (j_duration(run)[1],),
+    ),
+    Stated(
+        "docs/paper.md",
+        "Smooth mode: feasible, {} s.",
+        (CIRCLE_PAPER,),
+        lambda run: (j_duration(run)[1],),
     ),
     *(
         Stated(
