@@ -412,6 +412,12 @@ STATED: tuple[Stated, ...] = (
     ),
     Stated(
         "docs/seams.md",
+        "`approach_deviation` (result.json), {} mm for the 3 cm approach of the shipped case",
+        (BRACKET4,),
+        lambda run: (f"{_json(run)['approach_deviation'] * 1e3:.2f}",),
+    ),
+    Stated(
+        "docs/seams.md",
         "each seam's tracking (worst {} mm of 0.5 mm, at the gusset's sharp corner blend)",
         (BRACKET4,),
         worst_gusset,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from tests.docs import console
 from trackplan.paths import (
@@ -80,3 +81,34 @@ def test_tool_page_two_faces_blend():
     (blend,) = [piece for piece in pieces.planned.pieces if piece.kind == "blend"]
     assert f"the blend piece ({blend.length * 1e3:.0f} mm) widened by 5 mm" in text
     assert f"a {blend.length * 1e3 + 10:.0f} mm window" in text
+
+
+@pytest.mark.slow
+def test_dynamics_page_torque_limit_example():
+    """docs/dynamics.md: joint 1 of the PUMA560 limited to 35 N·m (and 30 N·m) on the corner
+    case at the paper's placement (as tests/timing/test_torque_limits.py plans it)."""
+    import dataclasses
+
+    from trackplan import load_case
+    from trackplan.planning.plan import plan_placement
+
+    text = _text("dynamics.md")
+    case = load_case(console.REPO / "cases" / "paper-corner.yaml")
+    X = case.bounds.example
+    base = plan_placement(case, X)
+
+    def limited(newton_metres: float):
+        torque_max = np.array(case.robot.dynamics.torque_max)
+        torque_max[0] = newton_metres
+        dynamics = dataclasses.replace(case.robot.dynamics, torque_max=torque_max)
+        robot = dataclasses.replace(case.robot, dynamics=dynamics)
+        return plan_placement(dataclasses.replace(case, robot=robot), X)
+
+    at_35, at_30 = limited(35.0), limited(30.0)
+    assert at_35.success and at_30.success
+    used = (1 - at_35.check.joint_margins["torque"][0]) * 100
+    assert (
+        f"takes {at_35.duration:.2f} s instead of {base.duration:.2f} s and is feasible, "
+        f"joint 1 at {used:.1f} % of its torque limit; at 30 N·m it takes "
+        f"{at_30.duration:.1f} s."
+    ) in text
