@@ -6,10 +6,11 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tests.docs import console, regenerate, screenshots, stated
-from tests.docs.figures import REPO, Block, Done, Stated, Workspace, agree, tolerance
+from tests.docs.figures import REPO, Block, Done, Picture, Stated, Workspace, agree, tolerance
 
 
 def _page(name: str) -> str:
@@ -117,6 +118,41 @@ def test_generated_blocks_agree_with_a_fresh_run(block: Block, workspace: Worksp
     start, end = block.span(_page(block.page))
     problem = agree(_page(block.page)[start:end], block.render(workspace.run(block.command)))
     assert problem is None, f"{block.page}, `{block.command}`: {problem}; run `make docs`"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("picture", stated.PICTURES, ids=lambda picture: picture.name)
+def test_pictures_show_what_their_commands_draw(picture: Picture, workspace: Workspace):
+    share = screenshots.difference(REPO / "docs" / picture.name, picture.make(workspace))
+    assert share <= screenshots.DIFFERING, (
+        f"docs/{picture.name}: {share:.1%} of its drawn pixels differ by more than "
+        f"{screenshots.LEVELS} levels from what its command draws now: run `make docs`"
+    )
+
+
+def test_picture_difference_counts_drawn_pixels(tmp_path: Path):
+    from matplotlib import image
+
+    white = np.full((40, 50, 3), 255, dtype=np.uint8)
+    drawn = white.copy()
+    drawn[10:20, 10:20] = 0  # 100 drawn pixels
+    moved = white.copy()
+    moved[10:20, 12:22] = 0  # the same square, 2 pixels to the right
+    faint = drawn.copy()
+    faint[10:20, 10:20] = 20  # within LEVELS of black
+    paths = {}
+    for name, pixels in {
+        "drawn": drawn,
+        "moved": moved,
+        "faint": faint,
+        "small": white[:30],
+    }.items():
+        paths[name] = tmp_path / f"{name}.png"
+        image.imsave(paths[name], pixels)
+    assert screenshots.difference(paths["drawn"], paths["drawn"]) == 0
+    assert screenshots.difference(paths["drawn"], paths["faint"]) == 0
+    assert screenshots.difference(paths["drawn"], paths["moved"]) == pytest.approx(40 / 120)
+    assert screenshots.difference(paths["drawn"], paths["small"]) == 1
 
 
 @pytest.mark.slow
