@@ -25,8 +25,6 @@ from tests.docs import console, screenshots, stated
 from tests.docs.figures import REPO, Block, Stated, Workspace, agree
 
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
-WALKTHROUGH_REPORT = "runs/bracket/report.html"
-"""The report the walk-through's `trackplan optimize` writes: the screenshots' page."""
 
 
 def restate_figures(text: str, figure: Stated, workspace: Workspace, log: list[str]) -> str:
@@ -100,17 +98,16 @@ def refresh_pictures(workspace: Workspace, log: list[str]) -> None:
 
 
 def refresh_screenshots(workspace: Workspace, log: list[str]) -> None:
-    """Take the walk-through's screenshots and replace those that differ."""
+    """Take the docs' screenshots of the pages the commands write; replace those that differ."""
     why = screenshots.unavailable()
     if why is not None:
         log.append(f"screenshots NOT regenerated: {why}")
         return
-    report = workspace.root / WALKTHROUGH_REPORT
-    if not report.is_file():
-        raise RuntimeError(f"no {WALKTHROUGH_REPORT}: the README's walk-through did not write it")
+    for shot in stated.SHOTS:
+        workspace.ok(shot.command)
     folder = workspace.root / "screenshots"
     folder.mkdir(exist_ok=True)
-    for name, fresh in screenshots.take(report, folder).items():
+    for name, fresh in screenshots.take(stated.SHOTS, workspace.root, folder).items():
         replace_if_differs(fresh, name, log)
 
 

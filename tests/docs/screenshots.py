@@ -1,9 +1,9 @@
-"""The walk-through's screenshots of ``report.html``, taken with headless Chromium, and how
-far two screenshots differ.
+"""Screenshots of the pages trackplan writes (``report.html``, ``summary.html``), taken with
+headless Chromium in a 1280 × 900 window, and how far two pictures differ.
 
-``docs/walkthrough-report-top.png`` is the top of the page in a 1280 × 900 window;
-``docs/walkthrough-report-view.png`` is the 3D view section with the time slider clicked
-40 % of the way along (plotly's hover toolbar hidden). Chromium is Debian's (``make
+``tests/docs/stated.py`` lists the shots: the top of the walk-through's report, its 3D view
+with the time slider clicked 40 % of the way along, the study's feasibility matrix (plotly's
+hover toolbar hidden). Chromium is Debian's (``make
 browser``), driven by the ``playwright`` package (``playwright install`` is never run: it
 would download a browser).
 """
@@ -28,7 +28,7 @@ CHROMIUM_ARGS = [
     "--disable-sync",
     "--force-device-scale-factor=1",
 ]
-WINDOW = {"width": 1280, "height": 900}
+WIDTH, HEIGHT = 1280, 900
 SLIDER_AT = 0.4
 VIEW_ID = "robot-view"
 
@@ -40,16 +40,17 @@ DIFFERING = 0.02
 
 @dataclass(frozen=True)
 class Shot:
-    """One screenshot the docs show: its file and how it is taken."""
+    """One screenshot the docs show: ``page`` (an HTML file, relative to the folder the
+    ``command`` that writes it runs in), the element shown (None: the window at the top of
+    the page), whether the 3D view's time slider is clicked first, and the plotly figure
+    to wait for."""
 
     name: str
-    section: str | None  # None: the window at the top of the page
-
-    def path(self) -> Path:
-        return Path(__file__).resolve().parents[2] / "docs" / self.name
-
-
-SHOTS = (Shot("walkthrough-report-top.png", None), Shot("walkthrough-report-view.png", "view"))
+    command: str
+    page: str
+    element: str | None
+    ready: str
+    slide: bool = False
 
 
 def unavailable() -> str | None:
@@ -63,37 +64,44 @@ def unavailable() -> str | None:
     return None
 
 
-def take(report: Path, folder: Path) -> dict[str, Path]:
-    """Screenshots of ``report`` (an ``report.html``) into ``folder``, by file name."""
+def take(shots: tuple[Shot, ...], root: Path, folder: Path) -> dict[str, Path]:
+    """The ``shots`` of the pages under ``root``, into ``folder``, by file name."""
     from playwright.sync_api import sync_playwright
 
     taken: dict[str, Path] = {}
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
         try:
-            page = browser.new_page(viewport=WINDOW)
-            page.set_default_timeout(180_000)  # a loaded machine parses plotly.js slowly
-            page.goto(report.as_uri())
-            page.wait_for_function(
-                f"() => {{ const gd = document.getElementById('{VIEW_ID}');"
-                " return gd && gd._transitionData && gd._transitionData._frames.length > 0; }"
-            )
-            for shot in SHOTS:
+            for shot in shots:
+                page = browser.new_page(viewport={"width": WIDTH, "height": HEIGHT})
+                page.set_default_timeout(180_000)  # a loaded machine parses plotly.js slowly
+                page.goto((root / shot.page).as_uri())
+                page.wait_for_function(
+                    f"() => {{ const gd = document.getElementById('{shot.ready}');"
+                    " return gd && gd.data && gd._fullLayout; }"
+                )
+                if shot.slide:
+                    _slide(page)
+                # the toolbar plotly shows while the pointer is over a plot is not drawn
+                page.add_style_tag(content=".modebar-container { display: none !important; }")
+                page.mouse.move(0, 0)
                 target = folder / shot.name
-                if shot.section is None:
-                    page.evaluate("() => window.scrollTo(0, 0)")
+                if shot.element is None:
                     page.screenshot(path=str(target))
                 else:
-                    _slide(page)
-                    page.locator(f"#{shot.section}").screenshot(path=str(target))
+                    page.locator(shot.element).screenshot(path=str(target))
                 taken[shot.name] = target
+                page.close()
         finally:
             browser.close()
     return taken
 
 
 def _slide(page) -> None:  # type: ignore[no-untyped-def]
-    """Click the time slider SLIDER_AT of the way along and wait for the frame."""
+    """Click the 3D view's time slider SLIDER_AT of the way along and wait for the frame."""
+    page.wait_for_function(
+        f"() => document.getElementById('{VIEW_ID}')._transitionData._frames.length > 0"
+    )
     page.evaluate(
         "(id) => { window.sliderDone = false; document.getElementById(id)"
         ".on('plotly_animated', () => { window.sliderDone = true; }); }",
@@ -103,9 +111,6 @@ def _slide(page) -> None:  # type: ignore[no-untyped-def]
     box = rail.bounding_box()
     rail.click(position={"x": SLIDER_AT * box["width"], "y": 0.5 * box["height"]})
     page.wait_for_function("() => window.sliderDone")
-    # the toolbar plotly shows while the pointer is over the plot is not part of the picture
-    page.add_style_tag(content=".modebar-container { display: none !important; }")
-    page.mouse.move(0, 0)
 
 
 def difference(a: Path, b: Path) -> float:

@@ -17,6 +17,7 @@ import textwrap
 from pathlib import Path
 
 from tests.docs.figures import Block, Done, Picture, Stated, Workspace, printed, summary_csv
+from tests.docs.screenshots import VIEW_ID, Shot
 
 # the commands, as written once so that figures from the same run share it
 WALK_OPTIMIZE = "trackplan optimize cases/bracket-weld.yaml --out runs/bracket"
@@ -136,6 +137,20 @@ def corner_map(workspace: Workspace) -> Path:
 
 
 PICTURES: tuple[Picture, ...] = (Picture("cell-map.png", corner_map),)
+
+_REPORT = "runs/bracket/report.html"
+SHOTS: tuple[Shot, ...] = (
+    Shot("walkthrough-report-top.png", WALK_OPTIMIZE, _REPORT, None, VIEW_ID),
+    Shot("walkthrough-report-view.png", WALK_OPTIMIZE, _REPORT, "#view", VIEW_ID, slide=True),
+    Shot(
+        "studies-matrix.png",
+        STUDY,
+        "runs/robot-selection/summary.html",
+        "#feasibility-matrix",
+        "feasibility-matrix",
+    ),
+)
+"""The screenshots the docs show, of the pages the commands write."""
 
 
 def _json(done: Done) -> dict:  # type: ignore[type-arg]
