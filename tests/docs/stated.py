@@ -22,6 +22,7 @@ from tests.docs.screenshots import VIEW_ID, Shot
 # the commands, as written once so that figures from the same run share it
 WALK_OPTIMIZE = "trackplan optimize cases/bracket-weld.yaml --out runs/bracket"
 """The README walk-through's search (also writes the report of the screenshots)."""
+WALK_EXPORT = "trackplan export runs/bracket --format ros"
 STUDY = "trackplan batch studies/robot-selection.yaml --out runs/robot-selection --no-report"
 CORNER = "trackplan optimize cases/paper-corner.yaml --out runs/corner-travel --no-report"
 CORNER_CELL = "trackplan optimize cases/paper-corner-cell.yaml --out runs/corner-cell --no-report"
@@ -78,6 +79,27 @@ CIRCLE_PAPER_TIMING = (
 )
 """docs/paper.md's console commands, as written there (their runs are shared)."""
 SEAM_WELD = "trackplan optimize cases/seam-weld-{}.yaml --out runs/seam-weld-{} --no-report"
+
+
+def ros_points(_search: Done, export: Done) -> tuple[str, ...]:
+    """The first two points of the walk-through's ROS message as docs/results.md shows them:
+    positions to 4 decimals, the second point's velocities and accelerations to 4
+    significant digits."""
+    import numpy as np
+    import yaml
+
+    message = yaml.safe_load((export.cwd / "runs/bracket/trajectory.ros.yaml").read_text())
+    first, second = message["points"][:2]
+
+    def digits4(value: float) -> str:
+        return np.format_float_positional(value, precision=4, unique=False, fractional=False)
+
+    return (
+        *(f"{q:.4f}" for q in first["positions"]),
+        *(f"{q:.4f}" for q in second["positions"]),
+        *(f"{v:.3e}" for v in second["velocities"]),
+        *(digits4(a) for a in second["accelerations"]),
+    )
 
 
 def worst_gusset(done: Done) -> tuple[str, ...]:
@@ -297,6 +319,17 @@ STATED: tuple[Stated, ...] = (
         "runs at exactly the rated 20 mm/s on **{} % of the path's length**",
         (WALK_OPTIMIZE,),
         printed(r"rated speed on (\S+) % of the path"),
+    ),
+    # docs/results.md: the first points of the walk-through's ROS message
+    Stated(
+        "docs/results.md",
+        "- positions: [{}, {}, {}, {}, {}, {}] # rad velocities: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0] "
+        "# rad/s accelerations: [0.0, 0.0, 0.0, 0.0, 0.0, 0.0] # rad/s² effort: [] "
+        "time_from_start: {sec: 0, nanosec: 0} - positions: [{}, {}, {}, {}, {}, {}] "
+        "velocities: [{}, {}, {}, {}, {}, {}] accelerations: [{}, {}, {}, {}, {}, {}]",
+        (WALK_OPTIMIZE, WALK_EXPORT),
+        ros_points,
+        minus="-",
     ),
     # docs/cell.md: the unconstrained optimum, where it collides, the optimum in the cell
     Stated(
