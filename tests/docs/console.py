@@ -1,26 +1,24 @@
-"""Run the ``console`` blocks of the documentation and compare what they print.
+"""The ``console`` blocks of the documentation: their commands, and what they print.
 
 A ``console`` block holds commands (lines starting with ``$ ``) each followed by the output
 it prints. A command may end with a shell comment ``# exit N`` giving its exit code
-(default 0). Each shown output line must equal a line of the real output (trailing spaces
-aside), in the same order; a shown line ending in ``...`` must be the beginning of one; a
-line ``...`` stands for output that is left out. Numbers agree within one unit of the last
-digit the documentation prints (``figures.agree``); the words around them exactly.
+(default 0). ``figures.Workspace`` runs them. Each shown output line must agree with a line
+of the real output (trailing spaces aside), in the same order; a shown line ending in
+``...`` must be the beginning of one; a line ``...`` stands for output that is left out.
+Numbers agree within one unit of the last digit the documentation prints
+(``figures.agree``); the words around them exactly.
 """
 
 from __future__ import annotations
 
-import os
 import re
 import shlex
-import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 from tests.docs import figures
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = figures.REPO
 BLOCK = re.compile(r"^```console\n(.*?)^```", re.M | re.S)
 EXIT = re.compile(r"#\s*exit\s+(\d+)\s*$")
 
@@ -56,21 +54,6 @@ def _command(line: str, shown: list[str]) -> Command:
     match = EXIT.search(line)
     argv = tuple(shlex.split(line, comments=True))
     return Command(line, argv, int(match.group(1)) if match else 0, tuple(shown))
-
-
-def run(command: Command, cwd: Path) -> subprocess.CompletedProcess[str]:
-    """Run a documented ``trackplan …`` command with this interpreter, in ``cwd``."""
-    assert command.argv[0] == "trackplan", f"not a trackplan command: {command.line}"
-    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "160"}
-    return subprocess.run(
-        [sys.executable, "-m", "trackplan", *command.argv[1:]],
-        cwd=cwd,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
 
 
 def mismatch(shown: tuple[str, ...], output: str) -> str | None:
