@@ -466,6 +466,15 @@ STATED: tuple[Stated, ...] = (
     ),
     Stated(
         "docs/seams.md",
+        "and the air moves between seams take {}–{} s each",
+        (BRACKET4,),
+        lambda run: tuple(
+            f"{pick(m['duration'] for m in _json(run)['moves'] if m['kind'] == 'air'):.1f}"
+            for pick in (min, max)
+        ),
+    ),
+    Stated(
+        "docs/seams.md",
         "each seam's tracking (worst {} mm of 0.5 mm, at the gusset's sharp corner blend)",
         (BRACKET4,),
         worst_gusset,
