@@ -112,3 +112,23 @@ def test_dynamics_page_torque_limit_example():
         f"joint 1 at {used:.1f} % of its torque limit; at 30 N·m it takes "
         f"{at_30.duration:.1f} s."
     ) in text
+
+
+@pytest.mark.slow
+def test_cell_page_least_self_distances():
+    """docs/cell.md: the least distance between non-adjacent links along the plans of the
+    shipped cases at the placements tests/cell/test_robot_bodies.py plans them at."""
+    from tests.cell.test_robot_bodies import SHIPPED_PLANS, TS
+    from trackplan import load_case
+    from trackplan.cell.check import check_cell
+    from trackplan.cell.model import Cell
+    from trackplan.cell.screening import CellGeometry
+    from trackplan.planning.plan import plan_placement
+
+    text = _text("cell.md")
+    for name, placement in SHIPPED_PLANS.items():
+        case = load_case(console.REPO / "cases" / f"{name}.yaml")
+        plan = plan_placement(case, np.array(placement))
+        geometry = CellGeometry.from_cell(Cell(), case.robot)
+        report = check_cell(geometry, case.robot, plan.trajectory.q, TS, np.eye(4))
+        assert f"{name} {report.min_clearance * 1e3:.1f} mm" in text, name
