@@ -80,5 +80,10 @@ lint: $(VENV)/.installed-test
 	$(VENV)/bin/ruff format --check trackplan tests benchmarks
 	$(VENV)/bin/mypy trackplan
 
+## docs: re-run every command the docs quote and rewrite their figures and screenshots
+.PHONY: docs
+docs: $(VENV)/.installed-test browser
+	$(PY) -m tests.docs.regenerate
+
 clean:
 	rm -rf $(VENV) .venv-latest .venv-lowest runs .pytest_cache .hypothesis

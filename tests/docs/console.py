@@ -1,24 +1,24 @@
-"""Run the ``console`` blocks of the documentation and compare what they print.
+"""The ``console`` blocks of the documentation: their commands, and what they print.
 
 A ``console`` block holds commands (lines starting with ``$ ``) each followed by the output
 it prints. A command may end with a shell comment ``# exit N`` giving its exit code
-(default 0). Each shown output line must equal a line of the real output (trailing spaces
-aside), in the same order; a shown line ending in ``...`` must be the beginning of one; a
-line ``...`` stands for output that is left out. Numbers are compared as printed, so they
-match within the precision the documentation states.
+(default 0). ``figures.Workspace`` runs them. Each shown output line must agree with a line
+of the real output (trailing spaces aside), in the same order; a shown line ending in
+``...`` must be the beginning of one; a line ``...`` stands for output that is left out.
+Numbers agree within one unit of the last digit the documentation prints
+(``figures.agree``); the words around them exactly.
 """
 
 from __future__ import annotations
 
-import os
 import re
 import shlex
-import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
+from tests.docs import figures
+
+REPO = figures.REPO
 BLOCK = re.compile(r"^```console\n(.*?)^```", re.M | re.S)
 EXIT = re.compile(r"#\s*exit\s+(\d+)\s*$")
 
@@ -56,21 +56,6 @@ def _command(line: str, shown: list[str]) -> Command:
     return Command(line, argv, int(match.group(1)) if match else 0, tuple(shown))
 
 
-def run(command: Command, cwd: Path) -> subprocess.CompletedProcess[str]:
-    """Run a documented ``trackplan …`` command with this interpreter, in ``cwd``."""
-    assert command.argv[0] == "trackplan", f"not a trackplan command: {command.line}"
-    env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "160"}
-    return subprocess.run(
-        [sys.executable, "-m", "trackplan", *command.argv[1:]],
-        cwd=cwd,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-
-
 def mismatch(shown: tuple[str, ...], output: str) -> str | None:
     """Why ``output`` does not show ``shown`` in order, or None when it does."""
     lines = [line.rstrip() for line in output.splitlines()]
@@ -78,14 +63,42 @@ def mismatch(shown: tuple[str, ...], output: str) -> str | None:
     for expected in shown:
         if expected in ("...", ""):
             continue
-        prefix = expected.endswith("...")
-        want = expected[:-3] if prefix else expected
-        while at < len(lines) and not (lines[at].startswith(want) if prefix else lines[at] == want):
+        while at < len(lines) and figures.agree_line(expected, lines[at]) is not None:
             at += 1
         if at == len(lines):
             return f"line not printed (in this order): {expected!r}"
         at += 1
     return None
+
+
+def refreshed(shown: tuple[str, ...], output: str) -> tuple[list[str], list[str]]:
+    """``shown`` with each line replaced by the printed line of the same words, in order
+    (its figures as printed now), and the shown lines no printed line has the words of.
+
+    Of the printed lines with the same words, a shown line stands for the one whose figures
+    are nearest: fewest integers (a joint, a count) that differ, then fewest other numbers
+    out of tolerance, then the first."""
+    lines = [line.rstrip() for line in output.splitlines()]
+    fresh: list[str] = []
+    lost: list[str] = []
+    at = 0
+    for expected in shown:
+        if expected in ("...", ""):
+            fresh.append(expected)
+            continue
+        candidates = [
+            (figures.distance(expected, lines[i]), i, new)
+            for i in range(at, len(lines))
+            if (new := figures.restate(expected, lines[i])) is not None
+        ]
+        if not candidates:
+            lost.append(expected)
+            fresh.append(expected)
+            continue
+        _, i, new = min(candidates)
+        fresh.append(new)
+        at = i + 1
+    return fresh, lost
 
 
 def workspace(tmp: Path) -> Path:

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
 from tests.docs import console
+from tests.docs.figures import Workspace
 
 README = console.REPO / "README.md"
 CASE = console.REPO / "cases" / "bracket-weld.yaml"
@@ -39,12 +39,12 @@ def test_walkthrough_commands_are_the_documented_steps():
 
 
 @pytest.mark.slow
-def test_walkthrough_runs_as_written(tmp_path: Path):
+def test_walkthrough_runs_as_written(workspace: Workspace):
     """Every command of the walk-through, in order, on the shipped case: exit codes and the
-    printed lines (numbers as printed, so within the README's precision)."""
-    cwd = console.workspace(tmp_path)
+    printed lines (numbers within one unit of the last digit the README prints)."""
+    cwd = workspace.root
     for command in console.commands(_walkthrough()):
-        done = console.run(command, cwd)
+        done = workspace.run(command.line)
         assert done.returncode == command.exit_code, (command.line, done.stdout, done.stderr)
         problem = console.mismatch(command.shown, done.stdout)
         assert problem is None, f"{command.line}\n{problem}\n--- printed:\n{done.stdout}"
