@@ -81,7 +81,6 @@ lint: $(VENV)/.installed-test
 	$(VENV)/bin/mypy trackplan
 
 ## docs: re-run every command the docs quote and rewrite their figures and screenshots
-.PHONY: docs
 docs: $(VENV)/.installed-test browser
 	$(PY) -m tests.docs.regenerate
 
