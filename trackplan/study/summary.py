@@ -51,7 +51,8 @@ class JobRow:
     tracking_error_m
         Largest distance of the tool point from the nominal path, m.
     worst_margin
-        Smallest unused fraction over every limit (negative: a limit is broken).
+        Smallest unused fraction over every limit (negative: a limit is broken; see
+        :func:`worst_margin`).
     wall_time_s
         Wall time of the job on its worker, s.
     worker
@@ -87,11 +88,17 @@ COLUMNS = tuple(field.name for field in fields(JobRow))
 
 
 def row_from_run(folder: str | Path) -> JobRow:
-    """The summary row of a complete run folder (its ``job.json`` and ``result.json``)."""
+    """The summary row of a complete run folder (its ``job.json`` and ``result.json``).
+
+    A run without a trajectory (an unreachable placement, say) is a row with its verdict:
+    its ``result.json`` holds ``null`` for the figures a trajectory would give, which are
+    NaN in the row.
+    """
     folder = Path(folder)
-    job = json.loads((folder / JOB_FILE).read_text())
-    result = json.loads((folder / RESULT_FILE).read_text())
-    n_samples = int(result["n_samples"])
+    job = json.loads((folder / JOB_FILE).read_text(encoding="utf-8"))
+    result = json.loads((folder / RESULT_FILE).read_text(encoding="utf-8"))
+    n_samples = int(result.get("n_samples") or 0)
+    sample_time = _number(result.get("sample_time"))
     return JobRow(
         job=job["job"],
         case=job["case"],
@@ -100,15 +107,20 @@ def row_from_run(folder: str | Path) -> JobRow:
         seed=int(job["seed"]),
         status=str(result["status"]),
         success=bool(result["feasible"]),
-        J=float(result["objective"]),
-        duration_s=float(result["duration"]),
-        cycle_time_s=(n_samples - 1) * float(result["sample_time"]) if n_samples else math.nan,
-        tracking_error_m=float(result["max_tracking_error"]),
-        worst_margin=worst_margin(result["margins"]),
-        wall_time_s=float(job["wall_time_s"]),
+        J=_number(result.get("objective")),
+        duration_s=_number(result.get("duration")),
+        cycle_time_s=(n_samples - 1) * sample_time if n_samples else math.nan,
+        tracking_error_m=_number(result.get("max_tracking_error")),
+        worst_margin=worst_margin(result.get("margins") or {}),
+        wall_time_s=_number(job.get("wall_time_s")),
         worker=str(job["worker"]),
         message=str(result["message"]),
     )
+
+
+def _number(value: Any) -> float:
+    """A number of ``result.json`` as a float: ``null`` (no such figure) is NaN."""
+    return math.nan if value is None else float(value)
 
 
 def failed_row(job: dict[str, Any], reason: str, wall_time_s: float, worker: str) -> JobRow:
@@ -145,18 +157,36 @@ def failed_row(job: dict[str, Any], reason: str, wall_time_s: float, worker: str
     )
 
 
-def worst_margin(margins: dict[str, Any]) -> float:
-    """The smallest margin of ``result.json``'s ``margins`` block (per joint or per task).
+IGNORED_UNLESS_BROKEN = frozenset({"speed", "coverage"})
+"""Margins that count towards the worst margin only when negative (broken).
 
-    NaN when there is none (no trajectory).
+A plan drives the tool at the rated speed wherever it can, so its speed margin is 0 by
+design, and the coverage margin is a pass (1) or fail (−1) flag, not an unused fraction.
+"""
+
+
+def worst_margin(margins: dict[str, Any]) -> float:
+    """The smallest unused fraction of a limit in ``result.json``'s ``margins`` block.
+
+    Every joint limit (per joint) and task limit counts, except those of
+    :data:`IGNORED_UNLESS_BROKEN`, which count only when broken. ``null`` entries (a limit
+    that does not apply) are skipped.
+
+    Returns
+    -------
+    float
+        The smallest margin (negative: a limit is broken), NaN when there is none (no
+        trajectory).
     """
-    values = [
-        float(value)
-        for entry in margins.values()
-        for value in (entry.values() if isinstance(entry, dict) else (entry,))
-    ]
-    finite = [value for value in values if math.isfinite(value)]
-    return min(finite) if finite else math.nan
+    values = []
+    for kind, entry in margins.items():
+        for value in entry.values() if isinstance(entry, dict) else (entry,):
+            number = _number(value)
+            if not math.isfinite(number):
+                continue
+            if kind not in IGNORED_UNLESS_BROKEN or number < 0:
+                values.append(number)
+    return min(values) if values else math.nan
 
 
 class SummaryWriter:
