@@ -13,7 +13,8 @@ import yaml
 
 from tests.conftest import CASES
 from trackplan.cli import main
-from trackplan.io.export import export_trajectory
+from trackplan.io.export import export_trajectory, read_trajectory_table
+from trackplan.io.results import read_trajectory_csv
 
 
 def test_export_ros_csv_json_and_bad_format(tmp_path, capsys):
@@ -85,3 +86,15 @@ def test_exported_files_respect_the_umask(tmp_path: Path, fmt: str) -> None:
         os.umask(previous)
     assert stat.S_IMODE(written.stat().st_mode) == 0o640
     assert stat.S_IMODE((run / "trajectory.csv").stat().st_mode) == 0o666 & ~previous
+
+
+def test_trajectory_files_with_a_byte_order_mark_are_read(tmp_path: Path) -> None:
+    run = _planned(tmp_path)
+    csv_file = tmp_path / "bom.csv"
+    csv_file.write_bytes(b"\xef\xbb\xbf" + (run / "trajectory.csv").read_bytes())
+    t, q = read_trajectory_csv(csv_file, 6)
+    table = read_trajectory_table(csv_file)
+    written = np.loadtxt(run / "trajectory.csv", delimiter=",", skiprows=1, ndmin=2)
+    np.testing.assert_array_equal(t, written[:, 0])
+    np.testing.assert_array_equal(q, written[:, 1:7])
+    np.testing.assert_array_equal(table.q, written[:, 1:7])

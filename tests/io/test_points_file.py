@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
+import threading
+import time
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -9,6 +15,7 @@ from tests.large_paths import helix_points, write_helix_case, write_points_csv
 from trackplan.errors import CaseError
 from trackplan.io import points_file
 from trackplan.io.points_file import load_points_csv
+from trackplan.io.sizes import MAX_POINTS_BYTES
 
 WELL_FORMED = {
     "header": "x,y,z\n0.1,0,0\n0.2,0.1,0\n0.3,0.1,1e-3\n",
@@ -68,3 +75,120 @@ def test_the_helix_case_names_its_points_file(tmp_path):
     case = write_helix_case(tmp_path, 50)
     assert "helix-50.csv" in case.read_text()
     np.testing.assert_array_equal(load_points_csv(tmp_path / "helix-50.csv"), helix_points(50))
+
+
+# --------------------------------------------------------------------------- hostile files
+
+
+def _load_in_thread(file: Path, timeout: float = 10.0) -> BaseException | None:
+    """Load ``file`` in a daemon thread; the exception raised, or fail when it takes over
+    ``timeout`` s (a FIFO without a writer blocks ``open`` forever)."""
+    outcome: list[BaseException | None] = []
+
+    def load() -> None:
+        try:
+            load_points_csv(file)
+            outcome.append(None)
+        except BaseException as exc:  # handed to the test
+            outcome.append(exc)
+
+    thread = threading.Thread(target=load, daemon=True)
+    thread.start()
+    thread.join(timeout)
+    assert outcome, f"loading {file} did not end within {timeout} s"
+    return outcome[0]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs here")
+def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path: Path) -> None:
+    fifo = tmp_path / "seam.csv"
+    os.mkfifo(fifo)
+    try:
+        error = _load_in_thread(fifo, timeout=5.0)
+    finally:  # release a reader that blocked (before the fix)
+        with contextlib.suppress(OSError):
+            os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+    assert isinstance(error, CaseError)
+    assert "is not a regular file (a FIFO)" in str(error) and str(fifo) in str(error)
+
+
+def test_a_device_is_refused_without_reading_it() -> None:
+    error = _load_in_thread(Path("/dev/null"))
+    assert isinstance(error, CaseError)
+    assert "is not a regular file (a character device)" in str(error)
+
+
+def test_a_directory_is_refused(tmp_path: Path) -> None:
+    error = _load_in_thread(tmp_path)
+    assert isinstance(error, CaseError) and "is a directory" in str(error)
+
+
+def test_a_file_over_the_byte_limit_is_refused_before_it_is_read(tmp_path: Path) -> None:
+    big = tmp_path / "seam.csv"
+    with big.open("wb") as handle:  # sparse: no disk, and nothing to read quickly
+        handle.truncate(MAX_POINTS_BYTES + 1)
+    start = time.perf_counter()
+    with pytest.raises(CaseError) as caught:
+        load_points_csv(big, "case.yaml", "path.segments[0].points.file")
+    assert time.perf_counter() - start < 1.0
+    assert caught.value.file == str(big)
+    assert f"{MAX_POINTS_BYTES + 1} bytes, more than the {MAX_POINTS_BYTES}" in caught.value.message
+
+
+def test_a_file_over_the_row_limit_is_refused_before_it_is_parsed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(points_file, "MAX_POINTS_ROWS", 10)
+    np.testing.assert_array_equal(load_points_csv(_rows(tmp_path, 10)), helix_points(10))
+    csv = write_points_csv(tmp_path / "seam.csv", helix_points(10))  # header + 10 rows
+    monkeypatch.setattr(points_file, "_parse_fast", _never)
+    with pytest.raises(CaseError, match="11 lines, more than the 10 a points file may have"):
+        load_points_csv(csv)
+
+
+def _never(_: str) -> None:
+    raise AssertionError("parsed a file over the limit")
+
+
+def _rows(folder: Path, n: int) -> Path:
+    """A points file of ``n`` rows without a header: at the limit when ``n`` is."""
+    file = folder / "ok.csv"
+    np.savetxt(file, helix_points(n), delimiter=",", fmt="%.17g")
+    return file
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "what"),
+    [
+        ("0.1,0,0\n0.3_1,0.1,0\n0.3,0.1,0\n", 2, "'0.3_1'"),
+        ("0.1,0,0\n\uff10.2,0.1,0\n0.3,0.1,0\n", 2, "'\uff10.2'"),
+        ("0.1,0,0\n0.2,0.1,0\n0x1p-3,0.1,0\n", 3, "'0x1p-3'"),
+        ("0.1,0,0\n0.2,0.1,0\ninfinity,0.1,0\n", 3, "'infinity'"),
+        ("0.1;0;0\n0.2;0.1;0\n", 1, "';'"),
+        ("x,y,z\n0.1\t0\t0\n0.2\t0.1\t0\n", 2, "a tab"),
+        ("0.1,0,0\n0.2,0.1,0\n0.3;0.1;0\n", 3, "';'"),
+    ],
+)
+def test_numbers_are_strict_and_other_separators_are_named(
+    tmp_path: Path, text: str, line: int, what: str
+) -> None:
+    csv = tmp_path / "seam.csv"
+    csv.write_text(text, encoding="utf-8")
+    with pytest.raises(CaseError) as caught:
+        load_points_csv(csv)
+    assert caught.value.key == f"line {line}" and what in caught.value.message
+
+
+def test_only_the_first_row_may_be_a_header(tmp_path: Path) -> None:
+    csv = tmp_path / "seam.csv"
+    csv.write_text("x,y,z\nseam,four,mm\n0.1,0,0\n0.2,0.1,0\n", encoding="utf-8")
+    with pytest.raises(CaseError) as caught:
+        load_points_csv(csv)
+    assert caught.value.key == "line 2" and "seam,four,mm" in caught.value.message
+
+
+@pytest.mark.parametrize("text", [*WELL_FORMED.values(), *READ_LINE_BY_LINE.values()])
+def test_a_byte_order_mark_is_accepted_with_or_without_a_header(tmp_path: Path, text: str) -> None:
+    csv = tmp_path / "seam.csv"
+    csv.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    np.testing.assert_array_equal(load_points_csv(csv), EXPECTED)

@@ -156,7 +156,7 @@ def read_trajectory_table(file: Path) -> TrajectoryTable:
     file = _trajectory_file(Path(file))
     where = str(file)
     try:
-        lines = file.read_text(encoding="utf-8").splitlines()
+        lines = file.read_text(encoding="utf-8-sig").splitlines()  # a byte order mark skipped
     except FileNotFoundError:
         raise CaseError("no trajectory file: plan or optimize a case first", file=where) from None
     except (OSError, UnicodeDecodeError) as error:

@@ -227,7 +227,7 @@ def write_summary_csv(rows: Iterable[JobRow], file: str | Path) -> None:
 
 def read_summary_csv(file: str | Path) -> list[JobRow]:
     """Read ``summary.csv`` back into rows."""
-    with Path(file).open(newline="", encoding="utf-8") as handle:
+    with Path(file).open(newline="", encoding="utf-8-sig") as handle:  # a spreadsheet's BOM
         return [_row(cells) for cells in csv.DictReader(handle)]
 
 
