@@ -181,3 +181,24 @@ def test_an_infeasible_size_is_refused_before_any_costly_path_work(
     monkeypatch.setattr("trackplan.io.case_file.NominalPath.from_specs", costly)
     line = validate_fails(capsys, str(file))
     assert line.startswith(f"{file}: path.segments[1]: the path is 2500.38 m long, more than")
+
+
+@pytest.mark.parametrize(
+    ("key", "shown"),
+    [("1", "1"), ("null", "null"), ("~", "null"), ("true", "true"), ("2.5", "2.5"), ("''", "''")],
+)
+@pytest.mark.parametrize("nested", [False, True])
+def test_a_key_that_is_not_a_name_is_one_line_at_its_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, key: str, shown: str, nested: bool
+) -> None:
+    # pydantic's own words came out: "[1]: Keys should be strings, got true"
+    text = write_case(tmp_path).read_text()
+    lines = text.splitlines()
+    at = lines.index("task:") + 2 if nested else len(lines) + 1
+    lines.insert(at - 1, f"  {key}: 1" if nested else f"{key}: 1")
+    line = validate_fails(capsys, str(_file(tmp_path, "\n".join(lines) + "\n")))
+    column = 3 if nested else 1
+    assert line.endswith(
+        f"at line {at}, column {column}: a key must be a non-empty name, got {shown}"
+    ), line
+    assert "should be" not in line

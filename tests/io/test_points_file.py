@@ -192,3 +192,11 @@ def test_a_byte_order_mark_is_accepted_with_or_without_a_header(tmp_path: Path, 
     csv = tmp_path / "seam.csv"
     csv.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
     np.testing.assert_array_equal(load_points_csv(csv), EXPECTED)
+
+
+def test_a_name_too_long_for_the_system_is_one_line(tmp_path: Path) -> None:
+    name = tmp_path / ("x" * 5000)
+    with pytest.raises(CaseError) as caught:
+        load_points_csv(name, "case.yaml", "path.segments[0].points.file")
+    assert caught.value.file == "case.yaml" and caught.value.key == "path.segments[0].points.file"
+    assert "file name too long" in caught.value.message and len(caught.value.message) < 300

@@ -131,11 +131,16 @@ def read_text(
     if referrer is None:  # the line starts with the file's name: do not repeat it
         where, at, name = str(path), None, what
     else:
-        where, at, name = referrer, key, f"{what} {str(path)!r}"
-    if not path.exists():
-        raise CaseError(f"{name} not found", file=where, key=at)
-    if path.is_dir():
-        raise CaseError(f"{name} is a directory, expected a file", file=where, key=at)
+        shown = str(path) if len(str(path)) <= 200 else str(path)[:200] + "…"
+        where, at, name = referrer, key, f"{what} {shown!r}"
+    try:
+        if not path.exists():
+            raise CaseError(f"{name} not found", file=where, key=at)
+        if path.is_dir():
+            raise CaseError(f"{name} is a directory, expected a file", file=where, key=at)
+    except OSError as exc:  # a name too long for the system, say
+        reason = (exc.strerror or type(exc).__name__).lower()
+        raise CaseError(f"cannot read {name}: {reason}", file=where, key=at) from None
     try:
         # O_NONBLOCK: opening a FIFO must not wait for a writer (a regular file ignores it)
         handle = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
@@ -212,7 +217,8 @@ class _Loader(yaml.SafeLoader):
       ``on``/``off``), decimal integers (``010`` is ten), ``0o`` and ``0x`` integers,
       floats such as ``1e-3`` and ``.inf``, ``null``/``~``; anything else, such as the
       YAML 1.1 sexagesimal ``1:30`` or a date, is a string.
-    - A key given twice, a list or mapping used as a key, nesting deeper than
+    - A key given twice, a list or mapping used as a key, a key that is not a non-empty
+      string (``1``, ``null``, ``true``), nesting deeper than
       :data:`MAX_DEPTH`, more than :data:`MAX_YAML_VALUES` values, an alias inside the
       node it names (recursion), and aliases that expand to more than
       :data:`MAX_ALIAS_EXPANSION` values ("billion laughs") are errors at their line.
@@ -288,7 +294,8 @@ class _Loader(yaml.SafeLoader):
         return size
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
-        """Build a mapping, refusing a key that occurs twice or that is a list or mapping."""
+        """Build a mapping, refusing a key that occurs twice, that is a list or mapping, or
+        that is not a non-empty string (``1:``, ``null:``, ``true:``, ``'':``)."""
         seen: set[Any] = set()
         for key_node, _ in node.value:
             if not isinstance(key_node, yaml.ScalarNode):
@@ -296,6 +303,13 @@ class _Loader(yaml.SafeLoader):
                     None, None, "a list or mapping as a key is not supported", key_node.start_mark
                 )
             key = self.construct_object(key_node, deep=deep)
+            if not isinstance(key, str) or not key:
+                raise yaml.constructor.ConstructorError(
+                    None,
+                    None,
+                    f"a key must be a non-empty name, got {show(key)}",
+                    key_node.start_mark,
+                )
             if key in seen:
                 raise yaml.constructor.ConstructorError(
                     None, None, f"duplicate key {show(key)}", key_node.start_mark
