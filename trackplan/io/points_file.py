@@ -93,7 +93,8 @@ def load_points_csv(
         points.append(point)
     if len(points) < MIN_POINTS:
         raise CaseError(
-            f"expected at least {MIN_POINTS} rows x,y,z, got {len(points)}", file=str(file)
+            f"the file has {len(points)} rows x,y,z, expected at least {MIN_POINTS}",
+            file=str(file),
         )
     return np.array(points, dtype=float)
 
@@ -112,7 +113,8 @@ def _point(row: str) -> list[float] | str:
         return f"{expected}, got {shown} between the numbers in {_show(row)}"
     cells = [cell.strip() for cell in row.split(",")]
     if len(cells) != 3:
-        return f"{expected}, got {len(cells)} values in {_show(row)}"
+        count = "1 value" if len(cells) == 1 else f"{len(cells)} values"
+        return f"{expected}, got {count} in {_show(row)}"
     bad = next((cell for cell in cells if not NUMBER.fullmatch(cell)), None)
     if bad is not None:
         return f"{expected}, got {_show(bad)} in {_show(row)}"
