@@ -22,11 +22,13 @@ WELL_FORMED = {
     "no header": "0.1,0,0\n0.2,0.1,0\n0.3,0.1,1e-3",
     "comments and blanks first": "# seam 4\n\n  \nx, y, z\n0.1,0,0\n0.2,0.1,0\n0.3,0.1,1e-3\n",
     "CRLF and spaces": "x,y,z\r\n 0.1 , 0 , 0\r\n0.2,0.1,0\r\n0.3,0.1,1e-3\r\n",
+    "a comment among the rows": "0.1,0,0\n# half way\n0.2,0.1,0\n0.3,0.1,1e-3\n# end",
+    "an empty line among the rows": "0.1,0,0\n\n0.2,0.1,0\r\n\r\n0.3,0.1,1e-3\n",
 }
 
 READ_LINE_BY_LINE = {
-    "a comment among the rows": "0.1,0,0\n# half way\n0.2,0.1,0\n0.3,0.1,1e-3\n",
     "a blank line among the rows": "0.1,0,0\n   \n0.2,0.1,0\n0.3,0.1,1e-3\n",
+    "an indented comment among the rows": "0.1,0,0\n  # half way\n0.2,0.1,0\n0.3,0.1,1e-3\n",
 }
 
 EXPECTED = np.array([[0.1, 0.0, 0.0], [0.2, 0.1, 0.0], [0.3, 0.1, 1e-3]])

@@ -24,6 +24,12 @@ points file does not."""
 _FAST_CHARACTERS = re.compile(r"[^0-9eE+\-., \r\n]")
 """A character outside the rows of plain numbers the compiled parser is given."""
 
+_LATE_HASH = re.compile(r"[^\n]#")
+"""A ``#`` that does not start its line."""
+
+_COMMENT_LINES = re.compile(r"^#[^\n]*(?:\n|$)", re.M)
+"""Comment lines (``#`` in the first column), with their line ends."""
+
 _SEPARATORS = re.compile(r"[,;\t]")
 """Separators a row may hold (only commas are accepted: the others are named in errors)."""
 
@@ -132,10 +138,11 @@ def _show(text: str, limit: int = 80) -> str:
 def _parse_fast(text: str) -> np.ndarray | None:
     """The points of a well-formed file, parsed in C (a million rows in about a second).
 
-    Returns None when the rows after the header are anything but three plain numbers each
-    (a comment, a blank line or any other character among them included), or fewer than
-    :data:`MIN_POINTS`: the line-by-line reader then takes the file, and names the row at
-    fault.
+    Comment lines (``#`` in the first column) and empty lines among the rows are skipped.
+    Returns None when the rows after the header are anything else than three plain numbers
+    each (an indented comment, a comment after the numbers or a line of spaces included),
+    or fewer than :data:`MIN_POINTS`: the line-by-line reader then takes the file, and
+    names the row at fault.
     """
     start = 0
     while True:  # skip blank and comment lines, and a header row, before the first point
@@ -150,6 +157,10 @@ def _parse_fast(text: str) -> np.ndarray | None:
             return None
         start = end + 1
     body = text[start:]
+    if "#" in body:
+        if _LATE_HASH.search(body):  # an indented comment, or one after the numbers
+            return None
+        body = _COMMENT_LINES.sub("", body)
     if _FAST_CHARACTERS.search(body):
         return None
     try:
