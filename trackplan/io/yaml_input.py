@@ -155,12 +155,14 @@ def read_text(
                 file=where,
                 key=at,
             )
-        try:
-            data = opened.read(limit + 1)
-        except OSError as exc:
-            reason = exc.strerror or type(exc).__name__
-            raise CaseError(f"cannot read {what}: {reason.lower()}", file=str(path)) from None
-        size = max(len(data), os.fstat(opened.fileno()).st_size)
+        size = os.fstat(opened.fileno()).st_size
+        if size <= limit:
+            try:
+                data = opened.read(limit + 1)  # one more: a file that grew meanwhile
+            except OSError as exc:
+                reason = exc.strerror or type(exc).__name__
+                raise CaseError(f"cannot read {what}: {reason.lower()}", file=str(path)) from None
+            size = len(data)
     if size > limit:
         raise CaseError(
             f"the {what} has {size} bytes, more than the {limit} accepted" + hint, file=str(path)
