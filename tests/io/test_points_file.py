@@ -202,3 +202,12 @@ def test_a_name_too_long_for_the_system_is_one_line(tmp_path: Path) -> None:
         load_points_csv(name, "case.yaml", "path.segments[0].points.file")
     assert caught.value.file == "case.yaml" and caught.value.key == "path.segments[0].points.file"
     assert "file name too long" in caught.value.message and len(caught.value.message) < 300
+
+
+def test_old_mac_line_ends_are_line_ends(tmp_path: Path) -> None:
+    csv = tmp_path / "seam.csv"
+    csv.write_bytes(b"x,y,z\r0.1,0,0\r0.2,0.1,0\r0.3,0.1,1e-3\r")
+    np.testing.assert_array_equal(load_points_csv(csv), EXPECTED)
+    csv.write_bytes(b"x,y,z\r0.1,0,0\r0.2,zero,0\r")
+    with pytest.raises(CaseError, match="line 3"):
+        load_points_csv(csv)

@@ -104,7 +104,8 @@ def read_text(
 
     A FIFO, a device or a socket is refused before anything is read from it (a FIFO
     without a writer would block, ``/dev/zero`` never ends), and so is a file larger than
-    ``max_bytes``. A byte order mark at the start is dropped.
+    ``max_bytes``. A byte order mark at the start is dropped, and line ends are read as
+    ``\\n`` whether written ``\\r\\n``, ``\\r`` or ``\\n``.
 
     Parameters
     ----------
@@ -173,6 +174,8 @@ def read_text(
         raise CaseError(
             f"{what} is not UTF-8 text (byte {exc.start} cannot be decoded)", file=str(path)
         ) from None
+    if "\r" in text:  # universal newlines, as a file opened in text mode reads them
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
     return text[1:] if text.startswith(BYTE_ORDER_MARK) else text
 
 
