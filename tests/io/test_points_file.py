@@ -211,3 +211,38 @@ def test_old_mac_line_ends_are_line_ends(tmp_path: Path) -> None:
     csv.write_bytes(b"x,y,z\r0.1,0,0\r0.2,zero,0\r")
     with pytest.raises(CaseError, match="line 3"):
         load_points_csv(csv)
+
+
+def test_the_screened_search_finds_the_row_the_line_by_line_reader_names(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from tests.fuzzing import ROOT, mutate_points
+
+    rng = np.random.default_rng(11)
+    shipped = (ROOT / "cases" / "bead.csv").read_text()
+    csv = tmp_path / "seam.csv"
+    n_bad = 0
+    special = [
+        "x,y,z\n0,0,0\n" + "9" * 400 + ",0,0\n",
+        "  x,y,z\n0,0,0\n1,1,1\n",
+        "0,0,0\n\x0c\n1,1,1\n2,2,x\n",
+        "0,0,0\n1,\u00a01,1\n1,2,;\n",
+        "x,y,z\nx,y,z\n0,0,0\n",
+        "\n\n  \n# only\n",
+        "0,0,0\n1,1,1e99\n2,2,1e100\n",
+    ]
+    for k in range(200 + len(special)):
+        text = special[k - 200] if k >= 200 else mutate_points(shipped, rng)
+        csv.write_text(text, encoding="utf-8")
+        outcomes = []
+        for screened in (True, False):
+            if not screened:
+                monkeypatch.setattr(points_file, "_first_bad_row", lambda _: None)
+            try:
+                outcomes.append(load_points_csv(csv).tolist())
+            except CaseError as exc:
+                outcomes.append(exc.one_line())
+        monkeypatch.undo()
+        assert outcomes[0] == outcomes[1], text
+        n_bad += isinstance(outcomes[0], str) and " line " in outcomes[0]
+    assert n_bad > 50  # the mutants do break rows

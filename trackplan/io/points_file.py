@@ -84,9 +84,13 @@ def load_points_csv(
     fast = _parse_fast(text)
     if fast is not None:
         return fast
+    bad = _first_bad_row(text)
+    if bad is not None:
+        raise CaseError(bad[1], file=str(file), key=f"line {bad[0]}")
+    # no bad row, but lines the compiled parser does not take (a line of spaces, say)
     points: list[list[float]] = []
     first = True
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in enumerate(text.split("\n"), start=1):
         row = line.strip()
         if not row or row.startswith("#"):
             continue
@@ -103,6 +107,40 @@ def load_points_csv(
             file=str(file),
         )
     return np.array(points, dtype=float)
+
+
+_PLAIN = r"[+-]?(?:[0-9]{1,20}(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]{1,2})?"
+"""A number of :data:`NUMBER` that is surely finite (at most 20 digits before the point,
+an exponent of at most 2 digits)."""
+
+_SUSPECT_LINE = re.compile(
+    rf"^(?![ \t]*(?:#[^\n]*|{_PLAIN} *, *{_PLAIN} *, *{_PLAIN})?[ \t]*$)[^\n]*", re.M | re.ASCII
+)
+"""A line that is not surely blank, a comment or a good row: the ones to look at closely."""
+
+_FIRST_CONTENT = re.compile(r"^[ \t]*[^#\s]", re.M)
+"""The start of the first line that is neither blank nor a comment (a header, maybe)."""
+
+
+def _first_bad_row(text: str) -> tuple[int, str] | None:
+    """The first row the line-by-line reader would refuse: its line number and message.
+
+    The lines are screened by one regular expression (in C); only the lines it cannot
+    vouch for are looked at in Python, so a bad row at the end of a million is found in
+    about the time the compiled parser takes.
+    """
+    first = _FIRST_CONTENT.search(text)
+    header_at = -1 if first is None else text.rfind("\n", 0, first.start()) + 1
+    for match in _SUSPECT_LINE.finditer(text):
+        row = match.group(0).strip()
+        if not row or row.startswith("#"):
+            continue
+        if match.start() == header_at and _is_header(row):
+            continue
+        problem = _point(row)
+        if isinstance(problem, str):
+            return text.count("\n", 0, match.start()) + 1, problem
+    return None
 
 
 def _is_header(row: str) -> bool:
@@ -161,7 +199,7 @@ def _parse_fast(text: str) -> np.ndarray | None:
         if _LATE_HASH.search(body):  # an indented comment, or one after the numbers
             return None
         body = _COMMENT_LINES.sub("", body)
-    if _FAST_CHARACTERS.search(body):
+    if _FAST_CHARACTERS.search(body) or not body.strip():
         return None
     try:
         points = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2)
