@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Discriminator, Field, Tag, model_validator
+from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 from pydantic_core import PydanticCustomError
 
 from trackplan.case import (
@@ -155,10 +155,21 @@ class SeamTaskModel(StrictModel):
     tool: ToolModel | None = None
 
 
+def _csv_safe_name(name: str) -> str:
+    """A seam name that ``trajectory.csv``'s ``segment`` column can hold as it is."""
+    if any(mark in name for mark in ',"') or not name.isprintable() or name[0] in "=+-@":
+        raise PydanticCustomError(
+            "seam_name",
+            "a seam name labels the rows of trajectory.csv: no commas, quotes, tabs or line "
+            "breaks, and no =, +, - or @ first (a spreadsheet would run it as a formula)",
+        )
+    return name
+
+
 class SeamModel(PathModel):
     """One entry of ``paths``: a named path, its task overrides, whether it may be reversed."""
 
-    name: NonEmptyStr
+    name: Annotated[NonEmptyStr, AfterValidator(_csv_safe_name)]
     task: SeamTaskModel | None = None
     reversible: bool = True
 
