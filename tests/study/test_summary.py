@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 from pathlib import Path
@@ -11,7 +12,7 @@ import pytest
 from tests.conftest import CASES
 from tests.study.conftest import write_study
 from trackplan.io.study_file import load_study
-from trackplan.study import read_summary_csv, run_job
+from trackplan.study import JobRow, read_summary_csv, run_job
 from trackplan.study.summary import (
     IGNORED_UNLESS_BROKEN,
     row_from_run,
@@ -106,3 +107,26 @@ def test_a_run_folder_with_nulls_reads_back_as_nan(tmp_path: Path) -> None:
     assert row.status == "limits_violated" and not row.failed
     assert math.isnan(row.J) and math.isnan(row.duration_s) and math.isnan(row.cycle_time_s)
     assert row.worst_margin == -0.5 and row.wall_time_s == 1.5
+
+
+def test_summary_text_a_spreadsheet_would_run_is_neutralised_and_reads_back(
+    tmp_path: Path,
+) -> None:
+    nan = math.nan
+    rows = [
+        JobRow("=cmd()__r__base__s0", "=cmd()", "r", "base", 0, "failed", False, nan, nan, nan,
+               nan, -0.25, 1.0, "w", "-failed: @once"),
+        JobRow("'=x__r__base__s1", "'=x", "r", "task.rated_speed=-1", 1, "feasible", True, 1.5,
+               2.0, 2.0, 1e-4, 0.1, 1.0, "+w", "ok"),
+    ]  # fmt: skip
+    write_summary_csv(rows, tmp_path / "summary.csv")
+    with (tmp_path / "summary.csv").open(newline="", encoding="utf-8") as handle:
+        cells = list(csv.reader(handle))[1:]
+    assert cells[0][:2] == ["'=cmd()__r__base__s0", "'=cmd()"]
+    assert cells[0][11] == "-0.25"  # a number stays a number
+    assert cells[0][14] == "'-failed: @once" and cells[1][13] == "'+w"
+    assert cells[1][1] == "''=x" and cells[1][3] == "task.rated_speed=-1"
+    back = read_summary_csv(tmp_path / "summary.csv")
+    assert [row.job for row in back] == [row.job for row in rows]
+    assert [row.message for row in back] == [row.message for row in rows]
+    assert [row.case for row in back] == ["=cmd()", "'=x"] and back[1].worker == "+w"

@@ -26,6 +26,7 @@ import numpy as np
 import yaml
 
 from trackplan.errors import CaseError
+from trackplan.io.csv_cells import neutralised
 from trackplan.io.csv_table import write_csv_table
 from trackplan.io.results import trajectory_header
 from trackplan.io.run_folder import OWNED_FILES, verified_trajectory, write_atomically
@@ -267,19 +268,6 @@ def _refuse_run_file(target: Path, csv_file: Path) -> None:
                 "it; give another file",
                 key="output",
             )
-
-
-def neutralised(cell: str) -> str:
-    """A text cell made safe to open in a spreadsheet (OWASP's CSV injection advice).
-
-    A cell that starts with ``=``, ``+``, ``-``, ``@``, a tab or a carriage return would
-    be taken as a formula: it is written with a leading single quote. Other text is kept.
-    """
-    return "'" + cell if cell[:1] in FORMULA_STARTS else cell
-
-
-FORMULA_STARTS = frozenset("=+-@\t\r")
-"""First characters that make a spreadsheet read a cell as a formula."""
 
 
 def _write_csv(table: TrajectoryTable, output: Path) -> None:

@@ -15,6 +15,7 @@ from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from trackplan.io.csv_cells import neutralised, restored
 from trackplan.run_files import RESULT_FILE
 from trackplan.status import Status
 
@@ -232,13 +233,16 @@ def read_summary_csv(file: str | Path) -> list[JobRow]:
 
 
 def _cells(row: JobRow) -> list[str]:
-    """CSV cells: floats in full precision (``repr``), booleans as true/false."""
+    """CSV cells: floats in full precision (``repr``), booleans as true/false, text that a
+    spreadsheet would run as a formula with a leading ``'`` (:func:`neutralised`)."""
     cells = []
     for value in astuple(row):
         if isinstance(value, bool):
             cells.append("true" if value else "false")
         elif isinstance(value, float):
             cells.append(repr(value))
+        elif isinstance(value, str):
+            cells.append(neutralised(value))
         else:
             cells.append(str(value))
     return cells
@@ -255,5 +259,5 @@ def _row(cells: dict[str, str]) -> JobRow:
         elif field.type == "float":
             values[field.name] = float(text)
         else:
-            values[field.name] = text
+            values[field.name] = restored(text)
     return JobRow(**values)
