@@ -2,8 +2,9 @@
 
 Used by ``tests/test_fuzz.py`` (a fast subset) and ``python -m benchmarks robustness`` (a
 larger run). A mutant replaces, deletes or duplicates one value of a shipped file, or
-damages its text; the harness runs ``validate`` and, for mutants that validate, ``plan``,
-and classifies the outcome. The contract: no exit 1, no traceback, every run within
+damages its text (the points file ``bead.csv`` too: a bad number, separator or row); the
+harness runs ``validate`` and, for mutants that validate, ``plan``, and classifies the
+outcome. The contract: no exit 1, no traceback, every run within
 :data:`RUN_LIMIT_S`, every exit-2 message one line naming the key (or line) at fault.
 """
 
@@ -57,6 +58,25 @@ HOSTILE_VALUES: tuple[Any, ...] = (
 
 TEXT_DAMAGE = ("delete line", "duplicate line", "truncate", "indent", "bracket", "alias")
 
+CSV_DAMAGE: tuple[str, ...] = (
+    "0.3_1",
+    "\uff10.2",
+    "nan",
+    "inf",
+    "1e999",
+    "0x1p-3",
+    "",
+    "x",
+    "1;2;3",
+    "1\t2\t3",
+    "1,2,3,4",
+    "1,2",
+    "# note",
+    "\ufeffx,y,z",
+    "x,y,z",
+)
+"""Cell or row replacements of a points file's mutants (a bad number, separator or row)."""
+
 
 def _paths(data: Any, prefix: tuple = ()) -> list[tuple]:
     """Every key path of a loaded YAML document (mappings and lists)."""
@@ -92,6 +112,28 @@ def mutate(text: str, rng: np.random.Generator) -> str:
     else:
         _set(data, path, HOSTILE_VALUES[int(rng.integers(len(HOSTILE_VALUES)))])
     return yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+
+
+def mutate_points(text: str, rng: np.random.Generator) -> str:
+    """One mutant of a points file's text: a cell or a row replaced, a row deleted or
+    repeated, the file cut short, or a byte order mark added."""
+    lines = text.splitlines()
+    k = int(rng.integers(len(lines)))
+    damage = CSV_DAMAGE[int(rng.integers(len(CSV_DAMAGE)))]
+    kind = int(rng.integers(5))
+    if kind == 0:  # one cell
+        cells = lines[k].split(",")
+        cells[int(rng.integers(len(cells)))] = damage
+        lines[k] = ",".join(cells)
+    elif kind == 1:  # a whole row
+        lines[k] = damage
+    elif kind == 2:
+        del lines[k]
+    elif kind == 3:
+        lines.insert(k, lines[k])
+    else:
+        return ("\ufeff" if rng.random() < 0.5 else "") + text[: int(rng.integers(len(text)))]
+    return "\n".join(lines) + "\n"
 
 
 def _damage_text(text: str, rng: np.random.Generator) -> str:
@@ -151,6 +193,7 @@ def _names_the_fault(err: str) -> bool:
         re.search(r"\.(yaml|csv): [\w.\[\]-]+: ", line)
         or re.search(r"at line \d+, column \d+", line)
         or re.search(r"\.(yaml|csv): (the file|case file|robot file|points file)", line)
+        or re.search(r"\.csv: line \d+: ", line)
     )
 
 
@@ -179,10 +222,16 @@ def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
     warm.write_text(base_case)
     run_cli(["plan", str(warm), "--out", str(folder / "warm-up"), "--no-report"])
     for i in range(n_mutants):
-        if ROBOT_FILES and rng.random() < 0.2:
+        draw = rng.random()
+        if ROBOT_FILES and draw < 0.2:
             robot = folder / f"robot-{i}.yaml"
             robot.write_text(mutate(ROBOT_FILES[0].read_text(), rng))
             text = base_case.replace("robot: puma560", f"robot: {robot.name}")
+        elif draw < 0.3:  # the points file of ur5-bead
+            points = folder / f"bead-{i}.csv"
+            points.write_text(mutate_points((ROOT / "cases" / "bead.csv").read_text(), rng))
+            text = (ROOT / "cases" / "ur5-bead.yaml").read_text()
+            text = text.replace("{file: bead.csv}", f"{{file: {points.name}}}")
         else:
             text = mutate(CASE_FILES[int(rng.integers(len(CASE_FILES)))].read_text(), rng)
         case = folder / f"case-{i}.yaml"

@@ -2,10 +2,19 @@
 
 from __future__ import annotations
 
+import csv
+import os
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
 import yaml
 
 from tests.conftest import CASES
 from trackplan.cli import main
+from trackplan.io.export import export_trajectory, read_trajectory_table
+from trackplan.io.results import read_trajectory_csv
 
 
 def test_export_ros_csv_json_and_bad_format(tmp_path, capsys):
@@ -24,3 +33,68 @@ def test_export_ros_csv_json_and_bad_format(tmp_path, capsys):
     assert other.read_text().startswith("t,")
     assert main(["export", str(run), "--format", "xml"]) == 2
     assert "unknown export format" in capsys.readouterr().err
+
+
+def _planned(tmp_path: Path) -> Path:
+    run = tmp_path / "run"
+    assert main(["plan", str(CASES / "paper-line.yaml"), "--out", str(run), "--no-report"]) == 0
+    return run
+
+
+@pytest.mark.parametrize("name", ["trajectory.csv", "result.json", "history.csv"])
+def test_export_refuses_to_overwrite_the_runs_own_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str
+) -> None:
+    run = _planned(tmp_path)
+    (run / "history.csv").write_text("generation\n")
+    before = {file.name: file.read_bytes() for file in run.iterdir()}
+    for fmt in ("csv", "json"):
+        for output in (run / name, run / "." / name, tmp_path / "run" / ".." / "run" / name):
+            capsys.readouterr()
+            assert main(["export", str(run), "--format", fmt, "--output", str(output)]) == 2
+            err = capsys.readouterr().err
+            assert err.count("\n") == 1 and err.startswith("output: ")
+            assert name in err and "run's own" in err
+    assert {file.name: file.read_bytes() for file in run.iterdir()} == before
+    # the CSV given as the source is protected too
+    csv = run / "trajectory.csv"
+    assert main(["export", str(csv), "--format", "csv", "--output", str(csv)]) == 2
+    assert csv.read_bytes() == before["trajectory.csv"]
+
+
+def test_csv_export_quotes_names_and_neutralises_formulas(tmp_path: Path) -> None:
+    run = _planned(tmp_path)
+    names = ['=HYPERLINK("http://x")', "a\nb", 'c"d,e', "+1", "-2", "@SUM(A1)"]
+    out = export_trajectory(run, "csv", tmp_path / "names.csv", joint_names=names)
+    with out.open(newline="", encoding="utf-8") as handle:
+        rows = list(csv.reader(handle))
+    assert rows[0] == ["t", *("'" + name if name[0] in "=+-@" else name for name in names)]
+    assert rows[0][2] == "a\nb" and rows[0][3] == 'c"d,e'
+    table = np.array(rows[1:], dtype=float)  # every other cell is a plain number
+    written = np.loadtxt(run / "trajectory.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert table.shape == (len(written), 7)
+    np.testing.assert_array_equal(table, written[:, :7])  # exact: shortest round trip
+
+
+@pytest.mark.parametrize("fmt", ["csv", "json", "ros"])
+def test_exported_files_respect_the_umask(tmp_path: Path, fmt: str) -> None:
+    run = _planned(tmp_path)
+    previous = os.umask(0o027)
+    try:
+        written = export_trajectory(run, fmt, tmp_path / f"out.{fmt}")
+    finally:
+        os.umask(previous)
+    assert stat.S_IMODE(written.stat().st_mode) == 0o640
+    assert stat.S_IMODE((run / "trajectory.csv").stat().st_mode) == 0o666 & ~previous
+
+
+def test_trajectory_files_with_a_byte_order_mark_are_read(tmp_path: Path) -> None:
+    run = _planned(tmp_path)
+    csv_file = tmp_path / "bom.csv"
+    csv_file.write_bytes(b"\xef\xbb\xbf" + (run / "trajectory.csv").read_bytes())
+    t, q = read_trajectory_csv(csv_file, 6)
+    table = read_trajectory_table(csv_file)
+    written = np.loadtxt(run / "trajectory.csv", delimiter=",", skiprows=1, ndmin=2)
+    np.testing.assert_array_equal(t, written[:, 0])
+    np.testing.assert_array_equal(q, written[:, 1:7])
+    np.testing.assert_array_equal(table.q, written[:, 1:7])

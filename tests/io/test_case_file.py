@@ -343,7 +343,10 @@ def test_bad_row_in_points_file(capsys: pytest.CaptureFixture[str], tmp_path: Pa
     (tmp_path / "seam.csv").write_text("0.1,0,0\n0.2,zero,0\n", encoding="utf-8")
     file = write_case(tmp_path, {"path.segments": [{"points": {"file": "seam.csv"}}]})
     line = validate_fails(capsys, str(file))
-    assert "seam.csv: line 2: expected three finite numbers x,y,z, got '0.2,zero,0'" in line
+    assert (
+        "seam.csv: line 2: expected three finite numbers x,y,z separated by commas, got 'zero'"
+        " in '0.2,zero,0'"
+    ) in line
 
 
 def test_yaml_syntax_error(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:

@@ -136,3 +136,36 @@ def test_cycle_keys_need_paths(
     assert validate_fails(capsys, str(file)) == (
         f"{file}: {key}: {key} is only used with paths (several seams)"
     )
+
+
+@pytest.mark.parametrize(
+    ("name", "shown"),
+    [
+        ("left,right", "'left,right'"),
+        ('say "a"', "'say \"a\"'"),
+        ("two\nlines", "'two\\nlines'"),
+        ("tab\there", "'tab\\there'"),
+        ("=HYPERLINK(1)", "'=HYPERLINK(1)'"),
+        ("+1", "'+1'"),
+        ("-fillet", "'-fillet'"),
+        ("@SUM", "'@SUM'"),
+    ],
+)
+def test_a_seam_name_that_would_break_trajectory_csv_is_refused(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, name: str, shown: str
+) -> None:
+    # seam names label trajectory.csv's segment column, written as they are
+    data = copy.deepcopy(SEAMS)
+    data["paths"][1]["name"] = name
+    file = write(tmp_path, data)
+    line = validate_fails(capsys, str(file))
+    assert line.startswith(f"{file}: paths[1].name: a seam name labels the rows of ")
+    assert line.endswith(f", got {shown}")
+
+
+def test_seam_names_with_spaces_and_digits_load(tmp_path: Path) -> None:
+    data = copy.deepcopy(SEAMS)
+    data["paths"][0]["name"] = "fillet 1 (left)"
+    data["paths"][1]["name"] = "2nd_seam.b"
+    case = load_case(write(tmp_path, data))
+    assert [seam.name for seam in case.seams] == ["fillet 1 (left)", "2nd_seam.b"]

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from tests.io.test_case_file import CASES, validate_fails, write_case
+from trackplan.io import yaml_input
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import robot_to_yaml
 from trackplan.io.sizes import MAX_SAMPLE_TIME, max_samples
-from trackplan.io.yaml_input import MAX_ALIAS_EXPANSION, MAX_DEPTH, show
+from trackplan.io.yaml_input import MAX_ALIAS_EXPANSION, MAX_DEPTH, MAX_YAML_VALUES, show
 from trackplan.planning.objective import joint_travel
 from trackplan.robots.builtin import puma560
 
@@ -138,3 +139,66 @@ def test_default_weights_for_twenty_joints(tmp_path: Path) -> None:
 def test_the_shipped_cases_still_load() -> None:
     for file in sorted(CASES.glob("*.yaml")):
         assert load_case(file).name
+
+
+def test_a_long_inline_list_is_refused_early_pointing_to_points_files(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rows = "".join(f"        - [{i * 1e-4:.4f}, 0.0, 0.0]\n" for i in range(1, 100_001))
+    text = (
+        "name: long\nrobot: puma560\npath:\n  start: [0, 0, 0]\n  segments:\n"
+        f"    - points:\n{rows}task: {{rated_speed: 0.1}}\n"
+    )
+    start = time.perf_counter()
+    line = validate_fails(capsys, str(_file(tmp_path, text)))
+    assert time.perf_counter() - start < 10.0  # the values past the limit are not parsed
+    assert f"holds more than {MAX_YAML_VALUES} values" in line
+    assert "points: {file: seam.csv}" in line
+
+    # the limit counts values: 4 a point ([x, y, z]), about 20 for the rest of the file
+    monkeypatch.setattr(yaml_input, "MAX_YAML_VALUES", 1000)
+    for n_points, fits in ((240, True), (260, False)):
+        some = "".join(f"        - [{i * 1e-4:.4f}, 0.0, 0.0]\n" for i in range(1, n_points + 1))
+        file = _file(tmp_path, text.replace(rows, some))
+        if fits:
+            assert len(load_case(file).segments[0].points) == n_points
+        else:
+            assert "holds more than 1000 values" in validate_fails(capsys, str(file))
+
+
+def test_an_infeasible_size_is_refused_before_any_costly_path_work(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a seam-frame tool on a path beyond the length limit: the 2500 m of arc were built and
+    # their tool frames sampled (10 s, 1 GB) before the one-line refusal
+    text = (CASES / "seam-weld-fixed.yaml").read_text()
+    text = text.replace("angle: 1.5707963267948966", "angle: 50000")
+    file = _file(tmp_path, text)
+
+    def costly(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the path was built before its size was checked")
+
+    monkeypatch.setattr("trackplan.io.case_file.NominalPath.from_specs", costly)
+    line = validate_fails(capsys, str(file))
+    assert line.startswith(f"{file}: path.segments[1]: the path is 2500.38 m long, more than")
+
+
+@pytest.mark.parametrize(
+    ("key", "shown"),
+    [("1", "1"), ("null", "null"), ("~", "null"), ("true", "true"), ("2.5", "2.5"), ("''", "''")],
+)
+@pytest.mark.parametrize("nested", [False, True])
+def test_a_key_that_is_not_a_name_is_one_line_at_its_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, key: str, shown: str, nested: bool
+) -> None:
+    # pydantic's own words came out: "[1]: Keys should be strings, got true"
+    text = write_case(tmp_path).read_text()
+    lines = text.splitlines()
+    at = lines.index("task:") + 2 if nested else len(lines) + 1
+    lines.insert(at - 1, f"  {key}: 1" if nested else f"{key}: 1")
+    line = validate_fails(capsys, str(_file(tmp_path, "\n".join(lines) + "\n")))
+    column = 3 if nested else 1
+    assert line.endswith(
+        f"at line {at}, column {column}: a key must be a non-empty name, got {shown}"
+    ), line
+    assert "should be" not in line

@@ -34,7 +34,7 @@ from trackplan.cli import batch as _batch  # noqa: F401  (registers its commands
 from trackplan.cli import cases as _cases  # noqa: F401
 from trackplan.cli import plan as _plan  # noqa: F401
 from trackplan.cli import search as _search  # noqa: F401
-from trackplan.cli.common import app, error
+from trackplan.cli.common import app, error, refuse_empty_outputs
 from trackplan.cli.signals import Stopped, forget_stops, last_stop, stopped_by_signal
 from trackplan.errors import CaseError
 
@@ -44,6 +44,7 @@ def run(args: list[str], *, debug: bool) -> int:
     keep_freed_memory()
     forget_stops()
     try:
+        refuse_empty_outputs(args)
         command = typer.main.get_command(app)
         result = command.main(args=args, prog_name="trackplan", standalone_mode=False)
     except CaseError as exc:

@@ -158,6 +158,37 @@ def method_option(value: str | None) -> Method | None:
     return None if value is None else choose(Method, value, "--method")
 
 
+OUTPUT_OPTIONS = {"--out": "folder", "--output": "file"}
+"""Options naming where a command writes, and what they name."""
+
+
+def refuse_empty_outputs(args: list[str]) -> None:
+    """Refuse an empty ``--out`` or ``--output`` on the command line, before parsing.
+
+    typer turns ``--out ""`` into ``Path("")``, which is ``Path(".")``: the command would
+    write into the current folder. The raw arguments are the only place the two differ.
+
+    Raises
+    ------
+    CaseError
+        Naming the option.
+    """
+    for i, arg in enumerate(args):
+        if arg == "--":
+            return
+        name, equals, value = arg.partition("=")
+        if name not in OUTPUT_OPTIONS:
+            continue
+        given = value if equals else args[i + 1] if i + 1 < len(args) else None
+        if given is not None and not given.strip():
+            what = OUTPUT_OPTIONS[name]
+            example = "runs/x" if what == "folder" else "trajectory.yaml"
+            raise CaseError(
+                f"an empty name is not a {what}; give the output {what}, e.g. {name} {example}",
+                key=name,
+            )
+
+
 def output_folder(out: Path, option: str = "--out") -> Path:
     """Check that ``out`` can be the folder of a run's files, before any work starts.
 

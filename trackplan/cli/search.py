@@ -204,7 +204,8 @@ def map_command(
         typer.Option("--z", help="Height of every placement, m (default: the search's best)."),
     ] = None,
     points: Annotated[
-        int, typer.Option("--points", min=2, help="Grid points along x and along y.")
+        int,
+        typer.Option("--points", help="Grid points along x and along y (2 to 501)."),
     ] = 41,
 ) -> ExitCode:
     """Map feasibility (reach, joint limit, collision) and J over an x-y grid of placements.
@@ -217,8 +218,9 @@ def map_command(
     from trackplan.io.case_file import load_case
     from trackplan.io.map_file import write_map_csv
     from trackplan.report.cell_figures import write_map_report
-    from trackplan.search.placement_map import placement_map
+    from trackplan.search.placement_map import check_map_points, placement_map
 
+    check_map_points(points, "--points")
     out = output_folder(out)
     given = placement_option((0.0, 0.0, z or 0.0, *(rpy or (0.0, 0.0, 0.0))))
     loaded = load_case(case)

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Discriminator, Field, Tag, model_validator
+from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 from pydantic_core import PydanticCustomError
 
 from trackplan.case import (
@@ -155,10 +155,21 @@ class SeamTaskModel(StrictModel):
     tool: ToolModel | None = None
 
 
+def _csv_safe_name(name: str) -> str:
+    """A seam name that ``trajectory.csv``'s ``segment`` column can hold as it is."""
+    if any(mark in name for mark in ',"') or not name.isprintable() or name[0] in "=+-@":
+        raise PydanticCustomError(
+            "seam_name",
+            "a seam name labels the rows of trajectory.csv: no commas, quotes, tabs or line "
+            "breaks, and no =, +, - or @ first (a spreadsheet would run it as a formula)",
+        )
+    return name
+
+
 class SeamModel(PathModel):
     """One entry of ``paths``: a named path, its task overrides, whether it may be reversed."""
 
-    name: NonEmptyStr
+    name: Annotated[NonEmptyStr, AfterValidator(_csv_safe_name)]
     task: SeamTaskModel | None = None
     reversible: bool = True
 
@@ -247,7 +258,7 @@ def load_case(file: str | Path, *, assume_limits: bool = False) -> Case:
         problem (in file order), an unknown robot or a bad robot file, an unreadable
         points file, then bad values (in file order).
     """
-    text = read_text(file, what="case file")
+    text = read_text(file, what="case file", hint=" (put long sampled curves in a points file)")
     return load_case_text(
         text, file=str(file), base_dir=Path(file).parent, assume_limits=assume_limits
     )
@@ -344,8 +355,12 @@ def load_case_data(
         *_objective_kind_problems(model.objective, robot),
         *_payload_problems(model.payload, robot),
     ]
+    # the sizes before any costly path work: a path too long for the memory budget is
+    # refused before it is built (and its tool frames sampled)
+    sizes = [] if problems else _size_problems(seams, paths, model, robot.n_dof)
     for (loc, seam), (seam_start, seam_segments) in zip(seams, paths, strict=True):
-        nominal = None if problems else NominalPath.from_specs(seam_start, seam_segments)
+        built = not problems and not sizes
+        nominal = NominalPath.from_specs(seam_start, seam_segments) if built else None
         own = seam.task if isinstance(seam, SeamModel) else None
         if own is not None and (own.tool is not None or own.tool_rpy is not None):
             problems += [
@@ -355,25 +370,7 @@ def load_case_data(
         else:
             problems += tool_problems(model.task.tool, model.task.tool_rpy, nominal)
     raise_first(problems, data, file)
-    for (loc, seam), (seam_start, seam_segments) in zip(seams, paths, strict=True):
-        own = seam.task if isinstance(seam, SeamModel) else None
-        sizes = size_problems(
-            seam_start,
-            seam_segments,
-            n_dof=robot.n_dof,
-            rated_speed=(
-                own.rated_speed
-                if own is not None and own.rated_speed is not None
-                else model.task.rated_speed
-            ),
-            sample_time=model.task.sample_time,
-            population=model.optimizer.population,
-        )
-        raise_first(
-            [(loc + where[1:] if where[:1] == ("path",) else where, m) for where, m in sizes],
-            data,
-            file,
-        )
+    raise_first(sizes, data, file)
     if model.payload is not None and robot.dynamics is not None:
         dynamics = dataclasses.replace(robot.dynamics, payload=as_payload(model.payload))
         robot = dataclasses.replace(robot, dynamics=dynamics)
@@ -383,6 +380,33 @@ def load_case_data(
     if model.cell is None:
         return case
     return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
+
+
+def _size_problems(
+    seams: list[tuple[Loc, PathModel]],
+    paths: list[tuple[np.ndarray, tuple[SegmentSpec, ...]]],
+    model: CaseModel,
+    n_dof: int,
+) -> list[Problem]:
+    """The size problems (:func:`~trackplan.io.sizes.size_problems`) of the first seam that
+    has any, located in the file."""
+    for (loc, seam), (seam_start, seam_segments) in zip(seams, paths, strict=True):
+        own = seam.task if isinstance(seam, SeamModel) else None
+        sizes = size_problems(
+            seam_start,
+            seam_segments,
+            n_dof=n_dof,
+            rated_speed=(
+                own.rated_speed
+                if own is not None and own.rated_speed is not None
+                else model.task.rated_speed
+            ),
+            sample_time=model.task.sample_time,
+            population=model.optimizer.population,
+        )
+        if sizes:
+            return [(loc + where[1:] if where[:1] == ("path",) else where, m) for where, m in sizes]
+    return []
 
 
 def _case(

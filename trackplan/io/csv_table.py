@@ -10,6 +10,8 @@ gets the same bits back.
 
 from __future__ import annotations
 
+import csv
+import io
 from collections.abc import Iterator, Sequence
 from functools import cache
 from pathlib import Path
@@ -70,11 +72,14 @@ def write_csv_table(file: Path, table: np.ndarray, header: Sequence[str]) -> Non
     table
         Shape (n_rows, len(header)), converted to float64.
     header
-        Column names, joined by commas on the first line.
+        Column names on the first line, quoted as the ``csv`` module quotes (only a name
+        holding a comma, a quote or a line break is quoted).
     """
     table = np.asarray(table, dtype=np.float64)
+    line = io.StringIO()
+    csv.writer(line, lineterminator="\n").writerow(header)
     with Path(file).open("wb") as handle:
-        handle.write((",".join(header) + "\n").encode("utf-8"))
+        handle.write(line.getvalue().encode("utf-8"))
         for chunk in _chunks(table):
             handle.write(chunk)
 

@@ -7,7 +7,9 @@ The source is a run directory (or its ``trajectory.csv``, header
 
 Formats and default files (written next to ``trajectory.csv``):
 
-- ``csv`` → ``trajectory.export.csv``: ``t,<joint names>``, one row per sample (s, rad).
+- ``csv`` → ``trajectory.export.csv``: ``t,<joint names>``, one row per sample (s, rad);
+  the header is quoted as the ``csv`` module quotes, and a name that a spreadsheet would
+  take for a formula gets a leading ``'`` (:func:`neutralised`).
 - ``json`` → ``trajectory.json``: joint names, units and every column as arrays.
 - ``ros`` → ``trajectory.ros.yaml``: a ``trajectory_msgs/msg/JointTrajectory`` as YAML.
 """
@@ -15,6 +17,7 @@ Formats and default files (written next to ``trajectory.csv``):
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -23,9 +26,10 @@ import numpy as np
 import yaml
 
 from trackplan.errors import CaseError
+from trackplan.io.csv_cells import neutralised
 from trackplan.io.csv_table import write_csv_table
 from trackplan.io.results import trajectory_header
-from trackplan.io.run_folder import verified_trajectory, write_atomically
+from trackplan.io.run_folder import OWNED_FILES, verified_trajectory, write_atomically
 from trackplan.planning.result import Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
@@ -153,7 +157,7 @@ def read_trajectory_table(file: Path) -> TrajectoryTable:
     file = _trajectory_file(Path(file))
     where = str(file)
     try:
-        lines = file.read_text(encoding="utf-8").splitlines()
+        lines = file.read_text(encoding="utf-8-sig").splitlines()  # a byte order mark skipped
     except FileNotFoundError:
         raise CaseError("no trajectory file: plan or optimize a case first", file=where) from None
     except (OSError, UnicodeDecodeError) as error:
@@ -246,8 +250,29 @@ def joint_trajectory_msg(table: TrajectoryTable, frame_id: str = "") -> dict:
     }
 
 
+def _refuse_run_file(target: Path, csv_file: Path) -> None:
+    """Refuse an output that is the source ``trajectory.csv`` or another file of its run.
+
+    Paths are compared resolved (``..``, symbolic links), and by inode when both exist
+    (hard links).
+    """
+    run_files = {csv_file, *(csv_file.parent / name for name in OWNED_FILES)}
+    resolved = target.resolve()
+    for own in run_files:
+        same = resolved == own.resolve()
+        if not same and target.exists() and own.exists():
+            same = os.path.samefile(target, own)
+        if same:
+            raise CaseError(
+                f"{str(target)!r} is the run's own {own.name}: exporting there would replace "
+                "it; give another file",
+                key="output",
+            )
+
+
 def _write_csv(table: TrajectoryTable, output: Path) -> None:
-    write_csv_table(output, np.column_stack([table.t, table.q]), ["t", *table.joint_names])
+    header = ["t", *(neutralised(name) for name in table.joint_names)]
+    write_csv_table(output, np.column_stack([table.t, table.q]), header)
 
 
 def _write_json(table: TrajectoryTable, output: Path) -> None:
@@ -339,6 +364,8 @@ def export_trajectory(
         target = csv_file.parent / EXPORT_FILES[fmt] if output is None else Path(output)
     if target.is_dir():
         target = target / EXPORT_FILES[fmt]
+    if not isinstance(source, Trajectory):
+        _refuse_run_file(target, csv_file)
     target.parent.mkdir(parents=True, exist_ok=True)
     if fmt == "csv":
         write_atomically(target, lambda file: _write_csv(table, file))

@@ -3,16 +3,35 @@
 from __future__ import annotations
 
 import io
-import math
+import re
 from pathlib import Path
 
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.io.sizes import MAX_POINTS_BYTES, MAX_POINTS_ROWS
 from trackplan.io.yaml_input import read_text
 
 MIN_POINTS = 2
 """Fewest points of a ``points`` segment (one point is a ``line``)."""
+
+NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
+"""A decimal number as a CSV cell holds one: ASCII digits, an optional point and exponent.
+
+Python's ``float`` also takes ``1_000``, full-width digits, ``infinity`` and ``nan``; a
+points file does not."""
+
+_FAST_CHARACTERS = re.compile(r"[^0-9eE+\-., \r\n]")
+"""A character outside the rows of plain numbers the compiled parser is given."""
+
+_LATE_HASH = re.compile(r"[^\n]#")
+"""A ``#`` that does not start its line."""
+
+_COMMENT_LINES = re.compile(r"^#[^\n]*(?:\n|$)", re.M)
+"""Comment lines (``#`` in the first column), with their line ends."""
+
+_SEPARATORS = re.compile(r"[,;\t]")
+"""Separators a row may hold (only commas are accepted: the others are named in errors)."""
 
 
 def load_points_csv(
@@ -20,8 +39,12 @@ def load_points_csv(
 ) -> np.ndarray:
     """Read the points of a sampled curve from a CSV file.
 
-    One point per row: ``x,y,z`` in metres, comma separated. Blank lines and lines
-    starting with ``#`` are skipped; the first row may be a header (``x,y,z``).
+    One point per row: ``x,y,z`` in metres, comma separated, each a plain decimal number
+    (:data:`NUMBER`). Blank lines and lines starting with ``#`` are skipped; the first
+    other row may be a header (a row without a number, such as ``x,y,z``); a byte order
+    mark at the start is skipped. The file is a regular file of at most
+    :data:`~trackplan.io.sizes.MAX_POINTS_BYTES` bytes and
+    :data:`~trackplan.io.sizes.MAX_POINTS_ROWS` lines.
 
     Parameters
     ----------
@@ -38,46 +61,126 @@ def load_points_csv(
     Raises
     ------
     CaseError
-        When the file is missing or unreadable (reported at ``key`` of the case file),
-        or a row is not three finite numbers, or there are fewer than two points
-        (reported against the CSV file, with its line number as the key).
+        When the file is missing, not a regular file, too large or unreadable (a missing
+        one reported at ``key`` of the case file), or a row is not three finite numbers
+        separated by commas, or there are fewer than two points (reported against the CSV
+        file, with its line number as the key).
     """
-    text = read_text(file, what="points file", referrer=case_file, key=key)
+    text = read_text(
+        file,
+        what="points file",
+        referrer=case_file,
+        key=key,
+        max_bytes=MAX_POINTS_BYTES,
+        hint="; split the curve into several points segments",
+    )
+    n_lines = text.count("\n") + (not text.endswith("\n"))
+    if n_lines > MAX_POINTS_ROWS:
+        raise CaseError(
+            f"the file has {n_lines} lines, more than the {MAX_POINTS_ROWS} a points file may "
+            "have; split the curve into several points segments",
+            file=str(file),
+        )
     fast = _parse_fast(text)
     if fast is not None:
         return fast
+    bad = _first_bad_row(text)
+    if bad is not None:
+        raise CaseError(bad[1], file=str(file), key=f"line {bad[0]}")
+    # no bad row, but lines the compiled parser does not take (a line of spaces, say)
     points: list[list[float]] = []
-    for number, line in enumerate(text.splitlines(), start=1):
+    first = True
+    for number, line in enumerate(text.split("\n"), start=1):
         row = line.strip()
         if not row or row.startswith("#"):
             continue
-        fields = [field.strip() for field in row.split(",")]
-        try:
-            point = [float(field) for field in fields]
-        except ValueError:
-            if not points and not any(_is_number(field) for field in fields):
-                continue  # a header row
-            point = []
-        if len(point) != 3 or not all(math.isfinite(value) for value in point):
-            raise CaseError(
-                f"expected three finite numbers x,y,z, got {row!r}",
-                file=str(file),
-                key=f"line {number}",
-            )
+        header, first = first and _is_header(row), False
+        if header:
+            continue
+        point = _point(row)
+        if isinstance(point, str):
+            raise CaseError(point, file=str(file), key=f"line {number}")
         points.append(point)
     if len(points) < MIN_POINTS:
         raise CaseError(
-            f"expected at least {MIN_POINTS} rows x,y,z, got {len(points)}", file=str(file)
+            f"the file has {len(points)} rows x,y,z, expected at least {MIN_POINTS}",
+            file=str(file),
         )
     return np.array(points, dtype=float)
+
+
+_PLAIN = r"[+-]?(?:[0-9]{1,20}(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]{1,2})?"
+"""A number of :data:`NUMBER` that is surely finite (at most 20 digits before the point,
+an exponent of at most 2 digits)."""
+
+_SUSPECT_LINE = re.compile(
+    rf"^(?![ \t]*(?:#[^\n]*|{_PLAIN} *, *{_PLAIN} *, *{_PLAIN})?[ \t]*$)[^\n]*", re.M | re.ASCII
+)
+"""A line that is not surely blank, a comment or a good row: the ones to look at closely."""
+
+_FIRST_CONTENT = re.compile(r"^[ \t]*[^#\s]", re.M)
+"""The start of the first line that is neither blank nor a comment (a header, maybe)."""
+
+
+def _first_bad_row(text: str) -> tuple[int, str] | None:
+    """The first row the line-by-line reader would refuse: its line number and message.
+
+    The lines are screened by one regular expression (in C); only the lines it cannot
+    vouch for are looked at in Python, so a bad row at the end of a million is found in
+    about the time the compiled parser takes.
+    """
+    first = _FIRST_CONTENT.search(text)
+    header_at = -1 if first is None else text.rfind("\n", 0, first.start()) + 1
+    for match in _SUSPECT_LINE.finditer(text):
+        row = match.group(0).strip()
+        if not row or row.startswith("#"):
+            continue
+        if match.start() == header_at and _is_header(row):
+            continue
+        problem = _point(row)
+        if isinstance(problem, str):
+            return text.count("\n", 0, match.start()) + 1, problem
+    return None
+
+
+def _is_header(row: str) -> bool:
+    """A first row without a number in any of its cells (split at ``,``, ``;`` or tabs)."""
+    return not any(NUMBER.fullmatch(cell.strip()) for cell in _SEPARATORS.split(row))
+
+
+def _point(row: str) -> list[float] | str:
+    """The point of a data row, or the message saying what is wrong with it."""
+    expected = "expected three finite numbers x,y,z separated by commas"
+    other = next((mark for mark in (";", "\t") if mark in row), None)
+    if other is not None:
+        shown = "';'" if other == ";" else "a tab"
+        return f"{expected}, got {shown} between the numbers in {_show(row)}"
+    cells = [cell.strip() for cell in row.split(",")]
+    if len(cells) != 3:
+        count = "1 value" if len(cells) == 1 else f"{len(cells)} values"
+        return f"{expected}, got {count} in {_show(row)}"
+    bad = next((cell for cell in cells if not NUMBER.fullmatch(cell)), None)
+    if bad is not None:
+        return f"{expected}, got {_show(bad)} in {_show(row)}"
+    point = [float(cell) for cell in cells]
+    if not all(abs(value) < float("inf") for value in point):
+        return f"{expected}, got a number beyond the double range in {_show(row)}"
+    return point
+
+
+def _show(text: str, limit: int = 80) -> str:
+    """``text`` quoted for a message, cut to about ``limit`` characters."""
+    return repr(text if len(text) <= limit else text[:limit] + "…")
 
 
 def _parse_fast(text: str) -> np.ndarray | None:
     """The points of a well-formed file, parsed in C (a million rows in about a second).
 
-    Returns None when the rows after the header are anything but three finite numbers each
-    (a comment or a blank line among them included), or fewer than :data:`MIN_POINTS`: the
-    line-by-line reader then takes the file, and names the row at fault.
+    Comment lines (``#`` in the first column) and empty lines among the rows are skipped.
+    Returns None when the rows after the header are anything else than three plain numbers
+    each (an indented comment, a comment after the numbers or a line of spaces included),
+    or fewer than :data:`MIN_POINTS`: the line-by-line reader then takes the file, and
+    names the row at fault.
     """
     start = 0
     while True:  # skip blank and comment lines, and a header row, before the first point
@@ -85,7 +188,7 @@ def _parse_fast(text: str) -> np.ndarray | None:
         end = len(text) if end < 0 else end
         row = text[start:end].strip()
         if row and not row.startswith("#"):
-            if not any(_is_number(field) for field in row.split(",")):
+            if _is_header(row):
                 start = end + 1
             break
         if end >= len(text):
@@ -93,6 +196,10 @@ def _parse_fast(text: str) -> np.ndarray | None:
         start = end + 1
     body = text[start:]
     if "#" in body:
+        if _LATE_HASH.search(body):  # an indented comment, or one after the numbers
+            return None
+        body = _COMMENT_LINES.sub("", body)
+    if _FAST_CHARACTERS.search(body) or not body.strip():
         return None
     try:
         points = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2)
@@ -101,11 +208,3 @@ def _parse_fast(text: str) -> np.ndarray | None:
     if points.shape[1:] != (3,) or len(points) < MIN_POINTS or not np.all(np.isfinite(points)):
         return None
     return points
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True

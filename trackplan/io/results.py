@@ -97,7 +97,7 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     """
     file = Path(file)
     try:
-        with file.open(encoding="utf-8") as handle:
+        with file.open(encoding="utf-8-sig") as handle:  # a byte order mark is skipped
             header = [name.strip() for name in handle.readline().strip().split(",")]
     except (OSError, UnicodeDecodeError) as error:
         raise _unreadable(error, file) from None

@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import secrets
 import shutil
 import tempfile
 from collections.abc import Callable
@@ -101,16 +102,29 @@ def write_atomically(target: Path, write: Callable[[Path], None]) -> None:
     """Write one file through a temporary file beside it, renamed over ``target`` at the end.
 
     A reader (or a signal) never sees a half-written ``target``: it is the old file or
-    the complete new one.
+    the complete new one. The file gets the permissions of any file the process creates
+    (``0o666`` less the umask), as a run's other outputs do.
     """
     target = Path(target)
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
-    os.close(handle)
+    temporary = _new_file_beside(target)
     try:
-        write(Path(temporary))
+        write(temporary)
         os.replace(temporary, target)
     finally:
-        Path(temporary).unlink(missing_ok=True)
+        temporary.unlink(missing_ok=True)
+
+
+def _new_file_beside(target: Path) -> Path:
+    """A new, empty, hidden file in ``target``'s folder, created with mode ``0o666`` less
+    the umask (``tempfile.mkstemp`` would create it ``0o600``)."""
+    for _ in range(tempfile.TMP_MAX):
+        candidate = target.parent / f".{target.name}.{secrets.token_hex(4)}"
+        try:
+            os.close(os.open(candidate, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        except FileExistsError:
+            continue
+        return candidate
+    raise FileExistsError(f"no free temporary name beside {target}")
 
 
 def _owned(folder: Path) -> set[str]:

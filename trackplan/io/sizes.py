@@ -37,6 +37,13 @@ POINTS_PER_TURN = 16
 MAX_SAMPLE_TIME = 0.05
 """Longest controller period accepted, s: 20 Hz, slower than any robot controller."""
 
+MAX_POINTS_ROWS = 2**20
+"""Most lines of a points file (1,048,576; comments and blank lines count): a curve sampled
+every 0.25 mm over the longest path a search can hold, parsed in about a second."""
+
+MAX_POINTS_BYTES = 2**27
+"""Largest points file, bytes (128 MiB: 128 characters a line at the most lines)."""
+
 
 def max_samples(n_dof: int) -> int:
     """Most trajectory samples a plan of an ``n_dof``-joint robot may have."""

@@ -2,11 +2,13 @@
 
 Shared by the case and robot file loaders. The rules, in the order they are applied:
 
-1. The file must exist and be UTF-8 text.
+1. The file must exist, be a regular file (not a FIFO or a device) of at most
+   :data:`MAX_YAML_BYTES` and be UTF-8 text (a byte order mark is skipped).
 2. It must be valid YAML with YAML 1.2 core-schema scalars (no ``yes``/``no`` booleans, no
    sexagesimal ``1:30``), at most :data:`MAX_YAML_BYTES` long; a key given twice, a
-   complex key, a recursive alias, an alias bomb and nesting deeper than
-   :data:`MAX_DEPTH` are errors. Errors name the line and column.
+   complex key, a recursive alias, an alias bomb, nesting deeper than :data:`MAX_DEPTH`
+   and more than :data:`MAX_YAML_VALUES` values are errors. Errors name the line and
+   column.
 3. It must match the pydantic schema of the file. Of all schema problems, the one that
    comes first in the file is reported.
 4. Checks that need more than one value (bounds, geometry, robot joint count) are
@@ -21,7 +23,9 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
 import re
+import stat
 import types
 import typing
 from collections.abc import Sequence
@@ -88,9 +92,20 @@ Range = Annotated[list[Coordinate], _fixed_length(2, "min, max")]
 
 
 def read_text(
-    file: str | Path, *, what: str, referrer: str | None = None, key: str | None = None
+    file: str | Path,
+    *,
+    what: str,
+    referrer: str | None = None,
+    key: str | None = None,
+    max_bytes: int | None = None,
+    hint: str = "",
 ) -> str:
-    """The text of an input file.
+    """The text of an input file: a regular file of at most ``max_bytes``, UTF-8.
+
+    A FIFO, a device or a socket is refused before anything is read from it (a FIFO
+    without a writer would block, ``/dev/zero`` never ends), and so is a file larger than
+    ``max_bytes``. A byte order mark at the start is dropped, and line ends are read as
+    ``\\n`` whether written ``\\r\\n``, ``\\r`` or ``\\n``.
 
     Parameters
     ----------
@@ -101,34 +116,94 @@ def read_text(
     referrer, key
         The file and key that name ``file``, if another file does; a missing file is then
         reported there. Otherwise the problem is reported against ``file`` itself.
+    max_bytes
+        Largest size accepted, bytes; :data:`MAX_YAML_BYTES` when None.
+    hint
+        What to do about a file over ``max_bytes``, appended to that message.
 
     Raises
     ------
     CaseError
-        When the file is missing, is a directory, cannot be read or is not UTF-8 text.
+        When the file is missing, is a directory or not a regular file, is larger than
+        ``max_bytes``, cannot be read or is not UTF-8 text.
     """
     path = Path(file)
+    limit = MAX_YAML_BYTES if max_bytes is None else max_bytes
     if referrer is None:  # the line starts with the file's name: do not repeat it
         where, at, name = str(path), None, what
     else:
-        where, at, name = referrer, key, f"{what} {str(path)!r}"
-    if not path.exists():
-        raise CaseError(f"{name} not found", file=where, key=at)
-    if path.is_dir():
-        raise CaseError(f"{name} is a directory, expected a file", file=where, key=at)
+        shown = str(path) if len(str(path)) <= 200 else str(path)[:200] + "…"
+        where, at, name = referrer, key, f"{what} {shown!r}"
     try:
-        return path.read_text(encoding="utf-8")
+        if not path.exists():
+            raise CaseError(f"{name} not found", file=where, key=at)
+        if path.is_dir():
+            raise CaseError(f"{name} is a directory, expected a file", file=where, key=at)
+    except OSError as exc:  # a name too long for the system, say
+        reason = (exc.strerror or type(exc).__name__).lower()
+        raise CaseError(f"cannot read {name}: {reason}", file=where, key=at) from None
+    try:
+        # O_NONBLOCK: opening a FIFO must not wait for a writer (a regular file ignores it)
+        handle = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise CaseError(f"cannot read {what}: {reason.lower()}", file=str(path)) from None
+    with os.fdopen(handle, "rb") as opened:
+        mode = os.fstat(opened.fileno()).st_mode
+        if not stat.S_ISREG(mode):
+            raise CaseError(
+                f"{name} is not a regular file ({_file_kind(mode)}), expected a file",
+                file=where,
+                key=at,
+            )
+        size = os.fstat(opened.fileno()).st_size
+        if size <= limit:
+            try:
+                data = opened.read(limit + 1)  # one more: a file that grew meanwhile
+            except OSError as exc:
+                reason = exc.strerror or type(exc).__name__
+                raise CaseError(f"cannot read {what}: {reason.lower()}", file=str(path)) from None
+            size = len(data)
+    if size > limit:
+        raise CaseError(
+            f"the {what} has {size} bytes, more than the {limit} accepted" + hint, file=str(path)
+        )
+    try:
+        text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise CaseError(
             f"{what} is not UTF-8 text (byte {exc.start} cannot be decoded)", file=str(path)
         ) from None
-    except OSError as exc:
-        reason = exc.strerror or type(exc).__name__
-        raise CaseError(f"cannot read {what}: {reason.lower()}", file=str(path)) from None
+    if "\r" in text:  # universal newlines, as a file opened in text mode reads them
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    return text[1:] if text.startswith(BYTE_ORDER_MARK) else text
+
+
+BYTE_ORDER_MARK = "\ufeff"
+"""U+FEFF at the start of a file (spreadsheets write it at the start of UTF-8 CSV files)."""
+
+
+def _file_kind(mode: int) -> str:
+    """What a file that is not regular is, for messages (``a FIFO``, ``a character device``)."""
+    for test, kind in (
+        (stat.S_ISFIFO, "a FIFO"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return kind
+    return "not a file"
 
 
 MAX_DEPTH = 100
 """Deepest nesting of lists and mappings accepted in a YAML file (a case file needs 6)."""
+
+MAX_YAML_VALUES = 50_000
+"""Most values (scalars, lists and mappings) a YAML file may hold: about 12,000 inline
+points of 4 values each, parsed in about 2 s. A file over it is refused as soon as the
+parser reaches the limit, before the rest is read (long sampled curves belong in a points
+file)."""
 
 MAX_ALIAS_EXPANSION = 100_000
 """Most values that aliases (``*name``) may add to a YAML document when expanded."""
@@ -147,15 +222,17 @@ class _Loader(yaml.SafeLoader):
       ``on``/``off``), decimal integers (``010`` is ten), ``0o`` and ``0x`` integers,
       floats such as ``1e-3`` and ``.inf``, ``null``/``~``; anything else, such as the
       YAML 1.1 sexagesimal ``1:30`` or a date, is a string.
-    - A key given twice, a list or mapping used as a key, nesting deeper than
-      :data:`MAX_DEPTH`, an alias inside the node it names (recursion), and aliases that
-      expand to more than :data:`MAX_ALIAS_EXPANSION` values ("billion laughs") are
-      errors at their line.
+    - A key given twice, a list or mapping used as a key, a key that is not a non-empty
+      string (``1``, ``null``, ``true``), nesting deeper than
+      :data:`MAX_DEPTH`, more than :data:`MAX_YAML_VALUES` values, an alias inside the
+      node it names (recursion), and aliases that expand to more than
+      :data:`MAX_ALIAS_EXPANSION` values ("billion laughs") are errors at their line.
     """
 
     def __init__(self, stream: str) -> None:
         super().__init__(stream)
         self._depth = 0
+        self._values = 0
         self._open_anchors: set[str] = set()
         self._sizes: dict[int, int] = {}
         self._expanded = 0
@@ -183,6 +260,15 @@ class _Loader(yaml.SafeLoader):
                     event.start_mark,
                 )
             return node
+        self._values += 1
+        if self._values > MAX_YAML_VALUES:
+            raise yaml.composer.ComposerError(
+                None,
+                None,
+                f"the file holds more than {MAX_YAML_VALUES} values; put long sampled curves "
+                "in a points file (points: {file: seam.csv})",
+                event.start_mark,
+            )
         self._depth += 1
         if self._depth > MAX_DEPTH:
             raise yaml.composer.ComposerError(
@@ -213,7 +299,8 @@ class _Loader(yaml.SafeLoader):
         return size
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
-        """Build a mapping, refusing a key that occurs twice or that is a list or mapping."""
+        """Build a mapping, refusing a key that occurs twice, that is a list or mapping, or
+        that is not a non-empty string (``1:``, ``null:``, ``true:``, ``'':``)."""
         seen: set[Any] = set()
         for key_node, _ in node.value:
             if not isinstance(key_node, yaml.ScalarNode):
@@ -221,6 +308,13 @@ class _Loader(yaml.SafeLoader):
                     None, None, "a list or mapping as a key is not supported", key_node.start_mark
                 )
             key = self.construct_object(key_node, deep=deep)
+            if not isinstance(key, str) or not key:
+                raise yaml.constructor.ConstructorError(
+                    None,
+                    None,
+                    f"a key must be a non-empty name, got {show(key)}",
+                    key_node.start_mark,
+                )
             if key in seen:
                 raise yaml.constructor.ConstructorError(
                     None, None, f"duplicate key {show(key)}", key_node.start_mark

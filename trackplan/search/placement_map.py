@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.search.fitness import Finding, PlacementFitness
 from trackplan.search.space import SearchSpace
@@ -33,6 +34,31 @@ _CODE = {
 }
 CHUNK = 256
 """Placements screened per batch (bounds the IK arrays' memory)."""
+
+MAX_MAP_POINTS = 501
+"""Most grid points along x and along y (251,001 placements).
+
+The screening is chunked (:data:`CHUNK`), so memory is not what limits a map: the time is,
+about 0.2 ms a placement for the paper's corner and more for longer paths (a minute at the
+limit; 100,000 points a side would take weeks and 75 GiB for the grid alone). A finer grid
+shows nothing more on the figure."""
+
+
+def check_map_points(n_points: int, key: str = "n_points") -> int:
+    """Check the grid size of a placement map: 2 to :data:`MAX_MAP_POINTS` points a side.
+
+    Raises
+    ------
+    CaseError
+        Naming ``key`` (``--points`` on the command line) and the bound.
+    """
+    if not 2 <= n_points <= MAX_MAP_POINTS:
+        raise CaseError(
+            f"expected at most {MAX_MAP_POINTS} grid points along x and y (and at least 2: "
+            f"the map screens points² placements), got {n_points}",
+            key=key,
+        )
+    return n_points
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,14 +125,21 @@ def placement_map(
         Placement (x, y, z, roll, pitch, yaw) whose z and orientation the map keeps,
         shape (6,), metres and radians (for example the search's best).
     n_points
-        Grid points along x and along y, over the case's placement ranges.
+        Grid points along x and along y, over the case's placement ranges (2 to
+        :data:`MAX_MAP_POINTS`).
     geometry
         The case's paths (smooth timing) when already built.
 
     Returns
     -------
     PlacementMap
+
+    Raises
+    ------
+    CaseError
+        When ``n_points`` is outside 2 to :data:`MAX_MAP_POINTS`.
     """
+    check_map_points(n_points)
     reference = np.asarray(reference, dtype=float)
     geometry = geometry or PathGeometry.from_case(case, "g2")
     fitness = PlacementFitness(case, SearchSpace.from_bounds(case.bounds), geometry, "smooth")

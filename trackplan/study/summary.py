@@ -15,6 +15,7 @@ from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from trackplan.io.csv_cells import neutralised, restored
 from trackplan.run_files import RESULT_FILE
 from trackplan.status import Status
 
@@ -51,7 +52,8 @@ class JobRow:
     tracking_error_m
         Largest distance of the tool point from the nominal path, m.
     worst_margin
-        Smallest unused fraction over every limit (negative: a limit is broken).
+        Smallest unused fraction over every limit (negative: a limit is broken; see
+        :func:`worst_margin`).
     wall_time_s
         Wall time of the job on its worker, s.
     worker
@@ -87,11 +89,17 @@ COLUMNS = tuple(field.name for field in fields(JobRow))
 
 
 def row_from_run(folder: str | Path) -> JobRow:
-    """The summary row of a complete run folder (its ``job.json`` and ``result.json``)."""
+    """The summary row of a complete run folder (its ``job.json`` and ``result.json``).
+
+    A run without a trajectory (an unreachable placement, say) is a row with its verdict:
+    its ``result.json`` holds ``null`` for the figures a trajectory would give, which are
+    NaN in the row.
+    """
     folder = Path(folder)
-    job = json.loads((folder / JOB_FILE).read_text())
-    result = json.loads((folder / RESULT_FILE).read_text())
-    n_samples = int(result["n_samples"])
+    job = json.loads((folder / JOB_FILE).read_text(encoding="utf-8"))
+    result = json.loads((folder / RESULT_FILE).read_text(encoding="utf-8"))
+    n_samples = int(result.get("n_samples") or 0)
+    sample_time = _number(result.get("sample_time"))
     return JobRow(
         job=job["job"],
         case=job["case"],
@@ -100,15 +108,20 @@ def row_from_run(folder: str | Path) -> JobRow:
         seed=int(job["seed"]),
         status=str(result["status"]),
         success=bool(result["feasible"]),
-        J=float(result["objective"]),
-        duration_s=float(result["duration"]),
-        cycle_time_s=(n_samples - 1) * float(result["sample_time"]) if n_samples else math.nan,
-        tracking_error_m=float(result["max_tracking_error"]),
-        worst_margin=worst_margin(result["margins"]),
-        wall_time_s=float(job["wall_time_s"]),
+        J=_number(result.get("objective")),
+        duration_s=_number(result.get("duration")),
+        cycle_time_s=(n_samples - 1) * sample_time if n_samples else math.nan,
+        tracking_error_m=_number(result.get("max_tracking_error")),
+        worst_margin=worst_margin(result.get("margins") or {}),
+        wall_time_s=_number(job.get("wall_time_s")),
         worker=str(job["worker"]),
         message=str(result["message"]),
     )
+
+
+def _number(value: Any) -> float:
+    """A number of ``result.json`` as a float: ``null`` (no such figure) is NaN."""
+    return math.nan if value is None else float(value)
 
 
 def failed_row(job: dict[str, Any], reason: str, wall_time_s: float, worker: str) -> JobRow:
@@ -145,18 +158,36 @@ def failed_row(job: dict[str, Any], reason: str, wall_time_s: float, worker: str
     )
 
 
-def worst_margin(margins: dict[str, Any]) -> float:
-    """The smallest margin of ``result.json``'s ``margins`` block (per joint or per task).
+IGNORED_UNLESS_BROKEN = frozenset({"speed", "coverage"})
+"""Margins that count towards the worst margin only when negative (broken).
 
-    NaN when there is none (no trajectory).
+A plan drives the tool at the rated speed wherever it can, so its speed margin is 0 by
+design, and the coverage margin is a pass (1) or fail (−1) flag, not an unused fraction.
+"""
+
+
+def worst_margin(margins: dict[str, Any]) -> float:
+    """The smallest unused fraction of a limit in ``result.json``'s ``margins`` block.
+
+    Every joint limit (per joint) and task limit counts, except those of
+    :data:`IGNORED_UNLESS_BROKEN`, which count only when broken. ``null`` entries (a limit
+    that does not apply) are skipped.
+
+    Returns
+    -------
+    float
+        The smallest margin (negative: a limit is broken), NaN when there is none (no
+        trajectory).
     """
-    values = [
-        float(value)
-        for entry in margins.values()
-        for value in (entry.values() if isinstance(entry, dict) else (entry,))
-    ]
-    finite = [value for value in values if math.isfinite(value)]
-    return min(finite) if finite else math.nan
+    values = []
+    for kind, entry in margins.items():
+        for value in entry.values() if isinstance(entry, dict) else (entry,):
+            number = _number(value)
+            if not math.isfinite(number):
+                continue
+            if kind not in IGNORED_UNLESS_BROKEN or number < 0:
+                values.append(number)
+    return min(values) if values else math.nan
 
 
 class SummaryWriter:
@@ -197,18 +228,21 @@ def write_summary_csv(rows: Iterable[JobRow], file: str | Path) -> None:
 
 def read_summary_csv(file: str | Path) -> list[JobRow]:
     """Read ``summary.csv`` back into rows."""
-    with Path(file).open(newline="", encoding="utf-8") as handle:
+    with Path(file).open(newline="", encoding="utf-8-sig") as handle:  # a spreadsheet's BOM
         return [_row(cells) for cells in csv.DictReader(handle)]
 
 
 def _cells(row: JobRow) -> list[str]:
-    """CSV cells: floats in full precision (``repr``), booleans as true/false."""
+    """CSV cells: floats in full precision (``repr``), booleans as true/false, text that a
+    spreadsheet would run as a formula with a leading ``'`` (:func:`neutralised`)."""
     cells = []
     for value in astuple(row):
         if isinstance(value, bool):
             cells.append("true" if value else "false")
         elif isinstance(value, float):
             cells.append(repr(value))
+        elif isinstance(value, str):
+            cells.append(neutralised(value))
         else:
             cells.append(str(value))
     return cells
@@ -225,5 +259,5 @@ def _row(cells: dict[str, str]) -> JobRow:
         elif field.type == "float":
             values[field.name] = float(text)
         else:
-            values[field.name] = text
+            values[field.name] = restored(text)
     return JobRow(**values)
