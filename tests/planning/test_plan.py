@@ -193,3 +193,15 @@ def test_a_time_law_too_long_to_sample_says_where(corner_case, corner_geometry, 
     assert result.status is Status.LIMITS_VIOLATED and not result.feasible
     assert "would need" in result.message and "m/s at s =" in result.message
     assert result.trajectory.n_samples == 0
+
+
+def test_worst_margin_of_a_feasible_plan_is_its_least_unused_limit(corner_plan):
+    """The speed margin (0 by design at the rated speed) and the coverage flag count only
+    when broken: a feasible plan's worst margin is its least unused joint or task limit."""
+    check = corner_plan.check
+    assert corner_plan.success
+    assert check.task_margins["speed"] == pytest.approx(0.0, abs=1e-6)
+    worst = check.worst_margin()
+    assert 0.0 < worst < 1.0
+    joint_least = min(float(np.min(m)) for m in check.joint_margins.values())
+    assert worst <= joint_least

@@ -16,6 +16,14 @@ from trackplan.timing.protocol import SlowDown
 TASK_KINDS = ("tracking", "orientation", "speed", "coverage")
 
 
+IGNORED_UNLESS_BROKEN = frozenset({"speed", "coverage"})
+"""Task margins that count towards the worst margin only when negative (broken).
+
+A plan drives the tool at the rated speed wherever it can, so its speed margin is 0 by
+design, and the coverage margin is a pass (1) or fail (−1) flag, not an unused fraction.
+"""
+
+
 @dataclass(frozen=True, eq=False, kw_only=True)
 class Trajectory:
     """Joint trajectory sampled at the controller period, from rest to rest.
@@ -187,10 +195,15 @@ class CheckReport:
     cell: CellReport | None = None
 
     def worst_margin(self) -> float:
-        """The smallest margin over every limit (negative when infeasible)."""
+        """The smallest margin over every limit (negative when infeasible); the margins of
+        :data:`IGNORED_UNLESS_BROKEN` count only when negative. NaN when none counts."""
         values = [float(np.min(m)) for m in self.joint_margins.values()]
-        values += list(self.task_margins.values())
-        return min(values)
+        values += [
+            float(value)
+            for kind, value in self.task_margins.items()
+            if kind not in IGNORED_UNLESS_BROKEN or value < 0
+        ]
+        return min(values) if values else float("nan")
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from trackplan.io.csv_cells import neutralised, restored
+from trackplan.planning.result import IGNORED_UNLESS_BROKEN
 from trackplan.run_files import RESULT_FILE
 from trackplan.status import Status
 
@@ -156,14 +157,6 @@ def failed_row(job: dict[str, Any], reason: str, wall_time_s: float, worker: str
         worker=worker,
         message=reason,
     )
-
-
-IGNORED_UNLESS_BROKEN = frozenset({"speed", "coverage"})
-"""Margins that count towards the worst margin only when negative (broken).
-
-A plan drives the tool at the rated speed wherever it can, so its speed margin is 0 by
-design, and the coverage margin is a pass (1) or fail (−1) flag, not an unused fraction.
-"""
 
 
 def worst_margin(margins: dict[str, Any]) -> float:
