@@ -69,14 +69,17 @@ def shipped_cases_dir() -> Path:
     return Path(trackplan.__file__).resolve().parents[1] / "cases"
 
 
-def load_each(files: list[Path]) -> list[tuple[Path, Case | None]]:
-    """Load case files one by one; a bad one is reported on stderr and comes with None."""
+def load_each(files: list[Path], *, assume_limits: bool = False) -> list[tuple[Path, Case | None]]:
+    """Load case files one by one; a bad one is reported on stderr and comes with None.
+
+    ``assume_limits`` is as for :func:`~trackplan.io.case_file.load_case` (``--assume-limits``).
+    """
     from trackplan.io.case_file import load_case
 
     loaded: list[tuple[Path, Case | None]] = []
     for file in files:
         try:
-            loaded.append((file, load_case(file)))
+            loaded.append((file, load_case(file, assume_limits=assume_limits)))
         except CaseError as exc:
             error(exc.one_line())
             loaded.append((file, None))
