@@ -1,10 +1,11 @@
-"""Seeded mutants of the shipped case and robot files, and a harness that runs the CLI on them.
+"""Seeded mutants of the shipped case, robot and URDF files, and a harness that runs the CLI.
 
 Used by ``tests/test_fuzz.py`` (a fast subset) and ``python -m benchmarks robustness`` (a
 larger run). A mutant replaces, deletes or duplicates one value of a shipped file, or
-damages its text; the harness runs ``validate`` and, for mutants that validate, ``plan``,
-and classifies the outcome. The contract: no exit 1, no traceback, every run within
-:data:`RUN_LIMIT_S`, every exit-2 message one line naming the key (or line) at fault.
+damages its text (a URDF: one attribute's value, or its XML); the harness runs ``validate``
+and, for mutants that validate, ``plan``, and classifies the outcome. The contract: no exit
+1, no traceback, no warning on stderr, every run within :data:`RUN_LIMIT_S`, every exit-2
+message one line naming the key (or line) at fault.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from trackplan.cli import main
 ROOT = Path(__file__).resolve().parent.parent
 CASE_FILES = sorted((ROOT / "cases").glob("*.yaml"))
 ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))
+URDF_FILES = sorted((ROOT / "trackplan" / "robots" / "library").glob("*.urdf"))
 RUN_LIMIT_S = 10.0
 """Longest time one command may take on a mutant, s."""
 
@@ -56,6 +58,24 @@ HOSTILE_VALUES: tuple[Any, ...] = (
 )
 
 TEXT_DAMAGE = ("delete line", "duplicate line", "truncate", "indent", "bracket", "alias")
+
+HOSTILE_ATTRIBUTES = (
+    "nan",
+    "inf",
+    "-1e308",
+    "1e308",
+    "0",
+    "-1",
+    "1e-300",
+    "1 2 3 4",
+    "0 0 1e-300",
+    "",
+    "x",
+    "0 0 0",
+)
+"""Values put into one attribute of a URDF."""
+
+XML_DAMAGE = ("unquote", "unclose", "duplicate joint", "truncate")
 
 
 def _paths(data: Any, prefix: tuple = ()) -> list[tuple]:
@@ -114,6 +134,27 @@ def _damage_text(text: str, rng: np.random.Generator) -> str:
     return "\n".join(lines) + "\n"
 
 
+def mutate_urdf(text: str, rng: np.random.Generator) -> str:
+    """One mutant of a URDF's text: one attribute's value replaced, or its XML damaged."""
+    if rng.random() < 0.3:
+        kind = XML_DAMAGE[int(rng.integers(len(XML_DAMAGE)))]
+        if kind == "unquote":  # <axis xyz=0 0 1/>: yourdfpy alone would drop the attribute
+            found = list(re.finditer(r'="([^"]*)"', text))
+            match = found[int(rng.integers(len(found)))]
+            return text[: match.start()] + "=" + match.group(1) + text[match.end() :]
+        if kind == "unclose":
+            return text.replace("</robot>", "")
+        if kind == "duplicate joint":
+            joints = re.findall(r"<joint .*?</joint>", text, flags=re.S)
+            joint = joints[int(rng.integers(len(joints)))]
+            return text.replace(joint, joint + "\n" + joint, 1)
+        return text[: int(rng.integers(len(text)))]
+    found = list(re.finditer(r'(\w+)="([^"]*)"', text))
+    match = found[int(rng.integers(len(found)))]
+    value = HOSTILE_ATTRIBUTES[int(rng.integers(len(HOSTILE_ATTRIBUTES)))]
+    return text[: match.start(2)] + value + text[match.end(2) :]
+
+
 @dataclass
 class FuzzCounts:
     """Outcomes of a fuzz run."""
@@ -121,6 +162,7 @@ class FuzzCounts:
     runs: int = 0
     exit_codes: dict[int, int] = field(default_factory=dict)
     tracebacks: int = 0
+    warnings: list[str] = field(default_factory=list)
     hangs: int = 0
     bad_messages: list[str] = field(default_factory=list)
     internal_errors: list[str] = field(default_factory=list)
@@ -133,6 +175,8 @@ class FuzzCounts:
         self.slowest_s = max(self.slowest_s, seconds)
         if "Traceback" in err:
             self.tracebacks += 1
+        if "Warning" in err:  # numpy's RuntimeWarning, a library's log line
+            self.warnings.append(err.strip()[:300])
         if seconds > RUN_LIMIT_S:
             self.hangs += 1
         if code == 1:
@@ -142,7 +186,9 @@ class FuzzCounts:
 
 
 def _names_the_fault(err: str) -> bool:
-    """One line ``file: key: message`` or ``file: YAML ... at line L, column C: ...``."""
+    """One line ``file: key: message``, ``file: YAML ... at line L, column C: ...`` or, for a
+    URDF, ``file: line L: ...``, ``file: not well-formed XML at line L, ...`` or naming the
+    joint or link."""
     lines = err.strip().splitlines()
     if len(lines) != 1:
         return False
@@ -151,6 +197,7 @@ def _names_the_fault(err: str) -> bool:
         re.search(r"\.(yaml|csv): [\w.\[\]-]+: ", line)
         or re.search(r"at line \d+, column \d+", line)
         or re.search(r"\.(yaml|csv): (the file|case file|robot file|points file)", line)
+        or re.search(r"\.urdf: (line \d+: |not well-formed XML at line \d+|(joint|link) ')", line)
     )
 
 
@@ -179,7 +226,15 @@ def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
     warm.write_text(base_case)
     run_cli(["plan", str(warm), "--out", str(folder / "warm-up"), "--no-report"])
     for i in range(n_mutants):
-        if ROBOT_FILES and rng.random() < 0.2:
+        options: list[str] = []
+        if URDF_FILES and rng.random() < 0.2:
+            urdf = folder / f"arm-{i}.urdf"
+            urdf.write_text(
+                mutate_urdf(URDF_FILES[int(rng.integers(len(URDF_FILES)))].read_text(), rng)
+            )
+            text = base_case.replace("robot: puma560", f"robot: {urdf.name}")
+            options = ["--assume-limits"]
+        elif ROBOT_FILES and rng.random() < 0.2:
             robot = folder / f"robot-{i}.yaml"
             robot.write_text(mutate(ROBOT_FILES[0].read_text(), rng))
             text = base_case.replace("robot: puma560", f"robot: {robot.name}")
@@ -187,11 +242,11 @@ def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
             text = mutate(CASE_FILES[int(rng.integers(len(CASE_FILES)))].read_text(), rng)
         case = folder / f"case-{i}.yaml"
         case.write_text(text)
-        code, err, seconds = run_cli(["validate", str(case)])
+        code, err, seconds = run_cli(["validate", str(case), *options])
         counts.add(code, err, seconds)
         if code == 0 and planned < n_plans:
             planned += 1
-            args = ["plan", str(case), "--out", str(folder / f"run-{i}"), "--no-report"]
+            args = ["plan", str(case), "--out", str(folder / f"run-{i}"), "--no-report", *options]
             if "example:" not in text:
                 args += ["--placement", "0.3", "0.1", "0.2", "0", "0", "0"]
             code, err, seconds = run_cli(args)

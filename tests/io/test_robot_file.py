@@ -107,6 +107,8 @@ PUMA_YAML = robot_to_yaml(puma560())
         ("alpha: 0.0,", "alpha: 1e300,", "joints[1].alpha: expected a number ≤ 1000, got"),
         ("velocity: 8.0,", "velocity: 1e300,", "joints[0].velocity: expected a number ≤ 1e+06"),
         ("jerk: 30.0}", "jerk: 1e7}", "joints[0].jerk: expected a number ≤ 1e+06, got 10000000"),
+        ("jerk: 30.0}", "jerk: 1e-300}", "joints[0].jerk: expected a number ≥ 0.001, got 1e-300"),
+        ("velocity: 8.0,", "velocity: 0,", "joints[0].velocity: expected a number > 0, got 0"),
         ("radius: 0.09}", "radius: 1e300}", "collision[0].radius: expected a number ≤ 1000"),
     ],
 )

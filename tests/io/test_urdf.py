@@ -170,6 +170,7 @@ def mutated_urdf(folder: Path, old: str, new: str) -> Path:
         ("</robot>", "", "not well-formed XML at line 57, column 1: Premature end of data in "),
         ('name="j5"', 'name="j4"', "line 37: joint name 'j4' is given twice (first at line 32)"),
         ('<link name="l5"/>', '<link name="l5"/>\n<link name="l5"/>', "line 9: link name 'l5' is"),
+        ("-->", "", "not well-formed XML at line 57, column 1: Comment not terminated\n"),
         ('<robot name="tilted7">', '<robo name="x">', "not well-formed XML at line 56, column 9: "),
         # values out of their range, named with the joint, the attribute and the range
         (
@@ -201,12 +202,13 @@ def mutated_urdf(folder: Path, old: str, new: str) -> Path:
         (
             J2_LIMIT,
             J2_LIMIT.replace('velocity="2"', 'velocity="0"'),
-            "line 21: joint 'j2' <limit velocity>: expected a number in (0, 1e+06] rad/s, got '0'",
+            "line 21: joint 'j2' <limit velocity>: expected a number in [0.001, 1e+06] rad/s, "
+            "got '0'",
         ),
         (
             J2_LIMIT,
             J2_LIMIT.replace('velocity="2"', 'velocity="-1"'),
-            "line 21: joint 'j2' <limit velocity>: expected a number in (0, 1e+06] rad/s, got '-1'",
+            "line 21: joint 'j2' <limit velocity>: expected a number in [0.001, 1e+06] rad/s, got",
         ),
         (
             J2_LIMIT,

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import Field
+from pydantic import AfterValidator, Field
+from pydantic_core import PydanticCustomError
 
 from trackplan.io.yaml_input import MAX_COORDINATE
 
@@ -19,6 +20,9 @@ MAX_ANGLE = MAX_COORDINATE
 """Largest |angle|, rad: DH alpha and offset, joint ranges, rpy."""
 MAX_RATE = 1.0e6
 """Largest joint velocity, acceleration and jerk limit, rad/s, rad/s², rad/s³."""
+MIN_RATE = 1.0e-3
+"""Smallest joint velocity, acceleration and jerk limit, rad/s, rad/s², rad/s³ (a slower
+joint would take longer than any trajectory can hold)."""
 MAX_MASS = 1.0e5
 """Largest link or payload mass, kg."""
 MAX_INERTIA = 1.0e5
@@ -36,7 +40,16 @@ MAX_MESH_SCALE = 1.0e3
 
 Length = Annotated[float, Field(ge=-MAX_LENGTH, le=MAX_LENGTH)]
 Angle = Annotated[float, Field(ge=-MAX_ANGLE, le=MAX_ANGLE)]
-Rate = Annotated[float, Field(gt=0, le=MAX_RATE)]
+
+
+def _at_least_min_rate(value: float) -> float:
+    if value < MIN_RATE:
+        raise PydanticCustomError("rate_too_small", f"expected a number ≥ {MIN_RATE:g}")
+    return value
+
+
+Rate = Annotated[float, Field(gt=0, le=MAX_RATE), AfterValidator(_at_least_min_rate)]
+"""A joint's rate limit in [:data:`MIN_RATE`, :data:`MAX_RATE`] (one ≤ 0 reads "> 0")."""
 Mass = Annotated[float, Field(le=MAX_MASS)]
 """A mass ≤ :data:`MAX_MASS`; a negative one is reported by the loaders, naming the unit."""
 InertiaEntry = Annotated[float, Field(ge=-MAX_INERTIA, le=MAX_INERTIA)]

@@ -36,6 +36,7 @@ from trackplan.io.robot_bounds import (
     MAX_MESH_SCALE,
     MAX_RATE,
     MAX_TORQUE,
+    MIN_RATE,
 )
 from trackplan.robots.collision import (
     Capsules,
@@ -147,7 +148,8 @@ def check_urdf_xml(path: str) -> None:
     - Every number attribute that trackplan reads (origins, axes, limits, masses, inertias,
       shape sizes, mesh scales) holds the right count of finite numbers within its range
       (:mod:`trackplan.io.robot_bounds`); a revolute or continuous joint's axis is at least
-      :data:`MIN_AXIS_LENGTH` long and its velocity limit > 0.
+      :data:`MIN_AXIS_LENGTH` long and its velocity limit at least
+      :data:`~trackplan.io.robot_bounds.MIN_RATE`.
 
     Raises
     ------
@@ -161,7 +163,8 @@ def check_urdf_xml(path: str) -> None:
         root = etree.parse(path, parser).getroot()
     except etree.XMLSyntaxError as exc:
         line, column = exc.position
-        message = re.sub(r", line \d+, column \d+$", "", str(exc.msg))
+        text = str(exc.msg).splitlines()[0] if str(exc.msg) else type(exc).__name__
+        message = re.sub(r", line \d+, column \d+$", "", text).strip()
         raise CaseError(
             f"not well-formed XML at line {line}, column {column}: {message}", file=path
         ) from None
@@ -233,7 +236,8 @@ def _check_numbers(
 
 
 def _check_moving_joint(joint: Any, path: str) -> None:
-    """A revolute or continuous joint's axis is not (nearly) zero, its velocity limit > 0."""
+    """A revolute or continuous joint's axis is not (nearly) zero, and its velocity limit is
+    at least :data:`~trackplan.io.robot_bounds.MIN_RATE`."""
     axis = joint.find("axis")
     if axis is not None and axis.get("xyz") is not None:
         values = _numbers(str(axis.get("xyz")))
@@ -246,10 +250,10 @@ def _check_moving_joint(joint: Any, path: str) -> None:
     limit = joint.find("limit")
     velocity = None if limit is None else limit.get("velocity")
     values = None if velocity is None else _numbers(velocity)
-    if values is not None and len(values) == 1 and not values[0] > 0.0:
+    if values is not None and len(values) == 1 and not values[0] >= MIN_RATE:
         raise CaseError(
-            f"{_where(limit, 'velocity')}: expected a number in (0, {MAX_RATE:g}] rad/s, got "
-            f"{velocity!r}",
+            f"{_where(limit, 'velocity')}: expected a number in [{MIN_RATE:g}, {MAX_RATE:g}] "
+            f"rad/s, got {velocity!r}",
             file=path,
         )
 
