@@ -290,3 +290,12 @@ def test_a_urdf_needs_a_robot_root(capsys: pytest.CaptureFixture[str], tmp_path:
     assert (
         capsys.readouterr().err == f"{file}: line 4: expected a <robot> root element, got <model>\n"
     )
+
+
+def test_messages_quote_at_most_60_characters_of_an_attribute(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    file = mutated_urdf(tmp_path, J2_AXIS, '<axis xyz="' + "0 " * 3000 + '"/>')
+    assert cli.main(["robots", str(file), "--assume-limits"]) == 2
+    err = capsys.readouterr().err
+    assert "<axis xyz>: expected 3 numbers, got '0 0 0" in err and len(err) < 200

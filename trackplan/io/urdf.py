@@ -210,6 +210,11 @@ def _where(element: Any, attribute: str) -> str:
     return f"line {element.sourceline}: {whose}{' '.join(tags)}"
 
 
+def _shown(text: str, limit: int = 60) -> str:
+    """An attribute's text for a message, at most ``limit`` characters."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
 def _numbers(text: str) -> list[float] | None:
     try:
         return [float(word) for word in text.split()]
@@ -222,7 +227,7 @@ def _check_numbers(
 ) -> None:
     count, low, high, unit = rule
     values = _numbers(text)
-    shown = text if len(text) <= 60 else text[:59] + "…"
+    shown = _shown(text)
     what = "a number" if count == 1 else f"{count} numbers"
     unit = f" {unit}" if unit else ""
     if values is None or len(values) != count:
@@ -241,10 +246,10 @@ def _check_moving_joint(joint: Any, path: str) -> None:
     axis = joint.find("axis")
     if axis is not None and axis.get("xyz") is not None:
         values = _numbers(str(axis.get("xyz")))
-        if values is not None and math.hypot(*values) < MIN_AXIS_LENGTH:
+        if values is not None and len(values) == 3 and math.hypot(*values) < MIN_AXIS_LENGTH:
             raise CaseError(
                 f"{_where(axis, 'xyz')}: expected a joint axis of length ≥ {MIN_AXIS_LENGTH:g}, "
-                f"got {axis.get('xyz')!r}",
+                f"got {_shown(str(axis.get('xyz')))!r}",
                 file=path,
             )
     limit = joint.find("limit")
@@ -253,7 +258,7 @@ def _check_moving_joint(joint: Any, path: str) -> None:
     if values is not None and len(values) == 1 and not values[0] >= MIN_RATE:
         raise CaseError(
             f"{_where(limit, 'velocity')}: expected a number in [{MIN_RATE:g}, {MAX_RATE:g}] "
-            f"rad/s, got {velocity!r}",
+            f"rad/s, got {_shown(str(velocity))!r}",
             file=path,
         )
 
