@@ -15,6 +15,7 @@ import io
 import re
 import shutil
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -201,13 +202,32 @@ def _names_the_fault(err: str) -> bool:
     )
 
 
+HIDDEN_WARNINGS = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+"""Warnings Python's default filters do not print outside ``__main__``."""
+
+
 def run_cli(args: list[str]) -> tuple[int, str, float]:
-    """Run ``trackplan args`` in this process: exit code, stderr, seconds."""
+    """Run ``trackplan args`` in this process: exit code, stderr, seconds.
+
+    Python warnings (numpy's RuntimeWarning) are recorded, every one, and added to stderr
+    as the command line would print them, whatever filter pytest has installed (except
+    those Python hides by default, :data:`HIDDEN_WARNINGS`).
+    """
     out, err = io.StringIO(), io.StringIO()
     start = time.perf_counter()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    with (
+        contextlib.redirect_stdout(out),
+        contextlib.redirect_stderr(err),
+        warnings.catch_warnings(record=True) as caught,
+    ):
+        warnings.simplefilter("always")
         code = main(args)
-    return code, err.getvalue(), time.perf_counter() - start
+    shown = "".join(
+        f"{w.category.__name__}: {w.message}\n"
+        for w in caught
+        if not issubclass(w.category, HIDDEN_WARNINGS)
+    )
+    return code, err.getvalue() + shown, time.perf_counter() - start
 
 
 def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
