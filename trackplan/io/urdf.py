@@ -85,15 +85,18 @@ class URDFChain:
 
 
 @contextmanager
-def _quiet_yourdfpy() -> Iterator[None]:
-    """yourdfpy's log silenced: its warnings would be a second line beside our one."""
-    logger = logging.getLogger("yourdfpy")
-    level = logger.level
-    logger.setLevel(logging.CRITICAL)
+def _quiet(*names: str) -> Iterator[None]:
+    """These libraries' logs silenced (yourdfpy, trimesh): a log line would be a second line
+    beside our one, printed by Python's last-resort handler."""
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL)
     try:
         yield
     finally:
-        logger.setLevel(level)
+        for logger, level in zip(loggers, levels, strict=True):
+            logger.setLevel(level)
 
 
 def load_urdf_model(path: str) -> Any:
@@ -104,7 +107,7 @@ def load_urdf_model(path: str) -> Any:
     """
     import yourdfpy
 
-    with _quiet_yourdfpy():
+    with _quiet("yourdfpy"):
         return yourdfpy.URDF.load(
             path, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
         ).robot
@@ -542,7 +545,7 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
     import trimesh
     import yourdfpy
 
-    with _quiet_yourdfpy():
+    with _quiet("yourdfpy"):
         name = yourdfpy.filename_handler_magic(mesh.filename, dir=str(Path(path).parent))
     kind = _file_kind(Path(name))
     if kind is not None:
@@ -553,7 +556,7 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
             file=path,
         )
     try:
-        with warnings.catch_warnings(), np.errstate(all="ignore"):  # checked below
+        with warnings.catch_warnings(), np.errstate(all="ignore"), _quiet("trimesh"):
             warnings.simplefilter("ignore")
             loaded = trimesh.load(name, force="mesh")
         vertices = np.asarray(getattr(loaded, "vertices"), dtype=float).reshape(-1, 3)  # noqa: B009
