@@ -1,11 +1,12 @@
-"""Seeded mutants of the shipped case and robot files, and a harness that runs the CLI on them.
+"""Seeded mutants of the shipped case, robot and URDF files, and a harness that runs the CLI.
 
 Used by ``tests/test_fuzz.py`` (a fast subset) and ``python -m benchmarks robustness`` (a
 larger run). A mutant replaces, deletes or duplicates one value of a shipped file, or
-damages its text (the points file ``bead.csv`` too: a bad number, separator or row); the
-harness runs ``validate`` and, for mutants that validate, ``plan``, and classifies the
-outcome. The contract: no exit 1, no traceback, every run within
-:data:`RUN_LIMIT_S`, every exit-2 message one line naming the key (or line) at fault.
+damages its text (a URDF: one attribute's value, or its XML; the points file ``bead.csv``:
+a bad number, separator or row); the harness runs ``validate`` and, for mutants that
+validate, ``plan``, and classifies the outcome. The contract: no exit 1, no traceback, no
+warning on stderr, every run within :data:`RUN_LIMIT_S`, every exit-2 message one line
+naming the key (or line) at fault.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import io
 import re
 import shutil
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -27,6 +29,7 @@ from trackplan.cli import main
 ROOT = Path(__file__).resolve().parent.parent
 CASE_FILES = sorted((ROOT / "cases").glob("*.yaml"))
 ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))
+URDF_FILES = sorted((ROOT / "trackplan" / "robots" / "library").glob("*.urdf"))
 RUN_LIMIT_S = 10.0
 """Longest time one command may take on a mutant, s."""
 
@@ -76,6 +79,24 @@ CSV_DAMAGE: tuple[str, ...] = (
     "x,y,z",
 )
 """Cell or row replacements of a points file's mutants (a bad number, separator or row)."""
+
+HOSTILE_ATTRIBUTES = (
+    "nan",
+    "inf",
+    "-1e308",
+    "1e308",
+    "0",
+    "-1",
+    "1e-300",
+    "1 2 3 4",
+    "0 0 1e-300",
+    "",
+    "x",
+    "0 0 0",
+)
+"""Values put into one attribute of a URDF."""
+
+XML_DAMAGE = ("unquote", "unclose", "duplicate joint", "truncate")
 
 
 def _paths(data: Any, prefix: tuple = ()) -> list[tuple]:
@@ -156,6 +177,27 @@ def _damage_text(text: str, rng: np.random.Generator) -> str:
     return "\n".join(lines) + "\n"
 
 
+def mutate_urdf(text: str, rng: np.random.Generator) -> str:
+    """One mutant of a URDF's text: one attribute's value replaced, or its XML damaged."""
+    if rng.random() < 0.3:
+        kind = XML_DAMAGE[int(rng.integers(len(XML_DAMAGE)))]
+        if kind == "unquote":  # <axis xyz=0 0 1/>: yourdfpy alone would drop the attribute
+            found = list(re.finditer(r'="([^"]*)"', text))
+            match = found[int(rng.integers(len(found)))]
+            return text[: match.start()] + "=" + match.group(1) + text[match.end() :]
+        if kind == "unclose":
+            return text.replace("</robot>", "")
+        if kind == "duplicate joint":
+            joints = re.findall(r"<joint .*?</joint>", text, flags=re.S)
+            joint = joints[int(rng.integers(len(joints)))]
+            return text.replace(joint, joint + "\n" + joint, 1)
+        return text[: int(rng.integers(len(text)))]
+    found = list(re.finditer(r'(\w+)="([^"]*)"', text))
+    match = found[int(rng.integers(len(found)))]
+    value = HOSTILE_ATTRIBUTES[int(rng.integers(len(HOSTILE_ATTRIBUTES)))]
+    return text[: match.start(2)] + value + text[match.end(2) :]
+
+
 @dataclass
 class FuzzCounts:
     """Outcomes of a fuzz run."""
@@ -163,6 +205,7 @@ class FuzzCounts:
     runs: int = 0
     exit_codes: dict[int, int] = field(default_factory=dict)
     tracebacks: int = 0
+    warnings: list[str] = field(default_factory=list)
     hangs: int = 0
     bad_messages: list[str] = field(default_factory=list)
     internal_errors: list[str] = field(default_factory=list)
@@ -175,6 +218,8 @@ class FuzzCounts:
         self.slowest_s = max(self.slowest_s, seconds)
         if "Traceback" in err:
             self.tracebacks += 1
+        if "Warning" in err:  # numpy's RuntimeWarning, a library's log line
+            self.warnings.append(err.strip()[:300])
         if seconds > RUN_LIMIT_S:
             self.hangs += 1
         if code == 1:
@@ -184,7 +229,9 @@ class FuzzCounts:
 
 
 def _names_the_fault(err: str) -> bool:
-    """One line ``file: key: message`` or ``file: YAML ... at line L, column C: ...``."""
+    """One line ``file: key: message``, ``file: YAML ... at line L, column C: ...`` or, for a
+    URDF, ``file: line L: ...``, ``file: not well-formed XML at line L, ...`` or naming the
+    joint or link."""
     lines = err.strip().splitlines()
     if len(lines) != 1:
         return False
@@ -194,16 +241,36 @@ def _names_the_fault(err: str) -> bool:
         or re.search(r"at line \d+, column \d+", line)
         or re.search(r"\.(yaml|csv): (the file|case file|robot file|points file)", line)
         or re.search(r"\.csv: line \d+: ", line)
+        or re.search(r"\.urdf: (line \d+: |not well-formed XML at line \d+|(joint|link) ')", line)
     )
 
 
+HIDDEN_WARNINGS = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+"""Warnings Python's default filters do not print outside ``__main__``."""
+
+
 def run_cli(args: list[str]) -> tuple[int, str, float]:
-    """Run ``trackplan args`` in this process: exit code, stderr, seconds."""
+    """Run ``trackplan args`` in this process: exit code, stderr, seconds.
+
+    Python warnings (numpy's RuntimeWarning) are recorded, every one, and added to stderr
+    as the command line would print them, whatever filter pytest has installed (except
+    those Python hides by default, :data:`HIDDEN_WARNINGS`).
+    """
     out, err = io.StringIO(), io.StringIO()
     start = time.perf_counter()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    with (
+        contextlib.redirect_stdout(out),
+        contextlib.redirect_stderr(err),
+        warnings.catch_warnings(record=True) as caught,
+    ):
+        warnings.simplefilter("always")
         code = main(args)
-    return code, err.getvalue(), time.perf_counter() - start
+    shown = "".join(
+        f"{w.category.__name__}: {w.message}\n"
+        for w in caught
+        if not issubclass(w.category, HIDDEN_WARNINGS)
+    )
+    return code, err.getvalue() + shown, time.perf_counter() - start
 
 
 def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
@@ -222,12 +289,20 @@ def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
     warm.write_text(base_case)
     run_cli(["plan", str(warm), "--out", str(folder / "warm-up"), "--no-report"])
     for i in range(n_mutants):
+        options: list[str] = []
         draw = rng.random()
-        if ROBOT_FILES and draw < 0.2:
+        if URDF_FILES and draw < 0.2:
+            urdf = folder / f"arm-{i}.urdf"
+            urdf.write_text(
+                mutate_urdf(URDF_FILES[int(rng.integers(len(URDF_FILES)))].read_text(), rng)
+            )
+            text = base_case.replace("robot: puma560", f"robot: {urdf.name}")
+            options = ["--assume-limits"]
+        elif ROBOT_FILES and draw < 0.35:
             robot = folder / f"robot-{i}.yaml"
             robot.write_text(mutate(ROBOT_FILES[0].read_text(), rng))
             text = base_case.replace("robot: puma560", f"robot: {robot.name}")
-        elif draw < 0.3:  # the points file of ur5-bead
+        elif draw < 0.5:  # the points file of ur5-bead
             points = folder / f"bead-{i}.csv"
             points.write_text(mutate_points((ROOT / "cases" / "bead.csv").read_text(), rng))
             text = (ROOT / "cases" / "ur5-bead.yaml").read_text()
@@ -236,11 +311,11 @@ def fuzz(folder: Path, n_mutants: int, n_plans: int, seed: int) -> FuzzCounts:
             text = mutate(CASE_FILES[int(rng.integers(len(CASE_FILES)))].read_text(), rng)
         case = folder / f"case-{i}.yaml"
         case.write_text(text)
-        code, err, seconds = run_cli(["validate", str(case)])
+        code, err, seconds = run_cli(["validate", str(case), *options])
         counts.add(code, err, seconds)
         if code == 0 and planned < n_plans:
             planned += 1
-            args = ["plan", str(case), "--out", str(folder / f"run-{i}"), "--no-report"]
+            args = ["plan", str(case), "--out", str(folder / f"run-{i}"), "--no-report", *options]
             if "example:" not in text:
                 args += ["--placement", "0.3", "0.1", "0.2", "0", "0", "0"]
             code, err, seconds = run_cli(args)

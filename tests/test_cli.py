@@ -119,7 +119,7 @@ def test_usage(capsys: pytest.CaptureFixture[str], args: tuple[str, ...], code: 
 def test_internal_error_is_one_line_without_traceback(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    def broken(file: object) -> None:
+    def broken(file: object, **options: object) -> None:
         raise RuntimeError("boom\nsecond line")
 
     monkeypatch.setattr(case_file, "load_case", broken)
@@ -133,7 +133,7 @@ def test_internal_error_is_one_line_without_traceback(
 def test_debug_prints_the_traceback(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, how: str
 ) -> None:
-    def broken(file: object) -> None:
+    def broken(file: object, **options: object) -> None:
         raise RuntimeError("boom")
 
     monkeypatch.setattr(case_file, "load_case", broken)
@@ -228,3 +228,19 @@ def test_plan_summary_gives_the_top_speed_when_no_sample_runs_at_the_rated_speed
         )
         assert expected in out.getvalue()
         assert absent not in out.getvalue()
+
+
+def test_validate_takes_assume_limits_as_its_message_says(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    from trackplan.io.robot_file import LIBRARY_DIR
+
+    (tmp_path / "ur5e.urdf").write_text((LIBRARY_DIR / "ur5e.urdf").read_text())
+    (tmp_path / "bead.csv").write_text((CASES / "bead.csv").read_text())
+    case = (CASES / "ur5-bead.yaml").read_text(encoding="utf-8")
+    assert "robot: ur5\n" in case
+    (tmp_path / "case.yaml").write_text(case.replace("robot: ur5\n", "robot: ur5e.urdf\n"))
+    code, _, err = run(capsys, "validate", str(tmp_path / "case.yaml"))
+    assert code == ExitCode.BAD_INPUT and "or pass --assume-limits" in err
+    code, out, err = run(capsys, "validate", str(tmp_path / "case.yaml"), "--assume-limits")
+    assert (code, err) == (0, "") and "ur5e" in out

@@ -190,6 +190,68 @@ def test_check_reads_columns_by_header(capsys, tmp_path: Path) -> None:
         assert code == ExitCode.BAD_INPUT and expected in err and err.count("\n") == 1
 
 
+def test_check_reads_the_placement_of_the_run(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    X = ["-0.2", "0.1", "0.19", "0.03", "-0.41", "0.5"]  # not the case's placement.example
+    assert run(capsys, "plan", LINE, "--out", str(out), "--no-report", "--placement", *X)[0] == 0
+    code, stdout, err = run(capsys, "check", LINE, str(out))
+    assert (code, err) == (ExitCode.OK, "") and stdout.rstrip().endswith("feasible")
+    example = ["-0.2230", "0.1029", "0.1829", "0.0312", "-0.4124", "0.5020"]
+    code, stdout, _ = run(capsys, "check", LINE, str(out), "--placement", *example)
+    assert code == ExitCode.INFEASIBLE  # the option still wins: the path lies elsewhere
+    (out / "trajectory.csv").rename(tmp_path / "trajectory.csv")
+    code, _, _ = run(capsys, "check", LINE, str(tmp_path / "trajectory.csv"))
+    assert code == ExitCode.INFEASIBLE  # a bare CSV: the case's placement.example
+    (tmp_path / "trajectory.csv").rename(out / "trajectory.csv")
+    summary = json.loads((out / "result.json").read_text())
+    summary["placement"]["yaw"] = "east"
+    (out / "result.json").write_text(json.dumps(summary))
+    code, _, err = run(capsys, "check", LINE, str(out))
+    assert code == ExitCode.BAD_INPUT and err.count("\n") == 1
+    assert err.startswith(f"{out / 'result.json'}: placement: expected {{x, y, z, roll, pitch,")
+
+
+def _retimed(source: Path, target: Path, rows: slice, stretch: float, shift: float) -> Path:
+    """The CSV ``source`` with only ``rows`` of its samples and t → stretch · t + shift."""
+    header, *lines = source.read_text().splitlines()
+    table = np.array([line.split(",") for line in lines])[rows]
+    t = table[:, 0].astype(float) * stretch + shift
+    table[:, 0] = [repr(float(value)) for value in t]
+    target.write_text(header + "\n" + "\n".join(",".join(row) for row in table) + "\n")
+    return target
+
+
+@pytest.mark.parametrize(
+    ("rows", "stretch", "shift", "message"),
+    [
+        # every 100th row kept, time stretched ×2 and shifted by 100 s: once called feasible
+        (slice(None, None, 100), 2.0, 100.0, "line 2: t = 100 s, expected 0 s (a trajectory "),
+        (slice(None), 1.0, 100.0, "line 2: t = 100 s, expected 0 s (a trajectory starts at t"),
+        (slice(None), 2.0, 0.0, "line 3: t = 0.002 s, expected 0.001 s: sample 1 of the case's "),
+        (slice(None, None, 100), 1.0, 0.0, "line 3: t = 0.1 s, expected 0.001 s: sample 1"),
+        (slice(None), 1.0, 2e-9, "line 2: t = 2e-09 s, expected 0 s"),  # off by 2e-6 Ts
+    ],
+)
+def test_check_holds_the_case_sample_time_and_start(
+    capsys, tmp_path: Path, rows: slice, stretch: float, shift: float, message: str
+) -> None:
+    out = tmp_path / "run"
+    assert run(capsys, "plan", LINE, "--out", str(out), "--no-report")[0] == 0
+    csv = _retimed(out / "trajectory.csv", tmp_path / "retimed.csv", rows, stretch, shift)
+    code, _, err = run(capsys, "check", LINE, str(csv))
+    assert code == ExitCode.BAD_INPUT and err.count("\n") == 1, err
+    assert err.startswith(f"{csv}: t: {message}"), err
+    assert "task.sample_time = 0.001 s, within 1e-06 · Ts" in err
+
+
+def test_check_accepts_times_within_the_tolerance(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    assert run(capsys, "plan", LINE, "--out", str(out), "--no-report")[0] == 0
+    csv = _retimed(out / "trajectory.csv", tmp_path / "retimed.csv", slice(None), 1.0, 0.9e-9)
+    code, stdout, err = run(capsys, "check", LINE, str(csv))
+    assert (code, err) == (ExitCode.OK, "") and stdout.rstrip().endswith("feasible")
+
+
 def test_trajectory_header_is_what_check_reads() -> None:
     assert trajectory_header(2)[:3] == ["t", "q1", "q2"]
 

@@ -43,6 +43,9 @@ SPIN_DEGREE = 3
 """Degree of the spin profile."""
 DEFAULT_SPIN_RATE = 20.0
 """Largest |d spin / ds| of a ``free-varying`` profile when the case gives none, rad/m."""
+MIN_NORMAL_LENGTH = 1e-6
+"""Shortest surface normal accepted (any length is normalised): a shorter one is refused as
+zero, well above where its squared length underflows."""
 PARALLEL_SINE = 1e-3
 """A normal whose component across the tangent is below this share of its length is parallel."""
 ZONE_STEP = 1e-3
@@ -707,7 +710,9 @@ def seam_problems(spec: ToolSpec, nominal: NominalPath) -> list[tuple[int | None
     if spec.frame is not ToolFrame.SEAM:
         return []
     given = spec.normals if spec.normals is not None else spec.normal
-    if given is None or not np.all(np.linalg.norm(np.atleast_2d(given), axis=1) > 0.0):
+    if given is None or not np.all(
+        np.linalg.norm(np.atleast_2d(given), axis=1) >= MIN_NORMAL_LENGTH
+    ):  # refused by the file's own check
         return []
     table = nominal.table
     s = np.unique(

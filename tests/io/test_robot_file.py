@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from tests.conftest import replace_dh
+from trackplan.cli import main
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_file import (
@@ -86,3 +88,39 @@ def test_errors_inside_a_robot_file_name_that_file(tmp_path: Path) -> None:
     assert error.value.file == str(file)
     assert error.value.key == "joints[3].weight"
     assert "unknown key" in error.value.message
+
+
+PUMA_YAML = robot_to_yaml(puma560())
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        # a link is a number or a name: the message names the key, not pydantic's union member
+        ("link: 2,", "link: 2.5,", "collision[3].link: expected a link number (0 = base, i ="),
+        ("link: 2,", "link: true,", "collision[3].link: expected a link number"),
+        ("link: 2,", "link: '',", "collision[3].link: expected a link number"),
+        ("link: 2,", "link: [2],", "collision[3].link: expected a link number"),
+        # physical values in their ranges (docs/files.md#ranges)
+        ("{d: 0.0, a: 0.0,", "{d: 1e300, a: 0.0,", "joints[0].d: expected a number ≤ 1000, got"),
+        ("a: 0.4318,", "a: -1e300,", "joints[1].a: expected a number ≥ -1000, got -1e+300"),
+        ("alpha: 0.0,", "alpha: 1e300,", "joints[1].alpha: expected a number ≤ 1000, got"),
+        ("velocity: 8.0,", "velocity: 1e300,", "joints[0].velocity: expected a number ≤ 1e+06"),
+        ("jerk: 30.0}", "jerk: 1e7}", "joints[0].jerk: expected a number ≤ 1e+06, got 10000000"),
+        ("jerk: 30.0}", "jerk: 1e-300}", "joints[0].jerk: expected a number ≥ 0.001, got 1e-300"),
+        ("velocity: 8.0,", "velocity: 0,", "joints[0].velocity: expected a number > 0, got 0"),
+        ("radius: 0.09}", "radius: 1e300}", "collision[0].radius: expected a number ≤ 1000"),
+    ],
+)
+def test_bad_robot_file_values_are_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    assert old in PUMA_YAML
+    file = tmp_path / "arm.yaml"
+    file.write_text(PUMA_YAML.replace(old, new, 1), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no numpy RuntimeWarning on the way
+        code = main(["robots", str(file)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert err.startswith(f"{file}: {message}"), err

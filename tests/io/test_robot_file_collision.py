@@ -218,7 +218,8 @@ def test_bad_collision_key_is_one_line_exit_2(
         (
             "l3",
             '<collision><geometry><cylinder radius="-0.1" length="0.2"/></geometry></collision>',
-            "link 'l3' <collision> cylinder radius, length must be > 0 m, got [-0.1, 0.2]",
+            "line 7: link 'l3' <collision> <cylinder radius>: expected a number in [0, 1000] m, "
+            "got '-0.1'",
         ),
         (
             "l2",

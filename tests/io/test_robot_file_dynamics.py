@@ -121,6 +121,17 @@ def test_payload_and_gravity_in_the_robot_file(rng: np.random.Generator) -> None
             robot_text("payload: {mass: -2}\n"),
             "payload.mass: mass must be >= 0 kg, got -2",
         ),
+        (robot_text("payload: {mass: 1e300}\n"), "payload.mass: expected a number ≤ 100000"),
+        (robot_text(j1_mass="1e300"), "joints[1].mass: expected a number ≤ 100000, got 1e+300"),
+        (robot_text(j1_torque="1e300"), "joints[1].torque: expected a number ≤ 1e+07, got"),
+        (
+            robot_text(j2_inertia="[1e300, 1, 1, 0, 0, 0]"),
+            "joints[2].inertia[0]: expected a number ≤ 100000, got 1e+300",
+        ),
+        (robot_text(j0_gear_ratio="1e300"), "joints[0].gear_ratio: expected a number ≤ 10000"),
+        (robot_text(j0_viscous="1e300"), "joints[0].viscous: expected a number ≤ 1e+06"),
+        (robot_text(j0_coulomb="[1e300, 0]"), "joints[0].coulomb[0]: expected a number ≤ 1e+07"),
+        (robot_text(j0_motor_inertia="1e300"), "joints[0].motor_inertia: expected a number ≤"),
     ],
 )
 def test_bad_dynamics_are_one_line_errors(text: str, message: str) -> None:

@@ -60,7 +60,26 @@ def test_seam_spec_keys():
 BAD = {
     "zero normal": (
         "  tool: {frame: seam, normal: [0, 0, 0]}",
-        "seam.yaml: task.tool.normal: expected a nonzero surface normal, got [0.0, 0.0, 0.0]",
+        "seam.yaml: task.tool.normal: expected a surface normal of length ≥ 1e-06, got "
+        "[0.0, 0.0, 0.0]",
+    ),
+    "normal too short to have a direction": (
+        "  tool: {frame: seam, normal: [0, 0, 1e-300]}",
+        "seam.yaml: task.tool.normal: expected a surface normal of length ≥ 1e-06, got "
+        "[0.0, 0.0, 1e-300]",
+    ),
+    "normal among normals too short": (
+        "  tool: {frame: seam, normals: [[0, 0, 1], [0, 0, 9e-7]]}",
+        "seam.yaml: task.tool.normals[1]: expected a surface normal of length ≥ 1e-06, got "
+        "[0.0, 0.0, 9e-07]",
+    ),
+    "work angle out of range": (
+        "  tool: {frame: seam, normal: [0, 0, 1], work_angle: 1e300}",
+        "seam.yaml: task.tool.work_angle: expected a number ≤ 1000, got 1e+300",
+    ),
+    "spin rate out of range": (
+        "  tool: {spin: free-varying, spin_rate: 1e300}",
+        "seam.yaml: task.tool.spin_rate: expected a number ≤ 1e+06, got 1e+300",
     ),
     "normal along the tangent": (
         "  tool: {frame: seam, normal: [0, 1, 0]}",
@@ -87,7 +106,8 @@ BAD = {
     ),
     "zero normal among normals": (
         "  tool: {frame: seam, normals: [[0, 0, 1], [0, 0, 0]]}",
-        "seam.yaml: task.tool.normals[1]: expected a nonzero surface normal, got [0.0, 0.0, 0.0]",
+        "seam.yaml: task.tool.normals[1]: expected a surface normal of length ≥ 1e-06, got "
+        "[0.0, 0.0, 0.0]",
     ),
     "normal along its segment's tangent": (
         "  tool: {frame: seam, normals: [[0, 0, 1], [0, 1, 0]]}",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -112,7 +113,7 @@ def robot_file(tmp_path: Path, urdf: str, extra: str = "") -> str:
 
 def test_malformed_urdf(capsys: pytest.CaptureFixture[str]) -> None:
     err = one_line_error(capsys, str(DATA / "malformed.urdf"))
-    assert "malformed.urdf: not a valid URDF" in err
+    assert "malformed.urdf: not well-formed XML at line 32, column 28: " in err
 
 
 def test_missing_named_link(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -143,3 +144,158 @@ def test_wrong_number_of_limit_entries(capsys: pytest.CaptureFixture[str], tmp_p
     err = one_line_error(capsys, file)
     assert "arm.yaml: limits.jerk: expected 6 entries, one per joint of the chain" in err
     assert "got 3" in err
+
+
+# --------------------------------------------------------------------------- hostile URDFs
+
+TILTED7 = (DATA / "tilted7.urdf").read_text(encoding="utf-8")
+J2_AXIS = '<axis xyz="0 1 0.2"/>'
+J2_LIMIT = '<limit lower="-2" upper="2" velocity="2" effort="1"/>'
+J2_ORIGIN = '<origin xyz="0.05 0.02 0.1" rpy="-0.3 0.1 0"/>'
+
+
+def mutated_urdf(folder: Path, old: str, new: str) -> Path:
+    """tilted7.urdf with ``old`` replaced by ``new`` (``old`` must occur)."""
+    assert old in TILTED7
+    file = folder / "arm.urdf"
+    file.write_text(TILTED7.replace(old, new, 1), encoding="utf-8")
+    return file
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        # malformed XML, which yourdfpy's recovering parser would read as something else
+        (J2_AXIS, "<axis xyz=0 0 1/>", "not well-formed XML at line 20, column 61: AttValue: "),
+        ("</robot>", "", "not well-formed XML at line 57, column 1: Premature end of data in "),
+        ('name="j5"', 'name="j4"', "line 37: joint name 'j4' is given twice (first at line 32)"),
+        ('<link name="l5"/>', '<link name="l5"/>\n<link name="l5"/>', "line 9: link name 'l5' is"),
+        ("-->", "", "not well-formed XML at line 57, column 1: Comment not terminated\n"),
+        ('<robot name="tilted7">', '<robo name="x">', "not well-formed XML at line 56, column 9: "),
+        # values out of their range, named with the joint, the attribute and the range
+        (
+            J2_AXIS,
+            '<axis xyz="0 1 0.2 1"/>',
+            "line 20: joint 'j2' <axis xyz>: expected 3 numbers, ",
+        ),
+        (J2_AXIS, '<axis xyz="a b c"/>', "line 20: joint 'j2' <axis xyz>: expected 3 numbers, "),
+        (
+            J2_AXIS,
+            '<axis xyz="0 0 1e-300"/>',
+            "line 20: joint 'j2' <axis xyz>: expected a joint axis of length ≥ 1e-06, got",
+        ),
+        (
+            J2_LIMIT,
+            J2_LIMIT.replace('lower="-2" upper="2"', 'lower="-1e308" upper="1e308"'),
+            "line 21: joint 'j2' <limit lower>: expected a number within ±1000 rad, got '-1e308'",
+        ),
+        (
+            J2_ORIGIN,
+            J2_ORIGIN.replace("0.05 0.02", "nan 0.02"),
+            "line 20: joint 'j2' <origin xyz>: expected 3 numbers within ±1000 m, got 'nan 0.02",
+        ),
+        (
+            J2_ORIGIN,
+            J2_ORIGIN.replace("0.1 0", "inf 0"),
+            "line 20: joint 'j2' <origin rpy>: expected 3 numbers within ±1000 rad, got",
+        ),
+        (
+            J2_LIMIT,
+            J2_LIMIT.replace('velocity="2"', 'velocity="0"'),
+            "line 21: joint 'j2' <limit velocity>: expected a number in [0.001, 1e+06] rad/s, "
+            "got '0'",
+        ),
+        (
+            J2_LIMIT,
+            J2_LIMIT.replace('velocity="2"', 'velocity="-1"'),
+            "line 21: joint 'j2' <limit velocity>: expected a number in [0.001, 1e+06] rad/s, got",
+        ),
+        (
+            J2_LIMIT,
+            J2_LIMIT.replace('effort="1"', 'effort="1e300"'),
+            "line 21: joint 'j2' <limit effort>: expected a number in [0, 1e+07] N·m, got '1e300'",
+        ),
+    ],
+)
+def test_hostile_urdf_is_one_line_naming_the_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    file = mutated_urdf(tmp_path, old, new)
+    code = cli.main(["robots", str(file), "--assume-limits"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert err.startswith(f"{file}: {message}"), err
+
+
+def test_a_fixed_joints_zero_axis_is_ignored(tmp_path: Path) -> None:
+    old = '<origin xyz="0 0 0.2" rpy="0.05 0 -0.1"/>'
+    file = mutated_urdf(tmp_path, old, old + '<axis xyz="0 0 0"/>')
+    assert load_robot(file, assume_limits=True).n_dof == 7
+
+
+@pytest.mark.parametrize(
+    ("filename", "what"),
+    [
+        ("package://arm_description/meshes/missing.stl", "not found"),
+        ("/dev/zero", "is a character device, not a regular file"),
+        (".", "is a directory, not a regular file"),
+    ],
+)
+def test_a_missing_mesh_is_one_line_suggesting_capsules(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, filename: str, what: str
+) -> None:
+    mesh = f'<collision><geometry><mesh filename="{filename}"/></geometry></collision>'
+    file = mutated_urdf(tmp_path, '<link name="l4"/>', f'<link name="l4">{mesh}</link>')
+    assert cli.main(["robots", str(file), "--assume-limits"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err  # yourdfpy's own warning line is silenced
+    assert err.startswith(f"{file}: link 'l4' <collision> mesh {filename!r} {what}: "), err
+    assert "capsules under collision: in a robot file" in err
+    # ... and that robot file reads no mesh
+    (tmp_path / "arm.yaml").write_text(
+        "name: arm\nurdf: arm.urdf\nlimits:\n  acceleration: [5, 5, 5, 5, 5, 5, 5]\n"
+        "  jerk: [50, 50, 50, 50, 50, 50, 50]\ncollision:\n"
+        "  - {link: l4, from: [0, 0, 0], to: [0.1, 0, 0], radius: 0.05}\n",
+        encoding="utf-8",
+    )
+    assert len(load_robot(tmp_path / "arm.yaml").collision or ()) == 1
+
+
+def test_mesh_vertices_far_out_are_refused_without_warnings(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    (tmp_path / "far.obj").write_text("v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n")
+    mesh = '<collision><geometry><mesh filename="far.obj" scale="1000 1 1"/></geometry></collision>'
+    file = mutated_urdf(tmp_path, '<link name="l4"/>', f'<link name="l4">{mesh}</link>')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert cli.main(["robots", str(file), "--assume-limits"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert (
+        "mesh 'far.obj' has a vertex 1e+303 m from its origin once scaled: vertices must lie "
+        in err
+    )
+    big = mesh.replace('scale="1000 1 1"', 'scale="1e300 1 1"')
+    file = mutated_urdf(tmp_path, '<link name="l4"/>', f'<link name="l4">{big}</link>')
+    assert cli.main(["robots", str(file), "--assume-limits"]) == 2
+    err = capsys.readouterr().err
+    assert "<mesh scale>: expected 3 numbers within ±1000, got '1e300 1 1'" in err
+
+
+def test_a_urdf_needs_a_robot_root(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    file = tmp_path / "arm.urdf"
+    file.write_text(TILTED7.replace("<robot ", "<model ").replace("</robot>", "</model>"))
+    assert cli.main(["robots", str(file), "--assume-limits"]) == 2
+    assert (
+        capsys.readouterr().err == f"{file}: line 4: expected a <robot> root element, got <model>\n"
+    )
+
+
+def test_messages_quote_at_most_60_characters_of_an_attribute(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    file = mutated_urdf(tmp_path, J2_AXIS, '<axis xyz="' + "0 " * 3000 + '"/>')
+    assert cli.main(["robots", str(file), "--assume-limits"]) == 2
+    err = capsys.readouterr().err
+    assert "<axis xyz>: expected 3 numbers, got '0 0 0" in err and len(err) < 200

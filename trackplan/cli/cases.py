@@ -21,11 +21,12 @@ from trackplan.cli.common import (
 @app.command()
 def validate(
     cases: Annotated[list[Path], typer.Argument(help="Case files to check.", show_default=False)],
+    assume_limits: AssumeLimitsOption = False,
 ) -> ExitCode:
     """Check case files and their robots; print a summary of each valid case."""
     from trackplan.cli.summaries import describe_case
 
-    loaded = load_each(cases)
+    loaded = load_each(cases, assume_limits=assume_limits)
     for file, case in loaded:
         if case is not None:
             typer.echo("\n".join(describe_case(case, file)))

@@ -69,14 +69,17 @@ def shipped_cases_dir() -> Path:
     return Path(trackplan.__file__).resolve().parents[1] / "cases"
 
 
-def load_each(files: list[Path]) -> list[tuple[Path, Case | None]]:
-    """Load case files one by one; a bad one is reported on stderr and comes with None."""
+def load_each(files: list[Path], *, assume_limits: bool = False) -> list[tuple[Path, Case | None]]:
+    """Load case files one by one; a bad one is reported on stderr and comes with None.
+
+    ``assume_limits`` is as for :func:`~trackplan.io.case_file.load_case` (``--assume-limits``).
+    """
     from trackplan.io.case_file import load_case
 
     loaded: list[tuple[Path, Case | None]] = []
     for file in files:
         try:
-            loaded.append((file, load_case(file)))
+            loaded.append((file, load_case(file, assume_limits=assume_limits)))
         except CaseError as exc:
             error(exc.one_line())
             loaded.append((file, None))
@@ -146,6 +149,79 @@ def placement(case: Case, values: np.ndarray | None) -> np.ndarray:
             key="placement.example",
         )
     return np.asarray(case.bounds.example, dtype=float)
+
+
+def run_placement(run: Path) -> np.ndarray | None:
+    """The placement a run folder's ``result.json`` records (None for a CSV file).
+
+    Read by ``check`` when no --placement is given: a run is checked where it was planned.
+
+    Raises
+    ------
+    CaseError
+        When ``result.json`` holds no placement of six finite numbers of sane size.
+    """
+    import json
+
+    import numpy as np
+
+    from trackplan.case import PLACEMENT_KEYS
+    from trackplan.run_files import RESULT_FILE
+
+    file = Path(run) / RESULT_FILE
+    if not Path(run).is_dir() or not file.is_file():
+        return None
+    try:
+        recorded = json.loads(file.read_text(encoding="utf-8")).get("placement")
+        values = [float(recorded[key]) for key in PLACEMENT_KEYS]
+    except (OSError, UnicodeDecodeError, ValueError, TypeError, KeyError, AttributeError):
+        raise CaseError(
+            f"expected {{{', '.join(PLACEMENT_KEYS)}}} (m, rad): give --placement instead",
+            file=str(file),
+            key="placement",
+        ) from None
+    if not all(math.isfinite(value) and abs(value) <= MAX_PLACEMENT for value in values):
+        raise CaseError(
+            f"expected finite numbers with |value| ≤ {MAX_PLACEMENT:g}, got {values}",
+            file=str(file),
+            key="placement",
+        )
+    return np.asarray(values, dtype=float)
+
+
+SAMPLE_TIME_TOLERANCE = 1e-6
+"""A trajectory's sample k may lie this share of the sample time off t = k · Ts."""
+
+
+def check_sample_times(t: np.ndarray, sample_time: float, file: str) -> None:
+    """Check that a trajectory's times are the case's samples: t_k = k · Ts from t = 0.
+
+    The checker takes the samples as the controller plays them, one per ``sample_time``
+    (docs/guarantees.md); a trajectory resampled, stretched or shifted in time would be
+    checked at the wrong rate. Each t_k may differ from k · Ts by at most
+    :data:`SAMPLE_TIME_TOLERANCE` · Ts.
+
+    Raises
+    ------
+    CaseError
+        Naming the file's line (the header is line 1) of the first sample off its time.
+    """
+    import numpy as np
+
+    tolerance = SAMPLE_TIME_TOLERANCE * sample_time
+    expected = np.arange(len(t)) * sample_time
+    off = np.flatnonzero(~(np.abs(t - expected) <= tolerance))
+    if not off.size:
+        return
+    k = int(off[0])
+    start = "" if k else " (a trajectory starts at t = 0)"
+    raise CaseError(
+        f"line {k + 2}: t = {t[k]:.9g} s, expected {expected[k]:.9g} s{start}: sample {k} "
+        f"of the case's task.sample_time = {sample_time:g} s, within "
+        f"{SAMPLE_TIME_TOLERANCE:g} · Ts; resample the trajectory at the case's sample time",
+        file=file,
+        key="t",
+    )
 
 
 def timing_option(value: str | None) -> Timing | None:

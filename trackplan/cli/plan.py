@@ -14,10 +14,12 @@ from trackplan.cli.common import (
     PlacementOption,
     TimingOption,
     app,
+    check_sample_times,
     console,
     output_folder,
     placement,
     placement_option,
+    run_placement,
     timing_option,
 )
 from trackplan.errors import CaseError
@@ -103,11 +105,11 @@ def check(
 ) -> ExitCode:
     """Re-check any trajectory.csv, whoever wrote it, against the case's limits and path.
 
-    A run folder must be consistent (its result.json written with its trajectory.csv);
-    a CSV file is read as it is, columns t and q1..qn found by their header names.
+    A run folder must be consistent (its result.json written with its trajectory.csv) and
+    is checked at the placement its result.json records unless --placement is given; a
+    CSV file is read as it is, columns t and q1..qn found by their header names. Its
+    samples must be the case's: t = k · task.sample_time from t = 0.
     """
-    import numpy as np
-
     from trackplan.cli.summaries import print_check
     from trackplan.io.case_file import load_case
     from trackplan.io.results import read_trajectory_csv
@@ -117,17 +119,16 @@ def check(
     X_given = placement_option(placement_values)
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
-    X = placement(loaded, X_given)
     csv = verified_trajectory(run)
+    X = placement(loaded, X_given if X_given is not None else run_placement(run))
     if loaded.cycle is not None:  # several seams: docs/seams.md
         from trackplan.cli.cycle import check_cycle_command, refuse_options
 
         refuse_options(timing=timing)
         return check_cycle_command(loaded, X, csv)
     t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
-    sample_time = float(np.median(np.diff(t)))
-    if not sample_time > 0 or not np.allclose(np.diff(t), sample_time, rtol=1e-6, atol=1e-9):
-        raise CaseError("samples are not evenly spaced in t", file=str(csv), key="t")
+    sample_time = loaded.task.sample_time
+    check_sample_times(t, sample_time, str(csv))
     report = check_case_trajectory(loaded, X, q, sample_time, timing=timing)
     print_check(console(), str(csv), len(t), sample_time, report)
     return ExitCode.OK if report.success else ExitCode.INFEASIBLE

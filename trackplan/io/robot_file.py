@@ -66,16 +66,30 @@ from typing import Annotated, Any
 
 import numpy as np
 import yaml
-from pydantic import Field
+from pydantic import Field, PlainValidator
+from pydantic_core import PydanticCustomError
 
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_from_matrix, rpy_matrix
+from trackplan.io.robot_bounds import (
+    MAX_ANGLE,
+    MAX_LENGTH,
+    Angle,
+    Friction,
+    GearRatio,
+    InertiaEntry,
+    Length,
+    Mass,
+    MotorConstant,
+    MotorInertia,
+    Rate,
+    Torque,
+    Viscous,
+)
 from trackplan.io.urdf import DEFAULT_CONTINUOUS_RANGE, read_urdf_chain, read_urdf_link_geometry
 from trackplan.io.urdf_inertials import read_urdf_inertials
 from trackplan.io.yaml_input import (
     NonEmptyStr,
-    NonNegative,
-    Positive,
     Problem,
     Range,
     StrictModel,
@@ -108,30 +122,32 @@ LIBRARY_DIR = Path(__file__).resolve().parent.parent / "robots" / "library"
 """Package data: one URDF and one robot file per built-in industrial arm."""
 
 
-Inertia6 = Annotated[list[float], Field(min_length=6, max_length=6)]
+Inertia6 = Annotated[list[InertiaEntry], Field(min_length=6, max_length=6)]
 """``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]``, kg·m²."""
+Coulomb = Annotated[list[Friction], Field(min_length=2, max_length=2)]
+"""``[Tc+, Tc−]``, N·m, motor side."""
 
 
 class JointModel(StrictModel):
     """One joint: DH parameters (m, rad) and limits (rad, rad/s, rad/s², rad/s³)."""
 
-    d: float
-    a: float
-    alpha: float
-    offset: float = 0.0
+    d: Length
+    a: Length
+    alpha: Angle
+    offset: Angle = 0.0
     position: Range
-    velocity: Positive
-    acceleration: Positive
-    jerk: Positive
-    mass: float | None = None
+    velocity: Rate
+    acceleration: Rate
+    jerk: Rate
+    mass: Mass | None = None
     com: Vec3 | None = None
     inertia: Inertia6 | None = None
-    torque: float | None = None
-    motor_inertia: NonNegative = 0.0
-    gear_ratio: float = 1.0
-    viscous: NonNegative = 0.0
-    coulomb: Annotated[list[float], Field(min_length=2, max_length=2)] = list_default(0.0, 0.0)
-    motor_constant: Positive | None = None
+    torque: Torque | None = None
+    motor_inertia: MotorInertia = 0.0
+    gear_ratio: GearRatio = 1.0
+    viscous: Viscous = 0.0
+    coulomb: Coulomb = list_default(0.0, 0.0)
+    motor_constant: MotorConstant | None = None
 
 
 DYNAMICS_KEYS = ("mass", "com", "inertia", "torque")
@@ -141,7 +157,7 @@ DYNAMICS_KEYS = ("mass", "com", "inertia", "torque")
 class PayloadModel(StrictModel):
     """A load at the TCP: mass (kg), centre of mass and inertia about it (TCP frame)."""
 
-    mass: float
+    mass: Mass
     com: Vec3 = list_default(0.0, 0.0, 0.0)
     inertia: Inertia6 = list_default(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
@@ -153,14 +169,27 @@ class ToolModel(StrictModel):
     rpy: Vec3 = list_default(0.0, 0.0, 0.0)
 
 
+def _link_reference(value: Any) -> int | str:
+    """A ``collision[i].link``: a frame number or a non-empty link name, nothing else."""
+    if isinstance(value, bool) or not isinstance(value, int | str) or value == "":
+        raise PydanticCustomError(
+            "link_type", "expected a link number (0 = base, i = joint i) or a URDF link name"
+        )
+    return value
+
+
+LinkReference = Annotated[int | str, PlainValidator(_link_reference)]
+"""A link by number (checked against the chain later) or by URDF link name."""
+
+
 class CollisionCapsuleModel(StrictModel):
     """A link capsule: the link (number 0..n, or a URDF link's name), axis end points
     ``from``, ``to`` in that link's frame (m) and radius (m)."""
 
-    link: int | NonEmptyStr
+    link: LinkReference
     from_: Vec3 = Field(alias="from")
     to: Vec3
-    radius: Positive
+    radius: Annotated[float, Field(gt=0, le=MAX_LENGTH)]
 
 
 Collision = Annotated[list[CollisionCapsuleModel], Field(min_length=1)]
@@ -170,13 +199,9 @@ Collision = Annotated[list[CollisionCapsuleModel], Field(min_length=1)]
 class LimitsModel(StrictModel):
     """Per-joint limits that a URDF lacks or that override it, in chain order."""
 
-    acceleration: list[Positive] | None = None
-    jerk: list[Positive] | None = None
-    velocity: list[Positive] | None = None
-
-
-Coulomb = Annotated[list[float], Field(min_length=2, max_length=2)]
-"""``[Tc+, Tc−]``, N·m, motor side."""
+    acceleration: list[Rate] | None = None
+    jerk: list[Rate] | None = None
+    velocity: list[Rate] | None = None
 
 
 class URDFDynamicsModel(StrictModel):
@@ -187,15 +212,15 @@ class URDFDynamicsModel(StrictModel):
     every ``<inertial>`` of the chain. ``torque`` replaces the ``<limit effort>`` values.
     """
 
-    mass: list[float] | None = None
+    mass: list[Mass] | None = None
     com: list[Vec3] | None = None
     inertia: list[Inertia6] | None = None
-    torque: list[float] | None = None
-    motor_inertia: list[NonNegative] | None = None
-    gear_ratio: list[float] | None = None
-    viscous: list[NonNegative] | None = None
+    torque: list[Torque] | None = None
+    motor_inertia: list[MotorInertia] | None = None
+    gear_ratio: list[GearRatio] | None = None
+    viscous: list[Viscous] | None = None
     coulomb: list[Coulomb] | None = None
-    motor_constant: list[Positive] | None = None
+    motor_constant: list[MotorConstant] | None = None
 
 
 class URDFRobotFileModel(StrictModel):
@@ -208,7 +233,7 @@ class URDFRobotFileModel(StrictModel):
     tip_link: NonEmptyStr | None = None
     tool: ToolModel | None = None
     limits: LimitsModel = Field(default_factory=LimitsModel)
-    continuous_range: Positive = DEFAULT_CONTINUOUS_RANGE
+    continuous_range: Annotated[float, Field(gt=0, le=MAX_ANGLE)] = DEFAULT_CONTINUOUS_RANGE
     dynamics: URDFDynamicsModel | None = None
     gravity: Vec3 = list_default(*STANDARD_GRAVITY)
     payload: PayloadModel | None = None

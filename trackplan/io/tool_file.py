@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
+from pydantic import Field
 
 from trackplan.errors import CaseError
 from trackplan.io.yaml_input import (
+    Coordinate,
     Loc,
     Problem,
     Range,
@@ -27,12 +29,16 @@ from trackplan.io.yaml_input import (
 from trackplan.paths.nominal import NominalPath
 from trackplan.tool import (
     DEFAULT_SPIN_RATE,
+    MIN_NORMAL_LENGTH,
     SpinMode,
     SpinProfile,
     ToolFrame,
     ToolSpec,
     seam_problems,
 )
+
+MAX_SPIN_RATE = 1.0e6
+"""Largest ``spin_rate``, rad/m (one ≤ 0 is reported with its unit by :func:`tool_problems`)."""
 
 
 class ToolModel(StrictModel):
@@ -42,12 +48,12 @@ class ToolModel(StrictModel):
     rpy: Vec3 | None = None
     normal: Vec3 | None = None
     normals: list[Vec3] | None = None
-    work_angle: float = 0.0
-    travel_angle: float = 0.0
+    work_angle: Coordinate = 0.0
+    travel_angle: Coordinate = 0.0
     spin: Literal["fixed", "free", "free-varying"] = "fixed"
-    spin_value: float = 0.0
+    spin_value: Coordinate = 0.0
     spin_range: Range = list_default(-math.pi, math.pi)
-    spin_rate: float = DEFAULT_SPIN_RATE
+    spin_rate: Annotated[float, Field(le=MAX_SPIN_RATE)] = DEFAULT_SPIN_RATE
 
 
 def tool_problems(
@@ -116,8 +122,9 @@ def _normal_problems(tool: ToolModel, nominal: NominalPath | None) -> list[Probl
                 "[[x, y, z], ...] (one per path segment)",
             )
         ]
-    if tool.normal is not None and math.hypot(*tool.normal) == 0.0:
-        return [((*at, "normal"), f"expected a nonzero surface normal, got {show(tool.normal)}")]
+    short = f"expected a surface normal of length ≥ {MIN_NORMAL_LENGTH:g}, got"
+    if tool.normal is not None and not math.hypot(*tool.normal) >= MIN_NORMAL_LENGTH:
+        return [((*at, "normal"), f"{short} {show(tool.normal)}")]
     if tool.normals is not None:
         if nominal is not None and len(tool.normals) != len(nominal.segments):
             n = len(nominal.segments)
@@ -129,13 +136,8 @@ def _normal_problems(tool: ToolModel, nominal: NominalPath | None) -> list[Probl
                 )
             ]
         for i, normal in enumerate(tool.normals):
-            if math.hypot(*normal) == 0.0:
-                return [
-                    (
-                        (*at, "normals", i),
-                        f"expected a nonzero surface normal, got {show(normal)}",
-                    )
-                ]
+            if not math.hypot(*normal) >= MIN_NORMAL_LENGTH:
+                return [((*at, "normals", i), f"{short} {show(normal)}")]
     if nominal is None:
         return []
     return [

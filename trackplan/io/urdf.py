@@ -15,6 +15,12 @@ mimic joints, are refused with a clear error. See ``docs/robots.md``.
 from __future__ import annotations
 
 import logging
+import math
+import re
+import stat
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,6 +28,16 @@ from typing import Any
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.io.robot_bounds import (
+    MAX_ANGLE,
+    MAX_INERTIA,
+    MAX_LENGTH,
+    MAX_MASS,
+    MAX_MESH_SCALE,
+    MAX_RATE,
+    MAX_TORQUE,
+    MIN_RATE,
+)
 from trackplan.robots.collision import (
     Capsules,
     box_capsule,
@@ -68,22 +84,186 @@ class URDFChain:
     T_tip: np.ndarray
 
 
+@contextmanager
+def _quiet(*names: str) -> Iterator[None]:
+    """These libraries' logs silenced (yourdfpy, trimesh): a log line would be a second line
+    beside our one, printed by Python's last-resort handler."""
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels, strict=True):
+            logger.setLevel(level)
+
+
 def load_urdf_model(path: str) -> Any:
     """yourdfpy's parsed robot model of a URDF (no meshes, no scene graph), its log quiet.
 
-    Raises whatever yourdfpy raises on a file it cannot parse.
+    Raises whatever yourdfpy raises on a file it cannot parse; :func:`check_urdf_xml`
+    checks the file strictly first.
     """
     import yourdfpy
 
-    logger = logging.getLogger("yourdfpy")
-    level = logger.level
-    logger.setLevel(logging.CRITICAL)
-    try:
+    with _quiet("yourdfpy"):
         return yourdfpy.URDF.load(
             path, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
         ).robot
-    finally:
-        logger.setLevel(level)
+
+
+MIN_AXIS_LENGTH = 1e-6
+"""Shortest joint axis (any length is normalised): a shorter one is refused as zero."""
+
+MOVING = ("revolute", "continuous")
+"""Joint types whose axis and velocity limit trackplan uses."""
+
+# (tag, attribute) → (count, low, high, unit): the numbers an attribute holds and their range;
+# the velocity of moving joints is checked apart.
+_NUMBERS: dict[tuple[str, str], tuple[int, float, float, str]] = {
+    ("origin", "xyz"): (3, -MAX_LENGTH, MAX_LENGTH, "m"),
+    ("origin", "rpy"): (3, -MAX_ANGLE, MAX_ANGLE, "rad"),
+    ("axis", "xyz"): (3, -MAX_LENGTH, MAX_LENGTH, ""),
+    ("limit", "lower"): (1, -MAX_ANGLE, MAX_ANGLE, "rad"),
+    ("limit", "upper"): (1, -MAX_ANGLE, MAX_ANGLE, "rad"),
+    ("limit", "velocity"): (1, 0.0, MAX_RATE, "rad/s"),
+    ("limit", "effort"): (1, 0.0, MAX_TORQUE, "N·m"),
+    ("mass", "value"): (1, 0.0, MAX_MASS, "kg"),
+    ("box", "size"): (3, 0.0, MAX_LENGTH, "m"),
+    ("cylinder", "radius"): (1, 0.0, MAX_LENGTH, "m"),
+    ("cylinder", "length"): (1, 0.0, MAX_LENGTH, "m"),
+    ("sphere", "radius"): (1, 0.0, MAX_LENGTH, "m"),
+    ("mesh", "scale"): (3, -MAX_MESH_SCALE, MAX_MESH_SCALE, ""),
+    **{
+        ("inertia", name): (1, -MAX_INERTIA, MAX_INERTIA, "kg·m²")
+        for name in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+    },
+}
+
+
+def check_urdf_xml(path: str) -> None:
+    """Check a URDF strictly before yourdfpy reads it (yourdfpy recovers from broken XML).
+
+    - The file is well-formed XML (lxml's strict parser: an unquoted attribute, an unclosed
+      element are errors), with a ``<robot>`` root.
+    - No two links and no two joints share a name.
+    - Every number attribute that trackplan reads (origins, axes, limits, masses, inertias,
+      shape sizes, mesh scales) holds the right count of finite numbers within its range
+      (:mod:`trackplan.io.robot_bounds`); a revolute or continuous joint's axis is at least
+      :data:`MIN_AXIS_LENGTH` long and its velocity limit at least
+      :data:`~trackplan.io.robot_bounds.MIN_RATE`.
+
+    Raises
+    ------
+    CaseError
+        The first problem, naming the line, the element (its joint or link) and the attribute.
+    """
+    from lxml import etree
+
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, remove_comments=True)
+    try:
+        root = etree.parse(path, parser).getroot()
+    except etree.XMLSyntaxError as exc:
+        line, column = exc.position
+        text = str(exc.msg).splitlines()[0] if str(exc.msg) else type(exc).__name__
+        message = re.sub(r", line \d+, column \d+$", "", text).strip()
+        raise CaseError(
+            f"not well-formed XML at line {line}, column {column}: {message}", file=path
+        ) from None
+    except OSError as exc:
+        raise CaseError(f"cannot read the URDF: {exc}".splitlines()[0], file=path) from None
+    if root.tag != "robot":
+        raise CaseError(
+            f"line {root.sourceline}: expected a <robot> root element, got <{root.tag}>",
+            file=path,
+        )
+    for tag in ("link", "joint"):
+        first: dict[str, int] = {}
+        for element in root.iterchildren(tag):
+            name = element.get("name")
+            if name in first:
+                raise CaseError(
+                    f"line {element.sourceline}: {tag} name {name!r} is given twice (first at "
+                    f"line {first[name]}): {tag} names must be unique",
+                    file=path,
+                )
+            first[str(name)] = int(element.sourceline or 0)
+    for joint in root.iterchildren("joint"):
+        if joint.get("type") in MOVING:
+            _check_moving_joint(joint, path)
+    for element in root.iter():
+        for attribute, text in element.attrib.items():
+            rule = _NUMBERS.get((str(element.tag), str(attribute)))
+            if rule is not None:
+                _check_numbers(element, str(attribute), str(text), rule, path)
+
+
+def _where(element: Any, attribute: str) -> str:
+    """``line 12: joint 'j1' <limit velocity>``: where an attribute is, for messages."""
+    tags = []
+    owner = element
+    while owner is not None and owner.tag not in ("joint", "link", "robot"):
+        if owner.tag != "geometry":
+            tags.append(f"<{owner.tag}>")
+        owner = owner.getparent()
+    tags.reverse()
+    tags[-1] = f"<{element.tag} {attribute}>"
+    whose = "" if owner is None or owner.tag == "robot" else f"{owner.tag} {owner.get('name')!r} "
+    return f"line {element.sourceline}: {whose}{' '.join(tags)}"
+
+
+def _shown(text: str, limit: int = 60) -> str:
+    """An attribute's text for a message, at most ``limit`` characters."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _numbers(text: str) -> list[float] | None:
+    try:
+        return [float(word) for word in text.split()]
+    except ValueError:
+        return None
+
+
+def _check_numbers(
+    element: Any, attribute: str, text: str, rule: tuple[int, float, float, str], path: str
+) -> None:
+    count, low, high, unit = rule
+    values = _numbers(text)
+    shown = _shown(text)
+    what = "a number" if count == 1 else f"{count} numbers"
+    unit = f" {unit}" if unit else ""
+    if values is None or len(values) != count:
+        raise CaseError(f"{_where(element, attribute)}: expected {what}, got {shown!r}", file=path)
+    if not all(low <= value <= high for value in values):  # NaN fails too
+        within = f"within ±{high:g}" if low == -high else f"in [{low:g}, {high:g}]"
+        raise CaseError(
+            f"{_where(element, attribute)}: expected {what} {within}{unit}, got {shown!r}",
+            file=path,
+        )
+
+
+def _check_moving_joint(joint: Any, path: str) -> None:
+    """A revolute or continuous joint's axis is not (nearly) zero, and its velocity limit is
+    at least :data:`~trackplan.io.robot_bounds.MIN_RATE`."""
+    axis = joint.find("axis")
+    if axis is not None and axis.get("xyz") is not None:
+        values = _numbers(str(axis.get("xyz")))
+        if values is not None and len(values) == 3 and math.hypot(*values) < MIN_AXIS_LENGTH:
+            raise CaseError(
+                f"{_where(axis, 'xyz')}: expected a joint axis of length ≥ {MIN_AXIS_LENGTH:g}, "
+                f"got {_shown(str(axis.get('xyz')))!r}",
+                file=path,
+            )
+    limit = joint.find("limit")
+    velocity = None if limit is None else limit.get("velocity")
+    values = None if velocity is None else _numbers(velocity)
+    if values is not None and len(values) == 1 and not values[0] >= MIN_RATE:
+        raise CaseError(
+            f"{_where(limit, 'velocity')}: expected a number in [{MIN_RATE:g}, {MAX_RATE:g}] "
+            f"rad/s, got {_shown(str(velocity))!r}",
+            file=path,
+        )
 
 
 def read_urdf_chain(
@@ -122,6 +302,7 @@ def read_urdf_chain(
     path = str(file)
     if not Path(path).is_file():
         raise CaseError("URDF file not found", file=path)
+    check_urdf_xml(path)
     try:
         robot = load_urdf_model(path)
     except Exception as exc:  # yourdfpy raises whatever its XML parsing meets
@@ -364,11 +545,20 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
     import trimesh
     import yourdfpy
 
-    name = yourdfpy.filename_handler_magic(mesh.filename, dir=str(Path(path).parent))
-    if not Path(name).is_file():
-        raise CaseError(f"{where} mesh {mesh.filename!r} not found", file=path)
+    with _quiet("yourdfpy"):
+        name = yourdfpy.filename_handler_magic(mesh.filename, dir=str(Path(path).parent))
+    kind = _file_kind(Path(name))
+    if kind is not None:
+        raise CaseError(
+            f"{where} mesh {mesh.filename!r} {kind}: fix the file name, or give the links' "
+            "capsules under collision: in a robot file pointing at the URDF, which reads no "
+            "meshes (docs/robots.md)",
+            file=path,
+        )
     try:
-        loaded = trimesh.load(name, force="mesh")
+        with warnings.catch_warnings(), np.errstate(all="ignore"), _quiet("trimesh"):
+            warnings.simplefilter("ignore")
+            loaded = trimesh.load(name, force="mesh")
         vertices = np.asarray(getattr(loaded, "vertices"), dtype=float).reshape(-1, 3)  # noqa: B009
     except Exception as exc:  # trimesh raises whatever its format readers meet
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
@@ -382,4 +572,34 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
             file=path,
         )
     scale = np.ones(3) if mesh.scale is None else np.asarray(mesh.scale, dtype=float)
-    return np.asarray(vertices * scale)
+    with np.errstate(over="ignore", invalid="ignore"):
+        scaled = np.asarray(vertices * scale)
+        extent = float(np.max(np.abs(scaled)))
+    if not extent <= MAX_LENGTH:  # NaN too
+        raise CaseError(
+            f"{where} mesh {mesh.filename!r} has a vertex {extent:g} m from its origin once "
+            f"scaled: vertices must lie within ±{MAX_LENGTH:g} m (check the mesh's units and "
+            "scale)",
+            file=path,
+        )
+    return scaled
+
+
+def _file_kind(file: Path) -> str | None:
+    """Why ``file`` is no mesh file: "not found", "is a directory, not a regular file", …;
+    None for a regular file."""
+    try:
+        mode = file.stat().st_mode
+    except OSError:
+        return "not found"
+    if stat.S_ISREG(mode):
+        return None
+    kinds = (
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISFIFO, "a named pipe"),
+        (stat.S_ISSOCK, "a socket"),
+    )
+    what = next((text for test, text in kinds if test(mode)), "a special file")
+    return f"is {what}, not a regular file"
