@@ -226,7 +226,6 @@ def test_non_finite_number(
         ("rated_speed", 0),
         ("rated_speed", -0.1),
         ("corner_speed", 0),
-        ("tolerance", 0),
         ("sample_time", -0.001),
     ],
 )
@@ -431,3 +430,20 @@ def test_robot_file_with_non_positive_limits(
     (tmp_path / "arm.yaml").write_text(text, encoding="utf-8")
     line = validate_fails(capsys, str(write_case(tmp_path, {"robot": "arm.yaml"})))
     assert f"arm.yaml: joints[1].{limit}: expected a number > 0, got {value}" in line
+
+
+@pytest.mark.parametrize("tolerance", [1e-300, 5e-7, 0, -0.001])
+def test_a_tolerance_below_a_micrometre_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], tolerance: float
+) -> None:
+    """A tolerance of 1e-300 m validated and then asked ``plan`` for some 23 GB."""
+    file = write_case(tmp_path, {"task.tolerance": tolerance})
+    line = validate_fails(capsys, str(file))
+    assert line == f"{file}: task.tolerance: expected a number ≥ 1e-06, got {tolerance}"
+
+
+def test_a_micrometre_tolerance_loads() -> None:
+    text = (CASES / "paper-corner.yaml").read_text()
+    text = text.replace("tolerance: 0.001 ", "tolerance: 1.0e-6 ")
+    assert "1.0e-6" in text
+    assert load_case_text(text, "micro.yaml", CASES).task.tolerance == 1e-6

@@ -133,12 +133,19 @@ class PathModel(StrictModel):
     segments: Annotated[list[SegmentModel], Field(min_length=1)]
 
 
+MIN_TOLERANCE = 1e-6
+"""Smallest path tolerance, m: a micrometre, below the repeatability of any industrial arm
+(0.02 mm and more). Corner blends and the checker's grid refine with the tolerance, so a
+tolerance far below it (1e-300) would ask for more memory than any machine has."""
+Tolerance = Annotated[float, Field(ge=MIN_TOLERANCE)]
+
+
 class TaskModel(StrictModel):
     """``task``: speeds (m/s), tolerance (m), sample time (s), tool orientation (rad)."""
 
     rated_speed: Positive
     corner_speed: Positive | None = None
-    tolerance: Positive = 0.001
+    tolerance: Tolerance = 0.001
     sample_time: Annotated[float, Field(gt=0, le=MAX_SAMPLE_TIME)] = 0.001
     tool_rpy: Vec3 | None = None
     tool: ToolModel | None = None
@@ -150,7 +157,7 @@ class SeamTaskModel(StrictModel):
 
     rated_speed: Positive | None = None
     corner_speed: Positive | None = None
-    tolerance: Positive | None = None
+    tolerance: Tolerance | None = None
     tool_rpy: Vec3 | None = None
     tool: ToolModel | None = None
 
