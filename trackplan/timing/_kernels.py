@@ -407,6 +407,10 @@ def rate_ratios(q: np.ndarray, steps: np.ndarray, limits: np.ndarray) -> np.ndar
     return out.T
 
 
+_RISE, _FALL = True, False
+"""``rise`` of :func:`quick_distances`."""
+
+
 @njit(cache=True)
 def _needed(
     z: int,
@@ -435,7 +439,7 @@ def _needed(
             running_from_start[first:stop],
             np.full(v.size, before),
             np.maximum(v, before),
-            True,
+            bool(_RISE),  # not the constant: one compiled version for both calls
             lengths[z],
             a_limit[z],
             j_limit[z],
@@ -449,7 +453,7 @@ def _needed(
             running_from_end[first:stop],
             np.maximum(v, after),
             np.full(v.size, after),
-            False,
+            bool(_FALL),
             lengths[z],
             a_limit[z],
             j_limit[z],
