@@ -766,7 +766,7 @@ def analyse_paths(
                         rep, val, switch[b, k], m, int(crossing[b, k, m]), int(NO_JOINT), 0.0
                     )
             for c in range(magnitude.shape[3]):
-                note_minima(magnitude[b, k, :, c], ok, channel_kind[c], rep, val, switch[b, k])
+                note_minima(magnitude[b, k, :, c], ok, int(channel_kind[c]), rep, val, switch[b, k])
             for j in range(n):
                 low[j] = np.inf
                 high[j] = -np.inf
@@ -910,9 +910,9 @@ def analyse_closed_form(
                     )
                     if dot <= 0.0:
                         note_switch(rep, val, sw, m, int(WRIST), int(NO_JOINT), 0.0)
-            note_minima(mag[0], ok, SHOULDER, rep, val, sw)
-            note_minima(mag[1], ok, ELBOW, rep, val, sw)
-            note_minima(mag[2], ok, WRIST, rep, val, sw)
+            note_minima(mag[0], ok, int(SHOULDER), rep, val, sw)
+            note_minima(mag[1], ok, int(ELBOW), rep, val, sw)
+            note_minima(mag[2], ok, int(WRIST), rep, val, sw)
             fit_limits(
                 path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high, offset
             )
@@ -1009,8 +1009,8 @@ def note_switch(
 ) -> None:  # pragma: no cover - compiled
     """Kernel: record a switch at pose m in one branch's report.
 
-    Its callers pass ``kind`` and ``joint`` through ``int()``: a constant argument would
-    compile a version of it per value.
+    Its callers pass ``kind`` and ``joint`` through ``int()`` (as :func:`note_minima`'s pass
+    ``kind``): a constant argument would compile a version of it per value.
     """
     if not switch[m]:
         switch[m] = True

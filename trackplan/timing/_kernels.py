@@ -592,8 +592,8 @@ def _stretch_peaks(
     stop = max(stop, first + 1)
     if first == 0:
         return running_from_start[stop - 1]
-    if stop == n_grid:
-        return running_from_end[first]
+    if stop == n_grid:  # a copy: one layout whichever branch (one compiled change_bounds)
+        return running_from_end[first].copy()
     out = np.zeros((3, d1.shape[1]))
     for r in range(first, stop):
         for i in range(d1.shape[1]):
