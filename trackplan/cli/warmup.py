@@ -9,10 +9,11 @@ process and plan beside it in a forked one (:func:`~trackplan.forking.forked_poo
   kernels that the search and the plans both start with (forward kinematics, the link
   frames, the closed-form IK of all branches), which the forked process then inherits
   instead of compiling them at the same time.
-- :func:`late_compiles` forks a process at the lowest priority that compiles a kernel only
-  the end of the run needs (the CSV writer's). It takes a core when one idles (the command
-  waits for the last plans once its search is done) and hands the kernel over through the
-  cache; once that kernel is cached, it forks nothing.
+- :func:`late_compiles` forks a process that compiles a kernel only the end of the run
+  needs (the CSV writer's) beside the search, long before the command writes its files, and
+  hands it over through numba's on-disk cache; once that kernel is cached, it forks nothing.
+  (At the lowest priority it would run only on an idle core: under other load it then
+  finished after the command had compiled the kernel itself.)
 
 Both only call the package's own functions on tiny inputs: the kernels compile with the
 types a run passes them (their callers pass read-only inputs,
@@ -93,7 +94,6 @@ def late_compiles() -> Iterator[None]:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
             signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
-            os.nice(19)
             _compile_late()
             code = 0
         finally:
