@@ -222,7 +222,7 @@ def _unreachable(
             aux[br, j] = np.nan
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _opw_joints(
     g: np.ndarray, a: np.ndarray, arm: int, flip: int, q: np.ndarray
 ) -> None:  # pragma: no cover - compiled
