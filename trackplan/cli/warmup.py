@@ -12,8 +12,6 @@ process and plan beside it in a forked one (:func:`~trackplan.forking.forked_poo
 - :func:`late_compiles` forks a process that compiles a kernel only the end of the run
   needs (the CSV writer's) beside the search, long before the command writes its files, and
   hands it over through numba's on-disk cache; once that kernel is cached, it forks nothing.
-  (At the lowest priority it would run only on an idle core: under other load it then
-  finished after the command had compiled the kernel itself.)
 
 Both only call the package's own functions on tiny inputs: the kernels compile with the
 types a run passes them (their callers pass read-only inputs,
