@@ -4,12 +4,30 @@
   pass; the Python API is :func:`trackplan.derivatives.backward_derivatives`. numpy makes
   the padded copy and three difference arrays before dividing; the kernel reads each sample
   once and does the same subtractions and divisions, so the results are the same to the bit.
+- :func:`read_only`: the read-only view a kernel's input arrays are passed as, so that a
+  kernel compiles once whoever made its inputs.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+
+def read_only(array: np.ndarray) -> np.ndarray:
+    """``array`` itself when it is read-only, else a read-only view of it (no copy).
+
+    numba compiles one version of a kernel per writable flag of each array argument (and
+    compiling is most of a first run's time, docs/benchmarks.md): the same case data are
+    read-only in the process that loaded the case and writable in a worker that unpickled
+    them, a cached array is read-only and a fresh one writable. Passing a kernel's inputs
+    through this gives it one version.
+    """
+    if not array.flags.writeable:
+        return array
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 @njit(cache=True, error_model="numpy")

@@ -280,16 +280,19 @@ def _search_and_write(  # type: ignore[no-untyped-def]
     """Search (SIGINT and SIGTERM stop it), write the run (its plots by ``worker`` when
     there is one), print it; the exit code."""
     from trackplan.cli.summaries import print_search
+    from trackplan.cli.warmup import compile_shared, late_compiles
     from trackplan.forking import forked_pool
     from trackplan.outputs import write_search_run
     from trackplan.paths.path_geometry import PathGeometry
     from trackplan.timing import time_law
 
-    # built first (numba's start), so that the processes forked below share it
+    # built first (numba's start), so that the processes forked below share it, with the
+    # kernels the search and the plans both start with (compiled once on a first run)
     mode = time_law(options.get("timing") or case.task.timing).path_mode
     geometry = PathGeometry.from_case(case, mode)
+    compile_shared(case)
     # a second signal while writing stops the writing
-    with stop_on_signals() as signals:
+    with late_compiles(), stop_on_signals() as signals:
         signals.deferring = True  # the search polls after each generation
         with forked_pool() as background:  # the plans at full Ts, beside the search
             result = _search(case, signals, geometry=geometry, background=background, **options)

@@ -274,6 +274,9 @@ def _write_text(
     return end
 
 
+_NO_BYTES = 0
+
+
 @njit(cache=True)
 def format_rows(
     bits: np.ndarray, out: np.ndarray, inv_split: np.ndarray, split: np.ndarray
@@ -295,7 +298,7 @@ def format_rows(
         Bytes written: each row's values separated by commas, each row ended by a newline.
     """
     n_rows, n_columns = bits.shape
-    at = 0
+    at = int(_NO_BYTES)  # not the constant 0: _write_text would compile a version for it
     for row in range(n_rows):
         for column in range(n_columns):
             at = _write_text(bits[row, column], out, at, inv_split, split)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from trackplan._kernels import read_only
 from trackplan.io._kernels import MAX_TEXT, POW5_BITS, format_rows
 
 CHUNK_ROWS = 8192
@@ -93,5 +94,5 @@ def _chunks(table: np.ndarray) -> Iterator[bytes]:
     buffer = np.empty(min(n_rows, CHUNK_ROWS) * n_columns * (MAX_TEXT + 1), dtype=np.uint8)
     for first in range(0, n_rows, CHUNK_ROWS):
         bits = np.ascontiguousarray(table[first : first + CHUNK_ROWS]).view(np.uint64)
-        used = format_rows(bits, buffer, inv_split, split)
+        used = format_rows(read_only(bits), buffer, read_only(inv_split), read_only(split))
         yield buffer[:used].tobytes()

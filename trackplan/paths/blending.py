@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trackplan._kernels import read_only
 from trackplan.paths._kernels import dense_pieces
 from trackplan.paths.geometry import (
     Arc,
@@ -167,9 +168,8 @@ def _distances(points: np.ndarray, neighbours: tuple[Primitive, ...]) -> np.ndar
     the blend search measures a few dozen points hundreds of times)."""
     t = PieceTable.from_curves(neighbours)
     return dense_pieces(
-        np.ascontiguousarray(points, dtype=float), 0.0, t.is_arc, t.start, t.direction,
-        t.length, t.center, t.axis, t.e1, t.e2, t.radius, t.angle,
-    )[4]  # fmt: skip
+        read_only(np.ascontiguousarray(points, dtype=float)), 0.0, *t.kernel_arrays()
+    )[4]
 
 
 def _curvature(offsets: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trackplan._kernels import read_only
 from trackplan.paths.geometry import Arc, CurveJet, Line, Primitive
 
 
@@ -103,6 +104,18 @@ class PieceTable:
         for value in fields.values():
             value.flags.writeable = False
         return cls(**fields)
+
+    def kernel_arrays(self) -> tuple[np.ndarray, ...]:
+        """``is_arc, start, direction, length, center, axis, e1, e2, radius, angle`` as the
+        path kernels take them (:mod:`trackplan.paths._kernels`), read-only
+        (:func:`~trackplan._kernels.read_only`: one compiled version of each kernel)."""
+        return tuple(
+            read_only(array)
+            for array in (
+                self.is_arc, self.start, self.direction, self.length, self.center,
+                self.axis, self.e1, self.e2, self.radius, self.angle,
+            )
+        )  # fmt: skip
 
     @property
     def n_pieces(self) -> int:

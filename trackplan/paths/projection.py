@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from trackplan._kernels import read_only
 from trackplan.paths._kernels import dense_pieces, near_pieces
 from trackplan.paths.piece_table import PieceTable
 
@@ -125,9 +126,8 @@ class PieceIndex:
             # every piece for every point, in one compiled pass: cheaper than a tree
             t = self.table
             _, piece, sigma, gap, nearest, row = dense_pieces(
-                np.ascontiguousarray(points), slack, t.is_arc, t.start, t.direction, t.length,
-                t.center, t.axis, t.e1, t.e2, t.radius, t.angle,
-            )  # fmt: skip
+                read_only(np.ascontiguousarray(points)), slack, *t.kernel_arrays()
+            )
             return Candidates(row, piece, sigma, gap, nearest)
         finite = np.flatnonzero(np.isfinite(points).all(axis=1))
         parts = [(np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]

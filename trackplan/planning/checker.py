@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from trackplan._kernels import read_only
 from trackplan.motion import SampledMotion
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
@@ -200,7 +201,9 @@ def check_motion(
         signals["torque"] = (motion.torque, zero, robot.dynamics.torque_max)
     for kind, (values, middle, scale) in signals.items():
         peak, peak_row = _kernels.peak_use(
-            np.ascontiguousarray(values), np.asarray(middle, dtype=float), np.asarray(scale)
+            read_only(np.ascontiguousarray(values)),
+            read_only(np.asarray(middle, dtype=float)),
+            read_only(np.asarray(scale, dtype=float)),
         )
         margins[kind] = _met(1.0 - peak, RELATIVE_SLACK)
         worst_joint = int(np.argmax(peak))
@@ -308,15 +311,14 @@ def _check_task(
     # joint-space interpolation a controller follows (each period in parts of at most
     # BETWEEN_STEP ρ of chord, at least two): one compiled pass over the poses and joints
     chain, tail = robot.kernel_chain
-    q_read = np.ascontiguousarray(q).view()
-    q_read.flags.writeable = False  # one compiled version whoever made the samples
+    # read-only inputs: one compiled version whoever made them (read_only)
     p_part, velocity, speed, x_part, z_part, p_between, t_between = _kernels.task_frames(
-        motion.T_base_tool,
-        T_base_part,
+        read_only(np.ascontiguousarray(motion.T_base_tool)),
+        read_only(T_base_part),
         sample_time,
-        chain,
-        tail,
-        q_read,
+        read_only(chain),
+        read_only(tail),
+        read_only(np.ascontiguousarray(q)),
         BETWEEN_STEP * ref.tolerance,
         MAX_BETWEEN_PER_PERIOD,
     )

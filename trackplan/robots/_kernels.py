@@ -89,7 +89,7 @@ def sincos(x: float) -> tuple[float, float]:  # pragma: no cover - compiled
     return cos_x, sin_x
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def chain_block(
     chain: np.ndarray,
     angle: np.ndarray,
@@ -760,11 +760,13 @@ def analyse_paths(
                     step -= two_pi * math.floor(step / two_pi + 0.5)
                     path[m, j] = path[m - 1, j] + step
                     if ok[m - 1] and abs(step) > max_step[j] and not switch[b, k, m]:
-                        note_switch(rep, val, switch[b, k], m, JUMP, j, abs(step))
+                        note_switch(rep, val, switch[b, k], m, int(JUMP), j, abs(step))
                 if crossing[b, k, m] != NONE and ok[m - 1]:
-                    note_switch(rep, val, switch[b, k], m, crossing[b, k, m], -1, 0.0)
+                    note_switch(
+                        rep, val, switch[b, k], m, int(crossing[b, k, m]), int(NO_JOINT), 0.0
+                    )
             for c in range(magnitude.shape[3]):
-                note_minima(magnitude[b, k, :, c], ok, channel_kind[c], rep, val, switch[b, k])
+                note_minima(magnitude[b, k, :, c], ok, int(channel_kind[c]), rep, val, switch[b, k])
             for j in range(n):
                 low[j] = np.inf
                 high[j] = -np.inf
@@ -896,7 +898,7 @@ def analyse_closed_form(
                     for j in range(n):
                         step = steps[j]
                         if abs(step) > max_step[j] and not sw[m]:
-                            note_switch(rep, val, sw, m, JUMP, j, abs(step))
+                            note_switch(rep, val, sw, m, int(JUMP), j, abs(step))
                 if ok[m - 1]:
                     x = aux[b, m, branch, 2]
                     y = aux[b, m, branch, 3]
@@ -907,16 +909,16 @@ def analyse_closed_form(
                         + z * aux[b, m - 1, branch, 4]
                     )
                     if dot <= 0.0:
-                        note_switch(rep, val, sw, m, WRIST, -1, 0.0)
-            note_minima(mag[0], ok, SHOULDER, rep, val, sw)
-            note_minima(mag[1], ok, ELBOW, rep, val, sw)
-            note_minima(mag[2], ok, WRIST, rep, val, sw)
+                        note_switch(rep, val, sw, m, int(WRIST), int(NO_JOINT), 0.0)
+            note_minima(mag[0], ok, int(SHOULDER), rep, val, sw)
+            note_minima(mag[1], ok, int(ELBOW), rep, val, sw)
+            note_minima(mag[2], ok, int(WRIST), rep, val, sw)
             fit_limits(
                 path, ok, q_min, q_max, rep, val, windings[b, k], winding[b, k], low, high, offset
             )
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def note_minima(
     mag: np.ndarray, ok: np.ndarray, kind: int, rep: np.ndarray, val: np.ndarray, switch: np.ndarray
 ) -> None:  # pragma: no cover - compiled
@@ -930,10 +932,10 @@ def note_minima(
         if left >= 0.0 and right >= 0.0 and (left > 0.0 or right > 0.0):
             if mag[m] <= max(left, right):  # reaches ~0 between poses
                 at = m + 1 if left > right else m
-                note_switch(rep, val, switch, at, kind, -1, 0.0)
+                note_switch(rep, val, switch, at, int(kind), int(NO_JOINT), 0.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def fit_limits(
     path: np.ndarray,
     ok: np.ndarray,
@@ -997,11 +999,19 @@ def fit_limits(
     rep[I_FIRST] = first_problem if first_problem < n_poses else -1
 
 
+NO_JOINT = -1
+"""``joint`` of a switch that is not a joint's jump."""
+
+
 @njit(cache=True, error_model="numpy")
 def note_switch(
     rep: np.ndarray, val: np.ndarray, switch: np.ndarray, m: int, kind: int, joint: int, step: float
 ) -> None:  # pragma: no cover - compiled
-    """Kernel: record a switch at pose m in one branch's report."""
+    """Kernel: record a switch at pose m in one branch's report.
+
+    Its callers pass ``kind`` and ``joint`` through ``int()`` (as :func:`note_minima`'s pass
+    ``kind``): a constant argument would compile a version of it per value.
+    """
     if not switch[m]:
         switch[m] = True
         rep[I_N_SWITCH] += 1

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from trackplan._kernels import read_only
 from trackplan.robots._kernels import fk_flat, frames_flat
 from trackplan.robots.model import Robot
 
@@ -59,7 +60,9 @@ def _frames(robot: Robot, q: np.ndarray, links: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     chain, tail = robot.kernel_chain
     flat = np.ascontiguousarray(q.reshape(-1, robot.n_dof))
-    frames = frames_flat(chain, tail, np.ascontiguousarray(links), flat)
+    frames = frames_flat(
+        read_only(chain), read_only(tail), read_only(np.ascontiguousarray(links)), read_only(flat)
+    )
     return frames.reshape(*q.shape[:-1], robot.n_dof + 2, 4, 4)
 
 
@@ -81,7 +84,8 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     chain, tail = robot.kernel_chain
     flat = np.ascontiguousarray(q.reshape(-1, robot.n_dof))
-    return fk_flat(chain, tail, flat).reshape(*q.shape[:-1], 4, 4)
+    T = fk_flat(read_only(chain), read_only(tail), read_only(flat))
+    return T.reshape(*q.shape[:-1], 4, 4)
 
 
 def jacobian(robot: Robot, q: np.ndarray) -> np.ndarray:

@@ -407,6 +407,10 @@ def rate_ratios(q: np.ndarray, steps: np.ndarray, limits: np.ndarray) -> np.ndar
     return out.T
 
 
+_RISE, _FALL = True, False
+"""``rise`` of :func:`quick_distances`."""
+
+
 @njit(cache=True)
 def _needed(
     z: int,
@@ -435,7 +439,7 @@ def _needed(
             running_from_start[first:stop],
             np.full(v.size, before),
             np.maximum(v, before),
-            True,
+            bool(_RISE),  # not the constant: one compiled version for both calls
             lengths[z],
             a_limit[z],
             j_limit[z],
@@ -449,7 +453,7 @@ def _needed(
             running_from_end[first:stop],
             np.maximum(v, after),
             np.full(v.size, after),
-            False,
+            bool(_FALL),
             lengths[z],
             a_limit[z],
             j_limit[z],
@@ -588,8 +592,8 @@ def _stretch_peaks(
     stop = max(stop, first + 1)
     if first == 0:
         return running_from_start[stop - 1]
-    if stop == n_grid:
-        return running_from_end[first]
+    if stop == n_grid:  # a copy: one layout whichever branch (one compiled change_bounds)
+        return running_from_end[first].copy()
     out = np.zeros((3, d1.shape[1]))
     for r in range(first, stop):
         for i in range(d1.shape[1]):

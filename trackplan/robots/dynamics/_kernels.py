@@ -190,46 +190,48 @@ def _forward(seg: np.ndarray, prev: np.ndarray, K: np.ndarray, i: int) -> None:
 
 
 @njit(cache=True, nogil=True, fastmath={"contract", "reassoc"})
-def _backward(seg: np.ndarray, after: np.ndarray, K: np.ndarray, i: int, last: bool) -> None:
-    """Joint i's inward step: the wrench from link i outward, and the joint torque."""
-    if last:
-        for b in range(BLOCK):
-            for k in range(6):
-                seg[(_W + k) * BLOCK + b] = seg[(_F + k) * BLOCK + b]
-    else:
-        # the next link's wrench into this frame, moment carried to this origin
-        px, py, pz = K[i + 1, ORIGIN], K[i + 1, ORIGIN + 1], K[i + 1, ORIGIN + 2]
-        for b in range(BLOCK):
-            r00 = after[(_R + 0) * BLOCK + b]
-            r01 = after[(_R + 1) * BLOCK + b]
-            r02 = after[(_R + 2) * BLOCK + b]
-            r10 = after[(_R + 3) * BLOCK + b]
-            r11 = after[(_R + 4) * BLOCK + b]
-            r12 = after[(_R + 5) * BLOCK + b]
-            r20 = after[(_R + 6) * BLOCK + b]
-            r21 = after[(_R + 7) * BLOCK + b]
-            r22 = after[(_R + 8) * BLOCK + b]
-            f0 = after[(_W + 0) * BLOCK + b]
-            f1 = after[(_W + 1) * BLOCK + b]
-            f2 = after[(_W + 2) * BLOCK + b]
-            t0 = after[(_W + 3) * BLOCK + b]
-            t1 = after[(_W + 4) * BLOCK + b]
-            t2 = after[(_W + 5) * BLOCK + b]
-            gx = r00 * f0 + r01 * f1 + r02 * f2
-            gy = r10 * f0 + r11 * f1 + r12 * f2
-            gz = r20 * f0 + r21 * f1 + r22 * f2
-            seg[(_W + 0) * BLOCK + b] = seg[(_F + 0) * BLOCK + b] + gx
-            seg[(_W + 1) * BLOCK + b] = seg[(_F + 1) * BLOCK + b] + gy
-            seg[(_W + 2) * BLOCK + b] = seg[(_F + 2) * BLOCK + b] + gz
-            seg[(_W + 3) * BLOCK + b] = (
-                seg[(_F + 3) * BLOCK + b] + r00 * t0 + r01 * t1 + r02 * t2 + py * gz - pz * gy
-            )
-            seg[(_W + 4) * BLOCK + b] = (
-                seg[(_F + 4) * BLOCK + b] + r10 * t0 + r11 * t1 + r12 * t2 + pz * gx - px * gz
-            )
-            seg[(_W + 5) * BLOCK + b] = (
-                seg[(_F + 5) * BLOCK + b] + r20 * t0 + r21 * t1 + r22 * t2 + px * gy - py * gx
-            )
+def _backward(seg: np.ndarray, after: np.ndarray, K: np.ndarray, i: int) -> None:
+    """Joint i's inward step below the last joint: the wrench from link i outward (its own
+    and the next link's), and the joint torque."""
+    # the next link's wrench into this frame, moment carried to this origin
+    px, py, pz = K[i + 1, ORIGIN], K[i + 1, ORIGIN + 1], K[i + 1, ORIGIN + 2]
+    for b in range(BLOCK):
+        r00 = after[(_R + 0) * BLOCK + b]
+        r01 = after[(_R + 1) * BLOCK + b]
+        r02 = after[(_R + 2) * BLOCK + b]
+        r10 = after[(_R + 3) * BLOCK + b]
+        r11 = after[(_R + 4) * BLOCK + b]
+        r12 = after[(_R + 5) * BLOCK + b]
+        r20 = after[(_R + 6) * BLOCK + b]
+        r21 = after[(_R + 7) * BLOCK + b]
+        r22 = after[(_R + 8) * BLOCK + b]
+        f0 = after[(_W + 0) * BLOCK + b]
+        f1 = after[(_W + 1) * BLOCK + b]
+        f2 = after[(_W + 2) * BLOCK + b]
+        t0 = after[(_W + 3) * BLOCK + b]
+        t1 = after[(_W + 4) * BLOCK + b]
+        t2 = after[(_W + 5) * BLOCK + b]
+        gx = r00 * f0 + r01 * f1 + r02 * f2
+        gy = r10 * f0 + r11 * f1 + r12 * f2
+        gz = r20 * f0 + r21 * f1 + r22 * f2
+        seg[(_W + 0) * BLOCK + b] = seg[(_F + 0) * BLOCK + b] + gx
+        seg[(_W + 1) * BLOCK + b] = seg[(_F + 1) * BLOCK + b] + gy
+        seg[(_W + 2) * BLOCK + b] = seg[(_F + 2) * BLOCK + b] + gz
+        seg[(_W + 3) * BLOCK + b] = (
+            seg[(_F + 3) * BLOCK + b] + r00 * t0 + r01 * t1 + r02 * t2 + py * gz - pz * gy
+        )
+        seg[(_W + 4) * BLOCK + b] = (
+            seg[(_F + 4) * BLOCK + b] + r10 * t0 + r11 * t1 + r12 * t2 + pz * gx - px * gz
+        )
+        seg[(_W + 5) * BLOCK + b] = (
+            seg[(_F + 5) * BLOCK + b] + r20 * t0 + r21 * t1 + r22 * t2 + px * gy - py * gx
+        )
+    _joint_torque(seg, K, i)
+
+
+@njit(cache=True, nogil=True, fastmath={"contract", "reassoc"})
+def _joint_torque(seg: np.ndarray, K: np.ndarray, i: int) -> None:
+    """Joint i's torque from the wrench at its origin, with armature and friction."""
     ux, uy, uz = K[i, AXIS], K[i, AXIS + 1], K[i, AXIS + 2]
     armature, viscous = K[i, ARMATURE], K[i, VISCOUS]
     coulomb_pos, coulomb_neg = K[i, COULOMB_POS], K[i, COULOMB_NEG]
@@ -288,9 +290,13 @@ def rne_kernel(
             _sincos(seg)
         for i in range(n):
             _forward(work[i + 1], work[i], K, i)
-        _backward(work[n], work[n], K, n - 1, True)
+        last = work[n]  # the last link's wrench is its own
+        for k in range(6):
+            for b in range(BLOCK):
+                last[(_W + k) * BLOCK + b] = last[(_F + k) * BLOCK + b]
+        _joint_torque(last, K, n - 1)
         for i in range(n - 2, -1, -1):
-            _backward(work[i + 1], work[i + 2], K, i, False)
+            _backward(work[i + 1], work[i + 2], K, i)
         for b in range(m):
             for i in range(n):
                 out[start + b, i] = work[i + 1, _TAU * BLOCK + b]

@@ -451,7 +451,7 @@ def _interval(grid: np.ndarray, x: float, guess: int) -> int:  # pragma: no cove
     return lo - 1
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def hold_and_wind(
     q: np.ndarray, valid: np.ndarray, s: np.ndarray, s_grid: np.ndarray, q_grid: np.ndarray
 ) -> None:  # pragma: no cover - compiled

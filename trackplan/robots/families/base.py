@@ -8,6 +8,8 @@ from typing import Protocol
 
 import numpy as np
 
+from trackplan._kernels import read_only
+
 N_BRANCHES = 8
 """Number of closed-form solutions of a pose (and of numeric seeds)."""
 
@@ -179,7 +181,9 @@ class FusedClosedForm:
             q = np.empty((n_poses, N_BRANCHES, 6))
             valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
             aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
-        self._all_branches(self._geometry, self._tail_inv, T, q, valid, aux)
+        self._all_branches(
+            read_only(self._geometry), read_only(self._tail_inv), read_only(T), q, valid, aux
+        )
         return q, valid, aux
 
     def solve_branch(
@@ -220,7 +224,17 @@ class FusedClosedForm:
         else:
             s, s_grid, q_grid = (np.ascontiguousarray(x, dtype=float) for x in wind_to)
         self._one_branch(
-            self._geometry, self._tail_inv, R, p, int(branch), q, valid, aux, s, s_grid, q_grid
+            read_only(self._geometry),
+            read_only(self._tail_inv),
+            read_only(R),
+            read_only(p),
+            int(branch),
+            q,
+            valid,
+            aux,
+            read_only(s),
+            read_only(s_grid),
+            read_only(q_grid),
         )
         return q, valid, aux
 
