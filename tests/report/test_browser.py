@@ -6,11 +6,10 @@ only to drive that browser (``playwright install`` is never run: it would downlo
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from tests.docs.screenshots import CHROMIUM, CHROMIUM_ARGS
 from tests.report.conftest import REPORT_FRAMES
 from trackplan.report import VIEW_ID
 from trackplan.report.robot_view import ROBOT_TRACE, frame_name
@@ -18,17 +17,6 @@ from trackplan.report.scene import chain_points, frame_indices
 
 pytestmark = pytest.mark.browser
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
 
 ROBOT_XYZ = (
     "(name) => { const trace = document.getElementById('"
