@@ -132,6 +132,7 @@ def test_puma_branches_match_roboticstoolbox(puma, rng):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         import roboticstoolbox as rtb
+        from spatialmath import SE3
     oracle = rtb.models.DH.Puma560()
     oracle.links[0].d = 0.0  # our table: no pedestal, d3 = 0.15
     oracle.links[2].d = 0.15
@@ -141,7 +142,8 @@ def test_puma_branches_match_roboticstoolbox(puma, rng):
     for k in range(len(q)):
         theirs = np.array(
             [
-                oracle.ikine_a(T[k], c).q
+                # An SE3, not a 4×4 array: roboticstoolbox 1.3 reads only an SE3 here.
+                oracle.ikine_a(SE3(T[k], check=False), c).q
                 for c in ("run", "ruf", "rdn", "rdf", "lun", "luf", "ldn", "ldf")
             ]
         )
