@@ -380,3 +380,28 @@ def test_ctrl_c_during_start_up_prints_no_traceback(tmp_path: Path) -> None:
         timeout=120,
     )
     assert (done.returncode, done.stderr) == (130, "interrupted\n")
+
+
+@pytest.mark.parametrize(
+    ("row", "expected"),
+    [
+        ("0.002;0.1;0.2", "line 4: values separated by ';', expected commas"),
+        ("0.002\t0.1\t0.2", "line 4: values separated by a tab, expected commas"),
+        ("0.002,0.3_1,0.2", "line 4, column q1: expected a number, got '0.3_1'"),
+        ("0.002,０.５,0.2", "line 4, column q1: expected a number, got '０.５'"),
+        ("0.002,0.1", "line 4: 2 values, expected one in column 3 (q2)"),
+    ],
+    ids=["semicolons", "tabs", "underscore", "full-width", "short-row"],
+)
+def test_a_bad_trajectory_row_names_its_line_and_column(
+    tmp_path: Path, row: str, expected: str
+) -> None:
+    from trackplan.errors import CaseError
+    from trackplan.io.results import read_trajectory_csv
+
+    file = tmp_path / "trajectory.csv"
+    # a comment and a blank line before the bad row: numpy's row count skips both
+    file.write_text(f"t,q1,q2\n0,0.1,0.2\n\n{row}\n# note\n0.003,0.1,0.2\n", encoding="utf-8")
+    with pytest.raises(CaseError) as error:
+        read_trajectory_csv(file)
+    assert str(error.value) == f"{file}: {expected}"
