@@ -405,3 +405,18 @@ def test_a_bad_trajectory_row_names_its_line_and_column(
     with pytest.raises(CaseError) as error:
         read_trajectory_csv(file)
     assert str(error.value) == f"{file}: {expected}"
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (("--z", "nan"), "--z: Z must be a finite number with |Z| ≤ 1000, got nan"),
+        (("--rpy", "0", "1e300", "0"), "--rpy: PITCH must be a finite number with |PITCH| ≤ 1000"),
+    ],
+)
+def test_map_names_the_option_of_a_bad_height_or_orientation(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, args: tuple[str, ...], expected: str
+) -> None:
+    code, out, err = run(capsys, "map", LINE, "--out", str(tmp_path / "map"), *args)
+    assert code == ExitCode.BAD_INPUT and out == ""
+    assert err.count("\n") == 1 and err.startswith(expected)
