@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -420,3 +421,17 @@ def test_map_names_the_option_of_a_bad_height_or_orientation(
     code, out, err = run(capsys, "map", LINE, "--out", str(tmp_path / "map"), *args)
     assert code == ExitCode.BAD_INPUT and out == ""
     assert err.count("\n") == 1 and err.startswith(expected)
+
+
+def test_a_trajectory_of_only_a_header_is_one_line_without_numpy_warnings(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    file = tmp_path / "trajectory.csv"
+    file.write_text("t,q1,q2,q3,q4,q5,q6\n", encoding="utf-8")
+    X = ["0", "0", "0", "0", "0", "0"]
+    with warnings.catch_warnings(record=True) as caught:  # a user sees these on stderr
+        warnings.simplefilter("always")
+        code, out, err = run(capsys, "check", LINE, str(file), "--placement", *X)
+    assert [str(w.message) for w in caught] == []
+    assert code == ExitCode.BAD_INPUT and out == ""
+    assert err == f"{file}: the trajectory needs at least 2 samples\n"

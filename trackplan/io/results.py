@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -119,9 +120,11 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
             key="header",
         )
     try:  # only the columns wanted are converted: 3 times faster on a 30-column file
-        data = np.loadtxt(
-            file, delimiter=",", skiprows=1, ndmin=2, usecols=[header.index(c) for c in wanted]
-        )
+        with warnings.catch_warnings():  # "input contained no data": refused below
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(
+                file, delimiter=",", skiprows=1, ndmin=2, usecols=[header.index(c) for c in wanted]
+            )
     except (OSError, UnicodeDecodeError) as error:
         raise _unreadable(error, file) from None
     except ValueError as error:
