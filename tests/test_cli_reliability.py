@@ -435,3 +435,18 @@ def test_a_trajectory_of_only_a_header_is_one_line_without_numpy_warnings(
     assert [str(w.message) for w in caught] == []
     assert code == ExitCode.BAD_INPUT and out == ""
     assert err == f"{file}: the trajectory needs at least 2 samples\n"
+
+
+def test_check_names_a_device_and_a_binary_trajectory_plainly(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"\xff\xfe\x00t,q1\n")
+    X = ["0", "0", "0", "0", "0", "0"]
+    for source, expected in (
+        ("/dev/null", "/dev/null: trajectory is not a regular file, expected a CSV file or a "),
+        (str(binary), f"{binary}: cannot read trajectory: not UTF-8 text"),
+    ):
+        code, out, err = run(capsys, "check", LINE, source, "--placement", *X)
+        assert code == ExitCode.BAD_INPUT and out == ""
+        assert err.count("\n") == 1 and err.startswith(expected)

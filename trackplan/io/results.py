@@ -183,6 +183,8 @@ def _field_problem(fields: list[str], columns: dict[str, int]) -> str | None:
 
 
 def _unreadable(error: OSError | UnicodeDecodeError, file: Path) -> CaseError:
+    if isinstance(error, UnicodeDecodeError):
+        return CaseError("cannot read trajectory: not UTF-8 text", file=str(file))
     reason = getattr(error, "strerror", None) or type(error).__name__
     return CaseError(f"cannot read trajectory: {reason}", file=str(file))
 
