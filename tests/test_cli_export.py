@@ -62,6 +62,19 @@ def test_export_refuses_to_overwrite_the_runs_own_files(
     assert csv.read_bytes() == before["trajectory.csv"]
 
 
+def test_export_refuses_an_output_that_is_no_regular_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the temporary file was renamed over it: as root, --output /dev/full became a file
+    run = _planned(tmp_path)
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    assert main(["export", str(run), "--format", "ros", "--output", str(fifo)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"output: {str(fifo)!r} is not a regular file; give a file name\n"
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+
+
 def test_csv_export_quotes_names_and_neutralises_formulas(tmp_path: Path) -> None:
     run = _planned(tmp_path)
     names = ['=HYPERLINK("http://x")', "a\nb", 'c"d,e', "+1", "-2", "@SUM(A1)"]

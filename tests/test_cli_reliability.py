@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -380,3 +381,72 @@ def test_ctrl_c_during_start_up_prints_no_traceback(tmp_path: Path) -> None:
         timeout=120,
     )
     assert (done.returncode, done.stderr) == (130, "interrupted\n")
+
+
+@pytest.mark.parametrize(
+    ("row", "expected"),
+    [
+        ("0.002;0.1;0.2", "line 4: values separated by ';', expected commas"),
+        ("0.002\t0.1\t0.2", "line 4: values separated by a tab, expected commas"),
+        ("0.002,0.3_1,0.2", "line 4, column q1: expected a number, got '0.3_1'"),
+        ("0.002,０.５,0.2", "line 4, column q1: expected a number, got '０.５'"),
+        ("0.002,0.1", "line 4: 2 values, expected one in column 3 (q2)"),
+    ],
+    ids=["semicolons", "tabs", "underscore", "full-width", "short-row"],
+)
+def test_a_bad_trajectory_row_names_its_line_and_column(
+    tmp_path: Path, row: str, expected: str
+) -> None:
+    from trackplan.errors import CaseError
+    from trackplan.io.results import read_trajectory_csv
+
+    file = tmp_path / "trajectory.csv"
+    # a comment and a blank line before the bad row: numpy's row count skips both
+    file.write_text(f"t,q1,q2\n0,0.1,0.2\n\n{row}\n# note\n0.003,0.1,0.2\n", encoding="utf-8")
+    with pytest.raises(CaseError) as error:
+        read_trajectory_csv(file)
+    assert str(error.value) == f"{file}: {expected}"
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (("--z", "nan"), "--z: Z must be a finite number with |Z| ≤ 1000, got nan"),
+        (("--rpy", "0", "1e300", "0"), "--rpy: PITCH must be a finite number with |PITCH| ≤ 1000"),
+    ],
+)
+def test_map_names_the_option_of_a_bad_height_or_orientation(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, args: tuple[str, ...], expected: str
+) -> None:
+    code, out, err = run(capsys, "map", LINE, "--out", str(tmp_path / "map"), *args)
+    assert code == ExitCode.BAD_INPUT and out == ""
+    assert err.count("\n") == 1 and err.startswith(expected)
+
+
+def test_a_trajectory_of_only_a_header_is_one_line_without_numpy_warnings(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    file = tmp_path / "trajectory.csv"
+    file.write_text("t,q1,q2,q3,q4,q5,q6\n", encoding="utf-8")
+    X = ["0", "0", "0", "0", "0", "0"]
+    with warnings.catch_warnings(record=True) as caught:  # a user sees these on stderr
+        warnings.simplefilter("always")
+        code, out, err = run(capsys, "check", LINE, str(file), "--placement", *X)
+    assert [str(w.message) for w in caught] == []
+    assert code == ExitCode.BAD_INPUT and out == ""
+    assert err == f"{file}: the trajectory needs at least 2 samples\n"
+
+
+def test_check_names_a_device_and_a_binary_trajectory_plainly(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"\xff\xfe\x00t,q1\n")
+    X = ["0", "0", "0", "0", "0", "0"]
+    for source, expected in (
+        ("/dev/null", "/dev/null: trajectory is not a regular file, expected a CSV file or a "),
+        (str(binary), f"{binary}: cannot read trajectory: not UTF-8 text"),
+    ):
+        code, out, err = run(capsys, "check", LINE, source, "--placement", *X)
+        assert code == ExitCode.BAD_INPUT and out == ""
+        assert err.count("\n") == 1 and err.startswith(expected)

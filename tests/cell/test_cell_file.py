@@ -95,13 +95,39 @@ def test_every_shape_loads(tmp_path: Path) -> None:
             "got [0.0, 0.0, 0.0]",
         ),
         ("  tool_contact: -0.01\n", "cell.tool_contact: expected a number ≥ 0, got -0.01"),
+        (
+            "  obstacles:\n    - {name: m, mesh: {file: tri.stl, scale: 1.0e+300}}\n",
+            "cell.obstacles[0].mesh.scale: mesh file '{dir}/tri.stl' has a vertex 1e+299 m from"
+            " its origin once scaled: vertices must lie within ±1000 m",
+        ),
+        (
+            "  obstacles:\n    - {name: m, mesh: {file: /dev/zero}}\n",
+            "cell.obstacles[0].mesh.file: mesh file '/dev/zero' is a character device, not a"
+            " regular file",
+        ),
+        (
+            "  obstacles:\n    - {name: m, mesh: {file: sub}}\n",
+            "cell.obstacles[0].mesh.file: mesh file '{dir}/sub' is a directory, not a regular file",
+        ),
     ],
-    ids=["missing-mesh", "unreadable-mesh", "box-size", "unknown-shape", "zero-normal", "contact"],
+    ids=[
+        "missing-mesh",
+        "unreadable-mesh",
+        "box-size",
+        "unknown-shape",
+        "zero-normal",
+        "contact",
+        "mesh-scale-1e300",
+        "mesh-dev-zero",
+        "mesh-directory",
+    ],
 )
 def test_bad_cell_is_one_line_exit_2(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, cell: str, message: str
 ) -> None:
     (tmp_path / "broken.stl").write_bytes(b"solid x\nthis is not an stl file\n")
+    trimesh.Trimesh([[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0]], [[0, 1, 2]]).export(tmp_path / "tri.stl")
+    (tmp_path / "sub").mkdir()
     file = write_case(tmp_path, cell)
     code, err = validate(capsys, file)
     assert code == ExitCode.BAD_INPUT

@@ -154,6 +154,8 @@ def test_a_long_inline_list_is_refused_early_pointing_to_points_files(
     assert time.perf_counter() - start < 10.0  # the values past the limit are not parsed
     assert f"holds more than {MAX_YAML_VALUES} values" in line
     assert "points: {file: seam.csv}" in line
+    assert "syntax error" not in line  # a size limit, not broken YAML
+    assert ": YAML limit reached at line " in line
 
     # the limit counts values: 4 a point ([x, y, z]), about 20 for the rest of the file
     monkeypatch.setattr(yaml_input, "MAX_YAML_VALUES", 1000)

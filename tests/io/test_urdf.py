@@ -298,4 +298,5 @@ def test_messages_quote_at_most_60_characters_of_an_attribute(
     file = mutated_urdf(tmp_path, J2_AXIS, '<axis xyz="' + "0 " * 3000 + '"/>')
     assert cli.main(["robots", str(file), "--assume-limits"]) == 2
     err = capsys.readouterr().err
-    assert "<axis xyz>: expected 3 numbers, got '0 0 0" in err and len(err) < 200
+    message = err.removeprefix(f"{file}: ")  # the temporary folder's name varies in length
+    assert "<axis xyz>: expected 3 numbers, got '0 0 0" in message and len(message) < 120

@@ -319,7 +319,8 @@ CYLINDER_1 = 'ixx="0.010436775" ixy="0" ixz="0" iyy="0.010436775" iyz="0" izz="0
             '<mass value="2.846"/>',
             '<mass value="-2.846"/>',
             "",
-            "ur5e.urdf: link 'link_3' has mass -2.846: a mass must be >= 0 kg",
+            "ur5e.urdf: line 40: link 'link_3' <inertial> <mass value>: expected a number in "
+            "[0, 100000] kg, got '-2.846'",
         ),
         (
             CYLINDER_1,
@@ -338,7 +339,8 @@ CYLINDER_1 = 'ixx="0.010436775" ixy="0" ixz="0" iyy="0.010436775" iyz="0" izz="0
             'effort="150"',
             'effort="-150"',
             "",
-            "ur5e.urdf: joint 'joint_1' has effort limit -150.0: give a torque limit >= 0 N·m",
+            "ur5e.urdf: line 77: joint 'joint_1' <limit effort>: expected a number in "
+            "[0, 1e+07] N·m, got '-150'",
         ),
         (
             "",
@@ -382,5 +384,6 @@ def test_bad_urdf_inertial_exits_2_from_the_cli(
     code = main(["validate", str(tmp_path / "case.yaml")])
     assert code == ExitCode.BAD_INPUT
     assert capsys.readouterr().err.strip().splitlines() == [
-        f"{tmp_path / 'ur5e.urdf'}: link 'link_3' has mass -2.846: a mass must be >= 0 kg"
+        f"{tmp_path / 'ur5e.urdf'}: line 40: link 'link_3' <inertial> <mass value>: expected a"
+        " number in [0, 100000] kg, got '-2.846'"
     ]

@@ -115,23 +115,29 @@ MAX_PLACEMENT = 1.0e3
 """Largest |value| of a --placement entry: m for x, y, z and rad for the angles."""
 
 
-def placement_option(values: tuple[float, ...] | None) -> np.ndarray | None:
+def placement_option(
+    values: tuple[float, ...] | None, options: tuple[str, ...] = ("--placement",) * 6
+) -> np.ndarray | None:
     """Check a --placement value: six finite numbers of sane size.
+
+    ``options`` names the command-line option of each entry (``map`` takes Z from ``--z``
+    and the angles from ``--rpy``).
 
     Raises
     ------
     CaseError
-        Naming ``--placement`` and the bad entry.
+        Naming the entry's option and the bad entry.
     """
     import numpy as np
 
     if values is None:
         return None
-    for name, value in zip(("X", "Y", "Z", "ROLL", "PITCH", "YAW"), values, strict=True):
+    names = ("X", "Y", "Z", "ROLL", "PITCH", "YAW")
+    for name, value, option in zip(names, values, options, strict=True):
         if not math.isfinite(value) or abs(value) > MAX_PLACEMENT:
             raise CaseError(
                 f"{name} must be a finite number with |{name}| ≤ {MAX_PLACEMENT:g}, got {value!r}",
-                key="--placement",
+                key=option,
             )
     return np.asarray(values, dtype=float)
 

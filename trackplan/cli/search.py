@@ -222,7 +222,9 @@ def map_command(
 
     check_map_points(points, "--points")
     out = output_folder(out)
-    given = placement_option((0.0, 0.0, z or 0.0, *(rpy or (0.0, 0.0, 0.0))))
+    given = placement_option(
+        (0.0, 0.0, z or 0.0, *(rpy or (0.0, 0.0, 0.0))), ("--z",) * 3 + ("--rpy",) * 3
+    )
     loaded = load_case(case)
     reference = np.full(6, np.nan)  # x, y stay unset unless the search ran
     if rpy is None or z is None:

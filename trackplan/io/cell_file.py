@@ -36,6 +36,8 @@ from trackplan.cell.model import DEFAULT_CLEARANCE, Body, Capsules, Cell, Shape
 from trackplan.cell.robot_bodies import builtin_link_capsules
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
+from trackplan.io.robot_bounds import MAX_LENGTH
+from trackplan.io.urdf import file_kind
 from trackplan.io.yaml_input import (
     NonEmptyStr,
     NonNegative,
@@ -240,16 +242,19 @@ def _body(body: BodyModel, base_dir: Path, case_file: str | None, loc: tuple[Any
             body.name, Shape.CAPSULE, _pose(c.pose), np.array([c.radius, 0.5 * c.length, 0.0])
         )
     assert body.mesh is not None  # the schema requires exactly one shape
-    vertices, faces = load_mesh(
-        base_dir / body.mesh.file, case_file, key_path((*loc, "mesh", "file"))
-    )
-    return Body(
-        body.name,
-        Shape.MESH,
-        _pose(body.mesh.pose),
-        vertices=vertices * body.mesh.scale,
-        faces=faces,
-    )
+    file = base_dir / body.mesh.file
+    vertices, faces = load_mesh(file, case_file, key_path((*loc, "mesh", "file")))
+    with np.errstate(over="ignore", invalid="ignore"):
+        scaled = vertices * body.mesh.scale
+        extent = float(np.max(np.abs(scaled)))
+    if not extent <= MAX_LENGTH:  # NaN too
+        raise CaseError(
+            f"mesh file {str(file)!r} has a vertex {extent:g} m from its origin once scaled: "
+            f"vertices must lie within ±{MAX_LENGTH:g} m (check the mesh's units and scale)",
+            file=case_file,
+            key=key_path((*loc, "mesh", "scale")),
+        )
+    return Body(body.name, Shape.MESH, _pose(body.mesh.pose), vertices=scaled, faces=faces)
 
 
 def _plane_frame(normal: np.ndarray, offset: float) -> np.ndarray:
@@ -273,8 +278,9 @@ def load_mesh(file: Path, case_file: str | None, key: str) -> tuple[np.ndarray, 
     """
     import trimesh
 
-    if not file.is_file():
-        raise CaseError(f"mesh file {str(file)!r} not found", file=case_file, key=key)
+    kind = file_kind(file)
+    if kind is not None:
+        raise CaseError(f"mesh file {str(file)!r} {kind}", file=case_file, key=key)
     try:
         mesh = trimesh.load(str(file), force="mesh")
     except Exception as exc:

@@ -364,6 +364,8 @@ def export_trajectory(
         target = csv_file.parent / EXPORT_FILES[fmt] if output is None else Path(output)
     if target.is_dir():
         target = target / EXPORT_FILES[fmt]
+    if target.exists() and not target.is_file():  # a device or a FIFO: never replaced
+        raise CaseError(f"{str(target)!r} is not a regular file; give a file name", key="output")
     if not isinstance(source, Trajectory):
         _refuse_run_file(target, csv_file)
     target.parent.mkdir(parents=True, exist_ok=True)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import math
+import re
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -118,14 +120,18 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
             key="header",
         )
     try:  # only the columns wanted are converted: 3 times faster on a 30-column file
-        data = np.loadtxt(
-            file, delimiter=",", skiprows=1, ndmin=2, usecols=[header.index(c) for c in wanted]
-        )
+        with warnings.catch_warnings():  # "input contained no data": refused below
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(
+                file, delimiter=",", skiprows=1, ndmin=2, usecols=[header.index(c) for c in wanted]
+            )
     except (OSError, UnicodeDecodeError) as error:
         raise _unreadable(error, file) from None
     except ValueError as error:
-        text = str(error).splitlines()[0][:200]
-        raise CaseError(f"not a numeric CSV table: {text}", file=str(file)) from None
+        where = _first_bad_line(file, header, wanted)
+        if where is None:  # not expected: numpy's own words, one line
+            where = "not a numeric CSV table: " + str(error).splitlines()[0][:200]
+        raise CaseError(where, file=str(file)) from None
     if data.shape[0] < 2:
         raise CaseError("the trajectory needs at least 2 samples", file=str(file))
     if not np.all(np.isfinite(data)):
@@ -134,7 +140,51 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     return data[:, 0], data[:, 1:]
 
 
+_VALUE = re.compile(
+    r"[+-]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|nan|inf(?:inity)?)",
+    re.ASCII | re.IGNORECASE,
+)
+"""A value ``numpy.loadtxt`` reads as a float (a non-finite one is refused afterwards)."""
+
+
+def _first_bad_line(file: Path, header: list[str], wanted: list[str]) -> str | None:
+    """Where ``numpy.loadtxt`` failed, as ``line N, column q1: …`` (file lines from 1).
+
+    Only called once loadtxt has failed: numpy's message counts rows without blank and
+    comment lines from 0 and its columns from 1, so the line is found again here.
+    """
+    columns = {name: header.index(name) for name in wanted}
+    with file.open(encoding="utf-8-sig") as handle:
+        handle.readline()  # the header
+        for number, line in enumerate(handle, start=2):
+            row = line.split("#", 1)[0].strip()
+            if not row:
+                continue
+            fields = row.split(",")
+            problem = _field_problem(fields, columns)
+            if problem is None:
+                continue
+            for mark, text in ((";", "';'"), ("\t", "a tab")):
+                if mark in row:
+                    return f"line {number}: values separated by {text}, expected commas"
+            return f"line {number}{problem}"
+    return None
+
+
+def _field_problem(fields: list[str], columns: dict[str, int]) -> str | None:
+    """What is wrong with a row's wanted fields (``, column q1: …``), or None."""
+    for name, column in columns.items():
+        if column >= len(fields):
+            return f": {len(fields)} values, expected one in column {column + 1} ({name})"
+        value = fields[column].strip()
+        if not _VALUE.fullmatch(value):
+            return f", column {name}: expected a number, got {value[:60]!r}"
+    return None
+
+
 def _unreadable(error: OSError | UnicodeDecodeError, file: Path) -> CaseError:
+    if isinstance(error, UnicodeDecodeError):
+        return CaseError("cannot read trajectory: not UTF-8 text", file=str(file))
     reason = getattr(error, "strerror", None) or type(error).__name__
     return CaseError(f"cannot read trajectory: {reason}", file=str(file))
 

@@ -157,8 +157,13 @@ def verified_trajectory(source: Path) -> Path:
     """
     source = Path(source)
     if not source.is_dir():
-        if not source.is_file():
+        if not source.exists():
             raise CaseError("trajectory not found", file=str(source))
+        if not source.is_file():  # a device or a FIFO: never opened
+            raise CaseError(
+                "trajectory is not a regular file, expected a CSV file or a run folder",
+                file=str(source),
+            )
         return source
     csv = source / TRAJECTORY_FILE
     result = source / RESULT_FILE

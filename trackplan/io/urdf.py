@@ -547,7 +547,7 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
 
     with _quiet("yourdfpy"):
         name = yourdfpy.filename_handler_magic(mesh.filename, dir=str(Path(path).parent))
-    kind = _file_kind(Path(name))
+    kind = file_kind(Path(name))
     if kind is not None:
         raise CaseError(
             f"{where} mesh {mesh.filename!r} {kind}: fix the file name, or give the links' "
@@ -585,7 +585,7 @@ def _mesh_vertices(mesh: Any, where: str, path: str) -> np.ndarray:
     return scaled
 
 
-def _file_kind(file: Path) -> str | None:
+def file_kind(file: Path) -> str | None:
     """Why ``file`` is no mesh file: "not found", "is a directory, not a regular file", …;
     None for a regular file."""
     try:

@@ -252,7 +252,7 @@ class _Loader(yaml.SafeLoader):
             node = super().compose_node(parent, index)
             self._expanded += self._size(node)
             if self._expanded > MAX_ALIAS_EXPANSION:
-                raise yaml.composer.ComposerError(
+                raise _LimitError(
                     None,
                     None,
                     f"alias *{anchor} expands the document beyond {MAX_ALIAS_EXPANSION} "
@@ -262,7 +262,7 @@ class _Loader(yaml.SafeLoader):
             return node
         self._values += 1
         if self._values > MAX_YAML_VALUES:
-            raise yaml.composer.ComposerError(
+            raise _LimitError(
                 None,
                 None,
                 f"the file holds more than {MAX_YAML_VALUES} values; put long sampled curves "
@@ -271,7 +271,7 @@ class _Loader(yaml.SafeLoader):
             )
         self._depth += 1
         if self._depth > MAX_DEPTH:
-            raise yaml.composer.ComposerError(
+            raise _LimitError(
                 None, None, f"nesting deeper than {MAX_DEPTH} levels", event.start_mark
             )
         anchor = getattr(event, "anchor", None)
@@ -363,6 +363,11 @@ _Loader.add_constructor("tag:yaml.org,2002:int", _Loader.construct_yaml_int)
 _Loader.add_constructor("tag:yaml.org,2002:bool", _Loader.construct_yaml_bool)
 
 
+class _LimitError(yaml.composer.ComposerError):
+    """A document over one of :class:`_Loader`'s size limits (values, depth, alias
+    expansion): well-formed YAML, refused for its size."""
+
+
 def parse_yaml(text: str, file: str | None) -> Any:
     """The data of a YAML document.
 
@@ -382,7 +387,8 @@ def parse_yaml(text: str, file: str | None) -> Any:
         # _Loader derives from SafeLoader: no arbitrary Python objects.
         data = yaml.load(text, Loader=_Loader)
     except yaml.MarkedYAMLError as exc:
-        message = "YAML syntax error" + _at(exc.problem_mark or exc.context_mark)
+        kind = "YAML limit reached" if isinstance(exc, _LimitError) else "YAML syntax error"
+        message = kind + _at(exc.problem_mark or exc.context_mark)
         message += f": {exc.problem or exc.context or 'invalid YAML'}"
         if exc.problem and exc.context and exc.context_mark:
             message += f" ({exc.context}{_at(exc.context_mark)})"
