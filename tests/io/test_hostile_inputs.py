@@ -204,3 +204,32 @@ def test_a_key_that_is_not_a_name_is_one_line_at_its_line(
         f"at line {at}, column {column}: a key must be a non-empty name, got {shown}"
     ), line
     assert "should be" not in line
+
+
+def test_an_oversized_trajectory_is_refused_before_it_is_read(tmp_path: Path) -> None:
+    """``check`` read a trajectory.csv of any size into memory."""
+    from trackplan.errors import CaseError
+    from trackplan.io.results import read_trajectory_csv
+    from trackplan.io.sizes import MAX_TRAJECTORY_BYTES
+
+    file = tmp_path / "trajectory.csv"
+    with file.open("w") as handle:  # sparse: no disk is used for the gap
+        handle.write("t,q1\n0,0\n")
+        handle.truncate(MAX_TRAJECTORY_BYTES + 1)
+    start = time.perf_counter()
+    with pytest.raises(CaseError, match=r"more than the 512 MiB of the longest trajectory"):
+        read_trajectory_csv(file)
+    assert time.perf_counter() - start < 1.0
+
+
+def test_more_samples_than_a_plan_may_have_are_refused(tmp_path: Path) -> None:
+    from trackplan.errors import CaseError
+    from trackplan.io.results import read_trajectory_csv
+
+    rows = max_samples(6) + 1
+    table = np.zeros((rows, 7))
+    table[:, 0] = np.arange(rows) * 1e-3
+    file = tmp_path / "trajectory.csv"
+    np.savetxt(file, table, delimiter=",", header="t,q1,q2,q3,q4,q5,q6", comments="", fmt="%g")
+    with pytest.raises(CaseError, match=rf"{rows} samples, more than the {rows - 1} a plan"):
+        read_trajectory_csv(file)

@@ -15,6 +15,7 @@ from trackplan.case import PLACEMENT_KEYS
 from trackplan.errors import CaseError
 from trackplan.io.csv_table import write_csv_table
 from trackplan.io.run_folder import HASH_KEY, file_sha256
+from trackplan.io.sizes import MAX_TRAJECTORY_BYTES, max_samples
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 from trackplan.timing.protocol import SlowDown
@@ -99,10 +100,17 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
     """
     file = Path(file)
     try:
+        size = file.stat().st_size
         with file.open(encoding="utf-8-sig") as handle:  # a byte order mark is skipped
             header = [name.strip() for name in handle.readline().strip().split(",")]
     except (OSError, UnicodeDecodeError) as error:
         raise _unreadable(error, file) from None
+    if size > MAX_TRAJECTORY_BYTES:
+        raise CaseError(
+            f"the file has {size / 2**20:.0f} MiB, more than the {MAX_TRAJECTORY_BYTES // 2**20} "
+            "MiB of the longest trajectory a plan may have: give a trajectory of one run",
+            file=str(file),
+        )
     columns = [name for name in header if name != "segment"]  # several seams
     twice = sorted({name for name in columns if columns.count(name) > 1})
     if twice:
@@ -134,6 +142,12 @@ def read_trajectory_csv(file: Path, n_dof: int | None = None) -> tuple[np.ndarra
         raise CaseError(where, file=str(file)) from None
     if data.shape[0] < 2:
         raise CaseError("the trajectory needs at least 2 samples", file=str(file))
+    if data.shape[0] > max_samples(n):
+        raise CaseError(
+            f"{data.shape[0]} samples, more than the {max_samples(n)} a plan of a {n}-joint "
+            "robot may have: give a trajectory of one run",
+            file=str(file),
+        )
     if not np.all(np.isfinite(data)):
         row = int(np.argwhere(~np.isfinite(data))[0, 0]) + 2
         raise CaseError(f"non-finite number on line {row}", file=str(file))

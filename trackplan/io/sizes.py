@@ -44,6 +44,11 @@ every 0.25 mm over the longest path a search can hold, parsed in about a second.
 MAX_POINTS_BYTES = 2**27
 """Largest points file, bytes (128 MiB: 128 characters a line at the most lines)."""
 
+MAX_TRAJECTORY_BYTES = 2**29
+"""Largest ``trajectory.csv`` that ``check`` reads, bytes (512 MiB): the longest plan any
+robot may have (:func:`max_samples` rows) with every column a run writes (about 600
+characters a row for six joints) takes some 150 MiB."""
+
 
 def max_samples(n_dof: int) -> int:
     """Most trajectory samples a plan of an ``n_dof``-joint robot may have."""
