@@ -19,7 +19,7 @@ from trackplan.report import (
     speed_figure,
     write_plots,
 )
-from trackplan.report.figures import envelope
+from trackplan.report.joints_plot import envelope
 from trackplan.report.scene import JOINT_QUANTITIES, joint_bounds, joint_series, transform_points
 
 

@@ -13,10 +13,13 @@ import pytest
 
 from tests.report.conftest import REPORT_FRAMES, REPORT_INFO, optimizer_history
 from trackplan import forking
-from trackplan.report import figures, run_report
-from trackplan.report.figures import joints_figure
+from trackplan.report import figures, path_plots, run_report, speed_plot
+from trackplan.report.figure_style import BandedFigure, figure_pixels
+from trackplan.report.joints_plot import JOINT_BANDS, joints_figure
+from trackplan.report.path_plots import path_figure, plot_kinematics
 from trackplan.report.plot_worker import PlotWorker, plot_worker
 from trackplan.report.run_report import can_fork, write_run_report
+from trackplan.report.speed_plot import speed_figure
 
 needs_fork = pytest.mark.skipif(
     not can_fork(), reason="no second core or no fork here: the plots are drawn in turn"
@@ -77,11 +80,8 @@ def test_the_plots_are_drawn_here_when_the_worker_is_gone(tmp_path, corner, corn
 
 
 def test_bands_stack_into_the_full_joints_figure(corner, corner_result):
-    full = figures.figure_pixels(joints_figure(corner_result, corner))
-    bands = [
-        figures.figure_pixels(joints_figure(corner_result, corner, rows))
-        for rows in figures.JOINT_BANDS
-    ]
+    full = figure_pixels(joints_figure(corner_result, corner))
+    bands = [figure_pixels(joints_figure(corner_result, corner, rows)) for rows in JOINT_BANDS]
     assert len(bands) > 1
     stacked = np.concatenate(bands)
     assert stacked.shape == full.shape
@@ -146,22 +146,27 @@ def test_the_plots_drawn_with_given_kinematics_start_no_kernel(monkeypatch, corn
     """Given the run's PlotKinematics (as a plot worker is), drawing the plots calls none of
     the functions that run numba's kernels, and the path and speed plots are the pixels of
     those that compute their kinematics themselves."""
-    kinematics = figures.plot_kinematics(corner_result, corner)
+    kinematics = plot_kinematics(corner_result, corner)
     builders = figures.plot_figures(corner_result, corner, None, kinematics)
     pixels = {}
     with monkeypatch.context() as patched:
-        for kernel in ("forward_kinematics", "chain_points", "tracking_error"):
-            patched.setattr(figures, kernel, _not_here)
+        for module, kernel in (
+            (path_plots, "forward_kinematics"),
+            (path_plots, "chain_points"),
+            (path_plots, "tracking_error"),
+            (speed_plot, "tracking_error"),
+        ):
+            patched.setattr(module, kernel, _not_here)
         for name, plot in builders.items():
-            bands = plot.bands if isinstance(plot, figures.BandedFigure) else (plot,)
-            pixels[name] = [figures.figure_pixels(build()) for build in bands]
+            bands = plot.bands if isinstance(plot, BandedFigure) else (plot,)
+            pixels[name] = [figure_pixels(build()) for build in bands]
     assert list(pixels) == ["joints.png", "path.png", "speed.png"]
     itself = {
-        "path.png": figures.path_figure(corner_result, corner),
-        "speed.png": figures.speed_figure(corner_result, corner),
+        "path.png": path_figure(corner_result, corner),
+        "speed.png": speed_figure(corner_result, corner),
     }
     for name, figure in itself.items():
-        np.testing.assert_array_equal(pixels[name][0], figures.figure_pixels(figure), name)
+        np.testing.assert_array_equal(pixels[name][0], figure_pixels(figure), name)
 
 
 def _wild(corner_result):
@@ -184,18 +189,18 @@ def test_plots_on_blank_figures_made_beforehand_are_the_same_pixels(
         "no trajectory": unreachable_result,
     }[which]
     history = optimizer_history(np.random.default_rng(7))
-    kinematics = figures.plot_kinematics(result, corner)
+    kinematics = plot_kinematics(result, corner)
     canvases = figures.blank_canvases(corner.robot.n_dof)
     on_blanks = figures.plot_figures(result, corner, history, kinematics, canvases)
     fresh = figures.plot_figures(result, corner, history, kinematics)
     assert on_blanks.keys() == fresh.keys()
     for name, plot in on_blanks.items():
-        if isinstance(plot, figures.BandedFigure):
+        if isinstance(plot, BandedFigure):
             pairs = zip(plot.bands, fresh[name].bands, strict=True)  # type: ignore[union-attr]
         else:
             pairs = zip([plot], [fresh[name]], strict=True)
         for build_on_blank, build_fresh in pairs:
             np.testing.assert_array_equal(
-                figures.figure_pixels(build_on_blank()), figures.figure_pixels(build_fresh()), name
+                figure_pixels(build_on_blank()), figure_pixels(build_fresh()), name
             )
     assert canvases == {}  # every blank figure was taken

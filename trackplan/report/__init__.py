@@ -7,16 +7,14 @@ functions return the figures themselves. matplotlib and plotly are imported only
 a figure is built, so importing this package is cheap.
 """
 
-from trackplan.report.figures import (
-    convergence_figure,
-    joints_figure,
-    path_figure,
-    speed_figure,
-    write_plots,
-)
+from trackplan.report.convergence_plot import convergence_figure
+from trackplan.report.figures import write_plots
 from trackplan.report.html import write_report
+from trackplan.report.joints_plot import joints_figure
+from trackplan.report.path_plots import path_figure
 from trackplan.report.robot_view import VIEW_ID, robot_view_figure, robot_view_spec
 from trackplan.report.run_report import write_run_report
+from trackplan.report.speed_plot import speed_figure
 
 __all__ = [
     "VIEW_ID",

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.planning.result import PlanResult
-from trackplan.report.figures import DPI, _new_figure
+from trackplan.report.figure_style import DPI, new_figure
+from trackplan.report.html_markup import PLACEMENT_HEADER, grid, html_page, num
 from trackplan.search.placement_map import REASONS, PlacementMap
 
 if TYPE_CHECKING:
@@ -32,7 +33,7 @@ def map_figure(pmap: PlacementMap) -> Figure:
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    figure = _new_figure(7.0, 6.0)
+    figure = new_figure(7.0, 6.0)
     ax = figure.add_subplot()
     extent = (pmap.x[0], pmap.x[-1], pmap.y[0], pmap.y[-1])
     codes = np.where(pmap.reason == 0, np.nan, pmap.reason.astype(float))
@@ -90,7 +91,7 @@ def clearance_figure(result: PlanResult) -> Figure:
     closest approach."""
     cell = result.check.cell
     assert cell is not None
-    figure = _new_figure(8.0, 3.2)
+    figure = new_figure(8.0, 3.2)
     ax = figure.add_subplot()
     t = result.trajectory.t
     ax.plot(t, 1e3 * cell.distance, color="tab:blue", lw=1.2, label="least distance")
@@ -120,10 +121,8 @@ def clearance_figure(result: PlanResult) -> Figure:
 
 def write_map_report(pmap: PlacementMap, out_dir: Path) -> list[Path]:
     """Write ``map.png`` and ``map.html`` into ``out_dir``: the map in the report's look
-    (:func:`~trackplan.report.html.html_page`), its grid, height, orientation, the share of
+    (:func:`~trackplan.report.html_markup.html_page`), its grid, height, orientation, the share of
     each class and the least J in tables, the plot as a captioned figure."""
-    from trackplan.report.html import PLACEMENT_HEADER, _grid, _num, html_page
-
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     png = out_dir / MAP_FILE
@@ -131,20 +130,20 @@ def write_map_report(pmap: PlacementMap, out_dir: Path) -> list[Path]:
     data = base64.b64encode(png.read_bytes()).decode("ascii")
     best = np.nanmin(pmap.objective) if np.isfinite(pmap.objective).any() else float("nan")
     name = html.escape(pmap.case_name)
-    grid = _grid(
+    table = grid(
         ["grid", "x range [m]", "y range [m]", *PLACEMENT_HEADER[2:], "least J"],
         [
             [
                 f"{len(pmap.x)} × {len(pmap.y)}",
-                f"{_num(pmap.x[0])} – {_num(pmap.x[-1])}",
-                f"{_num(pmap.y[0])} – {_num(pmap.y[-1])}",
-                _num(pmap.z),
-                *(_num(v) for v in pmap.rpy),
-                _num(best, 6),
+                f"{num(pmap.x[0])} – {num(pmap.x[-1])}",
+                f"{num(pmap.y[0])} – {num(pmap.y[-1])}",
+                num(pmap.z),
+                *(num(v) for v in pmap.rpy),
+                num(best, 6),
             ]
         ],
     )
-    shares = _grid(
+    shares = grid(
         list(REASONS),
         [[(f"{100 * np.mean(pmap.reason == code):.0f} %", "") for code in range(len(REASONS))]],
         row_header=False,
@@ -155,7 +154,7 @@ def write_map_report(pmap: PlacementMap, out_dir: Path) -> list[Path]:
         '<p class="muted">Every placement of the grid at the height and orientation below, '
         "classified by the first reason it fails, or feasible and coloured by its J "
         "(docs/cell.md).</p>"
-        f"{grid}<h3>Share of the grid</h3>{shares}"
+        f"{table}<h3>Share of the grid</h3>{shares}"
         f'<figure id="plot-map"><h3>Map</h3>'
         f'<img alt="placement map" src="data:image/png;base64,{data}">'
         "<figcaption>x–y grid of placement origins in the robot base frame: infeasible "

@@ -1,7 +1,7 @@
 """Drawing a run's plots on two cores when the machine has them.
 
 The plots are split into drawing tasks: a banded plot (``joints.png``,
-:class:`~trackplan.report.figures.BandedFigure`) gives one task per band, every other plot
+:class:`~trackplan.report.figure_style.BandedFigure`) gives one task per band, every other plot
 one task. :func:`draw_plots` forks a process, and the two take the next task left until none
 is; the fork shares everything already imported and computed (matplotlib, the result), so
 nothing is pickled or imported twice, and it hands its bands over as pixel files in a
@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from trackplan.forking import can_fork
-from trackplan.report.figures import BandedFigure, PlotBuilder, figure_pixels, save_png
+from trackplan.report.figure_style import BandedFigure, PlotBuilder, figure_pixels, save_png
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

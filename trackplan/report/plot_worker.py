@@ -7,7 +7,7 @@ second core while the command imports its planner, loads the case and starts num
 kernels on the first (the second core is idle then: the search and the plans beside it
 start later). :func:`~trackplan.report.run_report.write_run_report` then sends it the run's
 result with what the plots need from the compiled kernels
-(:class:`~trackplan.report.figures.PlotKinematics`), so that the worker never starts
+(:class:`~trackplan.report.path_plots.PlotKinematics`), so that the worker never starts
 numba, and it draws the plots (in two processes,
 :func:`~trackplan.report.drawing.draw_plots`) while the caller builds the 3D view. When the
 worker is gone or fails, the caller draws the plots itself, and raises any error.
@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # imported by the command line before its search: stays light
 
     from trackplan.case import Case
     from trackplan.planning.result import PlanResult
-    from trackplan.report.figures import PlotKinematics
+    from trackplan.report.path_plots import PlotKinematics
 
 
 _READY = "ready"
@@ -171,9 +171,9 @@ def _warm_up() -> None:
     import io
 
     import trackplan.report.drawing  # noqa: F401  (what draw_plots and the result need)
-    from trackplan.report.figures import DPI, PNG_COMPRESSION, _new_figure
+    from trackplan.report.figure_style import DPI, PNG_COMPRESSION, new_figure
 
-    figure = _new_figure(2.0, 2.0, layout=None)
+    figure = new_figure(2.0, 2.0, layout=None)
     ax = figure.add_subplot(1, 2, 1)
     ax.plot([0.0, 1.0], [0.0, 1.0], marker="o", label="x [m]")
     ax.set_title("warm-up", fontsize=7)

@@ -1,0 +1,127 @@
+"""The report's Case section: the robot, the path, the task and the placement search set-up."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from trackplan.case import Case
+from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
+from trackplan.planning.result import PlanResult
+from trackplan.report.html_markup import Cell, esc, grid, key_values, num, vector
+from trackplan.robots.families import ik_family
+
+
+def _describe_segment(segment: SegmentSpec) -> tuple[str, str]:
+    if isinstance(segment, LineSpec):
+        return "line", f"to {vector(segment.to)} m"
+    if isinstance(segment, ArcSpec):
+        return "arc", (
+            f"centre {vector(segment.center)} m, normal {vector(segment.normal)}, "
+            f"angle {num(segment.angle)} rad ({num(np.degrees(segment.angle))}°)"
+        )
+    if isinstance(segment, PointsSpec):
+        return "points", f"{len(segment.points)} sampled points"
+    return type(segment).__name__, ""
+
+
+def case_section(result: PlanResult, case: Case) -> str:
+    """The Case section of ``report.html`` (``id="case"``)."""
+    robot, task, bounds = case.robot, case.task, case.bounds
+    joint_rows = [
+        [
+            f"{j + 1} ({robot.joint_names[j]})",
+            vector(robot.origins[j][:3, 3]),
+            vector(robot.axes[j]),
+            f"[{num(robot.q_min[j])}, {num(robot.q_max[j])}]",
+            num(robot.v_max[j]),
+            num(robot.a_max[j]),
+            num(robot.j_max[j]),
+            num(case.objective.weights[j]) if j < len(case.objective.weights) else "–",
+        ]
+        for j in range(robot.n_dof)
+    ]
+    robot_html = key_values(
+        [
+            ("name", esc(robot.name)),
+            ("joints", str(robot.n_dof)),
+            ("IK family", esc(ik_family(robot).name)),
+            ("tool offset", "yes" if robot.has_tool else "none (tool = flange)"),
+            *(("assumption", esc(note)) for note in robot.assumptions),
+            ("source", esc(robot.source or "–")),
+        ]
+    ) + grid(
+        [
+            "joint",
+            "origin xyz [m]",
+            "axis",
+            "q range [rad]",
+            "q̇ max [rad/s]",
+            "q̈ max [rad/s²]",
+            "q⃛ max [rad/s³]",
+            "weight C_i",
+        ],
+        joint_rows,
+    )
+    segments: list[list[Cell]] = [
+        [str(i + 1), *((esc(text), "text") for text in _describe_segment(s))]
+        for i, s in enumerate(case.segments)
+    ]
+    path_html = key_values(
+        [
+            ("start", f"{vector(case.start)} m"),
+            ("segments", str(len(case.segments))),
+            ("nominal length", num(result.path_length, unit="m")),
+        ]
+    ) + grid(["#", "kind", "geometry (definition frame)"], segments)
+    task_html = key_values(
+        [
+            ("rated speed v_r", num(task.rated_speed, scale=1e3, unit="mm/s")),
+            ("corner speed cap v_t^max", num(task.corner_speed, scale=1e3, unit="mm/s")),
+            ("tolerance ρ", num(task.tolerance, scale=1e3, unit="mm")),
+            ("sample time Ts", num(task.sample_time, scale=1e3, unit="ms")),
+            ("tool orientation", _tool_text(task.tool)),
+            ("time law", esc(task.timing)),
+        ]
+    )
+    search_html = key_values(
+        [
+            ("lower bound X", vector(bounds.lower)),
+            ("upper bound X", vector(bounds.upper)),
+            ("reach of (x, y, z)", f"{num(bounds.reach[0])} – {num(bounds.reach[1])} m"),
+            (
+                "objective",
+                f"Eq. 8, time weight {num(case.objective.time_weight)} per s, "
+                f"{esc(case.objective.penalty)} penalty",
+            ),
+            (
+                "optimizer",
+                f"{esc(case.optimizer.method)}, population {case.optimizer.population}, "
+                f"seed {case.optimizer.seed}, "
+                f"budget {esc(case.optimizer.budget or 'method default')}",
+            ),
+            ("case file", esc(case.source or "–")),
+        ]
+    )
+    return (
+        '<section id="case"><h2>Case</h2>'
+        f'<div class="cols"><div><h3>Robot</h3>{robot_html}</div></div>'
+        f'<div class="cols"><div><h3>Path</h3>{path_html}</div><div><h3>Task</h3>{task_html}</div>'
+        f"<div><h3>Placement search</h3>{search_html}</div></div></section>"
+    )
+
+
+def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]
+    """The tool spec in one line (docs/tool.md)."""
+    if str(tool.frame) == "part":
+        where = f"part frame, roll/pitch/yaw {vector(tool.rpy)} rad"
+    else:
+        normal = (
+            f"normal {vector(tool.normal)}"
+            if tool.normals is None
+            else "normals " + " ".join(vector(n) for n in tool.normals)
+        )
+        where = (
+            f"seam frame, {normal}, work {tool.work_angle:.4g} rad, "
+            f"travel {tool.travel_angle:.4g} rad"
+        )
+    return f"{where}; spin {tool.spin}"

@@ -1,0 +1,185 @@
+"""The report's result tables: key figures, margins, violations, slow-downs, references."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from trackplan.case import Case
+from trackplan.planning.result import LIMIT_KINDS, PlanResult
+from trackplan.report.html_markup import (
+    Cell,
+    esc,
+    grid,
+    key_values,
+    margin_class,
+    num,
+    percent,
+)
+from trackplan.report.scene import JOINT_QUANTITIES
+
+
+def verdict_badge(result: PlanResult) -> str:
+    """The verdict (status) as a coloured badge."""
+    css = "ok" if result.feasible else "bad"
+    return f'<span class="verdict {css}">{esc(result.status.value)}</span>'
+
+
+def figures_table(result: PlanResult, case: Case) -> str:
+    """The key figures of a run: verdict, placement, J, duration, speeds, errors."""
+    check = result.check
+    task = case.task
+    ideal = result.path_length / task.rated_speed if task.rated_speed > 0 else float("nan")
+    x = result.placement
+    rows = [
+        ("verdict", verdict_badge(result)),
+        ("message", esc(result.message)),
+        (
+            "placement X",
+            f"({num(x[0])}, {num(x[1])}, {num(x[2])}) m, "
+            f"rpy ({num(x[3])}, {num(x[4])}, {num(x[5])}) rad",
+        ),
+        ("objective J (Eq. 8)", num(result.objective, 6)),
+        ("duration", num(result.duration, unit="s")),
+        ("path length", num(result.path_length, unit="m")),
+        (
+            "L / v_r (no ramps, no corners)",
+            f"{num(ideal, unit='s')}; duration is "
+            f"{num(result.duration / ideal if ideal else float('nan'))} × that",
+        ),
+        _rated_speed_row(result, task.rated_speed),
+        ("min corner speed", num(result.min_corner_speed, scale=1e3, unit="mm/s")),
+        (
+            "max tracking error",
+            f"{num(check.max_tracking_error, scale=1e3, unit='mm')} "
+            f"(ρ = {num(task.tolerance, scale=1e3, unit='mm')})",
+        ),
+        (
+            "max orientation error",
+            f"{num(check.max_orientation_error, unit='rad')} "
+            f"({num(np.degrees(check.max_orientation_error))}°)",
+        ),
+        (
+            "worst margin",
+            percent(check.worst_margin()) if check.joint_margins or check.task_margins else "–",
+        ),
+        *_energy_rows(result),
+        ("time law, IK branch", f"{esc(result.timing)}, branch {result.branch}"),
+        (
+            "samples",
+            f"{result.trajectory.n_samples} at "
+            f"Ts = {num(result.trajectory.sample_time, scale=1e3, unit='ms')}",
+        ),
+    ]
+    return key_values(rows)
+
+
+def _rated_speed_row(result: PlanResult, rated_speed: float) -> tuple[str, str]:
+    """The share of the path run at the rated speed, or the top speed when that share
+    would read 0.0 % (a curve cruising just below the rated speed; ``docs/results.md``)."""
+    share = percent(result.rated_speed_fraction)
+    if share != "0.0 %":
+        return "rated speed fraction", share
+    top = float(np.max(result.trajectory.speed, initial=0.0))
+    of_rated = f" ({percent(top / rated_speed)} of v_r)" if rated_speed > 0 else ""
+    return "top speed", num(top, scale=1e3, unit="mm/s") + of_rated
+
+
+def _energy_rows(result: PlanResult) -> list[tuple[str, str]]:
+    """Energy figures of a robot with dynamics (``docs/dynamics.md``), else none."""
+    energy = result.energy
+    if energy is None:
+        return []
+    return [
+        ("mechanical energy", num(energy.mechanical_energy, unit="J")),
+        ("copper loss", f"{num(energy.copper_loss)} {esc(energy.copper_loss_unit)}"),
+        (
+            "peak torque ratio",
+            f"{num(energy.peak_torque_ratio)} (joint {energy.peak_torque_joint})",
+        ),
+    ]
+
+
+def margins_table(result: PlanResult, case: Case) -> str:
+    """The unused fraction of every joint limit per joint, and of the task bounds."""
+    check = result.check
+    n = case.robot.n_dof
+    rows = []
+    for kind in (*LIMIT_KINDS, "torque"):
+        margins = check.joint_margins.get(kind)
+        if margins is None:
+            continue
+        name, unit = JOINT_QUANTITIES[kind]
+        cells: list[Cell] = [f"{name} [{unit}]"]
+        for j in range(n):
+            cells.append((percent(margins[j]), margin_class(margins[j])))
+        binding = check.binding.get(kind)
+        cells.append(f"joint {binding[0]} at t = {num(binding[1])} s" if binding else "–")
+        rows.append(cells)
+    joints = grid(["limit", *[f"joint {j + 1}" for j in range(n)], "closest to binding"], rows)
+    tasks = grid(
+        ["task bound", "margin"],
+        [[esc(k), (percent(v), margin_class(v))] for k, v in check.task_margins.items()],
+    )
+    return (
+        '<h3>Margins</h3><p class="muted">Unused fraction of each limit over all samples '
+        "(1 − |x| / limit; negative = exceeded).</p>" + joints + tasks
+    )
+
+
+def violations_table(result: PlanResult, limit: int = 60) -> str:
+    """The violation windows the checker reported, the first ``limit`` of them."""
+    violations = result.check.violations
+    if not violations:
+        return "<h3>Violations</h3><p>None.</p>"
+    rows: list[list[Cell]] = [
+        [
+            esc(v.limit),
+            "–" if v.joint is None else str(v.joint),
+            num(v.t_first, unit="s"),
+            num(v.t_last, unit="s"),
+            num(v.worst),
+            num(v.bound),
+            (esc(v.message), "text"),
+        ]
+        for v in violations[:limit]
+    ]
+    more = f"<p>… and {len(violations) - limit} more.</p>" if len(violations) > limit else ""
+    header = ["limit", "joint", "first", "last", "worst", "bound", "message"]
+    return f"<h3>Violations ({len(violations)})</h3>" + grid(header, rows) + more
+
+
+def slowdowns_table(result: PlanResult) -> str:
+    """The slow-downs below the rated speed, numbered as ``speed.png`` labels them."""
+    if not result.slowdowns:
+        return "<h3>Slow-downs</h3><p>None: every straight piece runs at the rated speed.</p>"
+    rows: list[list[Cell]] = [
+        [
+            str(k + 1),  # the number speed.png labels it with
+            num(s.s_start, unit="m"),
+            num(s.s_end, unit="m"),
+            num(s.speed, scale=1e3, unit="mm/s"),
+            num(s.rated_speed, scale=1e3, unit="mm/s"),
+            (esc(s.limit), "text"),
+        ]
+        for k, s in enumerate(result.slowdowns)
+    ]
+    return "<h3>Slow-downs</h3>" + grid(
+        ["#", "from s", "to s", "speed", "rated", "forced by"], rows
+    )
+
+
+def references_table(result: PlanResult) -> str:
+    """The reference durations (toppra, TOPP3) against the run's, when computed."""
+    if not result.references:
+        return "<h3>Reference durations</h3><p>Not computed.</p>"
+    rows = [
+        [
+            esc(name.removesuffix("_duration")),
+            num(value, unit="s"),
+            num(result.duration / value if value else float("nan")),
+        ]
+        for name, value in result.references.items()
+    ]
+    return "<h3>Reference durations</h3>" + grid(
+        ["reference", "duration", "ours / reference"], rows
+    )
