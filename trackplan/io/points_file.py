@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.io.input_text import read_text
 from trackplan.io.sizes import MAX_POINTS_BYTES, MAX_POINTS_ROWS
-from trackplan.io.yaml_input import read_text
 
 MIN_POINTS = 2
 """Fewest points of a ``points`` segment (one point is a ``line``)."""

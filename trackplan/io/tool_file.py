@@ -14,6 +14,7 @@ import numpy as np
 from pydantic import Field
 
 from trackplan.errors import CaseError
+from trackplan.io.input_text import read_text
 from trackplan.io.yaml_input import (
     Coordinate,
     Loc,
@@ -23,7 +24,6 @@ from trackplan.io.yaml_input import (
     Vec3,
     list_default,
     parse_yaml,
-    read_text,
     show,
 )
 from trackplan.paths.nominal import NominalPath
