@@ -1,4 +1,7 @@
-"""``history.csv`` of a placement search: one row per generation, and reading it back."""
+"""``history.csv`` of a placement search: one row per generation, and reading it back.
+
+A writer of the search's output: it sits above :mod:`trackplan.search` and imports it.
+"""
 
 from __future__ import annotations
 
@@ -10,8 +13,6 @@ from trackplan.errors import CaseError
 from trackplan.io.results import result_summary
 from trackplan.run_files import HISTORY_FILE, HISTORY_KEYS
 from trackplan.search.optimize import OptimizeResult, SearchHistory
-
-"""File name of the search history in a run folder."""
 
 
 def write_history_csv(history: SearchHistory, file: Path) -> None:
