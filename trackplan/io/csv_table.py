@@ -2,10 +2,17 @@
 
 Each value is written as Python's ``repr`` writes it (``0.001``, ``2.8368999995743955``,
 ``1e-05``, ``-0.0``, ``5e-324``, ``nan``, ``inf``): the shortest decimal that reads back
-to the same double, by the compiled kernel :func:`trackplan.io._kernels.format_rows` (Ryū),
-about 6 times faster than ``numpy.savetxt`` with ``%.17g`` and a few percent shorter.
+to the same double, by the compiled kernel :func:`trackplan.io._kernels.format_rows` (Ryū).
 Any correctly rounded reader (``float``, ``numpy.loadtxt``, pandas, a C ``strtod``)
 gets the same bits back.
+
+Why a compiled kernel and not the standard library, which writes the same bytes
+(``python -m benchmarks csv``, 2026-12-06, CPU times on a shared 2-core machine): the
+trajectory.csv of a 10-minute cycle at Ts = 4 ms (149,179 rows × 30 columns, 81 MB) takes
+0.37 s here, 2.74 s by ``float.__repr__`` mapped and joined, 3.86 s by ``csv.writer``
+and 2.76 s by ``numpy.savetxt`` with ``%.17g``; the whole ``trackplan plan --no-report``
+of that run takes 3.0 s of CPU, to which the standard library would add 78 %. On the
+longest shipped case (9,676 rows) it would add 10 %.
 """
 
 from __future__ import annotations
