@@ -9,6 +9,7 @@ from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.result import PlanResult
 from trackplan.report.html_markup import Cell, esc, grid, key_values, num, vector
 from trackplan.robots.families import ik_family
+from trackplan.tool import ToolFrame
 
 
 def _describe_segment(segment: SegmentSpec) -> tuple[str, str]:
@@ -112,7 +113,7 @@ def case_section(result: PlanResult, case: Case) -> str:
 
 def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]
     """The tool spec in one line (docs/tool.md)."""
-    if str(tool.frame) == "part":
+    if tool.frame == ToolFrame.PART:
         where = f"part frame, roll/pitch/yaw {vector(tool.rpy)} rad"
     else:
         normal = (

@@ -37,6 +37,7 @@ from trackplan.report.scene import (
     violation_samples,
 )
 from trackplan.robots.kinematics import forward_kinematics
+from trackplan.tool import SpinMode, ToolFrame
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -102,7 +103,7 @@ def plot_kinematics(
 def shows_tool(case: Case) -> bool:
     """Whether a run of this case gets ``tool.png``: a seam frame or a spin not fixed."""
     tool = case.task.tool
-    return str(tool.frame) == "seam" or str(tool.spin) != "fixed"
+    return tool.frame == ToolFrame.SEAM or tool.spin != SpinMode.FIXED
 
 
 def path_canvas() -> Canvas:
@@ -265,7 +266,7 @@ def tool_figure(
     ax_frames = figure.add_subplot(1, 2, 2, projection="3d")
     if trajectory.n_samples and len(trajectory.spin) == trajectory.n_samples:
         ax_spin.plot(trajectory.s, trajectory.spin, color=AFTER_COLOR, lw=1.8, gid="spin")
-    if str(tool.spin) != "fixed":
+    if tool.spin != SpinMode.FIXED:
         for bound in tool.spin_range:
             ax_spin.axhline(bound, ls="--", color="0.4", lw=1.0)
     ax_spin.set_xlabel("s along the planned path [m]")
