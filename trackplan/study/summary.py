@@ -15,8 +15,8 @@ from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from trackplan.check_report import IGNORED_UNLESS_BROKEN
 from trackplan.io.csv_cells import neutralised, restored
-from trackplan.planning.result import IGNORED_UNLESS_BROKEN
 from trackplan.run_files import RESULT_FILE
 from trackplan.status import Status
 
