@@ -90,7 +90,7 @@ def test_batch_prints_a_line_per_job_and_the_outcome(
     printed = {line[6:].split(": ")[0]: line for line in lines[:2]}
     assert sorted(printed) == sorted(row.job for row in rows)
     for row in rows:
-        assert f": {row.status} (" in printed[row.job] and row.worker in printed[row.job]
+        assert f": {row.status.value} (" in printed[row.job] and row.worker in printed[row.job]
     assert lines[2].startswith("study: 2 jobs: ") and f"summary in {out}" in lines[3]
     code, _, err = run(capsys, *args)
     assert code == ExitCode.BAD_INPUT and "add --resume" in err

@@ -89,7 +89,7 @@ def _study_progress(total: int):  # type: ignore[no-untyped-def]
             if row is not None:
                 figures = f"J = {row.J:.4f}, " if row.success else ""
                 typer.echo(
-                    f"[{state.done}/{state.total}] {row.job}: {row.status} "
+                    f"[{state.done}/{state.total}] {row.job}: {row.status.value} "
                     f"({figures}{row.wall_time_s:.1f} s on {row.worker})"
                 )
 

@@ -460,7 +460,7 @@ def _status(rows: tuple[JobRow, ...], interrupted: bool) -> Status:
         return Status.INTERRUPTED
     if any(row.failed for row in rows):
         return Status.FAILED
-    return next((Status(row.status) for row in rows if not row.success), Status.FEASIBLE)
+    return next((row.status for row in rows if not row.success), Status.FEASIBLE)
 
 
 def _message(rows: tuple[JobRow, ...], total: int, skipped: int, cancelled: int) -> str:
