@@ -82,3 +82,20 @@ def test_no_module_compares_against_a_status_word() -> None:
         for line, text in status_word_comparisons(file.read_text(encoding="utf-8"))
     ]
     assert not found, "compare with Status members, not their words:\n" + "\n".join(found)
+
+
+def test_status_values_are_the_words_files_hold() -> None:
+    """Members may be added at the end; the words already written to files never change."""
+    words = [status.value for status in Status]
+    assert words[:9] == [
+        "feasible",
+        "limits_violated",
+        "unreachable",
+        "branch_switch",
+        "position_limits",
+        "collision",
+        "not_converged",
+        "interrupted",
+        "failed",
+    ]
+    assert [status.success for status in Status] == [True] + [False] * (len(words) - 1)
