@@ -54,7 +54,7 @@ def batch(
             )
     finally:
         if client is not None:
-            client.close()
+            client.close()  # type: ignore[no-untyped-call]  # distributed is unannotated
     console = _console()
     console.print(f"{escape(loaded.name)}: {escape(result.message)} in {result.wall_time_s:.1f} s")
     for row in result.rows:
