@@ -67,7 +67,21 @@ def speed_slack(sample_time: float) -> float:
 def check_task(
     motion: SampledMotion, ref: TrackingReference
 ) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
-    """Tracking, orientation, Cartesian speed and coverage checks."""
+    """Tracking, orientation, Cartesian speed and coverage checks.
+
+    Parameters
+    ----------
+    motion
+        The joint samples at Ts, shape (N, n), rad, with their tool poses.
+    ref
+        What the tool must do.
+
+    Returns
+    -------
+    tuple
+        ((the margin per task kind, the violations found), the largest tracking error, m,
+        the largest tool axis error, rad).
+    """
     robot, q, sample_time = motion.robot, motion.q, motion.sample_time
     T_base_part = np.ascontiguousarray(ref.T_base_part, dtype=float)
     # the tool's points, velocities and speeds, and its x and z axes (all the tool checks
@@ -184,7 +198,26 @@ def coverage_violations(
     speed: np.ndarray,
     sample_time: float,
 ) -> list[Violation]:
-    """The whole nominal path covered from start to end, in order, with no jump."""
+    """The whole nominal path covered from start to end, in order, with no jump.
+
+    Parameters
+    ----------
+    ref
+        What the tool must do (the nominal path, the tolerance ρ, the speed caps).
+    t
+        Sample times, shape (N,), s.
+    s, piece
+        Each sample's arc length on the nominal path, m, and nominal piece index, shape (N,).
+    speed
+        Tool speed at each sample, shape (N,), m/s.
+    sample_time
+        Ts, s.
+
+    Returns
+    -------
+    list of Violation
+        ``coverage`` violations: a late start, an early end, a run backwards, a jump.
+    """
     nominal = ref.nominal
     tol = 2.0 * ref.tolerance
     found: list[Violation] = []
