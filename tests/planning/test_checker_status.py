@@ -5,7 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from trackplan.check_report import CellReport, CheckReport, Violation, violations_status
+from trackplan.io.case_file import load_case
+from trackplan.planning.plan import plan_placement
 from trackplan.status import Status
 
 
@@ -79,3 +82,18 @@ def test_result_module_re_exports_the_moved_classes() -> None:
 
     assert result.CheckReport is CheckReport and result.Violation is Violation
     assert result.CellReport is CellReport
+
+
+def test_a_plan_and_its_check_say_the_same(corner_plan) -> None:
+    assert corner_plan.check.status is corner_plan.status is Status.FEASIBLE
+
+
+def test_an_infeasible_plan_and_its_check_say_the_same() -> None:
+    """The paper's line in paper timing breaks the acceleration and jerk limits
+    (docs/paper.md): the plan, its check and each violation say LIMITS_VIOLATED."""
+    case = load_case(CASES / "paper-line.yaml")
+    X = np.array([-0.2230, 0.1029, 0.1829, 0.0312, -0.4124, 0.5020])
+    plan = plan_placement(case, X, timing="paper")
+    assert plan.status is plan.check.status is Status.LIMITS_VIOLATED
+    assert plan.check.violations
+    assert {v.status for v in plan.check.violations} == {Status.LIMITS_VIOLATED}
