@@ -132,3 +132,24 @@ def test_ctrl_c_cancels_the_pending_jobs_and_writes_the_summary(client, tmp_path
     assert read_summary_csv(tmp_path / "out" / "summary.csv") == list(result.rows)
     assert (tmp_path / "out" / "summary.html").is_file()
     assert f"{result.n_cancelled} cancelled" in result.message
+
+
+class _CancelledFuture:
+    """What a Dask future of a cancelled task answers."""
+
+    status = "cancelled"
+
+    def cancelled(self) -> bool:
+        return True
+
+    def exception(self) -> BaseException:
+        raise AssertionError("a cancelled task has no exception to wait for")
+
+
+def test_a_cancelled_task_is_a_failed_row(tmp_path: Path) -> None:
+    from trackplan.study.runner import _row
+
+    (job,) = load_study(write_study(tmp_path, f"cases: ['{CASES}/paper-circle.yaml']\n")).jobs
+    row = _row(_CancelledFuture(), job)  # type: ignore[arg-type]  # a stand-in future
+    assert row.status is Status.FAILED and row.failed and row.message == "cancelled"
+    assert row.job == job.key and math.isnan(row.J)

@@ -332,7 +332,7 @@ def _row(future: Future[JobRow], job: Job) -> JobRow:
     A task whose worker died after it finished, before its result was fetched, is pending
     again when it gets here (Dask recomputes it elsewhere): ``exception`` waits for that.
     """
-    if future.status == "cancelled":
+    if future.cancelled():  # type: ignore[no-untyped-call]  # distributed is unannotated
         return failed_row(job.describe(), "cancelled", math.nan, "")
     exc = future.exception()  # type: ignore[no-untyped-call]  # distributed is unannotated
     if exc is None:
