@@ -1,8 +1,10 @@
-"""One outcome vocabulary for IK, time laws, plans, searches and jobs.
+"""One outcome vocabulary for IK, time laws, checks, plans, searches and studies.
 
 Every result of trackplan carries a :class:`Status` and a boolean ``success`` that is true
 exactly when the status is :attr:`Status.FEASIBLE`. "It worked" is spelled ``success``
-everywhere; ``feasible`` is a read-only alias on plan results.
+everywhere; ``feasible`` is a read-only alias on plan results. Code compares members
+(``status is Status.FEASIBLE``), never their words; the words are what files hold
+(``docs/architecture.md``, "Outcomes and errors").
 """
 
 from __future__ import annotations
@@ -13,7 +15,8 @@ import enum
 class Status(enum.Enum):
     """Outcome of one computation (the first problem that applies).
 
-    The values are the words written to result files and summaries.
+    The values are the words written to result files and summaries. New members go at the
+    end; a value, once written to a file, never changes.
     """
 
     FEASIBLE = "feasible"
@@ -34,7 +37,7 @@ class Status(enum.Enum):
     INTERRUPTED = "interrupted"
     """Stopped by a signal; the result is the best found until then."""
     FAILED = "failed"
-    """The computation raised; the message says why."""
+    """The computation raised (a study job: or lost its workers); the message says why."""
 
     @property
     def success(self) -> bool:

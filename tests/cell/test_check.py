@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 from pathlib import Path
 
@@ -15,10 +16,12 @@ from trackplan.cell.screening import CellGeometry, clip_tool_segment
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.checker import check_trajectory
 from trackplan.robots.builtin import puma560, ur5
 from trackplan.robots.kinematics import forward_kinematics, joint_frames
 from trackplan.search.fitness import Finding, PlacementFitness
 from trackplan.search.space import SearchSpace
+from trackplan.status import Status
 
 REPO = Path(__file__).resolve().parents[2]
 CELL_CASE = REPO / "cases" / "paper-corner-cell.yaml"
@@ -178,3 +181,51 @@ def test_builtin_capsules_keep_the_default_clearance_at_home(robot, home) -> Non
     geometry = CellGeometry.from_cell(Cell(), robot)
     _, own = geometry.screen(joint_frames(robot, np.array([home])), np.eye(4))
     assert own.min() > Cell().clearance
+
+
+def test_checker_status_is_collision_when_only_the_clearance_breaks() -> None:
+    """A smooth sweep within every joint limit through a planted ball: status COLLISION."""
+    robot = puma560()
+    n = 400
+    u = np.linspace(0.0, 1.0, n)
+    q = np.zeros((n, 6))
+    q[:, 0] = np.pi / 2 * u**3 * (10.0 - 15.0 * u + 6.0 * u**2)  # rest to rest, 4 s
+    q[:, 2] = -np.pi / 2
+    elbow = joint_frames(robot, q[n // 2])[3, :3, 3]
+    ball = Body("ball", Shape.SPHERE, pose_matrix(elbow, np.eye(3)), [0.05, 0.0, 0.0])
+    geometry = CellGeometry.from_cell(Cell(obstacles=(ball,), clearance=0.01), robot)
+    report = check_trajectory(robot, q, TS, cell=geometry)
+    assert {v.limit for v in report.violations} == {"collision"}, [
+        v.message for v in report.violations
+    ]
+    assert report.status is Status.COLLISION and not report.success
+    assert report.cell is not None and report.cell.status is Status.COLLISION
+    assert report.task_margins["clearance"] < 0
+
+
+def test_cell_modules_import_no_higher_layer() -> None:
+    """cell/ sits below planning: none of its modules imports planning or anything above."""
+    higher = (
+        "trackplan.jointpath",
+        "trackplan.timing",
+        "trackplan.planning",
+        "trackplan.search",
+        "trackplan.study",
+        "trackplan.outputs",
+        "trackplan.report",
+        "trackplan.cli",
+    )
+    found = []
+    for file in sorted((REPO / "trackplan" / "cell").rglob("*.py")):
+        for node in ast.walk(ast.parse(file.read_text(encoding="utf-8"))):
+            names = []
+            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                names = [node.module]
+            elif isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            found += [
+                f"{file.name}:{node.lineno} {name}"
+                for name in names
+                if any(name == top or name.startswith(top + ".") for top in higher)
+            ]
+    assert not found

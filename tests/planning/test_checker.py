@@ -10,6 +10,7 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
 from trackplan.planning.plan import plan_placement, tracking_reference
 from trackplan.robots.path_ik import solve_path_ik
+from trackplan.status import Status
 
 
 def _check(case, geometry, q, X):
@@ -25,6 +26,7 @@ def _kinds(report):
 def test_feasible_plan_passes_every_check(corner_case, corner_geometry, corner_plan):
     report = _check(corner_case, corner_geometry, corner_plan.trajectory.q, corner_plan.placement)
     assert report.success, [v.message for v in report.violations]
+    assert report.status is Status.FEASIBLE
     assert report.max_tracking_error <= corner_case.task.tolerance
     for kind, margins in report.joint_margins.items():
         assert np.all(margins >= 0), kind
@@ -43,6 +45,7 @@ def test_planted_acceleration_step_is_caught(corner_case, corner_geometry, corne
     report = _check(corner_case, corner_geometry, q, corner_plan.placement)
     jerk = [v for v in report.violations if v.limit == "jerk" and v.joint == 1]
     assert jerk, [v.message for v in report.violations]
+    assert report.status is Status.LIMITS_VIOLATED and not report.success
     assert jerk[0].t_first == pytest.approx(k0 * Ts, abs=3 * Ts)
     # an acceleration step Δa between two samples is a jerk of Δa / Ts: worst at k0 + m
     assert abs(jerk[0].worst) == pytest.approx(2 * a / Ts, rel=0.05)

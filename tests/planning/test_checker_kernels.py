@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from trackplan.frames import placement_transform
 from trackplan.planning._kernels import peak_use, task_frames
-from trackplan.planning.checker import _largest_spin_errors, _smallest, _spin_error
+from trackplan.planning.check_tool import _largest_spin_errors, _smallest, _spin_error
 from trackplan.planning.tracking import BETWEEN_STEP, MAX_BETWEEN_PER_PERIOD
 from trackplan.robots.builtin import puma560
 from trackplan.robots.kinematics import forward_kinematics

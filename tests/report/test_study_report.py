@@ -10,6 +10,7 @@ from trackplan.report.study import (
     feasibility_matrix,
     write_study_report,
 )
+from trackplan.status import Status
 from trackplan.study import JobRow, Study
 
 
@@ -20,7 +21,7 @@ def row(case: str, robot: str, seed: int, J: float, cycle: float, ok: bool = Tru
         robot=robot,
         sweep="base",
         seed=seed,
-        status="feasible" if ok else "limits_violated",
+        status=Status.FEASIBLE if ok else Status.LIMITS_VIOLATED,
         success=ok,
         J=J,
         duration_s=cycle,

@@ -90,7 +90,7 @@ def test_batch_prints_a_line_per_job_and_the_outcome(
     printed = {line[6:].split(": ")[0]: line for line in lines[:2]}
     assert sorted(printed) == sorted(row.job for row in rows)
     for row in rows:
-        assert f": {row.status} (" in printed[row.job] and row.worker in printed[row.job]
+        assert f": {row.status.value} (" in printed[row.job] and row.worker in printed[row.job]
     assert lines[2].startswith("study: 2 jobs: ") and f"summary in {out}" in lines[3]
     code, _, err = run(capsys, *args)
     assert code == ExitCode.BAD_INPUT and "add --resume" in err
@@ -167,3 +167,22 @@ def _finished(out: Path) -> int:
     """Complete run folders in a study's output folder."""
     jobs = out / "jobs"
     return len(list(jobs.glob("*/job.json"))) if jobs.is_dir() else 0
+
+
+def test_resuming_over_a_run_folder_with_an_unknown_status_is_one_line_and_exit_2(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    study_file = write_study(tmp_path, f"cases: ['{CASES}/paper-circle.yaml']\nseeds: [0]\n")
+    (job,) = load_study(study_file).jobs
+    folder = tmp_path / "out" / "jobs" / job.key
+    folder.mkdir(parents=True)
+    (folder / "job.json").write_text(
+        json.dumps({**job.describe(), "wall_time_s": 1.0, "worker": "w"})
+    )
+    (folder / "result.json").write_text(json.dumps({"status": "great", "feasible": True}))
+    code, stdout, err = run(
+        capsys, "batch", str(study_file), "--out", str(tmp_path / "out"), "--resume"
+    )
+    assert code == ExitCode.BAD_INPUT and stdout == ""
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert f"{folder / 'result.json'}: status: unknown status 'great'" in err

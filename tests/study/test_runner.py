@@ -25,7 +25,7 @@ def test_six_jobs_summary_rows_match_each_runs_result_json(client, tmp_path: Pat
     assert result.n_jobs == 6 and result.status is (
         Status.FEASIBLE
         if result.success
-        else Status(next(row.status for row in result.rows if not row.success))
+        else next(row.status for row in result.rows if not row.success)
     )
     assert [row.job for row in result.rows] == [job.key for job in study.jobs]
     assert result.rows == tuple(read_summary_csv(tmp_path / "out" / "summary.csv"))
@@ -38,7 +38,7 @@ def test_six_jobs_summary_rows_match_each_runs_result_json(client, tmp_path: Pat
             "base",
             job.seed,
         )
-        assert row.status == written["status"] and row.success == written["feasible"]
+        assert row.status is Status(written["status"]) and row.success == written["feasible"]
         assert row.J == written["objective"] and row.duration_s == written["duration"]
         assert row.tracking_error_m == written["max_tracking_error"]
         assert written["optimizer"]["seed"] == job.seed
@@ -85,7 +85,7 @@ def test_a_job_that_raises_is_recorded_failed_and_the_rest_complete(client, tmp_
     ]
     for row in failed:
         assert row.message.startswith("CaseError: ") and "reach" in row.message
-        assert math.isnan(row.J) and row.status == "failed"
+        assert math.isnan(row.J) and row.status is Status.FAILED
         assert not (tmp_path / "out" / "jobs" / row.job).exists()
         assert "Traceback" in (tmp_path / "out" / "errors" / f"{row.job}.txt").read_text()
     others = [row for row in result.rows if not row.failed]
@@ -132,3 +132,24 @@ def test_ctrl_c_cancels_the_pending_jobs_and_writes_the_summary(client, tmp_path
     assert read_summary_csv(tmp_path / "out" / "summary.csv") == list(result.rows)
     assert (tmp_path / "out" / "summary.html").is_file()
     assert f"{result.n_cancelled} cancelled" in result.message
+
+
+class _CancelledFuture:
+    """What a Dask future of a cancelled task answers."""
+
+    status = "cancelled"
+
+    def cancelled(self) -> bool:
+        return True
+
+    def exception(self) -> BaseException:
+        raise AssertionError("a cancelled task has no exception to wait for")
+
+
+def test_a_cancelled_task_is_a_failed_row(tmp_path: Path) -> None:
+    from trackplan.study.runner import _row
+
+    (job,) = load_study(write_study(tmp_path, f"cases: ['{CASES}/paper-circle.yaml']\n")).jobs
+    row = _row(_CancelledFuture(), job)  # type: ignore[arg-type]  # a stand-in future
+    assert row.status is Status.FAILED and row.failed and row.message == "cancelled"
+    assert row.job == job.key and math.isnan(row.J)

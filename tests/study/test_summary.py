@@ -11,7 +11,9 @@ import pytest
 
 from tests.conftest import CASES
 from tests.study.conftest import write_study
+from trackplan.errors import CaseError
 from trackplan.io.study_file import load_study
+from trackplan.status import Status
 from trackplan.study import JobRow, read_summary_csv, run_job
 from trackplan.study.summary import (
     IGNORED_UNLESS_BROKEN,
@@ -41,14 +43,14 @@ def test_an_infeasible_job_without_a_trajectory_is_a_row_with_its_verdict(tmp_pa
     assert written["objective"] is None and written["n_samples"] == 0
     assert not (tmp_path / "out" / "errors").exists()
     assert not row.failed and not row.success
-    assert row.status == written["status"] == "unreachable"
+    assert row.status is Status.UNREACHABLE and written["status"] == "unreachable"
     assert row.message == written["message"] and "out of reach" in row.message
     for value in (row.J, row.duration_s, row.cycle_time_s, row.tracking_error_m):
         assert math.isnan(value)
     assert math.isnan(row.worst_margin)  # no trajectory: no margin at all
     write_summary_csv([row], tmp_path / "summary.csv")
     (back,) = read_summary_csv(tmp_path / "summary.csv")
-    assert back.status == "unreachable" and math.isnan(back.J)
+    assert back.status is Status.UNREACHABLE and math.isnan(back.J)
 
 
 def test_worst_margin_is_the_smallest_margin_of_a_limit_with_headroom(tmp_path: Path) -> None:
@@ -104,7 +106,7 @@ def test_a_run_folder_with_nulls_reads_back_as_nan(tmp_path: Path) -> None:
     }
     (folder / "result.json").write_text(json.dumps(result))
     row = row_from_run(folder)
-    assert row.status == "limits_violated" and not row.failed
+    assert row.status is Status.LIMITS_VIOLATED and not row.failed
     assert math.isnan(row.J) and math.isnan(row.duration_s) and math.isnan(row.cycle_time_s)
     assert row.worst_margin == -0.5 and row.wall_time_s == 1.5
 
@@ -114,9 +116,9 @@ def test_summary_text_a_spreadsheet_would_run_is_neutralised_and_reads_back(
 ) -> None:
     nan = math.nan
     rows = [
-        JobRow("=cmd()__r__base__s0", "=cmd()", "r", "base", 0, "failed", False, nan, nan, nan,
+        JobRow("=cmd()__r__base__s0", "=cmd()", "r", "base", 0, Status.FAILED, False, nan, nan, nan,
                nan, -0.25, 1.0, "w", "-failed: @once"),
-        JobRow("'=x__r__base__s1", "'=x", "r", "task.rated_speed=-1", 1, "feasible", True, 1.5,
+        JobRow("'=x__r__base__s1", "'=x", "r", "task.rated_speed=-1", 1, Status.FEASIBLE, True, 1.5,
                2.0, 2.0, 1e-4, 0.1, 1.0, "+w", "ok"),
     ]  # fmt: skip
     write_summary_csv(rows, tmp_path / "summary.csv")
@@ -130,3 +132,20 @@ def test_summary_text_a_spreadsheet_would_run_is_neutralised_and_reads_back(
     assert [row.job for row in back] == [row.job for row in rows]
     assert [row.message for row in back] == [row.message for row in rows]
     assert [row.case for row in back] == ["=cmd()", "'=x"] and back[1].worker == "+w"
+    assert [row.status for row in back] == [Status.FAILED, Status.FEASIBLE]
+    assert [cell[5] for cell in cells] == ["failed", "feasible"]  # the words of result files
+    assert back[0].failed and not back[1].failed
+
+
+def test_a_run_folder_with_an_unknown_status_is_one_clear_error(tmp_path: Path) -> None:
+    folder = tmp_path / "run"
+    folder.mkdir()
+    keys = {"job": "a__b__base__s0", "case": "a", "robot": "b", "sweep": "base", "seed": 0}
+    (folder / "job.json").write_text(json.dumps({**keys, "wall_time_s": 1.5, "worker": "w"}))
+    result = {"status": "splendid", "feasible": False, "message": "?"}
+    (folder / "result.json").write_text(json.dumps(result))
+    with pytest.raises(CaseError) as caught:
+        row_from_run(folder)
+    line = str(caught.value)
+    assert "result.json" in line and "status" in line and "'splendid'" in line
+    assert "feasible" in line and "\n" not in line

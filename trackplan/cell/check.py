@@ -13,7 +13,7 @@ import numpy as np
 from trackplan.cell.exact import ExactDistance
 from trackplan.cell.model import Capsules, Shape
 from trackplan.cell.screening import CellGeometry
-from trackplan.planning.result import CellReport, Violation
+from trackplan.check_report import CellReport, Violation
 from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.model import Robot
 

@@ -109,3 +109,6 @@ class Cell:
     links: Capsules | None = None
     clearance: float = DEFAULT_CLEARANCE
     tool_contact: float = 0.0
+
+
+__all__ = ["DEFAULT_CLEARANCE", "Body", "Capsules", "Cell", "Shape"]

@@ -54,7 +54,7 @@ def batch(
             )
     finally:
         if client is not None:
-            client.close()
+            client.close()  # type: ignore[no-untyped-call]  # distributed is unannotated
     console = _console()
     console.print(f"{escape(loaded.name)}: {escape(result.message)} in {result.wall_time_s:.1f} s")
     for row in result.rows:
@@ -89,7 +89,7 @@ def _study_progress(total: int):  # type: ignore[no-untyped-def]
             if row is not None:
                 figures = f"J = {row.J:.4f}, " if row.success else ""
                 typer.echo(
-                    f"[{state.done}/{state.total}] {row.job}: {row.status} "
+                    f"[{state.done}/{state.total}] {row.job}: {row.status.value} "
                     f"({figures}{row.wall_time_s:.1f} s on {row.worker})"
                 )
 

@@ -6,22 +6,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+# moved to trackplan.check_report; importers outside this package keep working
+from trackplan.check_report import (  # noqa: F401
+    IGNORED_UNLESS_BROKEN,
+    TASK_KINDS,
+    CellReport,
+    CheckReport,
+    Violation,
+)
 from trackplan.jointpath import JointPath
 from trackplan.paths import NominalPath, Path
 from trackplan.planning.energy import EnergyFigures
 from trackplan.robots.model import LIMIT_KINDS
 from trackplan.status import Status
 from trackplan.timing.protocol import SlowDown
-
-TASK_KINDS = ("tracking", "orientation", "speed", "coverage")
-
-
-IGNORED_UNLESS_BROKEN = frozenset({"speed", "coverage"})
-"""Task margins that count towards the worst margin only when negative (broken).
-
-A plan drives the tool at the rated speed wherever it can, so its speed margin is 0 by
-design, and the coverage margin is a pass (1) or fail (−1) flag, not an unused fraction.
-"""
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -85,125 +83,6 @@ class Trajectory:
     def duration(self) -> float:
         """Time of the last sample, s."""
         return float(self.t[-1])
-
-
-@dataclass(frozen=True, kw_only=True)
-class Violation:
-    """One limit broken over a time window.
-
-    Attributes
-    ----------
-    limit
-        A joint limit kind (``position``, ``velocity``, ``acceleration``, ``jerk``) or a
-        task kind (``tracking``, ``orientation``, ``speed``, ``coverage``).
-    joint
-        1-based joint number for joint limits, None for task limits.
-    t_first, t_last
-        First and last sample time at which the limit is exceeded, s.
-    worst
-        The worst value (signed for joint limits), in the limit's unit.
-    bound
-        The limit it exceeds (same unit).
-    message
-        One line: "joint 6 jerk 31.2 rad/s³ exceeds 20 at t = 2.415 s".
-    """
-
-    limit: str
-    joint: int | None
-    t_first: float
-    t_last: float
-    worst: float
-    bound: float
-    message: str
-
-
-@dataclass(frozen=True, eq=False, kw_only=True)
-class CellReport:
-    """What the cell check (:func:`trackplan.cell.check.check_cell`) found.
-
-    Attributes
-    ----------
-    min_clearance
-        Least signed distance over every checked pair and sample, m (negative: overlap).
-    closest
-        (robot body, other body) names of the pair where it occurs.
-    t_closest
-        Time of the closest approach, s.
-    point
-        Sample index of the closest approach.
-    clearance
-        The required clearance, m.
-    margin
-        ``(min_clearance − clearance) / max(clearance, 1 mm)``, capped at 1: the unused
-        share in the checker's sign convention (negative when violated).
-    distance
-        Least distance over all pairs at each sample, shape (N,), m (clearance vs time).
-    violations
-        One per pair that breaks the clearance (kind ``collision`` when the bodies
-        overlap, ``clearance`` otherwise), in time order.
-    """
-
-    min_clearance: float
-    closest: tuple[str, str]
-    t_closest: float
-    point: int
-    clearance: float
-    margin: float
-    distance: np.ndarray
-    violations: tuple[Violation, ...]
-
-    @property
-    def success(self) -> bool:
-        """True when every pair keeps the clearance at every sample."""
-        return not self.violations
-
-
-@dataclass(frozen=True, eq=False, kw_only=True)
-class CheckReport:
-    """What the checker found, sample by sample.
-
-    Attributes
-    ----------
-    success
-        True when nothing is violated.
-    joint_margins
-        Per joint limit kind, shape (n,): the smallest unused fraction of the limit
-        over all samples (1 = unused, 0 = reached, negative = exceeded). G <= 0 style:
-        ``-margin`` is the normalised constraint value.
-    task_margins
-        Per task kind, the unused fraction of the task bound (tracking: of ρ; speed: of
-        the speed cap; orientation: of the orientation tolerance; coverage: 1 or < 0).
-    violations
-        Every violation, in time order within each kind.
-    max_tracking_error
-        Largest distance of the tool point from the nominal path, m.
-    max_orientation_error
-        Largest tool orientation error, rad.
-    binding
-        For each joint limit kind, the (joint, time) at which it is closest to binding.
-    cell
-        The cell check, when the case has a cell.
-    """
-
-    success: bool
-    joint_margins: dict[str, np.ndarray]
-    task_margins: dict[str, float]
-    violations: tuple[Violation, ...]
-    max_tracking_error: float
-    max_orientation_error: float
-    binding: dict[str, tuple[int, float]] = field(default_factory=dict)
-    cell: CellReport | None = None
-
-    def worst_margin(self) -> float:
-        """The smallest margin over every limit (negative when infeasible); the margins of
-        :data:`IGNORED_UNLESS_BROKEN` count only when negative. NaN when none counts."""
-        values = [float(np.min(m)) for m in self.joint_margins.values()]
-        values += [
-            float(value)
-            for kind, value in self.task_margins.items()
-            if kind not in IGNORED_UNLESS_BROKEN or value < 0
-        ]
-        return min(values) if values else float("nan")
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)

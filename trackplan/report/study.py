@@ -251,7 +251,7 @@ def _jobs_table(rows: Sequence[JobRow], out_dir: Path) -> str:
                 _esc(row.robot),
                 _esc(row.sweep),
                 str(row.seed),
-                f'<span class="{css}">{_esc(row.status)}</span>',
+                f'<span class="{css}">{_esc(row.status.value)}</span>',
                 _num(row.J),
                 _num(row.duration_s),
                 _num(row.cycle_time_s),

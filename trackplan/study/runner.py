@@ -43,6 +43,7 @@ from trackplan.study.summary import (
 )
 
 if TYPE_CHECKING:
+    from dask.typing import Key
     from distributed import Client, Future
 
 MAX_RETRIES = 2
@@ -279,9 +280,9 @@ def _run_jobs(
     """Submit the jobs, collect their rows as they complete; True when Ctrl-C stopped it."""
     from distributed import as_completed
 
-    client.run_on_scheduler(limit_retries, MAX_RETRIES)
+    client.run_on_scheduler(limit_retries, MAX_RETRIES)  # type: ignore[no-untyped-call]  # distributed is unannotated
     token = uuid.uuid4().hex[:8]
-    futures: dict[Future, Job] = {
+    futures: dict[Future[JobRow], Job] = {
         client.submit(run_job, job, str(out), report, key=f"{job.key}-{token}", pure=False): job
         for job in jobs
     }
@@ -300,10 +301,10 @@ def _run_jobs(
             last=last,
         )
 
-    completed = as_completed(futures)
+    completed = as_completed(futures)  # type: ignore[no-untyped-call]  # distributed is unannotated
     try:
-        while not completed.is_empty():
-            if not completed.has_ready():
+        while not completed.is_empty():  # type: ignore[no-untyped-call]  # distributed is unannotated
+            if not completed.has_ready():  # type: ignore[no-untyped-call]  # distributed is unannotated
                 if time.perf_counter() - last_poll > 1.0:
                     running = _count_running(client, keys)
                     last_poll = time.perf_counter()
@@ -311,7 +312,7 @@ def _run_jobs(
                     progress(state())
                 time.sleep(POLL_S)
                 continue
-            for future in completed.next_batch(block=False):
+            for future in completed.next_batch(block=False):  # type: ignore[no-untyped-call]  # distributed is unannotated
                 row = _row(future, futures[future])
                 rows[row.job] = row
                 writer.add(row)
@@ -319,34 +320,36 @@ def _run_jobs(
                 if progress is not None:
                     progress(state(row))
     except KeyboardInterrupt:
-        client.cancel([future for future in futures if not future.done()])
+        pending = [future for future in futures if not future.done()]  # type: ignore[no-untyped-call]  # distributed is unannotated
+        client.cancel(pending)  # type: ignore[no-untyped-call]  # distributed is unannotated
         return True
     return False
 
 
-def _row(future: Future, job: Job) -> JobRow:
+def _row(future: Future[JobRow], job: Job) -> JobRow:
     """The row a finished task returned, or a failed row when the task itself failed.
 
     A task whose worker died after it finished, before its result was fetched, is pending
     again when it gets here (Dask recomputes it elsewhere): ``exception`` waits for that.
     """
-    if future.status == "cancelled":
+    if future.cancelled():  # type: ignore[no-untyped-call]  # distributed is unannotated
         return failed_row(job.describe(), "cancelled", math.nan, "")
-    exc = future.exception()
+    exc = future.exception()  # type: ignore[no-untyped-call]  # distributed is unannotated
     if exc is None:
-        return future.result()
+        row: JobRow = future.result()
+        return row
     reason = f"{type(exc).__name__}: {exc}".replace("\n", " ")
     return failed_row(job.describe(), reason, math.nan, "")
 
 
-def _count_running(client: Client, keys: set) -> int:
+def _count_running(client: Client, keys: set[Key]) -> int:
     """Tasks of this batch that a worker is running now.
 
     Workers hold a few more tasks than threads (Dask's queueing); at most one task per
     thread runs.
     """
-    processing = client.processing()
-    threads = client.nthreads()
+    processing = client.processing()  # type: ignore[no-untyped-call]  # distributed is unannotated
+    threads = client.nthreads()  # type: ignore[no-untyped-call]  # distributed is unannotated
     return sum(
         min(sum(key in keys for key in tasks), threads.get(worker, 1))
         for worker, tasks in processing.items()
@@ -376,12 +379,12 @@ def _client(client: Client | None, workers: int | None) -> Iterator[Client]:
     with local_cluster(workers) as cluster:
         from distributed import Client
 
-        with Client(cluster) as local:
+        with Client(cluster) as local:  # type: ignore[no-untyped-call]  # distributed is unannotated
             yield local
 
 
 @contextmanager
-def local_cluster(workers: int | None = None, preload: bool = True) -> Iterator:
+def local_cluster(workers: int | None = None, preload: bool = True) -> Iterator[Any]:
     """A ``LocalCluster`` of single-threaded worker processes, closed on exit.
 
     It runs with :data:`LOCAL_CLUSTER_CONFIG`, and gives its workers
@@ -400,7 +403,7 @@ def local_cluster(workers: int | None = None, preload: bool = True) -> Iterator:
     n_workers = workers or os.cpu_count() or 1
     with (
         dask.config.set(LOCAL_CLUSTER_CONFIG),
-        LocalCluster(
+        LocalCluster(  # type: ignore[no-untyped-call]  # distributed is unannotated
             n_workers=n_workers,
             threads_per_worker=1,
             processes=True,
@@ -445,7 +448,7 @@ def connect(address: str, timeout: float | None = None) -> Client:
     timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
 
     try:
-        return Client(address, timeout=timeout)
+        return Client(address, timeout=timeout)  # type: ignore[no-untyped-call]  # distributed is unannotated
     except (OSError, TimeoutError, ValueError) as exc:
         detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise CaseError(
@@ -460,7 +463,7 @@ def _status(rows: tuple[JobRow, ...], interrupted: bool) -> Status:
         return Status.INTERRUPTED
     if any(row.failed for row in rows):
         return Status.FAILED
-    return next((Status(row.status) for row in rows if not row.success), Status.FEASIBLE)
+    return next((row.status for row in rows if not row.success), Status.FEASIBLE)
 
 
 def _message(rows: tuple[JobRow, ...], total: int, skipped: int, cancelled: int) -> str:

@@ -15,8 +15,9 @@ from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from trackplan.check_report import IGNORED_UNLESS_BROKEN
+from trackplan.errors import CaseError
 from trackplan.io.csv_cells import neutralised, restored
-from trackplan.planning.result import IGNORED_UNLESS_BROKEN
 from trackplan.run_files import RESULT_FILE
 from trackplan.status import Status
 
@@ -24,9 +25,6 @@ JOB_FILE = "job.json"
 """The job's keys, wall time and worker, written last into a run folder."""
 
 SUMMARY_CSV = "summary.csv"
-
-FAILED = Status.FAILED.value
-"""Status of a job that raised, or whose workers died too often."""
 
 
 @dataclass(frozen=True)
@@ -40,8 +38,9 @@ class JobRow:
     case, robot, sweep, seed
         The job's keys (see :class:`~trackplan.study.jobs.Job`).
     status
-        The final plan's status (``feasible``, ``limits_violated``, ``unreachable``, …)
-        or ``failed`` when the job raised or lost its workers.
+        The final plan's status (:class:`~trackplan.status.Status`: ``FEASIBLE``,
+        ``LIMITS_VIOLATED``, ``UNREACHABLE``, …), or ``FAILED`` when the job raised or lost
+        its workers; written as its value (``feasible``, ``failed``, …).
     success
         True when the final plan passed the checker.
     J
@@ -68,7 +67,7 @@ class JobRow:
     robot: str
     sweep: str
     seed: int
-    status: str
+    status: Status
     success: bool
     J: float
     duration_s: float
@@ -82,7 +81,7 @@ class JobRow:
     @property
     def failed(self) -> bool:
         """True when the job produced no result."""
-        return self.status == FAILED
+        return self.status is Status.FAILED
 
 
 COLUMNS = tuple(field.name for field in fields(JobRow))
@@ -107,7 +106,7 @@ def row_from_run(folder: str | Path) -> JobRow:
         robot=job["robot"],
         sweep=job["sweep"],
         seed=int(job["seed"]),
-        status=str(result["status"]),
+        status=_status(result.get("status"), folder / RESULT_FILE),
         success=bool(result["feasible"]),
         J=_number(result.get("objective")),
         duration_s=_number(result.get("duration")),
@@ -118,6 +117,27 @@ def row_from_run(folder: str | Path) -> JobRow:
         worker=str(job["worker"]),
         message=str(result["message"]),
     )
+
+
+def _status(word: Any, file: Path) -> Status:
+    """The :class:`~trackplan.status.Status` whose value ``word`` is (the ``status`` of a
+    ``result.json`` or a ``summary.csv`` row).
+
+    Raises
+    ------
+    CaseError
+        When ``word`` is none of the Status values.
+    """
+    try:
+        return Status(word)
+    except ValueError:
+        words = ", ".join(status.value for status in Status)
+        raise CaseError(
+            f"unknown status {word!r}: expected one of {words} (not written by trackplan? "
+            "remove its run folder to run the job again)",
+            file=str(file),
+            key="status",
+        ) from None
 
 
 def _number(value: Any) -> float:
@@ -146,7 +166,7 @@ def failed_row(job: dict[str, Any], reason: str, wall_time_s: float, worker: str
         robot=job["robot"],
         sweep=job["sweep"],
         seed=int(job["seed"]),
-        status=FAILED,
+        status=Status.FAILED,
         success=False,
         J=nan,
         duration_s=nan,
@@ -220,9 +240,15 @@ def write_summary_csv(rows: Iterable[JobRow], file: str | Path) -> None:
 
 
 def read_summary_csv(file: str | Path) -> list[JobRow]:
-    """Read ``summary.csv`` back into rows."""
+    """Read ``summary.csv`` back into rows.
+
+    Raises
+    ------
+    CaseError
+        A row whose ``status`` is none of the :class:`~trackplan.status.Status` values.
+    """
     with Path(file).open(newline="", encoding="utf-8-sig") as handle:  # a spreadsheet's BOM
-        return [_row(cells) for cells in csv.DictReader(handle)]
+        return [_row(cells, Path(file)) for cells in csv.DictReader(handle)]
 
 
 def _cells(row: JobRow) -> list[str]:
@@ -232,6 +258,8 @@ def _cells(row: JobRow) -> list[str]:
     for value in astuple(row):
         if isinstance(value, bool):
             cells.append("true" if value else "false")
+        elif isinstance(value, Status):
+            cells.append(value.value)
         elif isinstance(value, float):
             cells.append(repr(value))
         elif isinstance(value, str):
@@ -241,11 +269,13 @@ def _cells(row: JobRow) -> list[str]:
     return cells
 
 
-def _row(cells: dict[str, str]) -> JobRow:
+def _row(cells: dict[str, str], file: Path) -> JobRow:
     values: dict[str, Any] = {}
     for field in fields(JobRow):
         text = cells[field.name]
-        if field.type == "bool":
+        if field.type == "Status":
+            values[field.name] = _status(text, file)
+        elif field.type == "bool":
             values[field.name] = text == "true"
         elif field.type == "int":
             values[field.name] = int(text)

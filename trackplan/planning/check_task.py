@@ -1,0 +1,284 @@
+"""The checker's task checks: tracking, tool orientation, Cartesian speed and coverage.
+
+Each compares the tool's sampled motion with a
+:class:`~trackplan.planning.check_reference.TrackingReference` (the nominal path, the tool
+spec, the tolerance and the speed caps).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from trackplan._kernels import read_only
+from trackplan.check_report import Violation
+from trackplan.motion import SampledMotion
+from trackplan.planning import _kernels
+from trackplan.planning.check_reference import TrackingReference
+from trackplan.planning.check_tool import check_tool
+from trackplan.planning.check_violations import (
+    RELATIVE_SLACK,
+    met,
+    plural,
+    violation_over,
+    violations_of,
+)
+from trackplan.planning.tracking import (
+    BETWEEN_STEP,
+    MAX_BETWEEN_PER_PERIOD,
+    jump_allowance,
+    locate_on_nominal,
+)
+from trackplan.robots.path_ik import _NEWTON_TOL as NEWTON_TOLERANCE
+
+IK_POSITION_TOLERANCE = NEWTON_TOLERANCE
+"""Largest distance between a sample's tool point (FK of its joints) and the path point the
+joints were solved for, m: the numeric IK's Newton tolerance
+(:data:`trackplan.robots.path_ik._NEWTON_TOL`), also the default of the paper law's
+resolved-rate IK (:func:`trackplan.robots.resolved_rate.solve_path_resolved_rate`);
+closed-form IK is exact to round-off."""
+
+
+def speed_slack(sample_time: float) -> float:
+    """Speed above a cap that still counts as meeting it, m/s: ``2 ε / Ts``.
+
+    The checker's speed is the backward difference ``|p_k − p_(k−1)| / Ts`` of two tool
+    points, each within ε = :data:`IK_POSITION_TOLERANCE` of the point of the path the time
+    law planned there, so it differs from the planned speed by at most ``2 ε / Ts``
+    (5e-8 m/s at Ts = 4 ms). The time laws plan the path at most at each cap, so a plan
+    counted feasible by the search (in smooth timing, every geometrically feasible
+    placement) passes this check; a sampled speed above ``cap + 2 ε / Ts`` (plus
+    :data:`RELATIVE_SLACK` of the cap for round-off) is a planned excess and a violation.
+
+    Parameters
+    ----------
+    sample_time
+        Ts, s.
+
+    Returns
+    -------
+    float
+        m/s.
+    """
+    return 2.0 * IK_POSITION_TOLERANCE / sample_time
+
+
+def check_task(
+    motion: SampledMotion, ref: TrackingReference
+) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
+    """Tracking, orientation, Cartesian speed and coverage checks.
+
+    Parameters
+    ----------
+    motion
+        The joint samples at Ts, shape (N, n), rad, with their tool poses.
+    ref
+        What the tool must do.
+
+    Returns
+    -------
+    tuple
+        ((the margin per task kind, the violations found), the largest tracking error, m,
+        the largest tool axis error, rad).
+    """
+    robot, q, sample_time = motion.robot, motion.q, motion.sample_time
+    T_base_part = np.ascontiguousarray(ref.T_base_part, dtype=float)
+    # the tool's points, velocities and speeds, and its x and z axes (all the tool checks
+    # read), in the definition frame; and its points between the samples, along the
+    # joint-space interpolation a controller follows (each period in parts of at most
+    # BETWEEN_STEP ρ of chord, at least two): one compiled pass over the poses and joints
+    chain, tail = robot.kernel_chain
+    # read-only inputs: one compiled version whoever made them (read_only)
+    p_part, velocity, speed, x_part, z_part, p_between, t_between = _kernels.task_frames(
+        read_only(np.ascontiguousarray(motion.T_base_tool)),
+        read_only(T_base_part),
+        sample_time,
+        read_only(chain),
+        read_only(tail),
+        read_only(np.ascontiguousarray(q)),
+        BETWEEN_STEP * ref.tolerance,
+        MAX_BETWEEN_PER_PERIOD,
+    )
+    t = np.arange(len(q)) * sample_time
+    violations: list[Violation] = []
+    margins: dict[str, float] = {}
+
+    # tracking error and the position along the nominal path, in order of travel
+    s_nominal, distance, piece = locate_on_nominal(
+        ref.nominal, p_part, velocity, ref.tolerance, speed
+    )
+    worst = float(distance.max())
+    if distance.max() > ref.tolerance * (1 + RELATIVE_SLACK):
+        violations.append(
+            violation_over("tracking", None, t, distance, distance / ref.tolerance, ref.tolerance)
+        )
+    # ... and between the samples
+    if len(p_between):
+        d_between = ref.nominal.index.candidates(p_between, 0.0).nearest  # distances only
+        worst = max(worst, float(d_between.max()))
+        if d_between.max() > ref.tolerance * (1 + RELATIVE_SLACK) and not violations_of(
+            violations, "tracking"
+        ):
+            t_b = t_between * sample_time
+            found = violation_over(
+                "tracking", None, t_b, d_between, d_between / ref.tolerance, ref.tolerance
+            )
+            message = found.message.replace("tracking", "tracking between samples", 1)
+            violations.append(replace(found, message=message))
+    margins["tracking"] = float(met(1.0 - worst / ref.tolerance, RELATIVE_SLACK))
+
+    orientation_error, tool_found = check_tool(ref, x_part, z_part, s_nominal, piece, t, margins)
+    violations.extend(tool_found)
+
+    # Cartesian speed against the cap that applies where the tool is
+    in_corner = np.zeros(len(q), dtype=bool)
+    for s0, s1 in np.asarray(ref.corner_intervals).reshape(-1, 2):
+        in_corner |= (s_nominal >= s0) & (s_nominal <= s1)
+    cap = np.where(in_corner, ref.corner_speed, ref.rated_speed)
+    # a backward difference is the mean speed over the last period: where that period
+    # straddles the end of a corner, the mean may reach the higher of the two caps
+    cap[1:] = np.maximum(cap[1:], cap[:-1])
+    corner = in_corner.copy()
+    corner[1:] |= in_corner[:-1]  # either end of the period in a corner …
+    corner &= cap == ref.corner_speed  # … and the corner speed its cap
+    margins["speed"], over_speed = speed_verdict(speed, cap, corner, t, sample_time)
+    violations.extend(over_speed)
+
+    coverage = coverage_violations(ref, t, s_nominal, piece, speed, sample_time)
+    margins["coverage"] = 1.0 if not coverage else -1.0
+    violations.extend(coverage)
+    return (margins, violations), worst, orientation_error
+
+
+def speed_verdict(
+    speed: np.ndarray, cap: np.ndarray, in_corner: np.ndarray, t: np.ndarray, sample_time: float
+) -> tuple[float, list[Violation]]:
+    """The speed margin and violation, one verdict: a sample is over its cap when it exceeds
+    it by more than :func:`speed_slack` plus :data:`RELATIVE_SLACK` of the cap; the margin
+    ``1 − max(speed / cap)`` is negative exactly then (0 when within the slack).
+
+    Parameters
+    ----------
+    speed, cap
+        Tool speed (backward differences) and the cap at each sample, shape (N,), m/s.
+    in_corner
+        Whether the corner speed is the cap at each sample (an arc or a corner blend),
+        shape (N,), bool; elsewhere the rated speed is (a straight piece).
+    t
+        Sample times, shape (N,), s.
+    sample_time
+        Ts, s.
+    """
+    over = speed - cap > speed_slack(sample_time) + RELATIVE_SLACK * cap
+    margin = 1.0 - float((speed / cap).max())
+    if not over.any():
+        return max(margin, 0.0), []
+    ratio = np.where(over, speed / cap, 0.0)
+    found = violation_over("speed", None, t, speed, ratio, float(cap[np.argmax(ratio)]))
+    worst = int(np.argmax(ratio))
+    value, bound = float(speed[worst]), float(cap[worst])
+    if in_corner[worst]:
+        which = f"the corner speed {bound:g} m/s (the cap on arcs and corner blends)"
+    else:
+        which = f"the rated speed {bound:g} m/s (the cap on straight pieces)"
+    message = (
+        f"speed {value:.6g} m/s exceeds {which} by {value - bound:.3g} m/s at "
+        f"t = {t[worst]:.3f} s ({plural(int(over.sum()), 'sample')} from "
+        f"t = {found.t_first:.3f} to {found.t_last:.3f} s)"
+    )
+    return min(margin, -RELATIVE_SLACK), [replace(found, message=message)]
+
+
+def coverage_violations(
+    ref: TrackingReference,
+    t: np.ndarray,
+    s: np.ndarray,
+    piece: np.ndarray,
+    speed: np.ndarray,
+    sample_time: float,
+) -> list[Violation]:
+    """The whole nominal path covered from start to end, in order, with no jump.
+
+    Parameters
+    ----------
+    ref
+        What the tool must do (the nominal path, the tolerance ρ, the speed caps).
+    t
+        Sample times, shape (N,), s.
+    s, piece
+        Each sample's arc length on the nominal path, m, and nominal piece index, shape (N,).
+    speed
+        Tool speed at each sample, shape (N,), m/s.
+    sample_time
+        Ts, s.
+
+    Returns
+    -------
+    list of Violation
+        ``coverage`` violations: a late start, an early end, a run backwards, a jump.
+    """
+    nominal = ref.nominal
+    tol = 2.0 * ref.tolerance
+    found: list[Violation] = []
+
+    def add(k: int, value: float, bound: float, text: str) -> None:
+        found.append(
+            Violation(
+                limit="coverage",
+                joint=None,
+                t_first=float(t[k]),
+                t_last=float(t[k]),
+                worst=value,
+                bound=bound,
+                message=text,
+            )
+        )
+
+    if s[0] > tol:
+        add(
+            0,
+            float(s[0]),
+            tol,
+            f"coverage: the trajectory starts {s[0]:.4g} m into the path, not at its start",
+        )
+    if s[-1] < nominal.length - tol:
+        add(
+            len(s) - 1,
+            float(s[-1]),
+            nominal.length,
+            f"coverage: the trajectory ends {nominal.length - s[-1]:.4g} m before the path end",
+        )
+    step = np.diff(s)
+    backwards = np.flatnonzero(step < -tol)
+    if backwards.size:
+        k = int(backwards[0]) + 1
+        add(
+            k,
+            float(step[k - 1]),
+            0.0,
+            f"coverage: the path is run backwards at t = {t[k]:.3f} s "
+            f"({plural(backwards.size, 'step')})",
+        )
+    allowance = jump_allowance(nominal, ref.tolerance)  # (P,) extra jump allowed after piece p
+    # one sample may advance up to a few times the task speed (a speed excess is reported
+    # as such); more is a jump over part of the path
+    step_cap = 4.0 * max(ref.rated_speed, ref.corner_speed) * sample_time + tol
+    allowed = step_cap + np.where(piece[1:] != piece[:-1], allowance[piece[:-1]], 0.0)
+    jumps = np.flatnonzero(step > allowed)
+    if jumps.size:
+        k = int(jumps[0]) + 1
+        segment = np.asarray(nominal.segment_index)
+        between = np.unique(segment[piece[k - 1] + 1 : piece[k]])
+        between = between[(between != segment[piece[k - 1]]) & (between != segment[piece[k]])]
+        if between.size:
+            what = "segment " + ", ".join(str(int(i) + 1) for i in between) + " skipped"
+        else:
+            what = f"part of segment {int(segment[piece[k]]) + 1} skipped"
+        add(
+            k,
+            float(step[k - 1]),
+            float(allowed[k - 1]),
+            f"coverage: {what} at t = {t[k]:.3f} s: {step[k - 1]:.4g} m in one sample",
+        )
+    return found
