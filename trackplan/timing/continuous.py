@@ -61,10 +61,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Task
 from trackplan.jointpath import STENCIL_FRACTION, JointPath
 from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
+from trackplan.task import Task
 from trackplan.timing.sample_checks import (
     LIMIT_MARGIN,
     RateLimits,

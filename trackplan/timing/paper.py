@@ -47,7 +47,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Task
 from trackplan.choices import Timing
 from trackplan.frames import placement_transform
 from trackplan.jointpath import JointPath
@@ -57,6 +56,7 @@ from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import solve_path_ik
 from trackplan.robots.resolved_rate import solve_path_resolved_rate
 from trackplan.status import Status
+from trackplan.task import Task
 from trackplan.timing.protocol import TimeLaw, TimeLawSpec, unsampled
 
 MIN_VIA_SPACING = 1e-3

@@ -13,12 +13,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Task
 from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
 from trackplan.motion import SampledMotion
 from trackplan.paths.path_geometry import PathMode
 from trackplan.status import Status
+from trackplan.task import Task
 
 
 @dataclass(frozen=True)

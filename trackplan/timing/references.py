@@ -31,10 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
-from trackplan.case import Task
 from trackplan.errors import CaseError
 from trackplan.jointpath import JointPath
 from trackplan.robots.model import Robot
+from trackplan.task import Task
 
 JointSamples = np.ndarray | Callable[[np.ndarray], np.ndarray]
 """Joint path on the grid: samples (M, n) at ``s_grid``, or a callable s (M,) -> q (M, n)."""

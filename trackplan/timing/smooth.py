@@ -32,12 +32,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Task
 from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
 from trackplan.motion import SampledMotion
 from trackplan.robots.model import Robot
 from trackplan.status import Status
+from trackplan.task import Task
 from trackplan.timing import _kernels
 from trackplan.timing.continuous import SpeedCurve, plan_speed_curve
 from trackplan.timing.demand import (
