@@ -55,3 +55,31 @@ def test_the_task_is_the_one_the_case_holds():
     from trackplan.task import Task
 
     assert CaseTask is Task
+
+
+def test_one_name_per_concept_the_law_and_what_it_gives():
+    from trackplan import timing
+    from trackplan.choices import Timing
+
+    law = timing.time_law("smooth")
+    assert isinstance(law, timing.TimeLaw)
+    assert law.timing is Timing.SMOOTH and callable(law.plan)
+    assert timing.TimedPath is not timing.TimeLaw
+
+
+@pytest.mark.parametrize(
+    ("module", "old", "new"),
+    [
+        ("trackplan.timing", "TimeLawSpec", "TimeLaw"),
+        ("trackplan.motion", "SampledMotion", "JointSamples"),
+    ],
+)
+def test_an_old_name_still_imports_with_a_deprecation_warning(module, old, new):
+    import importlib
+
+    imported = importlib.import_module(module)
+    with pytest.warns(DeprecationWarning, match=new):
+        found = getattr(imported, old)
+    assert found is getattr(imported, new)
+    with pytest.raises(AttributeError):
+        _ = imported.NoSuchName

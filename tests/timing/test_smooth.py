@@ -112,8 +112,8 @@ def test_rebuilds_until_the_sampled_trajectory_meets_every_limit(monkeypatch):
         laws.append(original(*args, **kwargs))
         return laws[-1]
 
-    spec = dataclasses.replace(smooth.SPEC, plan=spy)
-    monkeypatch.setitem(timing.TIME_LAWS, smooth.SPEC.timing, spec)
+    spec = dataclasses.replace(smooth.LAW, plan=spy)
+    monkeypatch.setitem(timing.TIME_LAWS, smooth.LAW.timing, spec)
     case = load_case(CASES / "paper-corner.yaml")
     result = plan_placement(case, case.bounds.example)
     assert laws[-1].iterations > 1 and laws[-1].success

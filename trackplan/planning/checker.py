@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan._kernels import read_only
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.paths import NominalPath
 from trackplan.planning import _kernels
 from trackplan.planning.result import CheckReport, Violation
@@ -157,16 +157,16 @@ def check_trajectory(
     CheckReport
         Margins, violations and the worst tracking and orientation errors.
     """
-    return check_motion(SampledMotion(robot, q, sample_time), reference, cell)
+    return check_motion(JointSamples(robot, q, sample_time), reference, cell)
 
 
 def check_motion(
-    motion: SampledMotion,
+    motion: JointSamples,
     reference: TrackingReference | None = None,
     cell: CellGeometry | None = None,
 ) -> CheckReport:
     """:func:`check_trajectory` of sampled joints whose derivatives, torques and tool poses
-    other readers share (:class:`~trackplan.motion.SampledMotion`: each computed once).
+    other readers share (:class:`~trackplan.motion.JointSamples`: each computed once).
 
     Parameters
     ----------
@@ -301,7 +301,7 @@ def _violation(
 
 
 def _check_task(
-    motion: SampledMotion, ref: TrackingReference
+    motion: JointSamples, ref: TrackingReference
 ) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
     """Tracking, orientation, Cartesian speed and coverage checks."""
     robot, q, sample_time = motion.robot, motion.q, motion.sample_time

@@ -62,7 +62,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.jointpath import STENCIL_FRACTION, JointPath
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.robots.model import Robot
 from trackplan.task import Task
 from trackplan.timing.sample_checks import (
@@ -156,7 +156,7 @@ class SpeedCurve:
     """
 
     s: np.ndarray
-    motion: SampledMotion
+    motion: JointSamples
     s_nodes: np.ndarray
     speed: np.ndarray
     joint_cap: np.ndarray
@@ -244,7 +244,7 @@ def plan_speed_curve(
         s = _sample(stretches, speeds, task.sample_time)
         if s is None:
             return None
-        motion = SampledMotion(robot, joint_path.joints(s), task.sample_time)
+        motion = JointSamples(robot, joint_path.joints(s), task.sample_time)
         # the rate checks name the limit to lower; any other check (the torques) asks for a
         # lower speed where it fails (order 5)
         sample, order, ratio = run_motion_checks(rates, motion)
@@ -356,7 +356,8 @@ def _demand(
 def _within(s: np.ndarray, gaps: np.ndarray) -> np.ndarray:
     """Whether each point of ``s`` (G,) lies in one of the closed ``gaps`` (M, 2), (G,) bool."""
     inside = (s[:, None] >= gaps[None, :, 0]) & (s[:, None] <= gaps[None, :, 1])
-    return np.any(inside, axis=1)
+    found: np.ndarray = np.any(inside, axis=1)
+    return found
 
 
 def _grid_step(grid: np.ndarray) -> float:
@@ -435,7 +436,8 @@ def _steady_demand(
     ``|q'''| / j_max`` over the joints."""
     _, d2, d3 = derivatives
     acceleration = np.max(np.abs(d2) / robot.a_max, axis=1) ** 1.5
-    return np.maximum(acceleration, np.max(np.abs(d3) / robot.j_max, axis=1))
+    demand: np.ndarray = np.maximum(acceleration, np.max(np.abs(d3) / robot.j_max, axis=1))
+    return demand
 
 
 def _nodes(grid: np.ndarray, a: float, b: float) -> np.ndarray:
@@ -608,7 +610,8 @@ def _time_weights(s: np.ndarray, reference: np.ndarray) -> np.ndarray:
     length = np.diff(s, prepend=s[0]) + np.diff(s, append=s[-1])
     floor = (SLOW_FLOOR**2) * max(float(reference.max()), 1e-300)
     weights = length / np.maximum(reference, floor) ** 1.5
-    return weights / weights.max()
+    normalised: np.ndarray = weights / weights.max()
+    return normalised
 
 
 def _cruising(s: np.ndarray, top: np.ndarray, steady: np.ndarray) -> np.ndarray:
@@ -627,7 +630,7 @@ def _cruising(s: np.ndarray, top: np.ndarray, steady: np.ndarray) -> np.ndarray:
     index = np.searchsorted(busy, s)
     after = busy[np.minimum(index, len(busy) - 1)]
     before = busy[np.maximum(index - 1, 0)]
-    nearest = np.minimum(np.abs(after - s), np.abs(s - before))
+    nearest: np.ndarray = np.minimum(np.abs(after - s), np.abs(s - before))
     return nearest > CRUISE_CLEARANCE
 
 
@@ -668,13 +671,14 @@ def _rest_envelope(s: np.ndarray, d1: np.ndarray, jerk: np.ndarray) -> np.ndarra
     backward = np.minimum.accumulate(path_jerk[::-1])[::-1]
     start = 6.0 ** (4.0 / 3.0) / 4.0 * np.cbrt(forward * (s - s[0]) ** 2) ** 2
     end = 6.0 ** (4.0 / 3.0) / 4.0 * np.cbrt(backward * (s[-1] - s) ** 2) ** 2
-    return np.minimum(start, end)
+    envelope: np.ndarray = np.minimum(start, end)
+    return envelope
 
 
 def _node_steps(stretch: _Stretch, speed: np.ndarray) -> np.ndarray:
     """Time between consecutive nodes, shape (G - 1,), s, at the node speeds ``speed`` (G,):
     constant acceleration between nodes, constant jerk next to the rests at both ends."""
-    step = 2.0 * np.diff(stretch.s) / np.maximum(speed[1:] + speed[:-1], 1e-300)
+    step: np.ndarray = 2.0 * np.diff(stretch.s) / np.maximum(speed[1:] + speed[:-1], 1e-300)
     step[[0, -1]] *= 1.5  # from and to rest at constant jerk: s/ṡ = t/3, not t/2
     return step
 

@@ -34,11 +34,11 @@ import numpy as np
 
 from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.task import Task
-from trackplan.timing import _kernels
+from trackplan.timing import _kernels, _kernels_samples
 from trackplan.timing.continuous import SpeedCurve, plan_speed_curve
 from trackplan.timing.demand import (
     SpeedChange,
@@ -52,7 +52,7 @@ from trackplan.timing.profile import (
     speed_change_phases,
     speed_change_time,
 )
-from trackplan.timing.protocol import SlowDown, TimeLaw, TimeLawSpec, unsampled
+from trackplan.timing.protocol import SlowDown, TimedPath, TimeLaw, unsampled
 from trackplan.timing.sample_checks import (
     LIMIT_MARGIN,
     SampleCheck,
@@ -101,7 +101,7 @@ class ZonePlan:
 
 def plan_smooth_time_law(
     joint_path: JointPath, task: Task, sample_checks: tuple[SampleCheck, ...] | None = None
-) -> TimeLaw:
+) -> TimedPath:
     """Shortest jerk-limited time law of the smooth mode (see the module docstring).
 
     Parameters
@@ -117,7 +117,7 @@ def plan_smooth_time_law(
 
     Returns
     -------
-    TimeLaw
+    TimedPath
         Sampled at Ts from rest to rest; the last sample is the end of the path.
     """
     robot = joint_path.robot
@@ -156,7 +156,7 @@ def plan_smooth_time_law(
         t = np.arange(n_steps + 1) * sample_time
         s = profile.position(t / time_scale)
         s[-1] = length
-        motion = SampledMotion(robot, joint_path.joints(s), sample_time)
+        motion = JointSamples(robot, joint_path.joints(s), sample_time)
         worst = run_motion_checks(checks, motion)
         if not worst[0].size:
             law = _sampled(plans, task, s, motion, iteration, converged=True)
@@ -188,7 +188,7 @@ _ORDER_KINDS = {1: "velocity", 2: "acceleration", 3: "jerk"}
 
 
 def _failing_limit(
-    worst: tuple[np.ndarray, np.ndarray, np.ndarray], motion: SampledMotion, s: np.ndarray
+    worst: tuple[np.ndarray, np.ndarray, np.ndarray], motion: JointSamples, s: np.ndarray
 ) -> str:
     """The worst failing sample of a sample check, in words: ``joint 1 acceleration is 4.8 ×
     its limit at s = 0.0020 m`` (``a joint limit …`` for a check other than the rates)."""
@@ -236,13 +236,13 @@ there)."""
 
 
 def _or_curve(
-    law: TimeLaw,
+    law: TimedPath,
     plans: list[ZonePlan],
     duration: float,
     joint_path: JointPath,
     task: Task,
     checks: tuple[SampleCheck, ...],
-) -> TimeLaw:
+) -> TimedPath:
     """The window law, or the continuous speed curve where the joints slow the windows down
     enough for it to pay (:data:`CURVE_SHARE`, or :data:`REST_CHANGE_SHARE` for the start
     and the stop) and it is faster (or the windows failed)."""
@@ -263,7 +263,7 @@ def _or_curve(
     )
     if curve is None or (law.success and curve.duration >= law.duration):
         return law
-    return TimeLaw(
+    return TimedPath(
         timing=Timing.SMOOTH,
         success=True,
         status=Status.FEASIBLE,
@@ -363,10 +363,10 @@ def _sampled(
     plans: list[ZonePlan],
     task: Task,
     s: np.ndarray,
-    motion: SampledMotion,
+    motion: JointSamples,
     iterations: int,
     converged: bool,
-) -> TimeLaw:
+) -> TimedPath:
     """The law's result: samples, slow-downs and corner speed from the zone plans."""
     rated = task.rated_speed
     plateaus = [z.plateau for z in plans if z.kind == "curved"]
@@ -376,7 +376,7 @@ def _sampled(
         if z.kind == "straight" and z.plateau < rated * (1 - 1e-9)
     )
     message = "" if converged else f"rate limits still exceeded after {iterations} rebuilds"
-    return TimeLaw(
+    return TimedPath(
         timing=Timing.SMOOTH,
         success=converged,
         status=Status.FEASIBLE if converged else Status.NOT_CONVERGED,
@@ -466,8 +466,8 @@ def _slow_down_windows(
 
 def _level_runs(s: np.ndarray, level: np.ndarray, shortest: float) -> list[tuple[int, int]]:
     """Runs (first, last grid index) of equal level, runs under ``shortest`` (m) merged
-    into slower ones (compiled: :func:`trackplan.timing._kernels.level_runs`)."""
-    starts, ends = _kernels.level_runs(s, level.astype(np.int64), shortest)
+    into slower ones (compiled: :func:`trackplan.timing._kernels_samples.level_runs`)."""
+    starts, ends = _kernels_samples.level_runs(s, level.astype(np.int64), shortest)
     return list(zip(starts.tolist(), ends.tolist(), strict=True))
 
 
@@ -703,5 +703,5 @@ def _jerk_for_duration(delta: float, accel: float, jerk: float, duration: float)
     return high
 
 
-SPEC = TimeLawSpec(Timing.SMOOTH, "g2", plan_smooth_time_law)
+LAW = TimeLaw(Timing.SMOOTH, "g2", plan_smooth_time_law)
 """The smooth law, as :data:`trackplan.timing.TIME_LAWS` lists it."""
