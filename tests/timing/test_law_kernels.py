@@ -15,7 +15,7 @@ from trackplan.derivatives import backward_derivatives
 from trackplan.timing._kernels_samples import rate_ratios
 from trackplan.timing.demand import ZoneDemand
 from trackplan.timing.profile import speed_change_time
-from trackplan.timing.smooth import _jerk_for_duration
+from trackplan.timing.zones import _jerk_for_duration
 
 
 @settings(max_examples=60, deadline=None)

@@ -10,7 +10,7 @@ operations as the numpy reference functions of :mod:`trackplan.timing.demand`
 
 The smooth law calls two of them per plan, each running a whole loop with the operations
 of its numpy statement: :func:`plateau_search` (the plateaus over all zones,
-:class:`trackplan.timing.smooth._ZonePlanner`) and :func:`change_search` (one speed change,
+:class:`trackplan.timing.zones.ZonePlanner`) and :func:`change_search` (one speed change,
 :func:`~trackplan.timing.demand.speed_change`); the others run inside them. The kernels
 that run along the path and its samples are in :mod:`trackplan.timing._kernels_samples`.
 """

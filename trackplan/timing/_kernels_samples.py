@@ -1,7 +1,7 @@
 """Compiled kernels the smooth law runs along its path and samples.
 
 :func:`level_runs` merges the windows where one limit rules
-(:class:`trackplan.timing.smooth._ZonePlanner`), :func:`local_caps` gives the zones' local
+(:class:`trackplan.timing.zones.ZonePlanner`), :func:`local_caps` gives the zones' local
 speed caps (:mod:`trackplan.timing.demand`), :func:`rate_ratios` checks the samples' joint
 rates (:mod:`trackplan.timing.sample_checks`) and :func:`profile_position` evaluates a
 speed profile at the samples (:meth:`~trackplan.timing.profile.SpeedProfile.position`).
