@@ -1,6 +1,7 @@
 """Time laws: joint path and task in, samples at Ts out (``docs/timing.md``).
 
-:data:`TIME_LAWS` lists the laws by name; :func:`time_law` looks one up from user input.
+A :class:`TimeLaw` times a joint path into a :class:`TimedPath`. :data:`TIME_LAWS` lists the
+laws by name; :func:`time_law` looks one up from user input.
 The reference laws (toppra, copp-py's TOPP3) are in :mod:`trackplan.timing.references`.
 """
 
