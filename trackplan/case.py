@@ -11,44 +11,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from trackplan.cell.model import Cell
-from trackplan.choices import Method, Penalty, Timing, choose
+from trackplan.choices import Method, Penalty, choose
 from trackplan.paths.specs import SegmentSpec
 from trackplan.robots.model import Robot
-from trackplan.tool import ToolSpec
+from trackplan.task import Task
 
 PLACEMENT_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
-
-
-@dataclass(frozen=True, eq=False)
-class Task:
-    """Process requirements.
-
-    Attributes
-    ----------
-    rated_speed
-        Tool speed on straight pieces, v_r, m/s.
-    corner_speed
-        Highest tool speed on arcs and corner blends, v_t^max, m/s.
-    tolerance
-        Largest distance of the tool point from the nominal path, ρ, m.
-    sample_time
-        Controller period Ts, s.
-    tool
-        How the tool is held along the path (:class:`trackplan.tool.ToolSpec`).
-    timing
-        The time law: ``smooth`` (jerk-limited, G2 blends) or ``paper`` (Section 3.1 as
-        written).
-    """
-
-    rated_speed: float
-    corner_speed: float
-    tolerance: float
-    sample_time: float
-    tool: ToolSpec = field(default_factory=ToolSpec)
-    timing: Timing = Timing.SMOOTH
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "timing", choose(Timing, self.timing, "task.timing"))
 
 
 @dataclass(frozen=True, eq=False)

@@ -3,13 +3,16 @@
 A plan's samples are read by the time law's sample checks, the checker, the energy figures
 and the trajectory it returns. Each of them needs the same backward differences
 (``docs/conventions.md``), the same joint torques and the same tool poses:
-:class:`SampledMotion` computes each of them on first use and hands the same arrays to
+:class:`JointSamples` computes each of them on first use and hands the same arrays to
 every reader, so that one plan makes one derivative pass, one FK pass and one inverse
-dynamics pass over its samples.
+dynamics pass over its samples. It is a working set of the checks, not a result: the
+plan's output record is :class:`trackplan.planning.result.Trajectory` (times, joints and
+tool figures per sample, written to ``trajectory.csv``).
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -22,7 +25,7 @@ from trackplan.robots.model import Robot
 
 
 @dataclass(frozen=True, eq=False)
-class SampledMotion:
+class JointSamples:
     """Joint positions at Ts from rest to rest, with their derivatives, torques and FK.
 
     Every derived array is computed on first use and read-only; the arrays of the
@@ -99,3 +102,16 @@ class SampledMotion:
         poses = forward_kinematics(self.robot, self.q)
         poses.flags.writeable = False
         return poses
+
+
+def __getattr__(name: str) -> type[JointSamples]:
+    """``SampledMotion``, the old name of :class:`JointSamples`, with a
+    :class:`DeprecationWarning` (one release)."""
+    if name == "SampledMotion":
+        warnings.warn(
+            "trackplan.motion.SampledMotion is now trackplan.motion.JointSamples",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return JointSamples
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

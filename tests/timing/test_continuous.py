@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.planning.plan import check_case_trajectory, plan_placement
-from trackplan.timing import continuous, smooth
+from trackplan.timing import continuous, curve_nodes, curve_program, smooth
 from trackplan.timing.profile import SpeedProfile, speed_change_phases, speed_change_time
 from trackplan.timing.sample_checks import robot_checks
 from trackplan.timing.smooth import LIMIT_SHARE
@@ -75,10 +75,10 @@ def test_the_linear_program_meets_its_node_bounds(wrist):
     every node, on both sides of every node, with the jerk bound at the planned speed."""
     case, result = wrist
     robot = case.robot
-    stretch = continuous._stretches(result.joint_path, case.task)[0]
+    stretch = curve_nodes.split_stretches(result.joint_path, case.task)[0]
     limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
     limits = np.broadcast_to(limits, (3, len(stretch.s), robot.n_dof))
-    x = continuous._solve(stretch, limits, stretch.cap)
+    x = curve_program.solve_curve(stretch, limits, stretch.cap)
     assert x is not None
     v = np.sqrt(x)
     assert v.max() <= case.task.rated_speed
@@ -100,8 +100,8 @@ def test_rest_envelope_is_a_start_at_constant_path_jerk():
     s = np.linspace(0.0, 0.01, 101)
     d1 = np.full((2, len(s), 1), 2.0)  # q' = 2 rad/m: path jerk J = j_max / 2
     jerk = np.full((len(s), 1), 8.0)
-    x = continuous._rest_envelope(s, d1, jerk)
-    J = continuous.REST_JERK_SHARE * 4.0
+    x = curve_program._rest_envelope(s, d1, jerk)
+    J = curve_program.REST_JERK_SHARE * 4.0
     t = np.cbrt(6 * s / J)  # s = J t³/6
     near_start = s <= 0.005
     assert np.allclose(x[near_start], (J * t[near_start] ** 2 / 2) ** 2, rtol=1e-12)
@@ -267,10 +267,10 @@ def test_no_node_inside_a_stretch_comes_to_rest_in_a_short_blend():
     case = load_case(CASES / "paper-corner.yaml")
     joint_path = plan_placement(case, CORNER_X).joint_path
     robot = case.robot
-    (stretch,) = continuous._stretches(joint_path, case.task)
+    (stretch,) = curve_nodes.split_stretches(joint_path, case.task)
     limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
     limits = np.broadcast_to(limits, (3, len(stretch.s), robot.n_dof))
-    x = continuous._solve(stretch, limits, stretch.cap)
+    x = curve_program.solve_curve(stretch, limits, stretch.cap)
     assert x is not None
     cap, _ = continuous._joint_caps(stretch, robot, LIMIT_SHARE)
     blend = (stretch.s > 0.4964) & (stretch.s < 0.5014)
@@ -282,15 +282,15 @@ def test_nodes_keep_the_grid_points_and_grow_gradually():
     grid = np.concatenate(
         [np.linspace(0.0, 0.5, 251), np.linspace(0.5, 0.505, 83), np.linspace(0.505, 1.0, 250)]
     )
-    nodes = continuous._nodes(grid, 0.0, 1.0)
+    nodes = curve_nodes._nodes(grid, 0.0, 1.0)
     steps = np.diff(nodes)
     assert nodes[0] == 0.0 and nodes[-1] == 1.0
     assert np.all(np.isin(np.unique(grid), nodes))
-    assert steps.max() <= continuous.NODE_SPACING * (1 + 1e-9)
+    assert steps.max() <= curve_nodes.NODE_SPACING * (1 + 1e-9)
     # neighbouring steps stay alike: at most NODE_GROWTH of the step apart (and a rounding)
     growth = np.maximum(steps[1:] / steps[:-1], steps[:-1] / steps[1:])
-    assert growth.max() <= 1.0 + 1.2 * continuous.NODE_GROWTH
-    assert len(nodes) < 1.2 * (1.0 / continuous.NODE_SPACING + 83)
+    assert growth.max() <= 1.0 + 1.2 * curve_nodes.NODE_GROWTH
+    assert len(nodes) < 1.2 * (1.0 / curve_nodes.NODE_SPACING + 83)
 
 
 @given(
@@ -303,7 +303,7 @@ def test_nodes_keep_the_grid_points_and_grow_gradually():
 def test_three_point_differences_are_exact_for_quadratics(steps, a, b, c):
     s = np.concatenate([[0.0], np.cumsum(steps)])
     x = a + b * s + c * s**2
-    slope, bend = continuous._differences(s)
+    slope, bend = curve_program._differences(s)
     rows = np.stack([x[:-2], x[1:-1], x[2:]], axis=1)
     scale = 1.0 + abs(b) + abs(c)
     assert np.allclose((slope * rows).sum(axis=1), b + 2 * c * s[1:-1], atol=1e-6 * scale)
@@ -319,11 +319,13 @@ def test_the_nodes_see_the_seam_frame_start_turning_between_grid_points():
     interpolated: a speed cap 1.8 times too high)."""
     case = load_case(CASES / "bracket-two-faces.yaml")
     joint_path = plan_placement(case, SEAM_X).joint_path
-    (stretch,) = continuous._stretches(joint_path, case.task)
+    (stretch,) = curve_nodes.split_stretches(joint_path, case.task)
     blend = joint_path.geometry.zones()[0][1]
     points = np.arange(blend - 0.022, blend, 2e-5)
-    demand = continuous._steady_demand(joint_path.derivatives(points, 0.0, blend, 2e-5), case.robot)
-    at_nodes = continuous._steady_demand(
+    demand = curve_nodes._steady_demand(
+        joint_path.derivatives(points, 0.0, blend, 2e-5), case.robot
+    )
+    at_nodes = curve_nodes._steady_demand(
         tuple(np.abs(d).max(axis=0) for d in (stretch.d1, stretch.d2, stretch.d3)), case.robot
     )
     after = np.searchsorted(stretch.s, points)
@@ -372,16 +374,16 @@ def test_a_lowered_jerk_limit_lowers_the_path_jerk_at_a_wrist_flip(rows, monkeyp
     rebuilds lower them around failing samples), the linear program without the path-jerk
     rows meets them by cancelling ``ṡ q' x''/2`` against the other terms, 3.1 times the
     lowered limit; with the rows that term itself stays within CANCEL_ROOM times it."""
-    room = continuous.CANCEL_ROOM
+    room = curve_program.CANCEL_ROOM
     case = load_case(CASES / "bracket-two-faces.yaml")
     joint_path = plan_placement(case, WRIST_FLIP_X).joint_path
     robot = case.robot
-    (stretch,) = continuous._stretches(joint_path, case.task)
+    (stretch,) = curve_nodes.split_stretches(joint_path, case.task)
     limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, 0.25 * robot.j_max])[:, None, :]
     limits = np.broadcast_to(limits, (3, len(stretch.s), robot.n_dof))
     if not rows:
-        monkeypatch.setattr(continuous, "CANCEL_ROOM", np.inf)
-    x = continuous._solve(stretch, limits, stretch.cap)
+        monkeypatch.setattr(curve_program, "CANCEL_ROOM", np.inf)
+    x = curve_program.solve_curve(stretch, limits, stretch.cap)
     assert x is not None
     _, bend = _divided_differences(stretch.s, x)
     path_jerk = np.sqrt(x[1:-1])[None, :, None] * stretch.d1[:, 1:-1] * bend[None, :, None] / 2

@@ -16,7 +16,7 @@ from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
 from trackplan.status import Status
-from trackplan.timing import smooth
+from trackplan.timing import smooth, zones
 from trackplan.timing.airmove import plan_air_move
 from trackplan.timing.continuous import _sample
 from trackplan.tool import ToolOrientation
@@ -69,15 +69,15 @@ def test_a_plan_collapsed_to_zero_speed_is_a_verdict(axis_case_file, monkeypatch
     tool = ToolOrientation.choose(case.task.tool, geometry)
     joint_path = JointPath.solve(case.robot, geometry, np.array([0.45, 0, 0.05, 0, 0, 0]), tool)
     assert joint_path.success
-    planned = smooth._ZonePlanner.plan
+    planned = zones.ZonePlanner.plan
 
     def at_rest(self):  # type: ignore[no-untyped-def]
         return [
-            smooth.ZonePlan(p.s_start, p.s_end, p.kind, p.cap, 0.0, "joint 2 velocity")
+            zones.ZonePlan(p.s_start, p.s_end, p.kind, p.cap, 0.0, "joint 2 velocity")
             for p in planned(self)
         ]
 
-    monkeypatch.setattr(smooth._ZonePlanner, "plan", at_rest)
+    monkeypatch.setattr(zones.ZonePlanner, "plan", at_rest)
     law = smooth.plan_smooth_time_law(joint_path, case.task)
     assert not law.success
     assert law.status is Status.LIMITS_VIOLATED

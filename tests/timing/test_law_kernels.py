@@ -12,10 +12,10 @@ from hypothesis import strategies as st
 
 from tests.tolerances import assert_ulp_close
 from trackplan.derivatives import backward_derivatives
-from trackplan.timing._kernels import rate_ratios
+from trackplan.timing._kernels_samples import rate_ratios
 from trackplan.timing.demand import ZoneDemand
 from trackplan.timing.profile import speed_change_time
-from trackplan.timing.smooth import _jerk_for_duration
+from trackplan.timing.zones import _jerk_for_duration
 
 
 @settings(max_examples=60, deadline=None)

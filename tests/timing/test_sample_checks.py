@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.derivatives import backward_derivatives
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.timing.sample_checks import (
     LIMIT_MARGIN,
     RateLimits,
@@ -47,7 +47,7 @@ def test_checks_read_a_motion_as_they_read_its_samples(puma):
         return np.array([0]), np.array([1]), np.array([2.0])
 
     checks = (RateLimits(puma), TorqueLimits(puma), plain)
-    motion = SampledMotion(puma, q, sample_time)
+    motion = JointSamples(puma, q, sample_time)
     by_motion = run_motion_checks(checks, motion)
     by_samples = run_checks(checks, q, sample_time)
     assert motion.torque is not None  # the torque check's RNE pass is kept for the checker

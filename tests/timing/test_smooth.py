@@ -13,7 +13,8 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import check_case_trajectory, plan_placement
 from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, run_checks
-from trackplan.timing.smooth import WINDOW_MIN_LENGTH, _level_runs, plan_smooth_time_law
+from trackplan.timing.smooth import plan_smooth_time_law
+from trackplan.timing.zones import WINDOW_MIN_LENGTH, level_runs
 
 WRIST_TURN_CASES = {"paper-circle-seam-fixed", "paper-circle-seam-free"}
 """Their seam frame turns the tool once about its axis: at a constant spin no placement has a
@@ -34,7 +35,7 @@ def test_level_runs_merge_short_runs_into_slower_ones():
     level = np.zeros(101, dtype=int)
     level[40:42] = 3  # a 1 mm dip: too short for a window of its own
     level[60:90] = 1
-    runs = _level_runs(s, level, WINDOW_MIN_LENGTH)
+    runs = level_runs(s, level, WINDOW_MIN_LENGTH)
     for first, last in runs:
         assert s[last] - s[first] >= WINDOW_MIN_LENGTH or len(runs) == 1
     # the dip survives (merged into a slower neighbourhood, never sped up)
@@ -70,7 +71,7 @@ def test_level_runs_match_the_plain_merge_rule():
         s = np.cumsum(rng.uniform(0.0, 2e-3, n))
         level = np.repeat(rng.integers(0, 4, n), rng.integers(1, 6, n))[:n]
         shortest = float(rng.uniform(0.0, 0.02))
-        assert _level_runs(s, level, shortest) == _level_runs_reference(s, level, shortest)
+        assert level_runs(s, level, shortest) == _level_runs_reference(s, level, shortest)
 
 
 def test_a_joint_limit_forces_a_reported_slow_down(tmp_path):
@@ -112,8 +113,8 @@ def test_rebuilds_until_the_sampled_trajectory_meets_every_limit(monkeypatch):
         laws.append(original(*args, **kwargs))
         return laws[-1]
 
-    spec = dataclasses.replace(smooth.SPEC, plan=spy)
-    monkeypatch.setitem(timing.TIME_LAWS, smooth.SPEC.timing, spec)
+    spec = dataclasses.replace(smooth.LAW, plan=spy)
+    monkeypatch.setitem(timing.TIME_LAWS, smooth.LAW.timing, spec)
     case = load_case(CASES / "paper-corner.yaml")
     result = plan_placement(case, case.bounds.example)
     assert laws[-1].iterations > 1 and laws[-1].success

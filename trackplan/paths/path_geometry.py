@@ -57,7 +57,7 @@ class PathGeometry:
             The case (path segments and tolerance).
         mode
             How corners are rounded; a time law names the mode it needs
-            (:attr:`trackplan.timing.TimeLawSpec.path_mode`).
+            (:attr:`trackplan.timing.TimeLaw.path_mode`).
         """
         nominal = NominalPath.from_specs(case.start, case.segments)
         return cls(nominal, build_path(nominal, case.task.tolerance, mode=mode), mode)

@@ -8,7 +8,7 @@ import numpy as np
 
 from trackplan._kernels import read_only
 from trackplan.check_report import Violation
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.planning import _kernels
 from trackplan.planning.check_violations import RELATIVE_SLACK, met, violation_over
 from trackplan.robots.dynamics.rne import inverse_dynamics
@@ -16,7 +16,7 @@ from trackplan.robots.model import Robot
 
 
 def check_joint_limits(
-    motion: SampledMotion, t: np.ndarray
+    motion: JointSamples, t: np.ndarray
 ) -> tuple[dict[str, np.ndarray], dict[str, tuple[int, float]], list[Violation]]:
     """Every sample's joint positions, rates and torques against the robot's limits.
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from trackplan._kernels import read_only
 from trackplan.check_report import Violation
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.planning import _kernels
 from trackplan.planning.check_reference import TrackingReference
 from trackplan.planning.check_tool import check_tool
@@ -65,7 +65,7 @@ def speed_slack(sample_time: float) -> float:
 
 
 def check_task(
-    motion: SampledMotion, ref: TrackingReference
+    motion: JointSamples, ref: TrackingReference
 ) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
     """Tracking, orientation, Cartesian speed and coverage checks.
 

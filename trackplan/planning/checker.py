@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.check_report import CheckReport
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.planning.check_joints import check_joint_limits
 from trackplan.planning.check_reference import ORIENTATION_TOLERANCE, TrackingReference
 from trackplan.planning.check_task import IK_POSITION_TOLERANCE, check_task, speed_slack
@@ -61,16 +61,16 @@ def check_trajectory(
     CheckReport
         Margins, violations and the worst tracking and orientation errors.
     """
-    return check_motion(SampledMotion(robot, q, sample_time), reference, cell)
+    return check_motion(JointSamples(robot, q, sample_time), reference, cell)
 
 
 def check_motion(
-    motion: SampledMotion,
+    motion: JointSamples,
     reference: TrackingReference | None = None,
     cell: CellGeometry | None = None,
 ) -> CheckReport:
     """:func:`check_trajectory` of sampled joints whose derivatives, torques and tool poses
-    other readers share (:class:`~trackplan.motion.SampledMotion`: each computed once).
+    other readers share (:class:`~trackplan.motion.JointSamples`: each computed once).
 
     Parameters
     ----------

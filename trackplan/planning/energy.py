@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.robots.model import Robot
 
 
@@ -59,7 +59,7 @@ def joint_torques(robot: Robot, q: np.ndarray, sample_time: float) -> tuple[np.n
     tuple of numpy.ndarray
         ``(tau, qd)``, each shape (N + 3, n), N·m and rad/s.
     """
-    motion = SampledMotion(robot, q, sample_time)
+    motion = JointSamples(robot, q, sample_time)
     if motion.torque is None:
         raise ValueError(f"robot {robot.name!r} has no dynamic parameters")
     return motion.torque, motion.qd
@@ -81,11 +81,11 @@ def energy_figures(robot: Robot, q: np.ndarray, sample_time: float) -> EnergyFig
     -------
     EnergyFigures
     """
-    return motion_energy(SampledMotion(robot, q, sample_time))
+    return motion_energy(JointSamples(robot, q, sample_time))
 
 
-def motion_energy(motion: SampledMotion) -> EnergyFigures:
-    """:func:`energy_figures` from the torques of a :class:`~trackplan.motion.SampledMotion`
+def motion_energy(motion: JointSamples) -> EnergyFigures:
+    """:func:`energy_figures` from the torques of a :class:`~trackplan.motion.JointSamples`
     (computed once for every reader).
 
     Parameters

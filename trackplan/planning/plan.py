@@ -17,7 +17,7 @@ from trackplan.case import Case, Task
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform, vector_norms
 from trackplan.jointpath import JointPath
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.paths.path_geometry import PathGeometry, PathMode
 from trackplan.planning.checker import TrackingReference, check_motion, check_trajectory
 from trackplan.planning.energy import motion_energy
@@ -26,7 +26,7 @@ from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.planning.tool_zones import transition_zones
 from trackplan.robots.model import Robot
 from trackplan.status import Status
-from trackplan.timing import TimeLaw, time_law
+from trackplan.timing import TimedPath, time_law
 from trackplan.tool import (
     SpinMode,
     SpinProfile,
@@ -108,14 +108,14 @@ def make_trajectory(
     spin
         Spin about the tool axis per sample, shape (N,), rad; default 0.
     """
-    return motion_trajectory(SampledMotion(robot, q, sample_time), s, spin)
+    return motion_trajectory(JointSamples(robot, q, sample_time), s, spin)
 
 
 def motion_trajectory(
-    motion: SampledMotion, s: np.ndarray, spin: np.ndarray | None = None
+    motion: JointSamples, s: np.ndarray, spin: np.ndarray | None = None
 ) -> Trajectory:
     """:func:`make_trajectory` reading the derivatives and tool poses of a
-    :class:`~trackplan.motion.SampledMotion` (shared with the checker).
+    :class:`~trackplan.motion.JointSamples` (shared with the checker).
 
     Parameters
     ----------
@@ -287,13 +287,13 @@ def _unplanned(
     )
 
 
-def _checked(case: Case, joint_path: JointPath, timed: TimeLaw) -> PlanResult:
+def _checked(case: Case, joint_path: JointPath, timed: TimedPath) -> PlanResult:
     """Check the sampled trajectory and assemble the result."""
     geometry = joint_path.geometry
     spin = joint_path.tool.spin.value(timed.s)
     motion = timed.motion
     if motion is None or motion.q is not timed.q or motion.robot is not case.robot:
-        motion = SampledMotion(case.robot, timed.q, timed.sample_time)
+        motion = JointSamples(case.robot, timed.q, timed.sample_time)
     trajectory = motion_trajectory(motion, timed.s, spin)
     check = check_motion(
         motion, tracking_reference(case, geometry, joint_path.placement), cell_geometry(case)
@@ -331,7 +331,7 @@ def _checked(case: Case, joint_path: JointPath, timed: TimeLaw) -> PlanResult:
 
 
 def _speed_summary(
-    case: Case, geometry: PathGeometry, trajectory: Trajectory, timed: TimeLaw
+    case: Case, geometry: PathGeometry, trajectory: Trajectory, timed: TimedPath
 ) -> tuple[float, float]:
     """Share of the path run at the rated speed, and the lowest corner speed.
 

@@ -22,7 +22,7 @@ from dataclasses import InitVar, dataclass, field
 import numpy as np
 
 from trackplan.robots.model import Robot
-from trackplan.timing import _kernels
+from trackplan.timing import _kernels, _kernels_samples
 from trackplan.timing._kernels import MAX_PATH_ACCELERATION, MAX_PATH_JERK
 
 
@@ -94,9 +94,13 @@ class ZoneDemand:
             return self._peaks
         rows = self._rows(s_from, s_to)
         if rows.start == 0:  # a stretch from the zone start: running maxima
-            return self.running_maxima(0)[rows.stop - 1]
+            from_start: tuple[np.ndarray, np.ndarray, np.ndarray] = self.running_maxima(0)[
+                rows.stop - 1
+            ]
+            return from_start
         if rows.stop == len(self.s):  # a stretch to the zone end
-            return self.running_maxima(1)[rows.start]
+            to_end: tuple[np.ndarray, np.ndarray, np.ndarray] = self.running_maxima(1)[rows.start]
+            return to_end
         q1, q2, q3 = self._abs
         return q1[rows].max(axis=0), q2[rows].max(axis=0), q3[rows].max(axis=0)
 
@@ -108,9 +112,11 @@ class ZoneDemand:
         """
         if at_start:
             stop = np.searchsorted(self.s, self.s[0] + distance, side="left") + 2
-            return self.running_maxima(0)[np.clip(stop, 1, len(self.s)) - 1]
+            peaks: np.ndarray = self.running_maxima(0)[np.clip(stop, 1, len(self.s)) - 1]
+            return peaks
         first = np.searchsorted(self.s, self.s[-1] - distance, side="right") - 2
-        return self.running_maxima(1)[np.clip(first, 0, len(self.s) - 1)]
+        peaks = self.running_maxima(1)[np.clip(first, 0, len(self.s) - 1)]
+        return peaks
 
     def quick_distances(
         self,
@@ -145,7 +151,7 @@ class ZoneDemand:
         numpy.ndarray
             Shape (V,), m (inf where the joints leave no room).
         """
-        return _kernels.quick_distances(  # type: ignore[no-any-return]
+        return _kernels.quick_distances(
             self.s,
             self._peak_array,
             self.running_maxima(0 if rise else 1),
@@ -180,14 +186,16 @@ class ZoneDemand:
 
         Per point the least of ``share · v_max / |q'|``, ``√(share · a_max / |q''|)`` and
         ``∛(share · j_max / |q'''|)`` over the joints (+inf where a demand is 0): one
-        compiled pass (:func:`trackplan.timing._kernels.local_caps`).
+        compiled pass (:func:`trackplan.timing._kernels_samples.local_caps`).
         """
         q1, q2, q3 = self._abs
         rooms = np.stack([share * robot.v_max, share * robot.a_max, share * robot.j_max])
-        return _kernels.local_caps(q1, q2, q3, rooms)  # type: ignore[no-any-return]
+        return _kernels_samples.local_caps(q1, q2, q3, rooms)
 
 
-def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
+def cruise_cap(
+    robot: Robot, peaks: tuple[np.ndarray, np.ndarray, np.ndarray], share: float
+) -> tuple[float, str]:
     """Highest constant path speed the joint limits allow given peak demands, and what binds.
 
     Parameters
@@ -226,7 +234,7 @@ def cruise_cap(robot: Robot, peaks: tuple, share: float) -> tuple[float, str]:
 
 
 def uniform_change_bounds(
-    robot: Robot, peaks: tuple, top_speed: float, share: float
+    robot: Robot, peaks: tuple[np.ndarray, np.ndarray, np.ndarray], top_speed: float, share: float
 ) -> tuple[float, float]:
     """Path acceleration and jerk bounds valid wherever the demand stays below ``peaks``.
 
@@ -240,13 +248,16 @@ def uniform_change_bounds(
         ``(accel, jerk)``, m/s² and m/s³ (≤ 0 when the top speed leaves no room).
     """
     q1, q2, q3 = (np.asarray(p, dtype=float) for p in peaks)
-    return _kernels.change_bounds(  # type: ignore[no-any-return]
+    return _kernels.change_bounds(
         q1, q2, q3, float(top_speed), share * robot.a_max, share * robot.j_max
     )
 
 
 def uniform_change_bounds_many(
-    robot: Robot, peaks: tuple | np.ndarray, top_speed: np.ndarray, share: float
+    robot: Robot,
+    peaks: tuple[np.ndarray, np.ndarray, np.ndarray] | np.ndarray,
+    top_speed: np.ndarray,
+    share: float,
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`uniform_change_bounds` for many top speeds at once.
 
@@ -429,7 +440,7 @@ def _changes_within_limits(
     distance : numpy.ndarray
         Path length of each change, shape (K,), m.
     """
-    return _kernels.changes_within_limits(  # type: ignore[no-any-return]
+    return _kernels.changes_within_limits(
         demand.s,
         demand.d1,
         demand.d2,

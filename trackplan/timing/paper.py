@@ -47,7 +47,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Task
 from trackplan.choices import Timing
 from trackplan.frames import placement_transform
 from trackplan.jointpath import JointPath
@@ -57,7 +56,8 @@ from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import solve_path_ik
 from trackplan.robots.resolved_rate import solve_path_resolved_rate
 from trackplan.status import Status
-from trackplan.timing.protocol import TimeLaw, TimeLawSpec, unsampled
+from trackplan.task import Task
+from trackplan.timing.protocol import TimedPath, TimeLaw, unsampled
 
 MIN_VIA_SPACING = 1e-3
 """Smallest distance between the via points of a line, m."""
@@ -99,7 +99,7 @@ class _Ramp:
     reached: int | None
 
 
-def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimeLaw:
+def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimedPath:
     """Sample the paper's trajectory (Section 3.1) along a placed path.
 
     Parameters
@@ -112,7 +112,7 @@ def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimeLaw:
 
     Returns
     -------
-    TimeLaw
+    TimedPath
         The samples, or none with the reason (resolved-rate divergence, a via point
         off the branch).
     """
@@ -122,7 +122,7 @@ def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimeLaw:
         q, s = planner.run(joint_path.q[0])
     except _PlanStop as stop:
         return unsampled(Timing.PAPER, stop.status, stop.message, task.sample_time, robot.n_dof)
-    return TimeLaw(
+    return TimedPath(
         timing=Timing.PAPER,
         success=True,
         status=Status.FEASIBLE,
@@ -282,15 +282,17 @@ class _PaperPlanner:
         result = solve_path_ik(self.robot, poses[None], branch=self.branch)
         if not result.success[0]:
             raise _PlanStop(result.status[0], str(result.message[0]))
-        q = result.q[0]
-        return q - 2 * np.pi * np.round((q[0] - q_near) / (2 * np.pi))
+        q: np.ndarray = result.q[0]
+        near: np.ndarray = q - 2 * np.pi * np.round((q[0] - q_near) / (2 * np.pi))
+        return near
 
     def _joint_velocity(self, q: np.ndarray, velocity: np.ndarray) -> np.ndarray:
         """q̇ giving the tool the linear velocity ``velocity`` (3,) and no rotation (Eq. 20)."""
         if not np.any(velocity):
             return np.zeros(self.robot.n_dof)
         twist = np.concatenate([velocity, np.zeros(3)])
-        return np.linalg.lstsq(jacobian(self.robot, q), twist, rcond=None)[0]
+        qd: np.ndarray = np.linalg.lstsq(jacobian(self.robot, q), twist, rcond=None)[0]
+        return qd
 
     def _ramp(self, q_via: np.ndarray, qd0: np.ndarray, rated: float) -> _Ramp:
         """Eq. 13–17 over the via points until the tool reaches ``rated`` (m/s)."""
@@ -372,8 +374,9 @@ class _PaperPlanner:
         sigma, _ = curve.project(points)
         if piece.kind == "arc" and curve.angle >= 2 * np.pi - 1e-9:  # samples in time order
             sigma = unwrap_closed_arc(sigma, 2 * np.pi * curve.radius, piece.length)
-        return np.clip(sigma, 0.0, piece.length)
+        along: np.ndarray = np.clip(sigma, 0.0, piece.length)
+        return along
 
 
-SPEC = TimeLawSpec(Timing.PAPER, "paper", plan_paper_trajectory, follows_joint_path=False)
+LAW = TimeLaw(Timing.PAPER, "paper", plan_paper_trajectory, follows_joint_path=False)
 """The paper's law, as :data:`trackplan.timing.TIME_LAWS` lists it."""

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.timing import _kernels
+from trackplan.timing import _kernels_samples
 
 
 def speed_change_phases(
@@ -141,8 +141,8 @@ class SpeedProfile:
     def position(self, t: np.ndarray) -> np.ndarray:
         """Path position at times ``t`` (N,), s: the ``s`` of :meth:`evaluate` alone, shape
         (N,), m, clipped to [0, length] (compiled, same operations:
-        :func:`trackplan.timing._kernels.profile_position`)."""
-        return _kernels.profile_position(  # type: ignore[no-any-return]
+        :func:`trackplan.timing._kernels_samples.profile_position`)."""
+        return _kernels_samples.profile_position(
             self.t_start,
             self.s0,
             self.v0,
@@ -156,7 +156,8 @@ class SpeedProfile:
         """Path position at ``tau`` (N,) s into phases ``k`` (N,), clipped, m."""
         j = self.jerk[k]
         s = self.s0[k] + self.v0[k] * tau + self.a0[k] * tau**2 / 2.0 + j * tau**3 / 6.0
-        return np.clip(s, 0.0, self.length, out=s)
+        clipped: np.ndarray = np.clip(s, 0.0, self.length, out=s)
+        return clipped
 
     def phase_index(self, t: np.ndarray) -> np.ndarray:
         """Index of the phase each time falls in, shape (N,)."""

@@ -1,9 +1,9 @@
 """What every time law takes and gives.
 
-A time law turns a :class:`~trackplan.jointpath.JointPath` and the task into samples
-``s(k·Ts)`` and ``q(k·Ts)`` from rest to rest. Laws are looked up by name in
-:data:`trackplan.timing.TIME_LAWS`; a new law is a module with a :class:`TimeLawSpec`,
-added there (``docs/architecture.md``).
+A :class:`TimeLaw` turns a :class:`~trackplan.jointpath.JointPath` and the task into a
+:class:`TimedPath`: samples ``s(k·Ts)`` and ``q(k·Ts)`` from rest to rest. Laws are
+looked up by name in :data:`trackplan.timing.TIME_LAWS`; a new law is a module with a
+:class:`TimeLaw`, added there (``docs/architecture.md``).
 """
 
 from __future__ import annotations
@@ -13,12 +13,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.case import Task
 from trackplan.choices import Timing
 from trackplan.jointpath import JointPath
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.paths.path_geometry import PathMode
 from trackplan.status import Status
+from trackplan.task import Task
 
 
 @dataclass(frozen=True)
@@ -45,8 +45,8 @@ class SlowDown:
 
 
 @dataclass(frozen=True, eq=False)
-class TimeLaw:
-    """A time law sampled at Ts, and its joints.
+class TimedPath:
+    """What a time law gives: arc length and joints at each Ts, from rest to rest.
 
     Attributes
     ----------
@@ -74,7 +74,7 @@ class TimeLaw:
         Rebuilds the law needed (1 for a law that builds once).
     motion
         The samples ``q`` with the derivatives and torques the law's sample checks computed
-        (:class:`~trackplan.motion.SampledMotion`), for the checker to read again; None
+        (:class:`~trackplan.motion.JointSamples`), for the checker to read again; None
         when the law checked nothing.
     """
 
@@ -88,7 +88,7 @@ class TimeLaw:
     slowdowns: tuple[SlowDown, ...] = ()
     corner_speed: float = float("nan")
     iterations: int = 1
-    motion: SampledMotion | None = None
+    motion: JointSamples | None = None
 
     @property
     def duration(self) -> float:
@@ -96,13 +96,13 @@ class TimeLaw:
         return max(len(self.s) - 1, 0) * self.sample_time
 
 
-TimeLawPlanner = Callable[[JointPath, Task], TimeLaw]
-"""``plan(joint_path, task) -> TimeLaw``: the signature of every law."""
+TimeLawPlanner = Callable[[JointPath, Task], TimedPath]
+"""``plan(joint_path, task) -> TimedPath``: the signature of every law."""
 
 
 @dataclass(frozen=True)
-class TimeLawSpec:
-    """A time law as the planner sees it.
+class TimeLaw:
+    """A time law: its name, the planned path it needs and the function that times it.
 
     Attributes
     ----------
@@ -127,9 +127,9 @@ class TimeLawSpec:
 
 def unsampled(
     timing: Timing, status: Status, message: str, sample_time: float, n_dof: int
-) -> TimeLaw:
+) -> TimedPath:
     """A law that produced no samples, with why."""
-    return TimeLaw(
+    return TimedPath(
         timing=timing,
         success=False,
         status=status,

@@ -31,12 +31,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
-from trackplan.case import Task
 from trackplan.errors import CaseError
 from trackplan.jointpath import JointPath
 from trackplan.robots.model import Robot
+from trackplan.task import Task
 
-JointSamples = np.ndarray | Callable[[np.ndarray], np.ndarray]
+GridJoints = np.ndarray | Callable[[np.ndarray], np.ndarray]
 """Joint path on the grid: samples (M, n) at ``s_grid``, or a callable s (M,) -> q (M, n)."""
 
 UNREACHABLE_ACCELERATION = 1.0e6
@@ -85,7 +85,7 @@ class ReferenceResult:
     q: np.ndarray
 
 
-def joint_spline(s_grid: np.ndarray, q_grid: JointSamples) -> tuple[np.ndarray, BSpline]:
+def joint_spline(s_grid: np.ndarray, q_grid: GridJoints) -> tuple[np.ndarray, BSpline]:
     """Quintic interpolating spline of q(s) through the samples.
 
     Parameters
@@ -128,7 +128,7 @@ def _sample_times(duration: float, sample_time: float) -> np.ndarray:
 def toppra_reference(
     robot: Robot,
     s_grid: np.ndarray,
-    q_grid: JointSamples,
+    q_grid: GridJoints,
     speed_cap_grid: np.ndarray,
     sample_time: float,
 ) -> ReferenceResult:
@@ -161,7 +161,7 @@ def toppra_reference(
     n = robot.n_dof
     caps = np.asarray(speed_cap_grid, dtype=float)
 
-    class _PathWithArcLength(toppra.interpolator.AbstractGeometricPath):
+    class _PathWithArcLength(toppra.interpolator.AbstractGeometricPath):  # type: ignore[misc]  # toppra has no stubs
         """q(s) with s itself appended as coordinate n + 1."""
 
         def __call__(self, path_positions, order=0):  # type: ignore[no-untyped-def]
@@ -215,7 +215,7 @@ def toppra_reference(
 def topp3_reference(
     robot: Robot,
     s_grid: np.ndarray,
-    q_grid: JointSamples,
+    q_grid: GridJoints,
     speed_cap_grid: np.ndarray,
     sample_time: float,
 ) -> ReferenceResult:

@@ -13,7 +13,7 @@ A sample check is any callable ``check(q, sample_time) -> (sample, order, ratio)
 :class:`RateLimits` is the joint velocity, acceleration and jerk check; :class:`TorqueLimits`
 the joint torque check of a robot with dynamics (``docs/dynamics.md``). :func:`robot_checks`
 is what a law checks by default: both, the second when the robot has dynamics. Both also
-read a :class:`~trackplan.motion.SampledMotion` (:class:`MotionCheck`), so that the torques
+read a :class:`~trackplan.motion.JointSamples` (:class:`MotionCheck`), so that the torques
 they compute are those the checker and the energy figures then read.
 """
 
@@ -25,10 +25,10 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from trackplan.motion import SampledMotion
+from trackplan.motion import JointSamples
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.model import Robot
-from trackplan.timing import _kernels
+from trackplan.timing import _kernels_samples
 
 LIMIT_MARGIN = 1e-6
 """Relative margin kept under every limit a law plans against, so that round-off in the
@@ -49,9 +49,9 @@ Found = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 @runtime_checkable
 class MotionCheck(Protocol):
-    """A sample check that also reads a :class:`~trackplan.motion.SampledMotion`."""
+    """A sample check that also reads a :class:`~trackplan.motion.JointSamples`."""
 
-    def check_motion(self, motion: SampledMotion) -> Found:
+    def check_motion(self, motion: JointSamples) -> Found:
         """The check of ``motion.q`` at ``motion.sample_time`` (see the module)."""
         ...
 
@@ -60,7 +60,7 @@ class MotionCheck(Protocol):
 class RateLimits:
     """Joint velocity, acceleration and jerk by backward differences at Ts, as the checker.
 
-    One compiled pass over the samples (:func:`trackplan.timing._kernels.rate_ratios`).
+    One compiled pass over the samples (:func:`trackplan.timing._kernels_samples.rate_ratios`).
 
     Attributes
     ----------
@@ -75,9 +75,9 @@ class RateLimits:
 
     def __call__(self, q: np.ndarray, sample_time: float) -> Found:
         """Samples where a rate limit (less the margin) is exceeded; see the module."""
-        return self.check_motion(SampledMotion(self.robot, q, sample_time))
+        return self.check_motion(JointSamples(self.robot, q, sample_time))
 
-    def check_motion(self, motion: SampledMotion) -> Found:
+    def check_motion(self, motion: JointSamples) -> Found:
         """:meth:`__call__` of the motion's samples."""
         q, sample_time = motion.q, motion.sample_time
         scale = 1.0 - self.margin
@@ -85,7 +85,7 @@ class RateLimits:
             [scale * self.robot.v_max, scale * self.robot.a_max, scale * self.robot.j_max]
         )
         steps = np.array([sample_time, sample_time**2, sample_time**3])
-        ratio = _kernels.rate_ratios(np.ascontiguousarray(q, dtype=float), steps, limits)
+        ratio = _kernels_samples.rate_ratios(np.ascontiguousarray(q, dtype=float), steps, limits)
         samples, orders, ratios = [], [], []
         for order in (1, 2, 3):
             bad = np.flatnonzero(ratio[:, order - 1] > 1.0)
@@ -134,9 +134,9 @@ class TorqueLimits:
         tuple of numpy.ndarray
             ``sample (V,)`` (clipped to ``N - 1``), ``order (V,)`` (2) and ``ratio (V,)`` (> 1).
         """
-        return self.check_motion(SampledMotion(self.robot, q, sample_time))
+        return self.check_motion(JointSamples(self.robot, q, sample_time))
 
-    def check_motion(self, motion: SampledMotion) -> Found:
+    def check_motion(self, motion: JointSamples) -> Found:
         """:meth:`__call__` of the motion's samples, reading its torques."""
         dynamics = self.robot.dynamics
         if dynamics is None or motion.torque is None:
@@ -195,7 +195,7 @@ def run_checks(checks: tuple[SampleCheck, ...], q: np.ndarray, sample_time: floa
     return _concatenated([check(q, sample_time) for check in checks])
 
 
-def run_motion_checks(checks: tuple[SampleCheck, ...], motion: SampledMotion) -> Found:
+def run_motion_checks(checks: tuple[SampleCheck, ...], motion: JointSamples) -> Found:
     """:func:`run_checks` on a motion's samples: a :class:`MotionCheck` reads the motion
     itself (its torques are then those the checker reads again)."""
     found = []
