@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from trackplan.robots._kernels import fk_jacobian_into
+from trackplan.robots._ik_kernels import fk_jacobian_into
 from trackplan.robots.ik_numeric import chain_arrays
 from trackplan.robots.kinematics import forward_kinematics, jacobian
 
