@@ -148,8 +148,8 @@ class IKFamily(Protocol):
 
 class FusedClosedForm:
     r"""The solve methods of a closed-form family (:class:`IKFamily`) whose compiled kernels
-    (``families/_kernels.py``) take its parameter array and the inverse of its tool
-    transform.
+    (``families/_opw_kernels.py``, ``families/_ur_kernels.py``) take its parameter array
+    and the inverse of its tool transform.
 
     A subclass sets ``_geometry`` and ``_tail_inv`` and names its kernels: ``_all_branches``
     (pose in, eight branches out: ``opw_solve``, ``ur_solve``) and ``_one_branch``

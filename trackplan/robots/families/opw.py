@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.robots.families import _kernels as kern
+from trackplan.robots.families import _opw_kernels as kern
 from trackplan.robots.families.base import FusedClosedForm, describe_bits
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot

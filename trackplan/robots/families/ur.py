@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from trackplan.robots.families import _kernels as kern
+from trackplan.robots.families import _ur_kernels as kern
 from trackplan.robots.families.base import FusedClosedForm, branch_bits
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
