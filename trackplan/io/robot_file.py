@@ -364,7 +364,7 @@ class _FlowMapping(dict[str, Any]):
     """A mapping written on one line (``{d: 0.0, a: 0.4318, ...}``)."""
 
 
-class _Dumper(yaml.SafeDumper):
+class _Dumper(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships no type stubs
     """Safe dumper that writes :class:`_FlowMapping` in flow style and indents list items."""
 
     def increase_indent(self, flow: bool = False, indentless: bool = False) -> None:
@@ -446,5 +446,7 @@ def robot_to_yaml(robot: Robot) -> str:
             )
             for k in range(len(robot.collision))
         ]
-    body = yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=1_000_000)
+    body: str = yaml.dump(
+        data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=1_000_000
+    )
     return _HEADER + body

@@ -57,7 +57,8 @@ def rotation_z_to(axis: np.ndarray) -> np.ndarray:
     s = np.linalg.norm(v)
     k = v / s
     K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    R: np.ndarray = np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    return R
 
 
 def dh_transform(d: float, a: float, alpha: float) -> np.ndarray:
@@ -233,7 +234,7 @@ class Robot:
     @property
     def n_dof(self) -> int:
         """Number of joints."""
-        return self.origins.shape[0]
+        return int(self.origins.shape[0])
 
     @property
     def has_tool(self) -> bool:

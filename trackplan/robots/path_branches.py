@@ -92,7 +92,8 @@ def numeric_seeds(robot: Robot) -> np.ndarray:
     seeds = middle + pattern[:, :n]
     shifted = seeds + 2 * np.pi * np.ceil((robot.q_min - seeds) / (2 * np.pi))  # lowest ≥ q_min
     outside = (seeds < robot.q_min) | (seeds > robot.q_max)
-    return np.where(outside & (shifted <= robot.q_max), shifted, seeds)
+    moved: np.ndarray = np.where(outside & (shifted <= robot.q_max), shifted, seeds)
+    return moved
 
 
 def branch_paths(
@@ -342,7 +343,8 @@ def _usable(report: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Which analysed branches are usable: reachable everywhere, no switch, inside the
     limits; shape (B, K), bool."""
     ok = (report[..., I_N_UNREACH] == 0) & (report[..., I_N_SWITCH] == 0)
-    return ok & (values[..., F_MARGIN] >= 0.0)
+    usable: np.ndarray = ok & (values[..., F_MARGIN] >= 0.0)
+    return usable
 
 
 def _candidate_branches(branch: int | np.ndarray | None, n_cand: int) -> np.ndarray:

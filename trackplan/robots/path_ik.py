@@ -390,7 +390,8 @@ def branch_joints_along(
     q = solve_path_ik(robot, T[None], branch=branch).q[0]  # missed poses held
     q_grid = np.asarray(q_grid, dtype=float)
     reference = np.column_stack([np.interp(s, s_grid, column) for column in q_grid.T])
-    return q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
+    wound: np.ndarray = q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
+    return wound
 
 
 def _choose(ok: np.ndarray, first_problem: np.ndarray, margin: np.ndarray) -> np.ndarray:

@@ -175,12 +175,13 @@ def wrist_entry(
 ) -> float:  # pragma: no cover - compiled
     """Kernel: entry (r, c) of ``T · tail_inv`` for pose b of a block P (12, BLOCK), summed
     in :func:`wrist_frame`'s order."""
-    return (
+    entry: float = (
         P[4 * r, b] * tail_inv[0, c]
         + P[4 * r + 1, b] * tail_inv[1, c]
         + P[4 * r + 2, b] * tail_inv[2, c]
         + P[4 * r + 3, b] * tail_inv[3, c]
     )
+    return entry
 
 
 BLOCK = 32

@@ -56,7 +56,8 @@ class ClosedFormIK:
     @property
     def reachable(self) -> np.ndarray:
         """Shape (...,), bool: at least one branch reaches the pose."""
-        return np.any(self.valid, axis=-1)
+        reached: np.ndarray = np.any(self.valid, axis=-1)
+        return reached
 
 
 class IKFamily(Protocol):

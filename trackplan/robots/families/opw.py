@@ -114,7 +114,8 @@ def _closest_point(p1: np.ndarray, u1: np.ndarray, p2: np.ndarray, u2: np.ndarra
     denom = 1.0 - b * b
     s = (b * e - d) / denom
     t = (e - b * d) / denom
-    return 0.5 * (p1 + s * u1 + p2 + t * u2)
+    midpoint: np.ndarray = 0.5 * (p1 + s * u1 + p2 + t * u2)
+    return midpoint
 
 
 def _line_distance(point: np.ndarray, p: np.ndarray, u: np.ndarray) -> float:
