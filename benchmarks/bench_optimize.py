@@ -311,7 +311,8 @@ one thread and shared among threads."""
 def _path_ik_threads() -> None:
     """Wall and CPU time of the screening's path IK on all branches (the corner case's grid,
     batches of 100 sampled placements), on one thread, on every core (``threads`` given) and
-    as the search runs it (``threads=None``: shared while sharing pays), alternated."""
+    as the search runs it (``threads=None`` with the fitness's ``ThreadSharing``: shared
+    while sharing pays), alternated."""
     from trackplan.robots.path_ik import path_threads, solve_path_ik_branches
     from trackplan.search.fitness import PlacementFitness
     from trackplan.search.space import SearchSpace
@@ -332,7 +333,7 @@ def _path_ik_threads() -> None:
         for name, threads in ways.items():
             wall, cpu = time.perf_counter(), time.process_time()
             for poses in batches:
-                solve_path_ik_branches(case.robot, poses, threads=threads)
+                solve_path_ik_branches(case.robot, poses, threads=threads, sharing=fitness.sharing)
             times[name].append((time.perf_counter() - wall, time.process_time() - cpu))
     print(
         f"\nPath IK on all branches, {PATH_IK_BATCHES} batches of 100 placements × "

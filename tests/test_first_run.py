@@ -21,7 +21,7 @@ from trackplan.cli import warmup
 from trackplan.forking import can_fork
 from trackplan.robots import _kernels as robot_kernels
 from trackplan.robots.builtin import puma560
-from trackplan.robots.families import _kernels as family_kernels
+from trackplan.robots.families import _opw_kernels as family_kernels
 from trackplan.robots.families import ik_family
 from trackplan.robots.kinematics import axis_frames, forward_kinematics, joint_frames
 

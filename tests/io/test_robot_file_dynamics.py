@@ -8,13 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.oracles import oracle
 from trackplan.cli import ExitCode, main
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import load_robot_text
 from trackplan.robots.dynamics.rne import inverse_dynamics
 
-rtb = pytest.importorskip("roboticstoolbox")
+rtb = oracle("roboticstoolbox")
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

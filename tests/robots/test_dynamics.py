@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import replace_dh
-from tests.oracles import rtb_robot_from
+from tests.oracles import oracle, rtb_robot_from
 from trackplan.errors import CaseError
 from trackplan.robots.dynamics.builtin import puma560_dynamics
 from trackplan.robots.dynamics.parameters import (
@@ -27,7 +27,7 @@ from trackplan.robots.dynamics.rne import (
 )
 from trackplan.robots.kinematics import jacobian, joint_frames
 
-rtb = pytest.importorskip("roboticstoolbox")
+rtb = oracle("roboticstoolbox")
 
 
 def random_states(rng, n_samples, n=6):
@@ -191,7 +191,7 @@ def test_payload_inertia_adds_rotational_torque(puma):
 
 def test_rne_matches_pinocchio_on_random_chains(rng):
     """Random chains with unaligned axes and full inertias against pinocchio's rnea."""
-    pin = pytest.importorskip("pinocchio")
+    pin = oracle("pinocchio")
     for _ in range(5):
         n = 6
         T = np.tile(np.eye(4), (n, 1, 1))

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.oracles import oracle
 from trackplan.cli import ExitCode, main
 from trackplan.errors import CaseError
 from trackplan.io.robot_file import LIBRARY_DIR, builtin_robot, load_robot
@@ -123,7 +124,7 @@ def write_test_robot(tmp_path: Path, rng: np.random.Generator) -> Path:
 
 def pinocchio_torques(urdf: Path, gravity, q, qd, qdd) -> np.ndarray:  # type: ignore[no-untyped-def]
     """τ = rnea(q, q̇, q̈) of pinocchio's model built from the URDF file itself."""
-    pin = pytest.importorskip("pinocchio")
+    pin = oracle("pinocchio")
     model = pin.buildModelFromUrdf(str(urdf))
     model.gravity.linear = np.asarray(gravity, dtype=float)
     data = model.createData()
@@ -193,7 +194,7 @@ UR5E_CYLINDERS = [
 def test_ur5e_urdf_inertials_are_urs_dh_table(rng: np.random.Generator) -> None:
     """The URDF's link-frame inertials are UR's DH-frame table: roboticstoolbox on the DH
     table with the same masses, centres of mass and cylinder inertias gives the same torques."""
-    rtb = pytest.importorskip("roboticstoolbox")
+    rtb = oracle("roboticstoolbox")
     links = []
     for i, (axis, length, radius) in enumerate(UR5E_CYLINDERS):
         m = UR5E_DH["mass"][i]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -10,6 +9,7 @@ import pytest
 from numba import njit
 
 from tests.conftest import replace_dh
+from tests.oracles import oracle
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_file import builtin_names, builtin_robot
@@ -102,7 +102,7 @@ def test_ur_parameters_are_derived_from_the_chain(name):
 @pytest.mark.parametrize("name", sorted(OPW_PUBLISHED))
 def test_opw_agrees_with_py_opw_kinematics(name, rng):
     """The same eight solutions as an independent OPW implementation (rs-opw-kinematics)."""
-    opw = pytest.importorskip("py_opw_kinematics")
+    opw = oracle("py_opw_kinematics")
     from scipy.spatial.transform import RigidTransform
 
     lengths, offsets, signs = OPW_PUBLISHED[name]
@@ -111,13 +111,13 @@ def test_opw_agrees_with_py_opw_kinematics(name, rng):
         offsets=tuple(float(v) for v in offsets),
         flip_axes=tuple(bool(s < 0) for s in signs),
     )
-    oracle = opw.Robot(model, degrees=False)
+    theirs_robot = opw.Robot(model, degrees=False)
     robot = builtin_robot(name)
     q = rng.uniform(-np.pi, np.pi, (2000, 6))
     T = forward_kinematics(robot, q)
-    T_oracle = np.array([oracle.forward(tuple(qk)).as_matrix() for qk in q[:200]])
+    T_oracle = np.array([theirs_robot.forward(tuple(qk)).as_matrix() for qk in q[:200]])
     assert np.abs(T[:200] - T_oracle).max() < 1e-9  # same flange frame and joint convention
-    theirs = wrapped(oracle.reach(RigidTransform.from_matrix(T)).joints)
+    theirs = wrapped(theirs_robot.reach(RigidTransform.from_matrix(T)).joints)
     ours = solve_ik(robot, T)
     for k in range(len(q)):
         mine = ours.q[k][ours.valid[k]]
@@ -129,13 +129,11 @@ def test_opw_agrees_with_py_opw_kinematics(name, rng):
 
 
 def test_puma_branches_match_roboticstoolbox(puma, rng):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        import roboticstoolbox as rtb
-        from spatialmath import SE3
-    oracle = rtb.models.DH.Puma560()
-    oracle.links[0].d = 0.0  # our table: no pedestal, d3 = 0.15
-    oracle.links[2].d = 0.15
+    rtb = oracle("roboticstoolbox")
+    SE3 = oracle("spatialmath").SE3  # installed with roboticstoolbox
+    reference = rtb.models.DH.Puma560()
+    reference.links[0].d = 0.0  # our table: no pedestal, d3 = 0.15
+    reference.links[2].d = 0.15
     q = rng.uniform(-np.pi, np.pi, (20, 6))
     T = forward_kinematics(puma, q)
     ik = solve_ik(puma, T)
@@ -143,7 +141,7 @@ def test_puma_branches_match_roboticstoolbox(puma, rng):
         theirs = np.array(
             [
                 # An SE3, not a 4×4 array: roboticstoolbox 1.3 reads only an SE3 here.
-                oracle.ikine_a(SE3(T[k], check=False), c).q
+                reference.ikine_a(SE3(T[k], check=False), c).q
                 for c in ("run", "ruf", "rdn", "rdf", "lun", "luf", "ldn", "ldf")
             ]
         )

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from trackplan.robots._kernels import fk_jacobian_into
+from tests.oracles import oracle
+from trackplan.robots._ik_kernels import fk_jacobian_into
 from trackplan.robots.ik_numeric import chain_arrays
 from trackplan.robots.kinematics import forward_kinematics, jacobian
 
@@ -17,9 +17,7 @@ N_CONFIGS = 1000
 
 def rtb_robot(robot):
     """roboticstoolbox DHRobot with exactly our DH table (no pedestal, no tool)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        import roboticstoolbox as rtb
+    rtb = oracle("roboticstoolbox")
     links = [
         rtb.RevoluteDH(d=d, a=a, alpha=alpha, offset=offset) for d, a, alpha, offset in robot.dh
     ]
@@ -71,3 +69,20 @@ def test_compiled_fk_jacobian_matches_numpy(name, request, rng):
         fk_jacobian_into(chain, tail, q, T, J, axes)
         assert np.abs(T - forward_kinematics(robot_with_tool, q)).max() < 1e-14
         assert np.abs(J - jacobian(robot_with_tool, q)).max() < 1e-14
+
+
+def test_a_missing_oracle_skips_with_its_reason():
+    """An oracle test skips, naming the missing package, instead of failing."""
+    with pytest.raises(pytest.skip.Exception, match="optional oracle no_such_oracle"):
+        oracle("no_such_oracle")
+
+
+def test_reach_is_the_farthest_tool_point_of_the_sampled_configurations(puma):
+    """Robot.reach: the largest |p_tool| over REACH_SAMPLES configurations drawn with seed 0
+    inside the limits, as forward_kinematics computes them (to 1e-12 m)."""
+    from trackplan.robots.model import REACH_SAMPLES
+
+    q = np.random.default_rng(0).uniform(puma.q_min, puma.q_max, (REACH_SAMPLES, puma.n_dof))
+    expected = np.linalg.norm(forward_kinematics(puma, q)[:, :3, 3], axis=1).max()
+    fresh = replace(puma)  # a new Robot: reach not yet cached
+    assert abs(fresh.reach - expected) < 1e-12

@@ -363,8 +363,8 @@ def test_screened_choice_is_the_choice_among_all_eight_branches(robot_name, requ
     it alone only when no other branch can beat it: the same branch, joints, analysis and
     message as choosing among all eight analysed branches, and the screen's bound is never
     below a usable branch's analysed margin."""
-    from trackplan.robots import path_ik
-    from trackplan.robots._kernels import room_bounds
+    from trackplan.robots import path_branches, path_ik
+    from trackplan.robots._path_kernels import room_bounds
     from trackplan.robots.families import ik_family
 
     robot = request.getfixturevalue(robot_name)
@@ -373,13 +373,13 @@ def test_screened_choice_is_the_choice_among_all_eight_branches(robot_name, requ
     X = np.column_stack([rng.normal(0.0, 0.08, (24, 3)), rng.normal(0.0, 0.4, (24, 3))])
     T = placement_transform(X)[:, None] @ base[None]
     every_branch = []
-    real_all = path_ik._all_branch_paths
+    real_all = path_branches.all_branch_paths
 
     def all_branches(*args):  # type: ignore[no-untyped-def]
         every_branch.append(args)
         return real_all(*args)
 
-    monkeypatch.setattr(path_ik, "_all_branch_paths", all_branches)
+    monkeypatch.setattr(path_branches, "all_branch_paths", all_branches)
     short = 0
     for c in range(len(X)):
         every_branch.clear()
@@ -403,7 +403,7 @@ def test_screened_choice_is_the_choice_among_all_eight_branches(robot_name, requ
 def gathered_and_analysed(q_all, valid, aux, candidates, q_min, q_max, max_step):
     """The oracle of analyse_closed_form: each candidate branch's joints, reach and branch
     quantities gathered by numpy, the wrist reversals found by numpy, then analyse_paths."""
-    from trackplan.robots._kernels import ELBOW, SHOULDER, WRIST, analyse_paths
+    from trackplan.robots._path_kernels import ELBOW, SHOULDER, WRIST, analyse_paths
 
     rows = np.arange(len(candidates))[:, None]
     q = q_all[rows, :, candidates]  # (B, K, M, n): the advanced indices' axes first
@@ -426,7 +426,7 @@ def test_fused_analysis_is_the_gather_then_analysis(seed):
     """analyse_closed_form gives, bit for bit, what gathering the candidate branches and
     analysing them with analyse_paths gives, on random solutions with missed poses, jumps,
     measures through zero, wrist reversals and paths beyond the limits."""
-    from trackplan.robots._kernels import N_FLOAT, N_INT, analyse_closed_form
+    from trackplan.robots._path_kernels import N_FLOAT, N_INT, analyse_closed_form
 
     rng = np.random.default_rng(seed)
     n_cand, n_poses, n = 5, 60, 6
@@ -493,36 +493,73 @@ def test_thread_sharing_pauses_while_it_does_not_pay(monkeypatch):
     """After a shared call below the efficiency that pays, the next calls run on one
     thread, for a pause that doubles while sharing keeps not paying (up to the last) and
     starts again from the first once it pays."""
-    from trackplan.robots import path_ik
+    from trackplan.robots import thread_sharing
 
-    monkeypatch.setattr(path_ik, "path_threads", lambda: 2)
-    sharing = path_ik.ThreadSharing()
+    monkeypatch.setattr(thread_sharing, "path_threads", lambda: 2)
+    sharing = thread_sharing.ThreadSharing()
     assert sharing.threads() == 2
     pauses = []
     for _ in range(7):
-        sharing.note(0.5 * path_ik.EFFICIENT)
-        counts = [sharing.threads() for _ in range(2 * path_ik.LAST_PAUSE)]
+        sharing.note(0.5 * thread_sharing.EFFICIENT)
+        counts = [sharing.threads() for _ in range(2 * thread_sharing.LAST_PAUSE)]
         pauses.append(counts.index(2))
         assert set(counts[: pauses[-1]]) == {1}
-    first, last = path_ik.FIRST_PAUSE, path_ik.LAST_PAUSE
+    first, last = thread_sharing.FIRST_PAUSE, thread_sharing.LAST_PAUSE
     assert pauses == [min(last, first * 2**i) for i in range(7)]
     assert pauses[-1] == last
-    sharing.note(path_ik.EFFICIENT)  # paid: no pause, and the next pause is the first
+    sharing.note(thread_sharing.EFFICIENT)  # paid: no pause, and the next pause is the first
     assert sharing.threads() == 2
     sharing.note(0.0)
     assert [sharing.threads() for _ in range(first + 1)] == [1] * first + [2]
 
 
-def test_shared_calls_report_their_efficiency(puma, monkeypatch):
+def test_shared_calls_report_their_efficiency_to_the_callers_record(puma, monkeypatch):
     """A call with threads=None on two threads reports its parallel efficiency (in
-    (0, 1.2]: the threads' CPU time over threads × wall) to the process's record."""
-    from trackplan.robots import path_ik
+    (0, 1.2]: the threads' CPU time over threads × wall) to the ThreadSharing its caller
+    passes; a call given threads, or given no record, records nothing anywhere."""
+    from trackplan.robots import path_ik, thread_sharing
 
-    seen = []
-    monkeypatch.setattr(path_ik, "_SHARING", path_ik.ThreadSharing())
-    monkeypatch.setattr(path_ik.ThreadSharing, "threads", lambda self: 2)
-    monkeypatch.setattr(path_ik.ThreadSharing, "note", lambda self, e: seen.append(e))
+    seen: list[tuple[int, float]] = []
+
+    class Record(thread_sharing.ThreadSharing):
+        def threads(self) -> int:
+            return 2
+
+        def note(self, efficiency: float) -> None:
+            seen.append((id(self), efficiency))
+
+    monkeypatch.setattr(thread_sharing, "path_threads", lambda: 2)
+    mine, other = Record(), Record()
     T = np.broadcast_to(feasible_line(200), (12, 200, 4, 4))
+    path_ik.solve_path_ik_branches(puma, T, sharing=mine)
+    path_ik.solve_path_ik_branches(puma, T, threads=2, sharing=other)  # given: nothing
+    path_ik.solve_path_ik_branches(puma, T)  # no record: two threads, nothing kept
+    assert len(seen) == 1 and seen[0][0] == id(mine) and 0.0 < seen[0][1] <= 1.2
+
+
+def test_a_paused_record_runs_the_callers_next_calls_on_one_thread(puma, monkeypatch):
+    """The pause belongs to the caller's record: a record in a pause gives its caller one
+    thread, while a call with another record (or none) still shares its work."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from trackplan.robots import path_branches, path_ik, thread_sharing
+
+    monkeypatch.setattr(thread_sharing, "path_threads", lambda: 2)
+    monkeypatch.setattr(path_branches, "path_threads", lambda: 2)
+    pools: list[int] = []
+    real_pool = ThreadPoolExecutor
+
+    def counting_pool(workers: int) -> ThreadPoolExecutor:
+        pools.append(workers)
+        return real_pool(workers)
+
+    monkeypatch.setattr(path_branches, "ThreadPoolExecutor", counting_pool)
+    paused, fresh = thread_sharing.ThreadSharing(), thread_sharing.ThreadSharing()
+    paused.note(0.0)  # did not pay: the next FIRST_PAUSE calls run on one thread
+    T = np.broadcast_to(feasible_line(200), (12, 200, 4, 4))
+    path_ik.solve_path_ik_branches(puma, T, sharing=paused)
+    assert pools == []
+    path_ik.solve_path_ik_branches(puma, T, sharing=fresh)
     path_ik.solve_path_ik_branches(puma, T)
-    path_ik.solve_path_ik_branches(puma, T, threads=2)  # given: nothing to record
-    assert len(seen) == 1 and 0.0 < seen[0] <= 1.2
+    assert pools == [1, 1]
+    assert paused.left == thread_sharing.FIRST_PAUSE - 1

@@ -54,47 +54,42 @@ cylinders, spheres and meshes are each fitted with an enclosing capsule.
 A URDF gives no acceleration or jerk limits. Without them the robot is refused, unless
 ``assume_limits`` is set: then acceleration = velocity / :data:`ASSUMED_ACCELERATION_TIME`
 and jerk = acceleration / :data:`ASSUMED_JERK_TIME`, recorded in ``Robot.assumptions``.
+
+This module reads robot files and serves the built-in library; the file schema is
+:mod:`trackplan.io.robot_schema`, robot files for a URDF are read by
+:mod:`trackplan.io.urdf_robot`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
 import numpy as np
 import yaml
-from pydantic import Field, PlainValidator
-from pydantic_core import PydanticCustomError
 
 from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_from_matrix, rpy_matrix
-from trackplan.io.robot_bounds import (
-    MAX_ANGLE,
-    MAX_LENGTH,
-    Angle,
-    Friction,
-    GearRatio,
-    InertiaEntry,
-    Length,
-    Mass,
-    MotorConstant,
-    MotorInertia,
-    Rate,
-    Torque,
-    Viscous,
+
+# moved to robot_schema and urdf_robot; importers outside this package keep working
+from trackplan.io.robot_schema import ASSUMED_ACCELERATION_TIME as ASSUMED_ACCELERATION_TIME
+from trackplan.io.robot_schema import ASSUMED_JERK_TIME as ASSUMED_JERK_TIME
+from trackplan.io.robot_schema import (
+    DYNAMICS_KEYS,
+    ROBOT_FILE_SUFFIXES,
+    RobotFileModel,
+    ToolModel,
+    collision_problems,
+    link_capsules,
 )
-from trackplan.io.urdf import DEFAULT_CONTINUOUS_RANGE, read_urdf_chain, read_urdf_link_geometry
-from trackplan.io.urdf_inertials import read_urdf_inertials
+from trackplan.io.robot_schema import PayloadModel as PayloadModel
+from trackplan.io.robot_schema import as_payload as as_payload
+from trackplan.io.robot_schema import payload_problems as payload_problems
+from trackplan.io.urdf_robot import load_urdf_robot_file, robot_from_urdf_file
 from trackplan.io.yaml_input import (
-    NonEmptyStr,
     Problem,
-    Range,
-    StrictModel,
-    Vec3,
-    list_default,
     parse_yaml,
     raise_first,
     read_text,
@@ -102,10 +97,7 @@ from trackplan.io.yaml_input import (
     validate_model,
 )
 from trackplan.robots.builtin import DH_ROBOTS
-from trackplan.robots.collision import Capsules, frame_name, transform_capsule
 from trackplan.robots.dynamics.parameters import (
-    STANDARD_GRAVITY,
-    Payload,
     RobotDynamics,
     inertia_matrix,
     inertia_problem,
@@ -113,144 +105,8 @@ from trackplan.robots.dynamics.parameters import (
 )
 from trackplan.robots.model import Robot
 
-ROBOT_FILE_SUFFIXES = (".yaml", ".yml", ".urdf")
-ASSUMED_ACCELERATION_TIME = 0.25
-"""s: with ``assume_limits``, a joint reaches its rated velocity in this time."""
-ASSUMED_JERK_TIME = 0.1
-"""s: with ``assume_limits``, a joint reaches its acceleration limit in this time."""
 LIBRARY_DIR = Path(__file__).resolve().parent.parent / "robots" / "library"
 """Package data: one URDF and one robot file per built-in industrial arm."""
-
-
-Inertia6 = Annotated[list[InertiaEntry], Field(min_length=6, max_length=6)]
-"""``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]``, kg·m²."""
-Coulomb = Annotated[list[Friction], Field(min_length=2, max_length=2)]
-"""``[Tc+, Tc−]``, N·m, motor side."""
-
-
-class JointModel(StrictModel):
-    """One joint: DH parameters (m, rad) and limits (rad, rad/s, rad/s², rad/s³)."""
-
-    d: Length
-    a: Length
-    alpha: Angle
-    offset: Angle = 0.0
-    position: Range
-    velocity: Rate
-    acceleration: Rate
-    jerk: Rate
-    mass: Mass | None = None
-    com: Vec3 | None = None
-    inertia: Inertia6 | None = None
-    torque: Torque | None = None
-    motor_inertia: MotorInertia = 0.0
-    gear_ratio: GearRatio = 1.0
-    viscous: Viscous = 0.0
-    coulomb: Coulomb = list_default(0.0, 0.0)
-    motor_constant: MotorConstant | None = None
-
-
-DYNAMICS_KEYS = ("mass", "com", "inertia", "torque")
-"""Per-joint keys that every joint needs once any joint has dynamics."""
-
-
-class PayloadModel(StrictModel):
-    """A load at the TCP: mass (kg), centre of mass and inertia about it (TCP frame)."""
-
-    mass: Mass
-    com: Vec3 = list_default(0.0, 0.0, 0.0)
-    inertia: Inertia6 = list_default(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-
-
-class ToolModel(StrictModel):
-    """Tool transform in the flange: ``Trans(xyz) · RPY(rpy)`` (m, rad)."""
-
-    xyz: Vec3 = list_default(0.0, 0.0, 0.0)
-    rpy: Vec3 = list_default(0.0, 0.0, 0.0)
-
-
-def _link_reference(value: Any) -> int | str:
-    """A ``collision[i].link``: a frame number or a non-empty link name, nothing else."""
-    if isinstance(value, bool) or not isinstance(value, int | str) or value == "":
-        raise PydanticCustomError(
-            "link_type", "expected a link number (0 = base, i = joint i) or a URDF link name"
-        )
-    return value
-
-
-LinkReference = Annotated[int | str, PlainValidator(_link_reference)]
-"""A link by number (checked against the chain later) or by URDF link name."""
-
-
-class CollisionCapsuleModel(StrictModel):
-    """A link capsule: the link (number 0..n, or a URDF link's name), axis end points
-    ``from``, ``to`` in that link's frame (m) and radius (m)."""
-
-    link: LinkReference
-    from_: Vec3 = Field(alias="from")
-    to: Vec3
-    radius: Annotated[float, Field(gt=0, le=MAX_LENGTH)]
-
-
-Collision = Annotated[list[CollisionCapsuleModel], Field(min_length=1)]
-"""The ``collision:`` key of a robot file: the robot's link capsules (``docs/cell.md``)."""
-
-
-class LimitsModel(StrictModel):
-    """Per-joint limits that a URDF lacks or that override it, in chain order."""
-
-    acceleration: list[Rate] | None = None
-    jerk: list[Rate] | None = None
-    velocity: list[Rate] | None = None
-
-
-class URDFDynamicsModel(StrictModel):
-    """Dynamics of a URDF robot that add to or replace the URDF's, one entry per joint.
-
-    ``mass``, ``com`` and ``inertia`` (about the centre of mass) are in the joints' child
-    frames, which are the URDF frames of the links the joints move; given, they replace
-    every ``<inertial>`` of the chain. ``torque`` replaces the ``<limit effort>`` values.
-    """
-
-    mass: list[Mass] | None = None
-    com: list[Vec3] | None = None
-    inertia: list[Inertia6] | None = None
-    torque: list[Torque] | None = None
-    motor_inertia: list[MotorInertia] | None = None
-    gear_ratio: list[GearRatio] | None = None
-    viscous: list[Viscous] | None = None
-    coulomb: list[Coulomb] | None = None
-    motor_constant: list[MotorConstant] | None = None
-
-
-class URDFRobotFileModel(StrictModel):
-    """Schema of a robot file that points at a URDF."""
-
-    name: NonEmptyStr
-    urdf: NonEmptyStr
-    source: str = ""
-    base_link: NonEmptyStr | None = None
-    tip_link: NonEmptyStr | None = None
-    tool: ToolModel | None = None
-    limits: LimitsModel = Field(default_factory=LimitsModel)
-    continuous_range: Annotated[float, Field(gt=0, le=MAX_ANGLE)] = DEFAULT_CONTINUOUS_RANGE
-    dynamics: URDFDynamicsModel | None = None
-    gravity: Vec3 = list_default(*STANDARD_GRAVITY)
-    payload: PayloadModel | None = None
-    assumptions: list[str] = Field(default_factory=list)
-    collision: Collision | None = None
-
-
-class RobotFileModel(StrictModel):
-    """Schema of a DH robot file."""
-
-    name: NonEmptyStr
-    source: str = ""
-    joints: Annotated[list[JointModel], Field(min_length=1)]
-    tool: ToolModel | None = None
-    gravity: Vec3 = list_default(*STANDARD_GRAVITY)
-    payload: PayloadModel | None = None
-    collision: Collision | None = None
 
 
 def load_robot(file: str | Path, *, assume_limits: bool = False) -> Robot:
@@ -280,23 +136,6 @@ def load_robot(file: str | Path, *, assume_limits: bool = False) -> Robot:
     return load_robot_text(text, file=str(file), assume_limits=assume_limits)
 
 
-def robot_from_urdf_file(file: str | Path, *, assume_limits: bool = False) -> Robot:
-    """A robot from a URDF alone: its chain from the root to the single leaf.
-
-    Raises
-    ------
-    CaseError
-        As :func:`~trackplan.io.urdf.read_urdf_chain`, and when limits are missing.
-    """
-    chain = read_urdf_chain(file)
-    robot = _urdf_robot(
-        chain, chain.name, LimitsModel(), np.eye(4), "", [], assume_limits, str(file)
-    )
-    capsules = read_urdf_link_geometry(file, chain.joint_names).capsules
-    robot = replace(robot, dynamics=urdf_dynamics(file, chain, None, None, str(file)))
-    return replace(robot, collision=capsules) if len(capsules) else robot
-
-
 def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool = False) -> Robot:
     """Build a robot from the text of a robot file.
 
@@ -318,7 +157,7 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
     """
     data = parse_yaml(text, file)
     if isinstance(data, dict) and "urdf" in data:
-        return _load_urdf_robot_file(data, file, assume_limits)
+        return load_urdf_robot_file(data, file, assume_limits)
     model = validate_model(RobotFileModel, data, file)
     problems: list[Problem] = [
         (
@@ -352,26 +191,6 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
         source=model.source,
         dynamics=_dynamics(model, columns),
         collision=link_capsules(model.collision, {}),
-    )
-
-
-def payload_problems(payload: PayloadModel, loc: tuple[str | int, ...]) -> list[Problem]:
-    """Negative mass or an unphysical inertia of a payload."""
-    problems: list[Problem] = []
-    if payload.mass < 0:
-        problems.append(((*loc, "mass"), f"mass must be >= 0 kg, got {payload.mass:g}"))
-    problem = inertia_problem(inertia_matrix(payload.inertia))
-    if problem:
-        problems.append(((*loc, "inertia"), f"inertia {problem}"))
-    return problems
-
-
-def as_payload(payload: PayloadModel) -> Payload:
-    """The payload of a validated ``payload`` block."""
-    return Payload(
-        mass=payload.mass,
-        com=np.array(payload.com),
-        inertia=inertia_matrix(np.array(payload.inertia)),
     )
 
 
@@ -443,298 +262,6 @@ def _dynamics(model: RobotFileModel, columns: dict[str, np.ndarray]) -> RobotDyn
         gravity=np.array(model.gravity),
         payload=None if model.payload is None else as_payload(model.payload),
         source=model.source,
-    )
-
-
-def _load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Robot:
-    """A robot from the data of a robot file with a ``urdf`` key."""
-    model = validate_model(URDFRobotFileModel, data, file)
-    base = Path(file).parent if file else Path(".")
-    chain = read_urdf_chain(
-        base / model.urdf,
-        model.base_link,
-        model.tip_link,
-        continuous_range=model.continuous_range,
-        referrer=file,
-    )
-    n = len(chain.joint_names)
-    problems: list[Problem] = [
-        (
-            ("limits", key),
-            f"expected {n} entries, one per joint of the chain "
-            f"({', '.join(chain.joint_names)}), got {len(values)}",
-        )
-        for key in ("acceleration", "jerk", "velocity")
-        if (values := getattr(model.limits, key)) is not None and len(values) != n
-    ]
-    raise_first(problems, data, file)
-    tool = model.tool or ToolModel()
-    T_tool = pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy)))
-    robot = _urdf_robot(
-        chain,
-        model.name,
-        model.limits,
-        T_tool,
-        model.source,
-        model.assumptions,
-        assume_limits,
-        file,
-    )
-    dynamics = urdf_dynamics(base / model.urdf, chain, model, data, file)
-    collision = _urdf_collision(model, base / model.urdf, chain, data, file)
-    return replace(robot, dynamics=dynamics, collision=collision)
-
-
-def collision_problems(
-    capsules: list[CollisionCapsuleModel] | None,
-    n_dof: int,
-    link_frames: dict[str, tuple[int, np.ndarray]],
-) -> list[Problem]:
-    """Link numbers past the chain and link names the URDF does not put on it."""
-    problems: list[Problem] = []
-    for i, capsule in enumerate(capsules or []):
-        if isinstance(capsule.link, int):
-            if not 0 <= capsule.link <= n_dof:
-                problems.append(
-                    (
-                        ("collision", i, "link"),
-                        f"expected a link number 0..{n_dof} (0 = base), got {capsule.link}",
-                    )
-                )
-        elif capsule.link not in link_frames:
-            if link_frames:
-                known = ", ".join(sorted(link_frames))
-                message = f"no link {capsule.link!r} on the URDF's chain: use one of {known}"
-            else:
-                message = (
-                    f"unknown link {capsule.link!r}: a DH robot numbers its links "
-                    f"0..{n_dof} (0 = base)"
-                )
-            problems.append((("collision", i, "link"), message))
-    return problems
-
-
-def link_capsules(
-    capsules: list[CollisionCapsuleModel] | None,
-    link_frames: dict[str, tuple[int, np.ndarray]],
-) -> Capsules | None:
-    """The validated ``collision:`` capsules on the chain's frames (None when not given).
-
-    A capsule given by a URDF link name is moved from that link's frame into the chain
-    frame the link is fixed to (:func:`~trackplan.io.urdf.read_urdf_link_geometry`).
-    """
-    if capsules is None:
-        return None
-    frames, segments, names = [], [], []
-    for capsule in capsules:
-        if isinstance(capsule.link, int):
-            frame, T_frame_link, name = capsule.link, np.eye(4), frame_name(capsule.link)
-        else:
-            (frame, T_frame_link), name = link_frames[capsule.link], capsule.link
-        frames.append(frame)
-        segments.append(transform_capsule(np.array([capsule.from_, capsule.to]), T_frame_link))
-        names.append(name)
-    return Capsules(
-        np.array(frames), np.array(segments), np.array([c.radius for c in capsules]), tuple(names)
-    )
-
-
-def _urdf_collision(
-    model: URDFRobotFileModel, urdf: Path, chain: Any, data: Any, file: str | None
-) -> Capsules | None:
-    """The link capsules of a URDF robot file: its ``collision:`` key, else the URDF's
-    ``<collision>`` elements fitted with capsules (None when it has neither)."""
-    geometry = read_urdf_link_geometry(
-        urdf, chain.joint_names, model.base_link, collisions=model.collision is None
-    )
-    if model.collision is None:
-        return geometry.capsules if len(geometry.capsules) else None
-    n_dof = len(chain.joint_names)
-    raise_first(collision_problems(model.collision, n_dof, geometry.link_frames), data, file)
-    return link_capsules(model.collision, geometry.link_frames)
-
-
-def urdf_dynamics(
-    urdf: str | Path,
-    chain: Any,
-    model: URDFRobotFileModel | None,
-    data: Any,
-    file: str | None,
-) -> RobotDynamics | None:
-    """The dynamics of a URDF robot: the URDF's inertials and efforts, then the robot file's.
-
-    The robot has dynamics when the chain has inertials (``<inertial>`` or
-    ``dynamics.mass``) and every joint a torque limit (``effort`` > 0 or
-    ``dynamics.torque``). A bare URDF short of either has none (no torque check); a robot
-    file that gives ``dynamics``, ``payload`` or ``gravity`` and is short of either is an
-    error.
-
-    Parameters
-    ----------
-    urdf
-        The URDF file.
-    chain
-        Its chain (:class:`~trackplan.io.urdf.URDFChain`).
-    model
-        The validated robot file pointing at the URDF, or None for a bare URDF.
-    data, file
-        The robot file's data and path, for error messages.
-
-    Returns
-    -------
-    RobotDynamics or None
-
-    Raises
-    ------
-    CaseError
-        On a bad value in the URDF's inertials or the robot file's dynamics.
-    """
-    names = chain.joint_names
-    inertials = read_urdf_inertials(urdf, names, None if model is None else model.base_link)
-    extra = model.dynamics if model is not None else None
-    dyn = extra or URDFDynamicsModel()
-    raise_first(_urdf_dynamics_problems(dyn, model, names), data, file)
-    if dyn.mass is not None and dyn.com is not None and dyn.inertia is not None:
-        mass, com = np.array(dyn.mass), np.array(dyn.com)
-        inertia = inertia_matrix(np.array(dyn.inertia))
-    elif inertials.has_inertials:
-        mass, com, inertia = inertials.mass, inertials.com, inertials.inertia
-    else:
-        mass = None
-    torque = np.array(dyn.torque) if dyn.torque is not None else inertials.effort
-    explicit = model is not None and (
-        extra is not None or model.payload is not None or "gravity" in model.model_fields_set
-    )
-    if mass is None or np.any(np.isnan(torque)):
-        if not explicit:
-            return None
-        if mass is None:
-            why = (
-                "the URDF has no <inertial> on the chain's links: add them or give "
-                "dynamics.mass, dynamics.com and dynamics.inertia"
-            )
-        else:
-            missing = ", ".join(names[i] for i in np.flatnonzero(np.isnan(torque)))
-            why = (
-                f"no torque limit for joints {missing}: give effort > 0 in their <limit> "
-                "in the URDF or dynamics.torque"
-            )
-        raise CaseError(why, file=file, key="dynamics")
-    return RobotDynamics(
-        mass=mass,
-        com=com,
-        inertia=inertia,
-        torque_max=torque,
-        motor_inertia=None if dyn.motor_inertia is None else np.array(dyn.motor_inertia),
-        gear_ratio=None if dyn.gear_ratio is None else np.array(dyn.gear_ratio),
-        viscous=None if dyn.viscous is None else np.array(dyn.viscous),
-        coulomb=None if dyn.coulomb is None else np.array(dyn.coulomb),
-        motor_constant=None if dyn.motor_constant is None else np.array(dyn.motor_constant),
-        gravity=np.array(STANDARD_GRAVITY if model is None else model.gravity),
-        payload=None if model is None or model.payload is None else as_payload(model.payload),
-        source="" if model is None else model.source,
-    )
-
-
-def _urdf_dynamics_problems(
-    dyn: URDFDynamicsModel, model: URDFRobotFileModel | None, names: tuple[str, ...]
-) -> list[Problem]:
-    """Wrong list lengths, negative masses, unphysical inertias, torque limits <= 0."""
-    n = len(names)
-    problems: list[Problem] = []
-    for key in URDFDynamicsModel.model_fields:
-        values = getattr(dyn, key)
-        if values is not None and len(values) != n:
-            problems.append(
-                (
-                    ("dynamics", key),
-                    f"expected {n} entries, one per joint of the chain ({', '.join(names)}), "
-                    f"got {len(values)}",
-                )
-            )
-    if problems:
-        return problems
-    inertial = [getattr(dyn, key) is not None for key in ("mass", "com", "inertia")]
-    if any(inertial) and not all(inertial):
-        problems.append(
-            (("dynamics",), "give mass, com and inertia together (they replace the URDF's)")
-        )
-    for i in range(n):
-        if dyn.mass is not None and dyn.mass[i] < 0:
-            problems.append((("dynamics", "mass", i), f"mass must be >= 0 kg, got {dyn.mass[i]:g}"))
-        if dyn.torque is not None and dyn.torque[i] <= 0:
-            problems.append(
-                (
-                    ("dynamics", "torque", i),
-                    f"torque limit must be > 0 N·m, got {dyn.torque[i]:g}",
-                )
-            )
-        if dyn.inertia is not None:
-            problem = inertia_problem(inertia_matrix(dyn.inertia[i]))
-            if problem:
-                problems.append((("dynamics", "inertia", i), f"inertia {problem}"))
-        if dyn.gear_ratio is not None and dyn.gear_ratio[i] == 0:
-            problems.append((("dynamics", "gear_ratio", i), "gear ratio must not be 0"))
-    if model is not None and model.payload is not None:
-        problems += payload_problems(model.payload, ("payload",))
-    return problems
-
-
-def _urdf_robot(
-    chain: Any,
-    name: str,
-    limits: LimitsModel,
-    T_tool: np.ndarray,
-    source: str,
-    assumptions: list[str],
-    assume_limits: bool,
-    file: str | None,
-) -> Robot:
-    """The robot of a URDF chain with the limits a robot file adds (or assumed ones)."""
-    notes = list(assumptions)
-    velocity = chain.v_max if limits.velocity is None else np.array(limits.velocity)
-    if np.any(np.isnan(velocity)):
-        missing = [chain.joint_names[i] for i in np.flatnonzero(np.isnan(velocity))]
-        raise CaseError(
-            f"no velocity limit for joints {', '.join(missing)}: add velocity to their "
-            "<limit> in the URDF or limits.velocity to a robot file",
-            file=file,
-        )
-    acceleration = None if limits.acceleration is None else np.array(limits.acceleration)
-    jerk = None if limits.jerk is None else np.array(limits.jerk)
-    if acceleration is None or jerk is None:
-        missing_keys = [
-            key for key, value in (("acceleration", acceleration), ("jerk", jerk)) if value is None
-        ]
-        if not assume_limits:
-            raise CaseError(
-                f"a URDF gives no {' or '.join(missing_keys)} limits: add "
-                f"{', '.join('limits.' + key for key in missing_keys)} (one per joint) to a "
-                "robot file pointing at the URDF (docs/robots.md), or pass --assume-limits",
-                file=file,
-            )
-        if acceleration is None:
-            acceleration = velocity / ASSUMED_ACCELERATION_TIME
-            notes.append(
-                f"acceleration assumed: velocity / {ASSUMED_ACCELERATION_TIME} s (--assume-limits)"
-            )
-        if jerk is None:
-            jerk = acceleration / ASSUMED_JERK_TIME
-            notes.append(f"jerk assumed: acceleration / {ASSUMED_JERK_TIME} s (--assume-limits)")
-    return Robot(
-        name=name,
-        origins=chain.origins,
-        axes=chain.axes,
-        q_min=chain.q_min,
-        q_max=chain.q_max,
-        v_max=velocity,
-        a_max=acceleration,
-        j_max=jerk,
-        T_tip=chain.T_tip,
-        T_flange_tool=T_tool,
-        source=source,
-        joint_names=chain.joint_names,
-        assumptions=tuple(notes),
     )
 
 
@@ -837,7 +364,7 @@ class _FlowMapping(dict[str, Any]):
     """A mapping written on one line (``{d: 0.0, a: 0.4318, ...}``)."""
 
 
-class _Dumper(yaml.SafeDumper):
+class _Dumper(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships no type stubs
     """Safe dumper that writes :class:`_FlowMapping` in flow style and indents list items."""
 
     def increase_indent(self, flow: bool = False, indentless: bool = False) -> None:
@@ -919,5 +446,7 @@ def robot_to_yaml(robot: Robot) -> str:
             )
             for k in range(len(robot.collision))
         ]
-    body = yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=1_000_000)
+    body: str = yaml.dump(
+        data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=1_000_000
+    )
     return _HEADER + body

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -115,7 +116,9 @@ def read_urdf_inertials(
     return URDFInertials(mass, com, inertia, effort, has_inertials)
 
 
-def _anchor(name: str, anchors: dict[str, int], by_child: dict) -> tuple[int | None, np.ndarray]:
+def _anchor(
+    name: str, anchors: dict[str, int], by_child: dict[str, Any]
+) -> tuple[int | None, np.ndarray]:
     """The chain frame a link is fixed to (-1 the base, None: none) and its pose in it."""
     T_frame_link = np.eye(4)
     while name not in anchors:

@@ -166,7 +166,8 @@ def transform_capsule(segment: np.ndarray, T_frame_local: np.ndarray) -> np.ndar
     """Capsule end points (2, 3) in a local frame, expressed in the frame ``T_frame_local``
     (4, 4) is given in."""
     segment = np.asarray(segment, dtype=float)
-    return segment @ T_frame_local[:3, :3].T + T_frame_local[:3, 3]
+    moved: np.ndarray = segment @ T_frame_local[:3, :3].T + T_frame_local[:3, 3]
+    return moved
 
 
 def _capsules(rows: list[tuple[int, tuple[float, ...], tuple[float, ...], float]]) -> Capsules:

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.errors import CaseError
-from trackplan.robots._kernels import newton_batch
+from trackplan.robots._ik_kernels import newton_batch
 from trackplan.robots.model import Robot
 
 

@@ -21,7 +21,9 @@ from functools import cached_property
 
 import numpy as np
 
+from trackplan._kernels import read_only
 from trackplan.errors import CaseError
+from trackplan.robots._kernels import fk_flat
 from trackplan.robots.collision import Capsules
 from trackplan.robots.dynamics.parameters import RobotDynamics
 
@@ -55,7 +57,8 @@ def rotation_z_to(axis: np.ndarray) -> np.ndarray:
     s = np.linalg.norm(v)
     k = v / s
     K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    R: np.ndarray = np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    return R
 
 
 def dh_transform(d: float, a: float, alpha: float) -> np.ndarray:
@@ -231,7 +234,7 @@ class Robot:
     @property
     def n_dof(self) -> int:
         """Number of joints."""
-        return self.origins.shape[0]
+        return int(self.origins.shape[0])
 
     @property
     def has_tool(self) -> bool:
@@ -297,11 +300,11 @@ class Robot:
         Estimated on :data:`REACH_SAMPLES` configurations drawn with a fixed seed inside the
         position limits (a lower bound of the true maximum, within about 1 %).
         """
-        from trackplan.robots.kinematics import forward_kinematics
-
         rng = np.random.default_rng(0)
         q = rng.uniform(self.q_min, self.q_max, (REACH_SAMPLES, self.n_dof))
-        return float(np.linalg.norm(forward_kinematics(self, q)[:, :3, 3], axis=1).max())
+        chain, tail = self.kernel_chain  # forward kinematics (kinematics.py) of the samples
+        T = fk_flat(read_only(chain), read_only(tail), read_only(q))
+        return float(np.linalg.norm(T[:, :3, 3], axis=1).max())
 
     @property
     def default_placement_reach(self) -> tuple[float, float]:

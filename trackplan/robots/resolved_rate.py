@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from trackplan.errors import CaseError
-from trackplan.robots._kernels import (
+from trackplan.robots._ik_kernels import (
     damped_solve_into,
     fk_jacobian_into,
     newton_into,

@@ -66,6 +66,7 @@ from trackplan.planning.result import PlanResult
 from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.path_ik import solve_path_ik_branches
+from trackplan.robots.thread_sharing import ThreadSharing
 from trackplan.search.space import SearchSpace
 from trackplan.timing import time_law
 from trackplan.tool import ToolOrientation, spin_rotations, spin_values
@@ -271,6 +272,7 @@ class PlacementFitness:
         self._map: Callable[[Callable, Iterable], Iterable] = (
             executor.map if executor is not None else map
         )
+        self.sharing = ThreadSharing()  # whether the path IK's threads pay, call after call
 
     def evaluate(self, X: np.ndarray, incumbent: float = np.inf) -> Screening:
         """Fitness of a batch of placements.
@@ -335,7 +337,7 @@ class PlacementFitness:
         BranchScreen
         """
         poses = tool_poses(X[:, :6], self.points, self.rotations(X[:, 6:]))
-        paths = solve_path_ik_branches(self.case.robot, poses)
+        paths = solve_path_ik_branches(self.case.robot, poses, sharing=self.sharing)
         n_poses = len(self.s_grid)
         unreachable = 1.0 - paths.reachable_fraction
         switches = paths.n_switches / n_poses

@@ -267,4 +267,5 @@ def holding_torque_ratio(robot: Robot, q: np.ndarray) -> np.ndarray:
     finite = np.isfinite(q).all(axis=-1, keepdims=True)
     holding = gravity_load(robot, np.where(finite, q, 0.0))
     ratio = np.where(finite, np.abs(holding) / dynamics.torque_max, 0.0)
-    return ratio.max(axis=(-2, -1))
+    largest: np.ndarray = ratio.max(axis=(-2, -1))
+    return largest

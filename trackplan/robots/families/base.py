@@ -56,7 +56,8 @@ class ClosedFormIK:
     @property
     def reachable(self) -> np.ndarray:
         """Shape (...,), bool: at least one branch reaches the pose."""
-        return np.any(self.valid, axis=-1)
+        reached: np.ndarray = np.any(self.valid, axis=-1)
+        return reached
 
 
 class IKFamily(Protocol):
@@ -148,8 +149,8 @@ class IKFamily(Protocol):
 
 class FusedClosedForm:
     r"""The solve methods of a closed-form family (:class:`IKFamily`) whose compiled kernels
-    (``families/_kernels.py``) take its parameter array and the inverse of its tool
-    transform.
+    (``families/_opw_kernels.py``, ``families/_ur_kernels.py``) take its parameter array
+    and the inverse of its tool transform.
 
     A subclass sets ``_geometry`` and ``_tail_inv`` and names its kernels: ``_all_branches``
     (pose in, eight branches out: ``opw_solve``, ``ur_solve``) and ``_one_branch``

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.robots.families import _kernels as kern
+from trackplan.robots.families import _opw_kernels as kern
 from trackplan.robots.families.base import FusedClosedForm, describe_bits
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
@@ -114,7 +114,8 @@ def _closest_point(p1: np.ndarray, u1: np.ndarray, p2: np.ndarray, u2: np.ndarra
     denom = 1.0 - b * b
     s = (b * e - d) / denom
     t = (e - b * d) / denom
-    return 0.5 * (p1 + s * u1 + p2 + t * u2)
+    midpoint: np.ndarray = 0.5 * (p1 + s * u1 + p2 + t * u2)
+    return midpoint
 
 
 def _line_distance(point: np.ndarray, p: np.ndarray, u: np.ndarray) -> float:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from trackplan.robots.families import _kernels as kern
+from trackplan.robots.families import _ur_kernels as kern
 from trackplan.robots.families.base import FusedClosedForm, branch_bits
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
@@ -141,7 +141,8 @@ def ur_from_chain(robot: Robot) -> URParameters | None:
     x1 = np.cross(ez, u)
 
     def foot(point: np.ndarray) -> np.ndarray:  # the axis through point, in o1's plane ⊥ u
-        return point - ((point - o1) @ u) * u
+        projected: np.ndarray = point - ((point - o1) @ u) * u
+        return projected
 
     o2, o3 = foot(p[2]), foot(p[3])
     if np.linalg.norm(o2 - o1) <= tol * scale or np.linalg.norm(o3 - o2) <= tol * scale:

@@ -1,0 +1,258 @@
+"""The robot file schema: the pydantic models of robot files (DH and URDF), their
+payload and collision blocks, and the checks and conversions of those blocks.
+
+:mod:`trackplan.io.robot_file` reads robot files with these models; the case file
+(:mod:`trackplan.io.case_file`) uses the payload block too. docs/files.md documents
+the keys.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import Field, PlainValidator
+from pydantic_core import PydanticCustomError
+
+from trackplan.io.robot_bounds import (
+    MAX_ANGLE,
+    MAX_LENGTH,
+    Angle,
+    Friction,
+    GearRatio,
+    InertiaEntry,
+    Length,
+    Mass,
+    MotorConstant,
+    MotorInertia,
+    Rate,
+    Torque,
+    Viscous,
+)
+from trackplan.io.urdf import DEFAULT_CONTINUOUS_RANGE
+from trackplan.io.yaml_input import (
+    NonEmptyStr,
+    Problem,
+    Range,
+    StrictModel,
+    Vec3,
+    list_default,
+)
+from trackplan.robots.collision import Capsules, frame_name, transform_capsule
+from trackplan.robots.dynamics.parameters import (
+    STANDARD_GRAVITY,
+    Payload,
+    inertia_matrix,
+    inertia_problem,
+)
+
+ROBOT_FILE_SUFFIXES = (".yaml", ".yml", ".urdf")
+ASSUMED_ACCELERATION_TIME = 0.25
+"""s: with ``assume_limits``, a joint reaches its rated velocity in this time."""
+ASSUMED_JERK_TIME = 0.1
+"""s: with ``assume_limits``, a joint reaches its acceleration limit in this time."""
+
+
+Inertia6 = Annotated[list[InertiaEntry], Field(min_length=6, max_length=6)]
+"""``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]``, kg·m²."""
+Coulomb = Annotated[list[Friction], Field(min_length=2, max_length=2)]
+"""``[Tc+, Tc−]``, N·m, motor side."""
+
+
+class JointModel(StrictModel):
+    """One joint: DH parameters (m, rad) and limits (rad, rad/s, rad/s², rad/s³)."""
+
+    d: Length
+    a: Length
+    alpha: Angle
+    offset: Angle = 0.0
+    position: Range
+    velocity: Rate
+    acceleration: Rate
+    jerk: Rate
+    mass: Mass | None = None
+    com: Vec3 | None = None
+    inertia: Inertia6 | None = None
+    torque: Torque | None = None
+    motor_inertia: MotorInertia = 0.0
+    gear_ratio: GearRatio = 1.0
+    viscous: Viscous = 0.0
+    coulomb: Coulomb = list_default(0.0, 0.0)
+    motor_constant: MotorConstant | None = None
+
+
+DYNAMICS_KEYS = ("mass", "com", "inertia", "torque")
+"""Per-joint keys that every joint needs once any joint has dynamics."""
+
+
+class PayloadModel(StrictModel):
+    """A load at the TCP: mass (kg), centre of mass and inertia about it (TCP frame)."""
+
+    mass: Mass
+    com: Vec3 = list_default(0.0, 0.0, 0.0)
+    inertia: Inertia6 = list_default(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+class ToolModel(StrictModel):
+    """Tool transform in the flange: ``Trans(xyz) · RPY(rpy)`` (m, rad)."""
+
+    xyz: Vec3 = list_default(0.0, 0.0, 0.0)
+    rpy: Vec3 = list_default(0.0, 0.0, 0.0)
+
+
+def _link_reference(value: Any) -> int | str:
+    """A ``collision[i].link``: a frame number or a non-empty link name, nothing else."""
+    if isinstance(value, bool) or not isinstance(value, int | str) or value == "":
+        raise PydanticCustomError(
+            "link_type", "expected a link number (0 = base, i = joint i) or a URDF link name"
+        )
+    return value
+
+
+LinkReference = Annotated[int | str, PlainValidator(_link_reference)]
+"""A link by number (checked against the chain later) or by URDF link name."""
+
+
+class CollisionCapsuleModel(StrictModel):
+    """A link capsule: the link (number 0..n, or a URDF link's name), axis end points
+    ``from``, ``to`` in that link's frame (m) and radius (m)."""
+
+    link: LinkReference
+    from_: Vec3 = Field(alias="from")
+    to: Vec3
+    radius: Annotated[float, Field(gt=0, le=MAX_LENGTH)]
+
+
+Collision = Annotated[list[CollisionCapsuleModel], Field(min_length=1)]
+"""The ``collision:`` key of a robot file: the robot's link capsules (``docs/cell.md``)."""
+
+
+class LimitsModel(StrictModel):
+    """Per-joint limits that a URDF lacks or that override it, in chain order."""
+
+    acceleration: list[Rate] | None = None
+    jerk: list[Rate] | None = None
+    velocity: list[Rate] | None = None
+
+
+class URDFDynamicsModel(StrictModel):
+    """Dynamics of a URDF robot that add to or replace the URDF's, one entry per joint.
+
+    ``mass``, ``com`` and ``inertia`` (about the centre of mass) are in the joints' child
+    frames, which are the URDF frames of the links the joints move; given, they replace
+    every ``<inertial>`` of the chain. ``torque`` replaces the ``<limit effort>`` values.
+    """
+
+    mass: list[Mass] | None = None
+    com: list[Vec3] | None = None
+    inertia: list[Inertia6] | None = None
+    torque: list[Torque] | None = None
+    motor_inertia: list[MotorInertia] | None = None
+    gear_ratio: list[GearRatio] | None = None
+    viscous: list[Viscous] | None = None
+    coulomb: list[Coulomb] | None = None
+    motor_constant: list[MotorConstant] | None = None
+
+
+class URDFRobotFileModel(StrictModel):
+    """Schema of a robot file that points at a URDF."""
+
+    name: NonEmptyStr
+    urdf: NonEmptyStr
+    source: str = ""
+    base_link: NonEmptyStr | None = None
+    tip_link: NonEmptyStr | None = None
+    tool: ToolModel | None = None
+    limits: LimitsModel = Field(default_factory=LimitsModel)
+    continuous_range: Annotated[float, Field(gt=0, le=MAX_ANGLE)] = DEFAULT_CONTINUOUS_RANGE
+    dynamics: URDFDynamicsModel | None = None
+    gravity: Vec3 = list_default(*STANDARD_GRAVITY)
+    payload: PayloadModel | None = None
+    assumptions: list[str] = Field(default_factory=list)
+    collision: Collision | None = None
+
+
+class RobotFileModel(StrictModel):
+    """Schema of a DH robot file."""
+
+    name: NonEmptyStr
+    source: str = ""
+    joints: Annotated[list[JointModel], Field(min_length=1)]
+    tool: ToolModel | None = None
+    gravity: Vec3 = list_default(*STANDARD_GRAVITY)
+    payload: PayloadModel | None = None
+    collision: Collision | None = None
+
+
+def payload_problems(payload: PayloadModel, loc: tuple[str | int, ...]) -> list[Problem]:
+    """Negative mass or an unphysical inertia of a payload."""
+    problems: list[Problem] = []
+    if payload.mass < 0:
+        problems.append(((*loc, "mass"), f"mass must be >= 0 kg, got {payload.mass:g}"))
+    problem = inertia_problem(inertia_matrix(payload.inertia))
+    if problem:
+        problems.append(((*loc, "inertia"), f"inertia {problem}"))
+    return problems
+
+
+def as_payload(payload: PayloadModel) -> Payload:
+    """The payload of a validated ``payload`` block."""
+    return Payload(
+        mass=payload.mass,
+        com=np.array(payload.com),
+        inertia=inertia_matrix(np.array(payload.inertia)),
+    )
+
+
+def collision_problems(
+    capsules: list[CollisionCapsuleModel] | None,
+    n_dof: int,
+    link_frames: dict[str, tuple[int, np.ndarray]],
+) -> list[Problem]:
+    """Link numbers past the chain and link names the URDF does not put on it."""
+    problems: list[Problem] = []
+    for i, capsule in enumerate(capsules or []):
+        if isinstance(capsule.link, int):
+            if not 0 <= capsule.link <= n_dof:
+                problems.append(
+                    (
+                        ("collision", i, "link"),
+                        f"expected a link number 0..{n_dof} (0 = base), got {capsule.link}",
+                    )
+                )
+        elif capsule.link not in link_frames:
+            if link_frames:
+                known = ", ".join(sorted(link_frames))
+                message = f"no link {capsule.link!r} on the URDF's chain: use one of {known}"
+            else:
+                message = (
+                    f"unknown link {capsule.link!r}: a DH robot numbers its links "
+                    f"0..{n_dof} (0 = base)"
+                )
+            problems.append((("collision", i, "link"), message))
+    return problems
+
+
+def link_capsules(
+    capsules: list[CollisionCapsuleModel] | None,
+    link_frames: dict[str, tuple[int, np.ndarray]],
+) -> Capsules | None:
+    """The validated ``collision:`` capsules on the chain's frames (None when not given).
+
+    A capsule given by a URDF link name is moved from that link's frame into the chain
+    frame the link is fixed to (:func:`~trackplan.io.urdf_geometry.read_urdf_link_geometry`).
+    """
+    if capsules is None:
+        return None
+    frames, segments, names = [], [], []
+    for capsule in capsules:
+        if isinstance(capsule.link, int):
+            frame, T_frame_link, name = capsule.link, np.eye(4), frame_name(capsule.link)
+        else:
+            (frame, T_frame_link), name = link_frames[capsule.link], capsule.link
+        frames.append(frame)
+        segments.append(transform_capsule(np.array([capsule.from_, capsule.to]), T_frame_link))
+        names.append(name)
+    return Capsules(
+        np.array(frames), np.array(segments), np.array([c.radius for c in capsules]), tuple(names)
+    )

@@ -1,0 +1,396 @@
+"""The candidate branches' joint paths along pose paths, solved and analysed.
+
+The shared core of :func:`trackplan.robots.path_ik.solve_path_ik` and
+:func:`~trackplan.robots.path_ik.solve_path_ik_branches` (see :mod:`trackplan.robots.path_ik`
+for the branches and what counts as a switch): the closed-form families solve all eight
+branches in pieces shared among threads (:class:`~trackplan.robots.thread_sharing.ThreadSharing`)
+or one branch alone; other robots march each numerical seed along the path
+(:func:`numeric_seeds`). The compiled analysis is in :mod:`trackplan.robots._path_kernels`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from trackplan.errors import CaseError
+from trackplan.robots._path_kernels import (
+    F_MARGIN,
+    I_N_SWITCH,
+    I_N_UNREACH,
+    N_FLOAT,
+    N_INT,
+    SINGULAR,
+    analyse_closed_form,
+    analyse_paths,
+    numeric_paths,
+    room_bounds,
+)
+from trackplan.robots.families import AUX_SIZE, N_BRANCHES, IKFamily, ik_family
+from trackplan.robots.ik_numeric import chain_arrays
+from trackplan.robots.model import Robot
+from trackplan.robots.thread_sharing import ThreadSharing, path_threads
+
+DEFAULT_MAX_STEP = np.pi / 4
+"""Joint step between consecutive poses that counts as a jump when ``max_step`` is None,
+rad: no sampling a planner uses moves a joint this far between two poses."""
+
+COARSE_STEP = 0.01
+"""Travel between the coarse poses the numerical path IK marches through, m; rotation
+counts :data:`ROTATION_LENGTH` metres per radian."""
+
+ROTATION_LENGTH = 0.2
+"""Metres of travel one radian of tool rotation counts for when choosing coarse poses."""
+
+_ROOM_SLACK = 1e-9
+"""Margin by which the screened branch must beat every other branch's bound, rad: far
+above the round-off of unwrapping a path (about 1e-12 rad over thousands of poses)."""
+
+SCREEN_STRIDE = 8
+"""Every how many poses the screen of :func:`~trackplan.robots.path_ik.solve_path_ik`
+solves all eight branches to bound their margins (a bound from fewer poses is looser but
+still a bound)."""
+
+PIECE_POSES = 512
+"""Poses per piece of work of the closed-form path IK on all branches: the candidates are
+solved and analysed a few at a time (whole candidates, about this many poses), so that a
+piece's eight-branch solutions (some 200 kB) are analysed while still in the core's cache;
+threads take the pieces in turn."""
+
+_NEWTON_TOL = 1e-10
+_MARCH_MAX_ITER = 100  # first pose from a seed, and the coarse march
+_FINE_MAX_ITER = 30  # every pose, seeded within a coarse step of its solution
+
+
+def numeric_seeds(robot: Robot) -> np.ndarray:
+    """The eight seed configurations that define the numerical branches.
+
+    Branch ``b = 4·s + 2·e + w`` starts from the middle of the joint range plus
+    ``(π·s, −π/4, ±π/3, 0, ±π/2, 0)`` on joints 1 to 6 (+π/3 for e = 0, +π/2 for w = 0;
+    joints past the sixth stay in the middle); a joint that lands outside its limits is
+    moved by a multiple of 2π into them where possible. Away from the usual singular
+    configurations of 6R arms (stretched elbow, q5 = 0), they sample the shoulder, elbow
+    and wrist alternatives of most industrial arms.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (8, n), rad.
+    """
+    n = robot.n_dof
+    b = np.arange(N_BRANCHES)
+    shoulder, elbow, wrist = (b >> 2) & 1, (b >> 1) & 1, b & 1
+    pattern = np.zeros((N_BRANCHES, max(n, 6)))
+    pattern[:, 0] = np.pi * shoulder
+    pattern[:, 1] = -np.pi / 4
+    pattern[:, 2] = (1 - 2 * elbow) * np.pi / 3
+    pattern[:, 4] = (1 - 2 * wrist) * np.pi / 2
+    middle = 0.5 * (robot.q_min + robot.q_max)
+    seeds = middle + pattern[:, :n]
+    shifted = seeds + 2 * np.pi * np.ceil((robot.q_min - seeds) / (2 * np.pi))  # lowest ≥ q_min
+    outside = (seeds < robot.q_min) | (seeds > robot.q_max)
+    moved: np.ndarray = np.where(outside & (shifted <= robot.q_max), shifted, seeds)
+    return moved
+
+
+def branch_paths(
+    robot: Robot,
+    T_base_tool: np.ndarray,
+    branch: int | np.ndarray | None,
+    max_step: float | np.ndarray | None,
+    method: str,
+    threads: int | None,
+    *,
+    screen: bool = False,
+    sharing: ThreadSharing | None = None,
+) -> tuple[
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    str,
+    np.ndarray,
+    np.ndarray,
+]:
+    """The candidate branches' joint paths, analysed: the shared core of both solvers.
+
+    Parameters are those of :func:`~trackplan.robots.path_ik.solve_path_ik`. With ``screen``
+    (closed form, no branch given), all eight branches are solved at every
+    :data:`SCREEN_STRIDE`-th pose, and the branch whose poses there leave the most room in
+    the limits one at a time (:func:`~trackplan.robots._path_kernels.room_bounds`) is solved
+    alone at every pose and analysed first; when its path is usable with a margin above
+    every other branch's bound (by :data:`_ROOM_SLACK`), no other branch can be chosen and
+    it is returned alone (K = 1): the same branch and analysis as from all eight. Otherwise
+    all eight are solved and analysed. A given branch is solved alone.
+
+    Returns
+    -------
+    q, reach, switch, report, values, ok, candidates, step, method, windings, winding
+        Shapes (B, K, M, n), (B, K, M), (B, K, M), (B, K, N_INT), (B, K, N_FLOAT),
+        (B, K) bool; the branches tried (B, K), the step limit (n,), the method used, and
+        per joint the number of 2π windings that fit and the one kept, (B, K, n) each.
+    """
+    T = np.ascontiguousarray(T_base_tool, dtype=float)
+    if T.ndim != 4 or T.shape[-2:] != (4, 4) or T.shape[1] < 1:
+        raise CaseError(f"T_base_tool must have shape (B, M, 4, 4), got {T.shape}")
+    candidates = _candidate_branches(branch, T.shape[0])
+    step = _max_step(max_step, robot.n_dof)
+    if threads is not None and not threads >= 1:
+        raise CaseError(f"threads must be None or ≥ 1, got {threads!r}")
+    n_cand = T.shape[0]
+    n = robot.n_dof
+    family = ik_family(robot)
+    if method == "auto":
+        method = "closed_form" if family.closed_form else "numeric"
+    if method == "closed_form":
+        if screen and branch is None:
+            # the subset's poses bound each branch's margin from above as all poses do
+            sub = np.ascontiguousarray(T[:, ::SCREEN_STRIDE]).reshape(-1, 4, 4)
+            q_sub, valid_sub, _ = family.solve_flat(sub, with_aux=False)
+            shape = (n_cand, -1, N_BRANCHES)
+            bound = room_bounds(
+                q_sub.reshape(*shape, n), valid_sub.reshape(shape), robot.q_min, robot.q_max
+            )
+            best = np.argmax(bound, axis=1)
+            rival = np.where(np.arange(N_BRANCHES) == best[:, None], -np.inf, bound).max(axis=1)
+            first = np.ascontiguousarray(best[:, None])
+            q, reach, switch, report, values, windings, winding = one_branch_paths(
+                family, robot, T, best, step
+            )
+            ok = _usable(report, values)
+            if np.all(ok[:, 0] & (values[:, 0, F_MARGIN] > rival + _ROOM_SLACK)):
+                return q, reach, switch, report, values, ok, first, step, method, windings, winding
+        if branch is None:
+            paths = all_branch_paths(family, robot, T, candidates, step, threads, sharing)
+        else:
+            paths = one_branch_paths(family, robot, T, candidates[:, 0], step)
+        q, reach, switch, report, values, windings, winding = paths
+        ok = _usable(report, values)
+        return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
+    if method == "numeric":
+        seeds = np.ascontiguousarray(numeric_seeds(robot)[candidates])
+        q, reach, magnitude, crossing = numeric_paths(
+            *chain_arrays(robot),
+            T,
+            seeds,
+            _coarse_poses(T),
+            _NEWTON_TOL,
+            _MARCH_MAX_ITER,
+            _FINE_MAX_ITER,
+        )
+        channel_kind = np.array([SINGULAR])
+    else:
+        raise CaseError(f"method must be auto, closed_form or numeric, got {method!r}")
+    switch, report, values, windings, winding = analyse_paths(
+        q, reach, magnitude, channel_kind, crossing, robot.q_min.copy(), robot.q_max.copy(), step
+    )
+    ok = _usable(report, values)
+    return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
+
+
+def one_branch_paths(
+    family: IKFamily, robot: Robot, T: np.ndarray, branches: np.ndarray, step: np.ndarray
+) -> tuple[np.ndarray, ...]:
+    """:func:`all_branch_paths` of one closed-form branch per candidate, solved alone
+    (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch`, the bits of that branch
+    of all eight).
+
+    Parameters
+    ----------
+    family
+        A closed-form family.
+    robot
+        The robot.
+    T
+        Tool poses, shape (B, M, 4, 4), m.
+    branches
+        The branch of each candidate, shape (B,), int.
+    step
+        The step limit per joint, shape (n,), rad.
+
+    Returns
+    -------
+    q, reach, switch, report, values, windings, winding
+        As :func:`all_branch_paths` with K = 1.
+    """
+    solved = [family.solve_branch(T[b], int(k), with_aux=True) for b, k in enumerate(branches)]
+    q_all, valid, aux = (np.stack([found[i] for found in solved])[:, :, None] for i in range(3))
+    only = np.zeros((len(branches), 1), dtype=np.int64)
+    paths = _analysis_arrays(len(branches), 1, T.shape[1], robot.n_dof)
+    limits = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
+    analyse_closed_form(q_all, valid, aux, only, *limits, step, *paths)
+    return paths
+
+
+def all_branch_paths(
+    family: IKFamily,
+    robot: Robot,
+    T: np.ndarray,
+    candidates: np.ndarray,
+    step: np.ndarray,
+    threads: int | None,
+    sharing: ThreadSharing | None = None,
+) -> tuple[np.ndarray, ...]:
+    """The candidate branches' closed-form joint paths, analysed
+    (:func:`~trackplan.robots._path_kernels.analyse_closed_form` of all eight branches'
+    solutions), in pieces of about :data:`PIECE_POSES` poses shared among threads.
+
+    Each piece's candidates are solved on all eight branches into the thread's scratch and
+    analysed from there; the pieces write disjoint parts of the outputs, so the results do
+    not depend on the number of threads.
+
+    Parameters
+    ----------
+    family
+        A closed-form family.
+    robot
+        The robot.
+    T
+        Tool poses, shape (B, M, 4, 4), m, C-contiguous.
+    candidates
+        Branches per candidate, shape (B, K), int64.
+    step
+        The step limit per joint, shape (n,), rad.
+    threads
+        Threads to share the pieces among; None: as ``sharing`` says.
+    sharing
+        The caller's record of whether sharing pays, consulted and updated when
+        ``threads`` is None; None: :func:`path_threads` threads, nothing recorded.
+
+    Returns
+    -------
+    q, reach, switch, report, values, windings, winding
+        Shapes (B, K, M, n), (B, K, M), (B, K, M), (B, K, N_INT), (B, K, N_FLOAT),
+        (B, K, n), (B, K, n).
+    """
+    n_cand, n_poses = T.shape[:2]
+    paths = _analysis_arrays(n_cand, candidates.shape[1], n_poses, robot.n_dof)
+    size = max(1, PIECE_POSES // n_poses)  # candidates per piece
+    flat = T.reshape(-1, 4, 4)
+    pieces = deque(range(0, n_cand, size))
+    q_min, q_max = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
+
+    def work(timed: bool = True) -> float:  # the thread's CPU time, s (0 untimed)
+        started = time.thread_time() if timed else 0.0
+        rows = size * n_poses
+        q_rows = np.empty((rows, N_BRANCHES, robot.n_dof))
+        valid_rows = np.empty((rows, N_BRANCHES), dtype=np.bool_)
+        aux_rows = np.empty((rows, N_BRANCHES, AUX_SIZE))
+        while True:
+            try:
+                start = pieces.popleft()
+            except IndexError:  # no piece left
+                return time.thread_time() - started if timed else 0.0
+            stop = min(start + size, n_cand)
+            rows = (stop - start) * n_poses
+            out = (q_rows[:rows], valid_rows[:rows], aux_rows[:rows])
+            q_all, valid, aux = family.solve_flat(flat[start * n_poses : stop * n_poses], out=out)
+            shape = (stop - start, n_poses, N_BRANCHES)
+            analyse_closed_form(
+                q_all.reshape(*shape, -1),
+                valid.reshape(shape),
+                aux.reshape(*shape, AUX_SIZE),
+                candidates[start:stop],
+                q_min,
+                q_max,
+                step,
+                *(array[start:stop] for array in paths),
+            )
+
+    if threads is None:
+        threads = path_threads() if sharing is None else sharing.threads()
+        record = sharing
+    else:
+        record = None  # a given number of threads: nothing to learn
+    n_threads = min(threads, len(pieces))
+    if n_threads < 2:
+        work(timed=False)
+        return paths
+    start = time.perf_counter()
+    with ThreadPoolExecutor(n_threads - 1) as pool:  # its threads end with the block
+        running = [pool.submit(work) for _ in range(n_threads - 1)]
+        try:
+            cpu = work()
+        finally:
+            pieces.clear()  # on an exception here the helpers stop after their piece
+        cpu += sum(future.result() for future in running)
+    if record is not None:
+        record.note(cpu / (n_threads * (time.perf_counter() - start)))
+    return paths
+
+
+def _analysis_arrays(n_cand: int, n_k: int, n_poses: int, n: int) -> tuple[np.ndarray, ...]:
+    """Uninitialised outputs of :func:`~trackplan.robots._path_kernels.analyse_closed_form`."""
+    return (
+        np.empty((n_cand, n_k, n_poses, n)),
+        np.empty((n_cand, n_k, n_poses), dtype=np.bool_),
+        np.empty((n_cand, n_k, n_poses), dtype=np.bool_),
+        np.empty((n_cand, n_k, N_INT), dtype=np.int64),
+        np.empty((n_cand, n_k, N_FLOAT)),
+        np.empty((n_cand, n_k, n), dtype=np.int64),
+        np.empty((n_cand, n_k, n), dtype=np.int64),
+    )
+
+
+def _usable(report: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Which analysed branches are usable: reachable everywhere, no switch, inside the
+    limits; shape (B, K), bool."""
+    ok = (report[..., I_N_UNREACH] == 0) & (report[..., I_N_SWITCH] == 0)
+    usable: np.ndarray = ok & (values[..., F_MARGIN] >= 0.0)
+    return usable
+
+
+def _candidate_branches(branch: int | np.ndarray | None, n_cand: int) -> np.ndarray:
+    """Branches to try per candidate, shape (B, K), int64."""
+    if branch is None:
+        return np.ascontiguousarray(np.broadcast_to(np.arange(N_BRANCHES), (n_cand, N_BRANCHES)))
+    chosen = np.asarray(branch)
+    if chosen.ndim == 0:
+        chosen = np.full(n_cand, chosen)
+    if chosen.shape != (n_cand,) or not np.issubdtype(chosen.dtype, np.integer):
+        raise CaseError(f"branch must be None, an int or an int array ({n_cand},), got {branch!r}")
+    if np.any((chosen < 0) | (chosen >= N_BRANCHES)):
+        raise CaseError(f"branch must be in 0…{N_BRANCHES - 1}, got {chosen.tolist()}")
+    return np.ascontiguousarray(chosen.astype(np.int64)[:, None])
+
+
+def _max_step(max_step: float | np.ndarray | None, n: int) -> np.ndarray:
+    """The step limit per joint, shape (n,), rad."""
+    step = np.full(n, DEFAULT_MAX_STEP) if max_step is None else np.asarray(max_step, float)
+    try:
+        step = np.ascontiguousarray(np.broadcast_to(step, (n,)), dtype=float)
+    except ValueError:
+        raise CaseError(
+            f"max_step must be a scalar or have {n} entries, got {max_step!r}"
+        ) from None
+    if np.any(~(step > 0.0)):
+        raise CaseError(f"max_step must be > 0, got {step.tolist()}")
+    return step
+
+
+def _coarse_poses(T: np.ndarray) -> np.ndarray:
+    """Poses the numerical path IK marches through, shape (B, M), bool.
+
+    The first and last pose and one pose each time the combined travel
+    ``|Δp| + ROTATION_LENGTH · |Δangle|`` passes a multiple of :data:`COARSE_STEP`.
+    """
+    position = T[..., :3, 3]
+    rotation = T[..., :3, :3]
+    dp = np.linalg.norm(np.diff(position, axis=1), axis=-1)
+    cos_angle = 0.5 * (np.einsum("bmij,bmij->bm", rotation[:, :-1], rotation[:, 1:]) - 1.0)
+    travel = dp + ROTATION_LENGTH * np.arccos(np.clip(cos_angle, -1.0, 1.0))
+    cell = np.floor(
+        np.concatenate([np.zeros((T.shape[0], 1)), np.cumsum(travel, 1)], 1) / COARSE_STEP
+    )
+    coarse = np.zeros(T.shape[:2], dtype=np.bool_)
+    coarse[:, 1:] = cell[:, 1:] != cell[:, :-1]
+    coarse[:, 0] = True
+    coarse[:, -1] = True
+    return coarse
