@@ -74,11 +74,12 @@ browser:
 bench: $(VENV)/.installed-test
 	$(PY) -m benchmarks
 
-## lint: ruff (lint and format) and mypy, as CI runs them
+## lint: ruff (lint and format), mypy and the layer contract (lint-imports), as CI runs them
 lint: $(VENV)/.installed-test
 	$(VENV)/bin/ruff check trackplan tests benchmarks
 	$(VENV)/bin/ruff format --check trackplan tests benchmarks
 	$(VENV)/bin/mypy trackplan
+	$(VENV)/bin/lint-imports
 
 ## docs: re-run every command the docs quote and rewrite their figures and screenshots
 docs: $(VENV)/.installed-test browser

@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import csv
+import json
 import os
 import stat
+from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -13,8 +17,18 @@ import yaml
 
 from tests.conftest import CASES
 from trackplan.cli import main
-from trackplan.io.export import export_trajectory, read_trajectory_table
+from trackplan.errors import CaseError
+from trackplan.io.export import TrajectoryTable, read_trajectory_table
 from trackplan.io.results import read_trajectory_csv
+from trackplan.writers import (
+    WRITERS,
+    Writer,
+    export,
+    export_trajectory,
+    register_writer,
+    writer_for_file,
+    writer_named,
+)
 
 
 def test_export_ros_csv_json_and_bad_format(tmp_path, capsys):
@@ -111,3 +125,80 @@ def test_trajectory_files_with_a_byte_order_mark_are_read(tmp_path: Path) -> Non
     np.testing.assert_array_equal(t, written[:, 0])
     np.testing.assert_array_equal(q, written[:, 1:7])
     np.testing.assert_array_equal(table.q, written[:, 1:7])
+
+
+@pytest.fixture
+def writers() -> Iterator[dict[str, Writer]]:
+    """The registry, restored after the test."""
+    before = dict(WRITERS)
+    yield WRITERS
+    WRITERS.clear()
+    WRITERS.update(before)
+
+
+def test_the_writers_are_registered_by_name_and_suffix() -> None:
+    assert list(WRITERS) == ["csv", "json", "ros"]
+    for writer in WRITERS.values():
+        assert isinstance(writer, Writer) and writer.default_file.endswith(writer.suffix)
+    assert writer_named("ROS") is WRITERS["ros"]
+    assert writer_for_file(Path("a/b.Json")) is WRITERS["json"]
+    assert writer_for_file(Path("motion.ros.yaml")) is WRITERS["ros"]
+    with pytest.raises(CaseError, match=r"unknown export format 'xml': use one of csv, json, ros"):
+        writer_named("xml")
+    with pytest.raises(CaseError, match=r"no export format for 'a.txt'.*\.csv \(csv\)"):
+        writer_for_file(Path("a.txt"))
+
+
+def test_export_picks_the_writer_by_the_output_suffix(tmp_path: Path) -> None:
+    run = _planned(tmp_path)
+    message = yaml.safe_load(export(run, tmp_path / "motion.yaml").read_text())
+    assert list(message) == ["header", "joint_names", "points"]
+    content = json.loads(export(run, tmp_path / "motion.json").read_text())
+    assert content["units"]["positions"] == "rad"
+    assert export(run, tmp_path / "motion.csv").read_text().startswith("t,")
+    with pytest.raises(CaseError, match="no export format: give one of csv, json, ros") as error:
+        export(run)
+    assert error.value.key == "format"
+    with pytest.raises(CaseError, match=r"no export format for 'motion\.txt'"):
+        export(run, tmp_path / "motion.txt")
+    assert not (tmp_path / "motion.txt").exists()
+
+
+@dataclass(frozen=True)
+class _LinesWriter:
+    """A format that is no built-in one: a comment, then ``t q1 ... qn`` per sample."""
+
+    name: str = "lines"
+    suffix: str = ".lines"
+    default_file: str = "trajectory.lines"
+
+    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
+        rows = np.column_stack([table.t, table.q]).tolist()
+        body = "\n".join(" ".join(map(repr, row)) for row in rows)
+        output.write_text(f"# {options.get('comment', '')}\n{body}\n")
+
+
+def test_a_registered_writer_serves_export_and_the_cli(
+    tmp_path: Path, writers: dict[str, Writer], capsys: pytest.CaptureFixture[str]
+) -> None:
+    run = _planned(tmp_path)
+    register_writer(_LinesWriter())
+    written = export(run, tmp_path / "out.lines", comment="hello")
+    lines = written.read_text().splitlines()
+    assert lines[0] == "# hello"
+    expected = np.loadtxt(run / "trajectory.csv", delimiter=",", skiprows=1, ndmin=2)[:, :7]
+    np.testing.assert_array_equal(np.loadtxt(lines[1:]), expected)  # repr round-trips exactly
+    capsys.readouterr()
+    assert main(["export", str(run), "--format", "lines"]) == 0
+    assert capsys.readouterr().out == f"wrote {run / 'trajectory.lines'}\n"
+    assert (run / "trajectory.lines").read_text().splitlines()[1:] == lines[1:]
+
+
+def test_a_writer_name_or_suffix_is_registered_once(writers: dict[str, Writer]) -> None:
+    with pytest.raises(ValueError, match="a writer named 'csv' is registered already"):
+        register_writer(_LinesWriter(name="csv"))
+    with pytest.raises(ValueError, match=r"the suffix '\.json' belongs to the 'json' writer"):
+        register_writer(_LinesWriter(suffix=".json", default_file="t.json"))
+    with pytest.raises(ValueError, match="does not end with"):
+        register_writer(_LinesWriter(default_file="trajectory.txt"))
+    assert list(WRITERS) == ["csv", "json", "ros"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import importlib
 import subprocess
 import sys
 
@@ -12,6 +13,7 @@ import pytest
 import trackplan
 import trackplan.jointpath as jointpath
 from tests.conftest import CASES, REPO
+from trackplan.choices import Penalty
 from trackplan.errors import CaseError
 
 
@@ -41,7 +43,7 @@ def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
     monkeypatch.setattr(jointpath, "tool_pose_parts", parts)
     monkeypatch.setattr(jointpath, "branch_joints_along", branch_ik)
     case = trackplan.load_case(CASES / "paper-corner.yaml")
-    result = trackplan.plan_placement(case, case.bounds.example)
+    result = trackplan.plan(case, case.bounds.example)
     assert result.success, result.message
     n_grid = 5 * len(result.joint_path.s)  # every grid point with its stencil
     assert calls[:2] == [("poses", n_grid), ("ik", n_grid)]
@@ -71,7 +73,7 @@ def test_the_five_line_notebook_use_works():
     code = (
         "import trackplan\n"
         f"case = trackplan.load_case({str(CASES / 'paper-corner.yaml')!r})\n"
-        "result = trackplan.plan_placement(case, case.bounds.example)\n"
+        "result = trackplan.plan(case, case.bounds.example)\n"
         "print(result.status.value, round(result.duration, 3))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -79,30 +81,99 @@ def test_the_five_line_notebook_use_works():
     assert status == "feasible" and float(duration) > 0
 
 
-def test_the_front_door_exports_the_api():
-    for name in (
-        "plan_placement",
-        "optimize_placement",
-        "check_trajectory",
-        "check_case_trajectory",
-        "load_case",
-        "load_robot",
-        "Status",
-    ):
-        assert callable(getattr(trackplan, name)) or name == "Status"
-    assert set(trackplan.__all__) >= {"plan_placement", "optimize_placement", "load_case"}
+FRONT_DOOR = {
+    "load_case",
+    "load_robot",
+    "builtin_robot",
+    "plan",
+    "optimize",
+    "check",
+    "export",
+    "study",
+    "Case",
+    "Robot",
+    "PlanResult",
+    "SearchResult",
+    "CheckReport",
+    "StudyResult",
+    "Status",
+    "TrackplanError",
+    "CaseError",
+}
+
+
+def test_the_front_door_is_the_verbs_and_their_result_types():
+    assert set(trackplan.__all__) == FRONT_DOOR | {"__version__"}
+    assert len(trackplan.__all__) <= 20
+    verbs = {"load_case", "load_robot", "builtin_robot", "plan", "optimize", "check", "export"}
+    for name in sorted(FRONT_DOOR):
+        value = getattr(trackplan, name)
+        assert callable(value), name
+        assert name in verbs | {"study"} or isinstance(value, type), name
+    assert issubclass(trackplan.CaseError, trackplan.TrackplanError)
+    assert trackplan.export is importlib.import_module("trackplan.writers").export
+
+
+def test_the_study_verb_is_the_callable_study_package(monkeypatch):
+    # importing a submodule binds the package to trackplan.study: the package is the verb
+    import trackplan.study.runner as runner
+
+    assert trackplan.study is sys.modules["trackplan.study"]
+    calls = []
+    monkeypatch.setattr("trackplan.study.runner.study", lambda *a, **k: calls.append((a, k)))
+    trackplan.study("spec.yaml", "out", workers=1)
+    assert calls == [(("spec.yaml", "out"), {"workers": 1})]
+    assert runner.run_study is sys.modules["trackplan.study.runner"].run_study
+
+
+def test_a_name_outside_the_front_door_and_the_deprecations_is_no_attribute():
+    with pytest.raises(AttributeError, match="no attribute 'plan_everything'"):
+        trackplan.plan_everything  # noqa: B018
+
+
+@pytest.mark.parametrize("name", sorted(trackplan._DEPRECATED))
+def test_an_old_name_warns_with_its_new_home_and_resolves(name):
+    module, attribute, instead = trackplan._DEPRECATED[name]
+    with pytest.warns(DeprecationWarning, match=instead or module) as record:
+        value = getattr(trackplan, name)
+    assert record[0].filename == __file__  # the warning points at the caller
+    assert value is getattr(importlib.import_module(module), attribute)
+    if instead == "trackplan.study":  # the callable package calls runner.study
+        assert value is sys.modules["trackplan.study.runner"].study
+    elif instead:  # a renamed name resolves to the front door's name
+        assert value is getattr(trackplan, instead.removeprefix("trackplan."))
+    assert name not in vars(trackplan)  # not cached: every use warns
+
+
+def test_every_name_exported_before_the_front_door_is_kept_or_deprecated():
+    before = {
+        *("BUILTIN_ROBOTS", "OBJECTIVES", "TIME_LAWS", "AirMove", "Case", "CaseError"),
+        *("CheckReport", "CycleResult", "CycleSearchResult", "EnergyFigures", "JointPath"),
+        *("Method", "OptimizeResult", "ParetoResult", "Payload", "Penalty", "PlanResult"),
+        *("Robot", "RobotDynamics", "Sequence", "Status", "TimeLaw", "Timing"),
+        *("TrackplanError", "Trajectory", "Visit", "air_time_estimate", "best_sequence"),
+        *("builtin_names", "builtin_robot", "check_case_trajectory", "check_cycle_trajectory"),
+        *("check_trajectory", "energy_figures", "forward_kinematics", "given_sequence"),
+        *("gravity_load", "inverse_dynamics", "jacobian", "load_case", "load_robot"),
+        *("optimize_cycle", "optimize_placement", "pareto_front", "plan_air_move"),
+        *("plan_cycle", "plan_placement", "run_study", "sequence_cost", "time_law"),
+        *("trapezoid_time", "optimize_spin", "ToolSpec", "placement_map", "PlacementMap"),
+        *("CellReport", "Cell"),
+    }
+    assert before <= FRONT_DOOR | set(trackplan._DEPRECATED)
+    assert not FRONT_DOOR & set(trackplan._DEPRECATED)
 
 
 @pytest.mark.parametrize(
     ("call", "key", "allowed"),
     [
         (
-            lambda case: trackplan.plan_placement(case, case.bounds.example, timing="smoooth"),
+            lambda case: trackplan.plan(case, case.bounds.example, timing="smoooth"),
             "timing",
             "smooth, paper",
         ),
         (
-            lambda case: trackplan.optimize_placement(case, method="gaa", budget=10),
+            lambda case: trackplan.optimize(case, method="gaa", budget=10),
             "method",
             "ga, cmaes, de, random",
         ),
@@ -117,8 +188,8 @@ def test_a_wrong_choice_lists_the_allowed_values(call, key, allowed):
 
 def test_a_penalty_outside_the_vocabulary_is_refused():
     case = trackplan.load_case(CASES / "paper-corner.yaml")
+    assert [penalty.value for penalty in Penalty] == ["graded", "flat"]  # the enum is public
     with pytest.raises(CaseError, match="graded, flat"):
-        trackplan.Penalty  # noqa: B018  (the enum is public)
         type(case.objective)(weights=case.objective.weights, penalty="flatt")
 
 
@@ -126,12 +197,12 @@ def test_a_penalty_outside_the_vocabulary_is_refused():
 def test_a_placement_must_be_six_finite_numbers(X):
     case = trackplan.load_case(CASES / "paper-corner.yaml")
     with pytest.raises(CaseError, match="placement"):
-        trackplan.plan_placement(case, X)
+        trackplan.plan(case, X)
 
 
 def test_every_result_spells_success_the_same_way():
     case = trackplan.load_case(CASES / "paper-corner.yaml")
-    result = trackplan.plan_placement(case, case.bounds.example)
+    result = trackplan.plan(case, case.bounds.example)
     assert result.success is result.feasible is result.check.success is True
     assert result.status is trackplan.Status.FEASIBLE and result.status.success
     assert result.joint_path.success and result.joint_path.ik.success.all()

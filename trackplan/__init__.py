@@ -4,64 +4,34 @@ Given a path (weld seam, glue bead, deburring edge), a speed and a tolerance, tr
 plans the joint trajectory under the robot's position, velocity, acceleration and jerk
 limits, and searches where to place the workpiece so the motion is feasible and cheap.
 
-Public API (``docs/api.md``)
-----------------------------
-load_case(file) -> Case
-    Read and validate a case file (see ``docs/files.md``).
-load_robot(file) -> Robot
-    Read and validate a robot file.
-builtin_robot(name) -> Robot, builtin_names() -> names
-    The built-in robots: the paper's ``puma560``, ``ur5`` and a library of industrial
-    arms read from URDFs (``docs/robots.md``).
-Case, Robot
-    The validated case and the robot model: frozen dataclasses of numpy arrays.
-forward_kinematics(robot, q) -> T_base_tool
-    Tool poses, q of shape (..., n) in rad, result (..., 4, 4).
-jacobian(robot, q) -> J
-    Geometric Jacobian at the tool point in the base frame, shape (..., 6, n).
-plan_placement(case, X, *, timing, branch) -> PlanResult
-    Plan and check the case with the workpiece at placement X (shape (6,), m and rad).
-optimize_placement(case, *, method, seed, budget, restarts, ...) -> OptimizeResult
-    Search the placement; ``method`` may also be a pymoo Algorithm.
-check_trajectory(robot, q, sample_time, reference) -> CheckReport
-    The checker: every sample against every limit (and the path, given a reference).
-check_case_trajectory(case, X, q, sample_time) -> CheckReport
-    The checker in one call for a case at a placement (``trackplan check``).
-inverse_dynamics(robot, q, qd, qdd) -> tau, gravity_load(robot, q) -> tau
-    Joint torques (N·m, shape (..., n)) of a robot with dynamics (``docs/dynamics.md``).
-RobotDynamics, Payload
-    Masses, inertias, actuators, friction, torque limits; a load at the TCP.
-energy_figures(robot, q, sample_time) -> EnergyFigures
-    Mechanical energy, copper loss and peak torque ratio of a sampled trajectory.
-OBJECTIVES
-    The search objectives by name (``travel``, ``time``, ``energy``, ``copper``).
-pareto_front(case, (A, B), ...) -> ParetoResult
-    NSGA-II front of two objectives over the placement, every point re-planned.
-JointPath
-    Poses and IK of a placed path on its planning grid, computed once per plan.
-TIME_LAWS, time_law(name)
-    The time laws by name (``smooth``, ``paper``).
-plan_air_move(q_start, q_end, ...) -> AirMove, air_time_estimate, trapezoid_time
-    Jerk-limited rest-to-rest joint moves through the air (ruckig), and their time estimates.
-plan_cycle(case, X) -> CycleResult, optimize_cycle(case, ...) -> CycleSearchResult
-    A case with several seams (``paths:``): one placement, approach, retract and air moves,
-    the sequence; ``check_cycle_trajectory`` re-checks its trajectory (``docs/seams.md``).
-best_sequence(...) -> Sequence, given_sequence, sequence_cost, Visit
-    The order and direction of several seams (``docs/seams.md``).
-Status, Timing, Method, Penalty
-    The outcome vocabulary and the named choices.
-PlanResult, OptimizeResult, CheckReport, Trajectory, TimeLaw
-    The results.
-run_study(study, out, client=None) -> StudyResult
-    Run a batch study (cases × robots × sweeps × seeds) on Dask (see ``docs/studies.md``).
-CaseError, TrackplanError
-    Bad input (with the file and key path), and the root of trackplan's exceptions.
+The front door (``docs/api.md``)
+--------------------------------
+load_case(file) -> Case, load_robot(file) -> Robot, builtin_robot(name) -> Robot
+    Read and validate a case or robot file; the built-in robots (``docs/robots.md``).
+plan(case, X, ...) -> PlanResult
+    Plan and check a case (one seam or several) with the workpiece at placement X
+    (shape (6,), m and rad).
+optimize(case, ...) -> SearchResult
+    Search the placement and plan the best one.
+check(case, X, q, sample_time, ...) -> CheckReport
+    Check a sampled joint trajectory q (N, n) against a case at placement X.
+export(source, output=None, *, format=None, ...) -> Path
+    Write a run's trajectory through a writer (CSV, JSON, ROS 2, ...: ``trackplan.writers``).
+study(study, out, client=None, ...) -> StudyResult
+    Run a batch study on Dask (``docs/studies.md``).
+Case, Robot, PlanResult, SearchResult, CheckReport, StudyResult, Status
+    The inputs, the results and the one outcome vocabulary.
+TrackplanError, CaseError
+    The root of trackplan's exceptions, and bad input (with the file and key path).
+
+Every other name lives in its subpackage; the names this package exported before stay
+importable from here for one release with a ``DeprecationWarning`` naming the new home.
 
 A notebook needs five lines::
 
     import trackplan
     case = trackplan.load_case("cases/paper-corner.yaml")
-    result = trackplan.plan_placement(case, case.bounds.example)
+    result = trackplan.plan(case, case.bounds.example)
     print(result.status, result.duration)
 
 Names (and ``__version__``) are imported on first use, so ``import trackplan`` stays
@@ -72,167 +42,144 @@ dependencies.
 from __future__ import annotations
 
 import importlib
+import warnings
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from trackplan.case import Case
-    from trackplan.choices import Method, Penalty, Timing
+    from trackplan.check_report import CheckReport
     from trackplan.errors import CaseError, TrackplanError
     from trackplan.io.case_file import load_case
-    from trackplan.io.robot_file import BUILTIN_ROBOTS, builtin_names, builtin_robot, load_robot
-    from trackplan.jointpath import JointPath
-    from trackplan.planning.checker import check_trajectory
-    from trackplan.planning.cycle import CycleResult, check_cycle_trajectory, plan_cycle
-    from trackplan.planning.energy import EnergyFigures, energy_figures
-    from trackplan.planning.objectives import OBJECTIVES
-    from trackplan.planning.plan import check_case_trajectory, plan_placement
-    from trackplan.planning.result import CheckReport, PlanResult, Trajectory
-    from trackplan.planning.sequence import (
-        Sequence,
-        Visit,
-        best_sequence,
-        given_sequence,
-        sequence_cost,
-    )
-    from trackplan.robots.dynamics.parameters import Payload, RobotDynamics
-    from trackplan.robots.dynamics.rne import gravity_load, inverse_dynamics
-    from trackplan.robots.kinematics import forward_kinematics, jacobian
+    from trackplan.io.robot_file import builtin_robot, load_robot
+    from trackplan.planning.plan import check, plan
+    from trackplan.planning.result import PlanResult
     from trackplan.robots.model import Robot
-    from trackplan.search import OptimizeResult, optimize_placement
-    from trackplan.search.cycle_search import CycleSearchResult, optimize_cycle
-    from trackplan.search.pareto import ParetoResult, pareto_front
+    from trackplan.search.optimize import SearchResult, optimize
     from trackplan.status import Status
-    from trackplan.study.runner import run_study
-    from trackplan.timing import TIME_LAWS, TimeLaw, time_law
-    from trackplan.timing.airmove import AirMove, air_time_estimate, plan_air_move, trapezoid_time
+    from trackplan.study.runner import StudyResult
+    from trackplan.writers import export
 
 _EXPORTS = {
-    "optimize_spin": "trackplan.search.spin",
-    "ToolSpec": "trackplan.tool",
-    "placement_map": "trackplan.search.placement_map",
-    "PlacementMap": "trackplan.search.placement_map",
-    "CellReport": "trackplan.planning.result",
-    "Cell": "trackplan.cell",
-    "BUILTIN_ROBOTS": "trackplan.io.robot_file",
-    "OBJECTIVES": "trackplan.planning.objectives",
-    "TIME_LAWS": "trackplan.timing",
-    "Case": "trackplan.case",
-    "CaseError": "trackplan.errors",
-    "CheckReport": "trackplan.planning.result",
-    "EnergyFigures": "trackplan.planning.energy",
-    "JointPath": "trackplan.jointpath",
-    "Method": "trackplan.choices",
-    "OptimizeResult": "trackplan.search",
-    "ParetoResult": "trackplan.search.pareto",
-    "Payload": "trackplan.robots.dynamics.parameters",
-    "Penalty": "trackplan.choices",
-    "PlanResult": "trackplan.planning.result",
-    "Robot": "trackplan.robots.model",
-    "RobotDynamics": "trackplan.robots.dynamics.parameters",
-    "Status": "trackplan.status",
-    "TimeLaw": "trackplan.timing",
-    "Timing": "trackplan.choices",
-    "TrackplanError": "trackplan.errors",
-    "Trajectory": "trackplan.planning.result",
-    "builtin_names": "trackplan.io.robot_file",
-    "builtin_robot": "trackplan.io.robot_file",
-    "check_case_trajectory": "trackplan.planning.plan",
-    "check_trajectory": "trackplan.planning.checker",
-    "energy_figures": "trackplan.planning.energy",
-    "forward_kinematics": "trackplan.robots.kinematics",
-    "gravity_load": "trackplan.robots.dynamics.rne",
-    "inverse_dynamics": "trackplan.robots.dynamics.rne",
-    "jacobian": "trackplan.robots.kinematics",
     "load_case": "trackplan.io.case_file",
     "load_robot": "trackplan.io.robot_file",
-    "optimize_placement": "trackplan.search",
-    "pareto_front": "trackplan.search.pareto",
-    "plan_placement": "trackplan.planning.plan",
-    "time_law": "trackplan.timing",
-    "run_study": "trackplan.study.runner",
-    "AirMove": "trackplan.timing.airmove",
-    "plan_air_move": "trackplan.timing.airmove",
-    "air_time_estimate": "trackplan.timing.airmove",
-    "trapezoid_time": "trackplan.timing.airmove",
-    "Sequence": "trackplan.planning.sequence",
-    "Visit": "trackplan.planning.sequence",
-    "best_sequence": "trackplan.planning.sequence",
-    "given_sequence": "trackplan.planning.sequence",
-    "sequence_cost": "trackplan.planning.sequence",
-    "plan_cycle": "trackplan.planning.cycle",
-    "CycleResult": "trackplan.planning.cycle",
-    "check_cycle_trajectory": "trackplan.planning.cycle",
-    "optimize_cycle": "trackplan.search.cycle_search",
-    "CycleSearchResult": "trackplan.search.cycle_search",
+    "builtin_robot": "trackplan.io.robot_file",
+    "plan": "trackplan.planning.plan",
+    "check": "trackplan.planning.plan",
+    "optimize": "trackplan.search.optimize",
+    "export": "trackplan.writers",
+    "Case": "trackplan.case",
+    "Robot": "trackplan.robots.model",
+    "PlanResult": "trackplan.planning.result",
+    "SearchResult": "trackplan.search.optimize",
+    "CheckReport": "trackplan.check_report",
+    "StudyResult": "trackplan.study.runner",
+    "Status": "trackplan.status",
+    "TrackplanError": "trackplan.errors",
+    "CaseError": "trackplan.errors",
 }
+"""The front door: name -> the module that defines it. ``study`` is the package
+:mod:`trackplan.study` itself, which is callable (its ``__call__`` runs
+:func:`trackplan.study.runner.study`), so ``trackplan.study(...)`` and
+``import trackplan.study.runner`` both keep working."""
+
+_DEPRECATED = {
+    # old name: (module, attribute there, what to use instead)
+    "plan_placement": ("trackplan.planning.plan", "plan", "trackplan.plan"),
+    "plan_cycle": ("trackplan.planning.plan", "plan", "trackplan.plan"),
+    "optimize_placement": ("trackplan.search.optimize", "optimize", "trackplan.optimize"),
+    "optimize_cycle": ("trackplan.search.optimize", "optimize", "trackplan.optimize"),
+    "check_case_trajectory": ("trackplan.planning.plan", "check", "trackplan.check"),
+    "check_cycle_trajectory": ("trackplan.planning.plan", "check", "trackplan.check"),
+    "CycleResult": ("trackplan.planning.result", "PlanResult", "trackplan.PlanResult"),
+    "OptimizeResult": ("trackplan.search.optimize", "SearchResult", "trackplan.SearchResult"),
+    "CycleSearchResult": ("trackplan.search.optimize", "SearchResult", "trackplan.SearchResult"),
+    "run_study": ("trackplan.study.runner", "study", "trackplan.study"),
+    "check_trajectory": ("trackplan.planning.checker", "check_trajectory", ""),
+    "forward_kinematics": ("trackplan.robots.kinematics", "forward_kinematics", ""),
+    "jacobian": ("trackplan.robots.kinematics", "jacobian", ""),
+    "builtin_names": ("trackplan.io.robot_file", "builtin_names", ""),
+    "BUILTIN_ROBOTS": ("trackplan.io.robot_file", "BUILTIN_ROBOTS", ""),
+    "inverse_dynamics": ("trackplan.robots.dynamics.rne", "inverse_dynamics", ""),
+    "gravity_load": ("trackplan.robots.dynamics.rne", "gravity_load", ""),
+    "RobotDynamics": ("trackplan.robots.dynamics.parameters", "RobotDynamics", ""),
+    "Payload": ("trackplan.robots.dynamics.parameters", "Payload", ""),
+    "energy_figures": ("trackplan.planning.energy", "energy_figures", ""),
+    "EnergyFigures": ("trackplan.planning.energy", "EnergyFigures", ""),
+    "OBJECTIVES": ("trackplan.planning.objectives", "OBJECTIVES", ""),
+    "pareto_front": ("trackplan.search.pareto", "pareto_front", ""),
+    "ParetoResult": ("trackplan.search.pareto", "ParetoResult", ""),
+    "optimize_spin": ("trackplan.search.spin", "optimize_spin", ""),
+    "placement_map": ("trackplan.search.placement_map", "placement_map", ""),
+    "PlacementMap": ("trackplan.search.placement_map", "PlacementMap", ""),
+    "JointPath": ("trackplan.jointpath", "JointPath", ""),
+    "TIME_LAWS": ("trackplan.timing", "TIME_LAWS", ""),
+    "time_law": ("trackplan.timing", "time_law", ""),
+    "TimeLaw": ("trackplan.timing", "TimeLaw", ""),
+    "AirMove": ("trackplan.timing.airmove", "AirMove", ""),
+    "plan_air_move": ("trackplan.timing.airmove", "plan_air_move", ""),
+    "air_time_estimate": ("trackplan.timing.airmove", "air_time_estimate", ""),
+    "trapezoid_time": ("trackplan.timing.airmove", "trapezoid_time", ""),
+    "Sequence": ("trackplan.planning.sequence", "Sequence", ""),
+    "Visit": ("trackplan.planning.sequence", "Visit", ""),
+    "best_sequence": ("trackplan.planning.sequence", "best_sequence", ""),
+    "given_sequence": ("trackplan.planning.sequence", "given_sequence", ""),
+    "sequence_cost": ("trackplan.planning.sequence", "sequence_cost", ""),
+    "Trajectory": ("trackplan.planning.result", "Trajectory", ""),
+    "CellReport": ("trackplan.check_report", "CellReport", ""),
+    "Cell": ("trackplan.cell", "Cell", ""),
+    "ToolSpec": ("trackplan.tool", "ToolSpec", ""),
+    "Method": ("trackplan.choices", "Method", ""),
+    "Penalty": ("trackplan.choices", "Penalty", ""),
+    "Timing": ("trackplan.choices", "Timing", ""),
+}
+"""Names exported before the front door, importable for one release with a warning: old
+name -> (module, attribute, the new name; empty when only the import path changes)."""
 
 __all__ = [
-    "BUILTIN_ROBOTS",
-    "OBJECTIVES",
-    "TIME_LAWS",
-    "AirMove",
     "Case",
     "CaseError",
     "CheckReport",
-    "CycleResult",
-    "CycleSearchResult",
-    "EnergyFigures",
-    "JointPath",
-    "Method",
-    "OptimizeResult",
-    "ParetoResult",
-    "Payload",
-    "Penalty",
     "PlanResult",
     "Robot",
-    "RobotDynamics",
-    "Sequence",
+    "SearchResult",
     "Status",
-    "TimeLaw",
-    "Timing",
+    "StudyResult",
     "TrackplanError",
-    "Trajectory",
-    "Visit",
     "__version__",
-    "air_time_estimate",
-    "best_sequence",
-    "builtin_names",
     "builtin_robot",
-    "check_case_trajectory",
-    "check_cycle_trajectory",
-    "check_trajectory",
-    "energy_figures",
-    "forward_kinematics",
-    "given_sequence",
-    "gravity_load",
-    "inverse_dynamics",
-    "jacobian",
+    "check",
+    "export",
     "load_case",
     "load_robot",
-    "optimize_cycle",
-    "optimize_placement",
-    "pareto_front",
-    "plan_air_move",
-    "plan_cycle",
-    "plan_placement",
-    "run_study",
-    "sequence_cost",
-    "time_law",
-    "trapezoid_time",
+    "optimize",
+    "plan",
+    "study",
 ]
 
 
 def __getattr__(name: str) -> Any:
-    """Import a public name on first use (PEP 562)."""
+    """Import a public name on first use (PEP 562); warn for a deprecated one."""
     if name == "__version__":
         globals()[name] = _version()
         return globals()[name]
+    if name == "study":  # the callable package; importing it binds it here
+        return importlib.import_module("trackplan.study")
     module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'trackplan' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+    if module is not None:
+        value = getattr(importlib.import_module(module), name)
+        globals()[name] = value
+        return value
+    if name in _DEPRECATED:
+        module, attribute, instead = _DEPRECATED[name]
+        use = f"use {instead}" if instead else f"import {attribute} from {module}"
+        warnings.warn(
+            f"trackplan.{name} is deprecated and leaves the top-level package in the next "
+            f"release: {use}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return getattr(importlib.import_module(module), attribute)
+    raise AttributeError(f"module 'trackplan' has no attribute {name!r}")
 
 
 def _version() -> str:
@@ -247,5 +194,5 @@ def _version() -> str:
 
 
 def __dir__() -> list[str]:
-    """Public names, for tab completion."""
-    return sorted({*globals(), *_EXPORTS, "__version__"})
+    """The front door's names, for tab completion."""
+    return sorted({*globals(), *__all__})

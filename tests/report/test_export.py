@@ -9,9 +9,10 @@ import pytest
 import yaml
 
 from trackplan.errors import CaseError
-from trackplan.io.export import export_trajectory, read_trajectory_table
+from trackplan.io.export import read_trajectory_table
 from trackplan.io.results import trajectory_header, write_result_json, write_trajectory_csv
 from trackplan.io.run_folder import HASH_KEY, file_sha256
+from trackplan.writers import export_trajectory
 
 # yaml.safe_load's constructors, in libyaml's C loader: ten times faster on 1834 points
 SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)

@@ -156,11 +156,11 @@ def export(
     ] = "",
 ) -> ExitCode:
     """Export a run's trajectory as CSV, JSON or a ROS 2 trajectory_msgs/JointTrajectory."""
-    from trackplan.io.export import export_trajectory
+    from trackplan.writers import export as export_run
 
     if output is not None and not output.is_dir():
         output_folder(output.parent, "--output")
     names = [name.strip() for name in joint_names.split(",")] if joint_names else None
-    written = export_trajectory(run, format, output, joint_names=names, frame_id=frame_id)
+    written = export_run(run, output, format=format, joint_names=names, frame_id=frame_id)
     typer.echo(f"wrote {written}")
     return ExitCode.OK

@@ -266,6 +266,10 @@ def run_study(
     )
 
 
+study = run_study
+"""The front door's name for :func:`run_study`: ``trackplan.study(study, out, ...)``."""
+
+
 def _run_jobs(
     client: Client,
     jobs: list[Job],

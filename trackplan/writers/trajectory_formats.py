@@ -1,0 +1,141 @@
+"""The plain trajectory writers: CSV, JSON and a ROS 2 JointTrajectory (YAML).
+
+- ``csv`` → ``trajectory.export.csv``: ``t,<joint names>``, one row per sample (s, rad);
+  the header is quoted as the ``csv`` module quotes, and a name that a spreadsheet would
+  take for a formula gets a leading ``'`` (:func:`~trackplan.io.csv_cells.neutralised`).
+- ``json`` → ``trajectory.json``: joint names, units and every column as arrays.
+- ``ros`` → ``trajectory.ros.yaml``: a ``trajectory_msgs/msg/JointTrajectory`` as YAML.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from trackplan.io.csv_cells import neutralised
+from trackplan.io.csv_table import write_csv_table
+from trackplan.io.export import TrajectoryTable
+
+UNITS = {
+    "t": "s",
+    "positions": "rad",
+    "velocities": "rad/s",
+    "accelerations": "rad/s^2",
+    "jerks": "rad/s^3",
+    "tool_position": "m",
+    "speed": "m/s",
+}
+"""Units of the JSON export's arrays."""
+
+
+@dataclass(frozen=True)
+class CsvWriter:
+    """``t,<joint names>``: times (s) and joint positions (rad), shortest round-trip floats."""
+
+    name: str = "csv"
+    suffix: str = ".csv"
+    default_file: str = "trajectory.export.csv"
+
+    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
+        """Write the CSV file (options are ignored)."""
+        header = ["t", *(neutralised(name) for name in table.joint_names)]
+        write_csv_table(output, np.column_stack([table.t, table.q]), header)
+
+
+@dataclass(frozen=True)
+class JsonWriter:
+    """Joint names, units and every column of the trajectory as JSON arrays."""
+
+    name: str = "json"
+    suffix: str = ".json"
+    default_file: str = "trajectory.json"
+
+    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
+        """Write the JSON file, one key per line (options are ignored)."""
+        content = {
+            "joint_names": list(table.joint_names),
+            "units": UNITS,
+            "t": table.t.tolist(),
+            "positions": table.q.tolist(),
+            "velocities": table.qd.tolist(),
+            "accelerations": table.qdd.tolist(),
+            "jerks": table.qddd.tolist(),
+            "tool_position": table.tool_position.tolist(),
+            "speed": table.speed.tolist(),
+        }
+        # one key per line keeps the file readable without a line per number
+        body = ",\n".join(
+            f"  {json.dumps(key)}: {json.dumps(value)}" for key, value in content.items()
+        )
+        output.write_text("{\n" + body + "\n}\n", encoding="utf-8")
+
+
+@dataclass(frozen=True)
+class RosWriter:
+    """A ROS 2 ``trajectory_msgs/msg/JointTrajectory`` as YAML (option ``frame_id``)."""
+
+    name: str = "ros"
+    suffix: str = ".yaml"
+    default_file: str = "trajectory.ros.yaml"
+
+    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
+        """Write the YAML message; ``frame_id`` (default empty) goes to ``header.frame_id``."""
+        dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+        text = yaml.dump(
+            joint_trajectory_msg(table, str(options.get("frame_id", ""))),
+            Dumper=dumper,
+            sort_keys=False,
+            default_flow_style=None,
+            width=120,
+        )
+        output.write_text(text, encoding="utf-8")
+
+
+def _duration_msg(t: float) -> dict[str, int]:
+    """A ``builtin_interfaces/Duration`` of t seconds: whole seconds and nanoseconds."""
+    sec, nanosec = divmod(round(t * 1e9), 1_000_000_000)
+    return {"sec": sec, "nanosec": nanosec}
+
+
+def joint_trajectory_msg(table: TrajectoryTable, frame_id: str = "") -> dict[str, Any]:
+    """A ROS 2 ``trajectory_msgs/msg/JointTrajectory`` as plain data.
+
+    Parameters
+    ----------
+    table
+        The trajectory.
+    frame_id
+        ``header.frame_id``; empty by default, as joint-space trajectories carry none.
+
+    Returns
+    -------
+    dict
+        ``{header: {stamp: {sec, nanosec}, frame_id}, joint_names, points: [{positions,
+        velocities, accelerations, effort: [], time_from_start: {sec, nanosec}}]}``; a zero
+        stamp means "start when received".
+    """
+    return {
+        "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": frame_id},
+        "joint_names": list(table.joint_names),
+        "points": [
+            {
+                "positions": q,
+                "velocities": qd,
+                "accelerations": qdd,
+                "effort": [],
+                "time_from_start": _duration_msg(t),
+            }
+            for t, q, qd, qdd in zip(
+                table.t.tolist(),
+                table.q.tolist(),
+                table.qd.tolist(),
+                table.qdd.tolist(),
+                strict=True,
+            )
+        ],
+    }
