@@ -11,19 +11,19 @@ from tests.conftest import replace_dh
 from tests.oracles import oracle, rtb_robot_from
 from trackplan.errors import CaseError
 from trackplan.robots.dynamics.builtin import puma560_dynamics
-from trackplan.robots.dynamics.parameters import (
+from trackplan.robots.dynamics.rne import (
+    chain_inverse_dynamics,
+    gravity_load,
+    inverse_dynamics,
+    robot_chain,
+)
+from trackplan.robots.dynamics_parameters import (
     JointChain,
     Payload,
     RobotDynamics,
     dh_chain,
     inertia_matrix,
     inertia_problem,
-)
-from trackplan.robots.dynamics.rne import (
-    chain_inverse_dynamics,
-    gravity_load,
-    inverse_dynamics,
-    robot_chain,
 )
 from trackplan.robots.kinematics import jacobian, joint_frames
 

@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from trackplan.robots.dynamics.parameters import Payload
+from trackplan.robots.dynamics_parameters import Payload
 from trackplan.timing.sample_checks import TorqueLimits
 
 TS = 1e-3

@@ -97,7 +97,7 @@ from trackplan.io.yaml_input import (
     validate_model,
 )
 from trackplan.robots.builtin import DH_ROBOTS
-from trackplan.robots.dynamics.parameters import (
+from trackplan.robots.dynamics_parameters import (
     RobotDynamics,
     inertia_matrix,
     inertia_problem,

@@ -39,7 +39,7 @@ from trackplan.io.yaml_input import (
     list_default,
 )
 from trackplan.robots.collision import Capsules, frame_name, transform_capsule
-from trackplan.robots.dynamics.parameters import (
+from trackplan.robots.dynamics_parameters import (
     STANDARD_GRAVITY,
     Payload,
     inertia_matrix,

@@ -3,7 +3,7 @@
 Each link's ``<inertial>`` (mass, ``<origin>`` of the centre of mass and of the inertia's
 axes, inertia about the centre of mass) is moved into the child frame of the moving joint
 it rides on, which is the frame the inverse dynamics works in
-(:mod:`trackplan.robots.dynamics.parameters`): a URDF link's frame is its parent joint's
+(:mod:`trackplan.robots.dynamics_parameters`): a URDF link's frame is its parent joint's
 frame, turned by the joint. Links fixed to that link (fixed joints, on or off the chain) are
 merged into it by the parallel-axis theorem; links fixed to the base do not move and are left
 out, as are links behind moving joints that are not on the chain. Effort limits come from
@@ -21,7 +21,7 @@ import numpy as np
 
 from trackplan.errors import CaseError
 from trackplan.io.urdf import load_urdf_model
-from trackplan.robots.dynamics.parameters import combine_bodies, inertia_problem
+from trackplan.robots.dynamics_parameters import combine_bodies, inertia_problem
 
 
 @dataclass(frozen=True, eq=False)

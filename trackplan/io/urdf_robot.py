@@ -37,7 +37,7 @@ from trackplan.io.yaml_input import (
     validate_model,
 )
 from trackplan.robots.collision import Capsules
-from trackplan.robots.dynamics.parameters import (
+from trackplan.robots.dynamics_parameters import (
     STANDARD_GRAVITY,
     RobotDynamics,
     inertia_matrix,

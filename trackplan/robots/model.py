@@ -25,7 +25,7 @@ from trackplan._kernels import read_only
 from trackplan.errors import CaseError
 from trackplan.robots._kernels import fk_flat
 from trackplan.robots.collision import Capsules
-from trackplan.robots.dynamics.parameters import RobotDynamics
+from trackplan.robots.dynamics_parameters import RobotDynamics
 
 LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk")
 DH_COLUMNS = ("d", "a", "alpha", "offset")

@@ -248,7 +248,7 @@ def run_study(
         writer.close()
     ordered = tuple(rows[job.key] for job in study.jobs if job.key in rows)
     write_summary_csv(ordered, out / SUMMARY_CSV)
-    from trackplan.report.study import write_study_report
+    from trackplan.study.report import write_study_report
 
     write_study_report(study, ordered, out)
     n_cancelled = len(study.jobs) - len(ordered)

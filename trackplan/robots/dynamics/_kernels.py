@@ -1,6 +1,6 @@
 """Compiled recursive Newton–Euler inverse dynamics over a generic serial chain.
 
-Conventions are those of :mod:`trackplan.robots.dynamics.parameters`: joint i at
+Conventions are those of :mod:`trackplan.robots.dynamics_parameters`: joint i at
 ``T_parent_joint[i]`` in the child frame of joint i-1, turning about ``axis[i]``; link
 inertials in the child frames. Every quantity of the recursion is kept in the child frame of
 its link (Luh, Walker and Paul's "outward" form), so no world-frame transform is built.

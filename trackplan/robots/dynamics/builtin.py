@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from trackplan.robots.dynamics.parameters import (
+from trackplan.robots.dynamics_parameters import (
     RobotDynamics,
     inertia_matrix,
     inertials_from_dh,
@@ -62,7 +62,7 @@ def puma560_dynamics(d: np.ndarray, a: np.ndarray, alpha: np.ndarray) -> RobotDy
     # As published, links 1 and 3 break the triangle inequality (0.35 > 0 + 0 and
     # 0.086 > 0.066 + 0.0125 kg·m²): the consensus values are fitted, not measured on
     # bodies. They are kept exactly, so the torques match the reference; robot files are
-    # held to the physical check (:func:`~trackplan.robots.dynamics.parameters.inertia_problem`).
+    # held to the physical check (:func:`~trackplan.robots.dynamics_parameters.inertia_problem`).
     com, inertia = inertials_from_dh(d, a, alpha, com_dh, inertia_dh)
     return RobotDynamics(
         mass=np.array([0.0, 17.4, 4.8, 0.82, 0.34, 0.09]),

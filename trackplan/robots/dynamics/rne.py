@@ -11,7 +11,7 @@ from weakref import WeakKeyDictionary
 import numpy as np
 
 from trackplan.robots.dynamics import _kernels as kernels
-from trackplan.robots.dynamics.parameters import (
+from trackplan.robots.dynamics_parameters import (
     JointChain,
     RobotDynamics,
     combine_payload,

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from trackplan.report.study import (
+from trackplan.status import Status
+from trackplan.study import JobRow, Study
+from trackplan.study.report import (
     MATRIX_ID,
     best_per_part,
     feasibility_matrix,
     write_study_report,
 )
-from trackplan.status import Status
-from trackplan.study import JobRow, Study
 
 
 def row(case: str, robot: str, seed: int, J: float, cycle: float, ok: bool = True) -> JobRow:
