@@ -30,7 +30,7 @@ import numpy as np
 
 from trackplan._kernels import read_only
 from trackplan.paths._kernels import dense_pieces
-from trackplan.paths.geometry import (
+from trackplan.paths.curves import (
     Arc,
     Line,
     Primitive,

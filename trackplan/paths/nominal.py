@@ -13,7 +13,7 @@ from typing import cast
 import numpy as np
 
 from trackplan.errors import CaseError
-from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, CurveJet, Line, Primitive
+from trackplan.paths.curves import COLLINEAR_ANGLE, Arc, CurveJet, Line, Primitive
 from trackplan.paths.piece_table import PieceTable
 from trackplan.paths.pieces import Piece
 from trackplan.paths.projection import PieceIndex
@@ -158,7 +158,7 @@ class NominalPath:
     @cached_property
     def corner_junctions(self) -> np.ndarray:
         """Junctions where the tangent turns by more than
-        :data:`~trackplan.paths.geometry.COLLINEAR_ANGLE`, shape (C,): entry ``k`` joins
+        :data:`~trackplan.paths.curves.COLLINEAR_ANGLE`, shape (C,): entry ``k`` joins
         pieces k and k + 1 (polyline vertices included)."""
         return np.flatnonzero(self.junction_angles > COLLINEAR_ANGLE)
 

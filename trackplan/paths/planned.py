@@ -25,8 +25,8 @@ from trackplan.paths.blending import (
     paper_corner_radius,
     tangent_corner_arc,
 )
+from trackplan.paths.curves import COLLINEAR_ANGLE, Arc, Curve, Line, Primitive, turning_angle
 from trackplan.paths.fitting import fit_polyline
-from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, Curve, Line, Primitive, turning_angle
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.pieces import Piece, PointTable, chain, evaluate_pieces, evaluate_points
 from trackplan.paths.specs import PointsSpec

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from trackplan.paths.geometry import Arc
+from trackplan.paths.curves import Arc
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 
 #: Two points closer than this are the same point (m).
