@@ -396,7 +396,7 @@ def fit_deviation(
 @njit(cache=True, inline="always")
 def _horner(coefficients: np.ndarray, x: float) -> float:  # pragma: no cover
     """Kernel: the polynomial with ascending ``coefficients`` at ``x`` (numpy's polyval)."""
-    value = coefficients[-1]
+    value: float = coefficients[-1]
     for i in range(coefficients.size - 2, -1, -1):
         value = coefficients[i] + value * x
     return value
@@ -419,7 +419,8 @@ def _blend_arc_length(
     partial = 0.0
     for i in range(nodes.size):
         partial += math.sqrt(_horner(speed_squared, lower + half * (nodes[i] + 1.0))) * weights[i]
-    return cumulative[panel] + half * partial
+    length: float = cumulative[panel] + half * partial
+    return length
 
 
 @njit(cache=True)

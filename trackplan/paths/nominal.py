@@ -151,7 +151,7 @@ class NominalPath:
         t_in = self.table.end_tangents()[:-1]
         t_out = self.table.start_tangents()[1:]
         across = np.linalg.norm(np.cross(t_in, t_out), axis=1)
-        angles = np.arctan2(across, np.einsum("ij,ij->i", t_in, t_out))
+        angles: np.ndarray = np.arctan2(across, np.einsum("ij,ij->i", t_in, t_out))
         angles.flags.writeable = False
         return angles
 

@@ -170,7 +170,7 @@ class PieceTable:
     def tangent_on(self, piece: np.ndarray, sigma: np.ndarray) -> np.ndarray:
         """Unit tangents (M, 3) on pieces ``piece`` (M,) at their arc lengths ``sigma`` (M,), m."""
         piece = np.asarray(piece, dtype=int)
-        tangent = self.direction[piece]
+        tangent: np.ndarray = self.direction[piece]
         arc = self.is_arc[piece]
         if arc.any():
             k = piece[arc]

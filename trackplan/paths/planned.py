@@ -177,7 +177,8 @@ class Path:
         if np.any(outside):
             bad = float(s[np.argmax(outside)])
             raise ValueError(f"arc length {bad} m outside the path [0, {self.length}] m")
-        return np.clip(s, 0.0, self.length)
+        clipped: np.ndarray = np.clip(s, 0.0, self.length)
+        return clipped
 
 
 @dataclass(frozen=True, eq=False)
