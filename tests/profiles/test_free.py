@@ -35,6 +35,8 @@ def test_values_and_derivatives_are_scipys_for_many_profiles_at_once(k, order):
         # derivative magnitudes grow with 1/span^order: scale the tolerance with them
         expected = spline.derivative(order)(s) if order else spline(s)
         np.testing.assert_allclose(row, expected, atol=EXACT * (k / length) ** order * 10)
+        one = Profile(c, length).derivative(s, order)
+        np.testing.assert_allclose(one, expected, atol=EXACT * (k / length) ** order * 10)
 
 
 def test_a_constant_profile_has_zero_derivatives():

@@ -74,8 +74,9 @@ def profile_values(
     c = np.atleast_2d(np.asarray(coefficients, dtype=float))
     s = np.asarray(s, dtype=float)
     if c.shape[1] == 1:
-        constant = c if order == 0 else np.zeros_like(c)
-        return np.broadcast_to(constant, (len(c), s.size)).copy()
+        if order > 0:
+            return np.zeros((len(c), s.size))
+        return np.broadcast_to(c, (len(c), s.size)).copy()
     from scipy.interpolate import BSpline  # only varying profiles need scipy (startup time)
 
     knots = clamped_knots(c.shape[1], length)

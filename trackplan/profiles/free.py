@@ -25,7 +25,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.profiles.bspline import DEGREE, clamped_knots, increment_spans, profile_values
+from trackplan.profiles.bspline import (
+    DEGREE,
+    MAX_ORDER,
+    clamped_knots,
+    increment_spans,
+    profile_values,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,8 +73,19 @@ class Profile:
 
     def derivative(self, s: np.ndarray, order: int) -> np.ndarray:
         """The value (order 0) or its first or second derivative in s at ``s`` (M,), shape (M,)."""
-        values: np.ndarray = profile_values(self.coefficients[None], s, self.length, order)[0]
-        return values
+        if order == 0:
+            values: np.ndarray = profile_values(self.coefficients[None], s, self.length)[0]
+            return values
+        s = np.asarray(s, dtype=float)
+        if len(self.coefficients) == 1 or not 0 < order <= MAX_ORDER:
+            constant: np.ndarray = profile_values(self.coefficients[None], s, self.length, order)[0]
+            return constant
+        from scipy.interpolate import BSpline  # only varying profiles need scipy (startup time)
+
+        # one curve: scipy's derivative spline, cheaper than a design matrix per call
+        spline = BSpline(self.knots, self.coefficients, DEGREE).derivative(order)
+        rates: np.ndarray = spline(np.clip(s, 0.0, self.length))
+        return rates
 
     def value(self, s: np.ndarray) -> np.ndarray:
         """The profile at path parameters ``s`` (M,), shape (M,)."""
