@@ -152,7 +152,8 @@ def vector_norms(v: np.ndarray) -> np.ndarray:
     a few times faster: numpy reduces a short last axis slowly.
     """
     x, y, z = v[:, 0], v[:, 1], v[:, 2]
-    return np.sqrt(x * x + y * y + z * z)
+    norm: np.ndarray = np.sqrt(x * x + y * y + z * z)
+    return norm
 
 
 def tool_poses(X: np.ndarray, positions: np.ndarray, R_part_tool: np.ndarray) -> np.ndarray:

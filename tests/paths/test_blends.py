@@ -23,7 +23,7 @@ from trackplan.paths import (
     paper_corner_radius,
 )
 from trackplan.paths.blending import tangent_corner_arc
-from trackplan.paths.geometry import end_jet, start_jet
+from trackplan.paths.curves import end_jet, start_jet
 
 PROPERTY = settings(max_examples=40, deadline=None, derandomize=True)
 

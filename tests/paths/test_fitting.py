@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from trackplan.paths import NominalPath, PointsSpec, build_path, fit_polyline
+from trackplan.paths.curves import Arc, Line, end_jet, start_jet, turning_angle
 from trackplan.paths.fitting import biarc, fit_deviation, vertex_tangents
-from trackplan.paths.geometry import Arc, Line, end_jet, start_jet, turning_angle
 from trackplan.paths.pieces import chain, evaluate_pieces
 from trackplan.paths.planned import FIT_SHARE
 

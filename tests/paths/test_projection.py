@@ -1,7 +1,7 @@
 """The indexed projection onto a path equals the dense one (every point against every piece).
 
 The dense projection is the oracle: each piece's own ``project`` (the closed forms of
-``trackplan.paths.geometry``) on every point, the nearest taken, the earliest piece on ties.
+``trackplan.paths.curves``) on every point, the nearest taken, the earliest piece on ties.
 Random paths of lines, arcs (closed ones included) and sampled curves up to 400 points,
 random points near the path and far from it, drawn by hypothesis (derandomized).
 """

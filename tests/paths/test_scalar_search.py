@@ -10,7 +10,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from trackplan.paths import blending
 from trackplan.paths.blending import g2_blend
-from trackplan.paths.geometry import Line
+from trackplan.paths.curves import Line
 from trackplan.paths.scalar_search import find_root, minimize_bounded
 
 coefficient = st.floats(-3.0, 3.0, allow_nan=False)

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from tests.paths.random_paths import paths, random_nominal
 from trackplan.paths import LineSpec, NominalPath, PointsSpec
-from trackplan.paths.geometry import unwrap_closed_arc
+from trackplan.paths.curves import unwrap_closed_arc
 from trackplan.planning import tracking
 from trackplan.planning.tracking import DIRECTION_SLACK, jump_allowance, locate_on_nominal
 

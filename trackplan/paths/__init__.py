@@ -11,8 +11,8 @@ from trackplan.paths.blending import (
     paper_corner_angle,
     paper_corner_radius,
 )
+from trackplan.paths.curves import Arc, Line, QuinticBlend
 from trackplan.paths.fitting import PolylineFit, fit_polyline
-from trackplan.paths.geometry import Arc, Line, QuinticBlend
 from trackplan.paths.nominal import Corner, NominalPath
 from trackplan.paths.piece_table import PieceTable
 from trackplan.paths.pieces import Piece

@@ -4,7 +4,7 @@
 The Python API is :class:`trackplan.paths.projection.PieceIndex`; the table layout is that
 of :class:`trackplan.paths.piece_table.PieceTable`. :func:`blend_parameter` is the curve
 parameter of a quintic blend at arc lengths
-(:meth:`trackplan.paths.geometry.QuinticBlend.parameter`); :func:`piece_points` the piece,
+(:meth:`trackplan.paths.curves.QuinticBlend.parameter`); :func:`piece_points` the piece,
 position and tangent of a path's lines and arcs at arc lengths
 (:func:`trackplan.paths.pieces.evaluate_points`).
 """
@@ -396,7 +396,7 @@ def fit_deviation(
 @njit(cache=True, inline="always")
 def _horner(coefficients: np.ndarray, x: float) -> float:  # pragma: no cover
     """Kernel: the polynomial with ascending ``coefficients`` at ``x`` (numpy's polyval)."""
-    value = coefficients[-1]
+    value: float = coefficients[-1]
     for i in range(coefficients.size - 2, -1, -1):
         value = coefficients[i] + value * x
     return value
@@ -419,7 +419,8 @@ def _blend_arc_length(
     partial = 0.0
     for i in range(nodes.size):
         partial += math.sqrt(_horner(speed_squared, lower + half * (nodes[i] + 1.0))) * weights[i]
-    return cumulative[panel] + half * partial
+    length: float = cumulative[panel] + half * partial
+    return length
 
 
 @njit(cache=True)
@@ -497,8 +498,8 @@ def piece_points(
     start, ``first`` its direction) gives ``origin + σ first`` and ``first``; an arc
     (``origin`` its centre, ``first`` and ``second`` its e1 and e2, ``radius``) gives
     ``origin + radius (cos φ e1 + sin φ e2)`` and ``cos φ e2 − sin φ e1``, φ = σ / radius:
-    the operations of :meth:`trackplan.paths.geometry.Line.point_tangent` and
-    :meth:`~trackplan.paths.geometry.Arc.point_tangent`, elementwise, so the same bits.
+    the operations of :meth:`trackplan.paths.curves.Line.point_tangent` and
+    :meth:`~trackplan.paths.curves.Arc.point_tangent`, elementwise, so the same bits.
     Rows on other pieces are not written.
 
     Parameters

@@ -30,7 +30,7 @@ import numpy as np
 
 from trackplan._kernels import read_only
 from trackplan.paths._kernels import dense_pieces
-from trackplan.paths.geometry import (
+from trackplan.paths.curves import (
     Arc,
     Line,
     Primitive,
@@ -99,7 +99,8 @@ def corrected_corner_radius(beta: float, tolerance: float) -> float:
     tolerance
         ρ, m.
     """
-    return tolerance / (1.0 - np.sin(0.5 * beta))
+    radius: float = tolerance / (1.0 - np.sin(0.5 * beta))
+    return radius
 
 
 def tangent_corner_arc(incoming: Line, outgoing: Line, radius: float) -> tuple[Arc, float]:
@@ -175,7 +176,9 @@ def _distances(points: np.ndarray, neighbours: tuple[Primitive, ...]) -> np.ndar
 def _curvature(offsets: np.ndarray) -> np.ndarray:
     """Curvature (1/m) of the quintic with control ``offsets`` (6, 3) at the sample parameters."""
     first, second = _BASIS[1] @ offsets, _BASIS[2] @ offsets
-    return np.linalg.norm(np.cross(first, second), axis=-1) / np.linalg.norm(first, axis=-1) ** 3
+    across = np.linalg.norm(np.cross(first, second), axis=-1)
+    curvature: np.ndarray = across / np.linalg.norm(first, axis=-1) ** 3
+    return curvature
 
 
 @dataclass(frozen=True, eq=False)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.paths import _kernels as kernels
-from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, Line, Primitive, end_jet, unit
+from trackplan.paths.curves import COLLINEAR_ANGLE, Arc, Line, Primitive, end_jet, unit
 from trackplan.paths.piece_table import PieceTable
 
 # Sub-intervals per polyline segment when bounding the distance of a fit from the polyline.

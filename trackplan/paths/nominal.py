@@ -13,7 +13,7 @@ from typing import cast
 import numpy as np
 
 from trackplan.errors import CaseError
-from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, CurveJet, Line, Primitive
+from trackplan.paths.curves import COLLINEAR_ANGLE, Arc, CurveJet, Line, Primitive
 from trackplan.paths.piece_table import PieceTable
 from trackplan.paths.pieces import Piece
 from trackplan.paths.projection import PieceIndex
@@ -151,14 +151,14 @@ class NominalPath:
         t_in = self.table.end_tangents()[:-1]
         t_out = self.table.start_tangents()[1:]
         across = np.linalg.norm(np.cross(t_in, t_out), axis=1)
-        angles = np.arctan2(across, np.einsum("ij,ij->i", t_in, t_out))
+        angles: np.ndarray = np.arctan2(across, np.einsum("ij,ij->i", t_in, t_out))
         angles.flags.writeable = False
         return angles
 
     @cached_property
     def corner_junctions(self) -> np.ndarray:
         """Junctions where the tangent turns by more than
-        :data:`~trackplan.paths.geometry.COLLINEAR_ANGLE`, shape (C,): entry ``k`` joins
+        :data:`~trackplan.paths.curves.COLLINEAR_ANGLE`, shape (C,): entry ``k`` joins
         pieces k and k + 1 (polyline vertices included)."""
         return np.flatnonzero(self.junction_angles > COLLINEAR_ANGLE)
 

@@ -1,23 +1,24 @@
 """The case's path, built once: the nominal path, the planned path and its zones.
 
 Every placement of a case shares one :class:`PathGeometry`; a time law states which planned
-path it needs (G2 blends, or the paper's tangent arcs).
+path it needs (G2 blends, or the paper's tangent arcs). The path is built from anything that
+has a start, segments and a task with a tolerance (:class:`PathSource`, which a case and each
+of its seams satisfy), so this module imports nothing above :mod:`trackplan.paths`.
 """
 
 from __future__ import annotations
 
 import itertools
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING, Literal
+from typing import Literal, Protocol
 
 import numpy as np
 
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.planned import Path, build_path
-
-if TYPE_CHECKING:
-    from trackplan.case import Case
+from trackplan.paths.specs import SegmentSpec
 
 GEOMETRIC_STEP = 2e-3
 """Arc-length step of the planning grid on straight zones, m."""
@@ -28,6 +29,34 @@ MAX_ZONE_POINTS = 2000
 
 PathMode = Literal["g2", "paper"]
 """``g2``: curvature-continuous blends; ``paper``: the paper's tangent arcs (Eq. 10)."""
+
+
+class Toleranced(Protocol):
+    """A task that states how far the planned path may leave the nominal one."""
+
+    @property
+    def tolerance(self) -> float:
+        """ρ, the largest distance of the planned path from the nominal one, m."""
+        ...
+
+
+class PathSource(Protocol):
+    """What :meth:`PathGeometry.from_case` reads: a case, or one seam of it."""
+
+    @property
+    def start(self) -> np.ndarray:
+        """First point of the path, shape (3,), m."""
+        ...
+
+    @property
+    def segments(self) -> Sequence[SegmentSpec]:
+        """The path segments, in order."""
+        ...
+
+    @property
+    def task(self) -> Toleranced:
+        """The task (its :attr:`Toleranced.tolerance`)."""
+        ...
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,19 +77,42 @@ class PathGeometry:
     mode: PathMode = "g2"
 
     @classmethod
-    def from_case(cls, case: Case, mode: PathMode = "g2") -> PathGeometry:
-        """Build the nominal and planned paths of a case.
+    def build(
+        cls,
+        start: np.ndarray,
+        segments: Sequence[SegmentSpec],
+        tolerance: float,
+        mode: PathMode = "g2",
+    ) -> PathGeometry:
+        """Build the nominal and planned paths of a start point and segments.
 
         Parameters
         ----------
-        case
-            The case (path segments and tolerance).
+        start
+            First point of the path, shape (3,), m.
+        segments
+            The path segments, in order.
+        tolerance
+            ρ, the largest distance of the planned path from the nominal one, m, > 0.
         mode
             How corners are rounded; a time law names the mode it needs
             (:attr:`trackplan.timing.TimeLaw.path_mode`).
         """
-        nominal = NominalPath.from_specs(case.start, case.segments)
-        return cls(nominal, build_path(nominal, case.task.tolerance, mode=mode), mode)
+        nominal = NominalPath.from_specs(start, segments)
+        return cls(nominal, build_path(nominal, tolerance, mode=mode), mode)
+
+    @classmethod
+    def from_case(cls, case: PathSource, mode: PathMode = "g2") -> PathGeometry:
+        """Build the nominal and planned paths of a case (see :meth:`build`).
+
+        Parameters
+        ----------
+        case
+            A case or one of its seams: its start, segments and ``task.tolerance``.
+        mode
+            How corners are rounded.
+        """
+        return cls.build(case.start, case.segments, case.task.tolerance, mode)
 
     def zones(self) -> list[tuple[float, float, str]]:
         """Zones of the planned path with stops inserted as zero-length zones."""

@@ -3,8 +3,8 @@
 A path of a sampled curve has as many pieces as points (a million in a scanned seam), too
 many for one Python object each. :class:`PieceTable` holds them as arrays, is built from a
 polyline without a loop, and evaluates and projects pairs of (point, piece) vectorised.
-The formulas are those of :class:`~trackplan.paths.geometry.Line` and
-:class:`~trackplan.paths.geometry.Arc`, so the values agree to round-off.
+The formulas are those of :class:`~trackplan.paths.curves.Line` and
+:class:`~trackplan.paths.curves.Arc`, so the values agree to round-off.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan._kernels import read_only
-from trackplan.paths.geometry import Arc, CurveJet, Line, Primitive
+from trackplan.paths.curves import Arc, CurveJet, Line, Primitive
 
 
 @dataclass(frozen=True, eq=False)
@@ -33,7 +33,7 @@ class PieceTable:
     direction
         Unit direction of a line, shape (P, 3) (zero on arcs).
     center, axis, e1, e2
-        Of an arc (:class:`~trackplan.paths.geometry.Arc`), shape (P, 3) each (zero on lines).
+        Of an arc (:class:`~trackplan.paths.curves.Arc`), shape (P, 3) each (zero on lines).
     radius, angle
         Of an arc, m and rad, shape (P,) each (1 and 0 on lines).
     """
@@ -128,7 +128,7 @@ class PieceTable:
         return float(self.s_start[-1] + self.length[-1])
 
     def curve(self, k: int) -> Primitive:
-        """Piece ``k`` as a :class:`~trackplan.paths.geometry.Line` or ``Arc``."""
+        """Piece ``k`` as a :class:`~trackplan.paths.curves.Line` or ``Arc``."""
         if self.is_arc[k]:
             return Arc(
                 self.center[k],
@@ -170,7 +170,7 @@ class PieceTable:
     def tangent_on(self, piece: np.ndarray, sigma: np.ndarray) -> np.ndarray:
         """Unit tangents (M, 3) on pieces ``piece`` (M,) at their arc lengths ``sigma`` (M,), m."""
         piece = np.asarray(piece, dtype=int)
-        tangent = self.direction[piece]
+        tangent: np.ndarray = self.direction[piece]
         arc = self.is_arc[piece]
         if arc.any():
             k = piece[arc]
@@ -206,7 +206,7 @@ class PieceTable:
         """Nearest points of M points, each on its own piece.
 
         For an arc of more than one turn the first turn is reported (the distance is the same),
-        as :func:`~trackplan.paths.geometry.project_onto_arcs` does.
+        as :func:`~trackplan.paths.curves.project_onto_arcs` does.
 
         Parameters
         ----------

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.paths._kernels import ARC_KIND, LINE_KIND, OTHER_KIND, piece_points
-from trackplan.paths.geometry import Arc, Curve, CurveJet, Line
+from trackplan.paths.curves import Arc, Curve, CurveJet, Line
 
 
 @dataclass(frozen=True, eq=False)
@@ -19,8 +19,8 @@ class Piece:
     Attributes
     ----------
     curve
-        A :class:`~trackplan.paths.geometry.Line`, :class:`~trackplan.paths.geometry.Arc`
-        or :class:`~trackplan.paths.geometry.QuinticBlend`.
+        A :class:`~trackplan.paths.curves.Line`, :class:`~trackplan.paths.curves.Arc`
+        or :class:`~trackplan.paths.curves.QuinticBlend`.
     s_start
         Arc length of the path at the start of the piece, m.
     """
@@ -137,7 +137,7 @@ def evaluate_points(
     The first two fields of :func:`evaluate_pieces`, with the same values, without the
     curvature terms: lines and arcs in one compiled pass
     (:func:`~trackplan.paths._kernels.piece_points`), each blend's rows by its own
-    :meth:`~trackplan.paths.geometry.QuinticBlend.point_tangent`.
+    :meth:`~trackplan.paths.curves.QuinticBlend.point_tangent`.
 
     Parameters
     ----------

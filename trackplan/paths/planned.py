@@ -25,8 +25,8 @@ from trackplan.paths.blending import (
     paper_corner_radius,
     tangent_corner_arc,
 )
+from trackplan.paths.curves import COLLINEAR_ANGLE, Arc, Curve, Line, Primitive, turning_angle
 from trackplan.paths.fitting import fit_polyline
-from trackplan.paths.geometry import COLLINEAR_ANGLE, Arc, Curve, Line, Primitive, turning_angle
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.pieces import Piece, PointTable, chain, evaluate_pieces, evaluate_points
 from trackplan.paths.specs import PointsSpec
@@ -177,7 +177,8 @@ class Path:
         if np.any(outside):
             bad = float(s[np.argmax(outside)])
             raise ValueError(f"arc length {bad} m outside the path [0, {self.length}] m")
-        return np.clip(s, 0.0, self.length)
+        clipped: np.ndarray = np.clip(s, 0.0, self.length)
+        return clipped
 
 
 @dataclass(frozen=True, eq=False)

@@ -10,8 +10,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from trackplan.paths.geometry import Arc
+from trackplan.paths.curves import Arc
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
+
+_Checked = tuple[list[tuple[str, str]], np.ndarray]
+"""Problems found (key, message) and the point where the checked segment ends."""
 
 #: Two points closer than this are the same point (m).
 LENGTH_TOLERANCE = 1e-9
@@ -43,7 +46,7 @@ def _as_vector(value: object, n_rows: int | None = None) -> np.ndarray | None:
     return array
 
 
-def _check_line(key: str, spec: LineSpec, current: np.ndarray) -> tuple[list, np.ndarray]:
+def _check_line(key: str, spec: LineSpec, current: np.ndarray) -> _Checked:
     to = _as_vector(spec.to)
     if to is None:
         return [(f"{key}.line.to", "must be 3 finite numbers (x, y, z) in m")], current
@@ -53,7 +56,7 @@ def _check_line(key: str, spec: LineSpec, current: np.ndarray) -> tuple[list, np
     return [], to
 
 
-def _check_arc(key: str, spec: ArcSpec, current: np.ndarray) -> tuple[list, np.ndarray]:
+def _check_arc(key: str, spec: ArcSpec, current: np.ndarray) -> _Checked:
     problems: list[tuple[str, str]] = []
     center, normal = _as_vector(spec.center), _as_vector(spec.normal)
     try:
@@ -98,7 +101,7 @@ def _check_arc(key: str, spec: ArcSpec, current: np.ndarray) -> tuple[list, np.n
     return problems, Arc.from_rotation(current, center, normal, angle).end
 
 
-def _check_points(key: str, spec: PointsSpec, current: np.ndarray) -> tuple[list, np.ndarray]:
+def _check_points(key: str, spec: PointsSpec, current: np.ndarray) -> _Checked:
     points = _as_vector(spec.points, n_rows=0)
     if points is None:
         return [(f"{key}.points", "must be a list of finite (x, y, z) points in m")], current

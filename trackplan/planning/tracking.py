@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.frames import vector_norms
-from trackplan.paths.geometry import unwrap_closed_arc
+from trackplan.paths.curves import unwrap_closed_arc
 from trackplan.paths.nominal import NominalPath
 from trackplan.planning._kernels import assign_pieces
 

@@ -50,7 +50,7 @@ import numpy as np
 from trackplan.choices import Timing
 from trackplan.frames import placement_transform
 from trackplan.jointpath import JointPath
-from trackplan.paths.geometry import unwrap_closed_arc
+from trackplan.paths.curves import unwrap_closed_arc
 from trackplan.robots.kinematics import forward_kinematics, jacobian
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import solve_path_ik

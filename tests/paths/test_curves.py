@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from trackplan.paths.geometry import (
+from trackplan.paths.curves import (
     Arc,
     CurveJet,
     Line,

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from math import comb
-from typing import ClassVar, NamedTuple
+from typing import ClassVar, NamedTuple, cast
 
 import numpy as np
 
@@ -43,7 +43,7 @@ def bezier_basis(u: np.ndarray, order: int) -> np.ndarray:
         factor *= np.arange(6) - k
     u = np.asarray(u, dtype=float)[:, None]
     powers = np.where(exponents >= 0, u ** np.maximum(exponents, 0), 0.0)
-    return (factor * powers) @ _BERNSTEIN_TO_POWER
+    return cast(np.ndarray, (factor * powers) @ _BERNSTEIN_TO_POWER)
 
 
 class CurveJet(NamedTuple):
@@ -95,7 +95,7 @@ def hermite_offsets(start: CurveJet, end: CurveJet, speed: float) -> np.ndarray:
 
 def unit(vector: np.ndarray) -> np.ndarray:
     """``vector`` (..., 3) divided by its norm along the last axis."""
-    return vector / np.linalg.norm(vector, axis=-1, keepdims=True)
+    return cast(np.ndarray, vector / np.linalg.norm(vector, axis=-1, keepdims=True))
 
 
 def turning_angle(t_in: np.ndarray, t_out: np.ndarray) -> float:
@@ -359,7 +359,7 @@ class Arc:
     @property
     def end(self) -> np.ndarray:
         """End point (3,), m."""
-        return self.evaluate(np.array([self.length])).position[0]
+        return cast(np.ndarray, self.evaluate(np.array([self.length])).position[0])
 
     def evaluate(self, sigma: np.ndarray) -> CurveJet:
         """Position and derivatives at arc lengths ``sigma`` (M,), m."""
@@ -486,7 +486,7 @@ class QuinticBlend:
     @property
     def control(self) -> np.ndarray:
         """Control points P0 … P5, shape (6, 3), m."""
-        return self.origin + self.offsets
+        return cast(np.ndarray, self.origin + self.offsets)
 
     @property
     def start(self) -> np.ndarray:
@@ -496,12 +496,12 @@ class QuinticBlend:
     @property
     def end(self) -> np.ndarray:
         """End point P5 (3,), m."""
-        return self.origin + self.offsets[-1]
+        return cast(np.ndarray, self.origin + self.offsets[-1])
 
     def speed(self, u: np.ndarray) -> np.ndarray:
         """Parametric speed |dB/du| at ``u`` (M,), m."""
         u = np.asarray(u, dtype=float)
-        return np.sqrt(np.polynomial.polynomial.polyval(u, self._speed_squared))
+        return cast(np.ndarray, np.sqrt(np.polynomial.polynomial.polyval(u, self._speed_squared)))
 
     def _panel_table(self, n_panels: int) -> tuple[np.ndarray, np.ndarray]:
         breaks = np.linspace(0.0, 1.0, n_panels + 1)
@@ -518,7 +518,7 @@ class QuinticBlend:
         half = 0.5 * (u - lower)
         nodes = lower[:, None] + half[:, None] * (_GAUSS_NODES + 1.0)
         partial = half * (self.speed(nodes.ravel()).reshape(nodes.shape) @ _GAUSS_WEIGHTS)
-        return self._cumulative[panel] + partial
+        return cast(np.ndarray, self._cumulative[panel] + partial)
 
     def parameter(self, sigma: np.ndarray) -> np.ndarray:
         """Curve parameter u (M,) at arc lengths ``sigma`` (M,), m, to machine precision.
