@@ -12,8 +12,8 @@ import pytest
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import algorithms, optimize_placement
-from trackplan.search.algorithms import LocalRun, MultiStartSearch
+from trackplan.search import multistart, optimize_placement
+from trackplan.search.multistart import LocalRun, MultiStartSearch
 from trackplan.search.space import SearchSpace
 
 
@@ -30,7 +30,7 @@ def _descend(run: LocalRun, centre: np.ndarray) -> list[np.ndarray]:
 def test_the_cma_class_is_cmaes_own() -> None:
     import cmaes
 
-    assert algorithms.cmaes_cma() is cmaes.CMA
+    assert multistart.cmaes_cma() is cmaes.CMA
 
 
 def test_local_run_descends_a_sphere_inside_the_unit_box() -> None:
@@ -38,8 +38,8 @@ def test_local_run_descends_a_sphere_inside_the_unit_box() -> None:
     run = LocalRun(np.full(6, 0.35), seed=3)
     asked = _descend(run, centre)
     assert all(np.all((Z >= 0.0) & (Z <= 1.0)) for Z in asked)
-    assert run.evaluations <= algorithms.LOCAL_EVALUATIONS
-    assert run.evaluations == algorithms.LOCAL_POPULATION * len(asked)
+    assert run.evaluations <= multistart.LOCAL_EVALUATIONS
+    assert run.evaluations == multistart.LOCAL_POPULATION * len(asked)
     # from a start 0.15 off in every variable (f = 0.135) to the floor
     assert run.best < 1e-6
 
@@ -56,19 +56,19 @@ def test_local_run_stops_when_the_fitness_is_flat() -> None:
     run = LocalRun(np.full(6, 0.5), seed=1)
     while not run.stopped:
         run.ask()
-        run.tell(np.full(algorithms.LOCAL_POPULATION, 0.25))
-    assert run.evaluations < algorithms.LOCAL_EVALUATIONS
+        run.tell(np.full(multistart.LOCAL_POPULATION, 0.25))
+    assert run.evaluations < multistart.LOCAL_EVALUATIONS
 
 
 def test_the_race_stops_the_runs_that_fell_behind() -> None:
     search = MultiStartSearch(SearchSpace.from_case(load_case(CASES / "paper-corner.yaml")))
     runs = [LocalRun(np.full(6, 0.5), seed=s) for s in range(4)]
-    margin = algorithms.RACE_MARGIN
+    margin = multistart.RACE_MARGIN
     # leader, close behind, far behind, far behind but too young to judge
     for run, best, generations in zip(
         runs,
         (1.0, 1.0 + 0.5 * margin, 1.0 + 2 * margin, 1.0 + 2 * margin),
-        (9, 9, algorithms.RACE_GENERATIONS, algorithms.RACE_GENERATIONS - 1),
+        (9, 9, multistart.RACE_GENERATIONS, multistart.RACE_GENERATIONS - 1),
         strict=True,
     ):
         run.best, run.generations = best, generations
@@ -85,7 +85,7 @@ def test_a_pymoo_termination_runs_the_same_search_as_a_pymoo_algorithm() -> None
     termination stops it."""
     case = load_case(CASES / "paper-corner.yaml")
     geometry = PathGeometry.from_case(case)
-    n_gen = algorithms.MULTISTART_SAMPLES // algorithms.MULTISTART_BATCH + 4  # 4 local ones
+    n_gen = multistart.MULTISTART_SAMPLES // multistart.MULTISTART_BATCH + 4  # 4 local ones
     alone = optimize_placement(case, seed=3, geometry=geometry)
     stopped = optimize_placement(case, seed=3, geometry=geometry, termination=("n_gen", n_gen))
     assert stopped.stop_reason == "custom" and stopped.generations == n_gen < alone.generations
@@ -102,10 +102,10 @@ def test_the_search_imports_neither_cma_nor_matplotlib_nor_scipy_stats() -> None
     code = (
         "import sys; import trackplan.cli.app; "
         "from trackplan.io.case_file import load_case; "
-        "from trackplan.search import optimize_placement, algorithms; "
+        "from trackplan.search import optimize_placement, multistart; "
         f"case = load_case({str(CASES / 'paper-line.yaml')!r}); "
-        "r = optimize_placement(case, budget=algorithms.MULTISTART_SAMPLES + 30); "
-        "assert r.history.evaluations[-1] > algorithms.MULTISTART_SAMPLES; "
+        "r = optimize_placement(case, budget=multistart.MULTISTART_SAMPLES + 30); "
+        "assert r.history.evaluations[-1] > multistart.MULTISTART_SAMPLES; "
         "print(sorted(m for m in ('cma', 'matplotlib', 'scipy.stats') if m in sys.modules))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

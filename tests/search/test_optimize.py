@@ -266,14 +266,14 @@ def test_multistart_descends_from_its_best_distinct_samples(
     case: Case, geometry: PathGeometry
 ) -> None:
     """Local runs start from mutually distant good samples and improve on the sampling."""
-    from trackplan.search import algorithms
+    from trackplan.search import multistart
 
     result = optimize_placement(case, method="multistart", seed=2, geometry=geometry)
-    sampled = result.history.evaluations <= algorithms.MULTISTART_SAMPLES
+    sampled = result.history.evaluations <= multistart.MULTISTART_SAMPLES
     assert result.success and result.stop_reason == "converged"
     assert result.history.best[~sampled].min() < result.history.best[sampled].min()
-    assert result.evaluations <= algorithms.MULTISTART_SAMPLES + algorithms.MULTISTART_STARTS * (
-        algorithms.LOCAL_EVALUATIONS + algorithms.LOCAL_POPULATION
+    assert result.evaluations <= multistart.MULTISTART_SAMPLES + multistart.MULTISTART_STARTS * (
+        multistart.LOCAL_EVALUATIONS + multistart.LOCAL_POPULATION
     )
 
 

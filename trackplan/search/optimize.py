@@ -356,7 +356,7 @@ def run_search(
 ) -> str:
     """One run of a search from ``seed`` on ``problem``; the stop reason.
 
-    A :class:`~trackplan.search.algorithms.MultiStartSearch` asks for arrays and is told
+    A :class:`~trackplan.search.multistart.MultiStartSearch` asks for arrays and is told
     fitness arrays, without pymoo (:func:`_run_arrays`), unless a pymoo ``termination``
     is given (it then runs as a pymoo Algorithm:
     :class:`~trackplan.search.pymoo_algorithms.AskTellAlgorithm`, the same draws); a pymoo

@@ -133,7 +133,7 @@ class PlacementProblem(Problem):
         """Evaluate a batch of candidates, shape (B, 6 + k), and record it; its fitness (B,).
 
         What pymoo's evaluator calls (through ``_evaluate``), and what the driver calls
-        for a search that asks for arrays (:class:`~trackplan.search.algorithms.MultiStartSearch`).
+        for a search that asks for arrays (:class:`~trackplan.search.multistart.MultiStartSearch`).
         """
         screening = self.fitness.evaluate(X, incumbent=self.best_fitness)
         self.n_evaluations += len(screening.X)
