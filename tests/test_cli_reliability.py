@@ -60,7 +60,7 @@ def test_optimize_refuses_bad_arguments_before_searching(
     def no_search(*_args: object, **_kwargs: object) -> None:
         pytest.fail("the search started before the arguments were checked")
 
-    monkeypatch.setattr(trackplan.search, "optimize_placement", no_search)
+    monkeypatch.setattr(trackplan.search, "optimize", no_search)
     file = tmp_path / "taken"
     file.write_text("not a folder")
     args = tuple(arg.format(file=file) for arg in args)

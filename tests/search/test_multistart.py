@@ -12,7 +12,7 @@ import pytest
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import multistart, optimize_placement
+from trackplan.search import multistart, optimize
 from trackplan.search.multistart import LocalRun, MultiStartSearch
 from trackplan.search.space import SearchSpace
 
@@ -86,8 +86,8 @@ def test_a_pymoo_termination_runs_the_same_search_as_a_pymoo_algorithm() -> None
     case = load_case(CASES / "paper-corner.yaml")
     geometry = PathGeometry.from_case(case)
     n_gen = multistart.MULTISTART_SAMPLES // multistart.MULTISTART_BATCH + 4  # 4 local ones
-    alone = optimize_placement(case, seed=3, geometry=geometry)
-    stopped = optimize_placement(case, seed=3, geometry=geometry, termination=("n_gen", n_gen))
+    alone = optimize(case, seed=3, geometry=geometry)
+    stopped = optimize(case, seed=3, geometry=geometry, termination=("n_gen", n_gen))
     assert stopped.stop_reason == "custom" and stopped.generations == n_gen < alone.generations
     for key in ("evaluations", "best", "mean", "feasible_share"):
         np.testing.assert_array_equal(
@@ -102,12 +102,27 @@ def test_the_search_imports_neither_cma_nor_matplotlib_nor_scipy_stats() -> None
     code = (
         "import sys; import trackplan.cli.app; "
         "from trackplan.io.case_file import load_case; "
-        "from trackplan.search import optimize_placement, multistart; "
+        "from trackplan.search import optimize, multistart; "
         f"case = load_case({str(CASES / 'paper-line.yaml')!r}); "
-        "r = optimize_placement(case, budget=multistart.MULTISTART_SAMPLES + 30); "
+        "r = optimize(case, budget=multistart.MULTISTART_SAMPLES + 30); "
         "assert r.history.evaluations[-1] > multistart.MULTISTART_SAMPLES; "
         "print(sorted(m for m in ('cma', 'matplotlib', 'scipy.stats') if m in sys.modules))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+def test_the_method_modules_import_one_way() -> None:
+    """algorithms.py may reach pymoo_algorithms.py (for CMA-ES), never the reverse: no cycle."""
+    import ast
+    import inspect
+
+    from trackplan.search import pymoo_algorithms
+
+    tree = ast.parse(inspect.getsource(pymoo_algorithms))
+    imported = {
+        node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module
+    }
+    assert "trackplan.search.algorithms" not in imported
+    assert "trackplan.search.multistart" in imported

@@ -139,7 +139,7 @@ class MultiStartSearch:
     seeded from the search's, so a seed reproduces the search exactly.
 
     It follows ask/tell with arrays (:meth:`ask`, :meth:`tell`), not pymoo's populations:
-    the driver (:func:`trackplan.search.optimize.optimize_placement`) evaluates what it
+    the driver (:func:`trackplan.search.optimize.optimize`) evaluates what it
     asks; :class:`~trackplan.search.pymoo_algorithms.AskTellAlgorithm` runs it as a pymoo
     Algorithm where a pymoo termination is given.
 

@@ -87,7 +87,7 @@ class Archive:
 
 class Fitness(Protocol):
     """What the problem evaluates: :class:`~trackplan.search.fitness.PlacementFitness`, or
-    the several-seam fitness of :mod:`trackplan.search.cycle_search`."""
+    the case fitness of :mod:`trackplan.search.case_fitness`."""
 
     penalty: float
 
