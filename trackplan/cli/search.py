@@ -21,6 +21,7 @@ from trackplan.cli.common import (
 )
 from trackplan.cli.signals import SignalLog, stop_on_signals
 from trackplan.errors import CaseError
+from trackplan.status import Status
 
 if TYPE_CHECKING:
     from contextlib import AbstractContextManager
@@ -289,7 +290,7 @@ def _search_and_write(  # type: ignore[no-untyped-def]
         with forked_pool() as background:  # the plans at full Ts, beside the search
             result = _search(case, signals, geometries=geometries, background=background, **options)
         signals.deferring = False
-        interrupted = result.stop_reason == "interrupted" or signals.first is not None
+        interrupted = result.status is Status.INTERRUPTED or signals.first is not None
         marks = _interrupted_marks(result, signals) if interrupted else None
         _write_and_print(out, result, case, report=report, worker=worker, extra=marks)
     if interrupted:
@@ -335,7 +336,7 @@ def _interrupted_marks(result, signals: SignalLog) -> dict:  # type: ignore[no-u
     """The keys of result.json that mark a search stopped by a signal."""
     name = "SIGTERM" if signals.exit_code == ExitCode.TERMINATED else "SIGINT"
     return {
-        "status": "interrupted",
+        "status": Status.INTERRUPTED.value,
         "plan_status": result.final.status.value,
         "interrupted": {
             "signal": name,

@@ -8,6 +8,7 @@ reports each generation (:class:`GenerationRecord`) and stops cleanly on Ctrl-C.
 
 from __future__ import annotations
 
+import enum
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -24,6 +25,23 @@ from trackplan.search.problem import PlacementProblem
 if TYPE_CHECKING:  # pymoo's Algorithm is imported by the methods that run as one only
     from pymoo.core.algorithm import Algorithm
     from pymoo.core.termination import Termination
+
+
+class StopReason(enum.StrEnum):
+    """Why a run of a search stopped (the words of ``optimizer.stop_reason`` in result.json)."""
+
+    STALL = "stall"
+    """The best fitness stalled (the MATLAB stall test)."""
+    MAX_GENERATIONS = "max_generations"
+    """The generation limit."""
+    BUDGET = "budget"
+    """The evaluation budget."""
+    CONVERGED = "converged"
+    """The method's own convergence (CMA-ES, the local runs of multistart)."""
+    INTERRUPTED = "interrupted"
+    """A signal (Ctrl-C)."""
+    CUSTOM = "custom"
+    """A pymoo termination given by the caller."""
 
 
 @dataclass(frozen=True)
@@ -111,7 +129,7 @@ def run_search(
     method: Method | None,
     seed: int,
     driver: tuple[int | None, ProgressCallback | None, float, list[GenerationRecord]],
-) -> str:
+) -> StopReason:
     """One run of a search from ``seed`` on ``problem``; the stop reason.
 
     A :class:`~trackplan.search.multistart.MultiStartSearch` asks for arrays and is told
@@ -142,7 +160,7 @@ def _run_arrays(
     progress: ProgressCallback | None,
     start: float,
     records: list[GenerationRecord],
-) -> str:
+) -> StopReason:
     """:func:`_run` of a search that asks for arrays: the same stopping rules (the budget,
     the search's convergence, :data:`~trackplan.search.algorithms.MAX_GENERATIONS`), the
     same records."""
@@ -150,7 +168,7 @@ def _run_arrays(
         while True:
             X = search.ask()
             if X is None or len(X) == 0:
-                return "converged"
+                return StopReason.CONVERGED
             remaining = None if budget is None else budget - problem.n_evaluations
             truncated = remaining is not None and len(X) > remaining
             if truncated:
@@ -162,11 +180,11 @@ def _run_arrays(
             if progress is not None:
                 progress(records[-1])
             if budget is not None and problem.n_evaluations >= budget:
-                return "budget"
+                return StopReason.BUDGET
             if search.converged:
-                return "converged"
+                return StopReason.CONVERGED
             if search.n_gen >= MAX_GENERATIONS:
-                return "max_generations"
+                return StopReason.MAX_GENERATIONS
     except KeyboardInterrupt:
         return _interrupted(problem, start, records)
 
@@ -179,14 +197,14 @@ def _run(
     progress: ProgressCallback | None,
     start: float,
     records: list[GenerationRecord],
-) -> str:
+) -> StopReason:
     """Ask, evaluate, tell until a stopping rule fires, appending one record per generation
     to ``records`` (numbered on from earlier runs); the stop reason."""
     try:
         while True:
             infills = algorithm.ask()
             if infills is None or len(infills) == 0:  # the algorithm has nothing left to try
-                return "converged"
+                return StopReason.CONVERGED
             remaining = None if budget is None else budget - problem.n_evaluations
             truncated = remaining is not None and len(infills) > remaining
             if truncated:
@@ -198,17 +216,19 @@ def _run(
             if progress is not None:
                 progress(records[-1])
             if budget is not None and problem.n_evaluations >= budget:
-                return "budget"
+                return StopReason.BUDGET
             if getattr(algorithm, "converged", None):
-                return "converged"
+                return StopReason.CONVERGED
             if algorithm.termination.has_terminated():
                 fired = [name for name, part in parts.items() if part.has_terminated()]
-                return fired[0] if fired else "stall"
+                return StopReason(fired[0]) if fired else StopReason.STALL
     except KeyboardInterrupt:
         return _interrupted(problem, start, records)
 
 
-def _interrupted(problem: PlacementProblem, start: float, records: list[GenerationRecord]) -> str:
+def _interrupted(
+    problem: PlacementProblem, start: float, records: list[GenerationRecord]
+) -> StopReason:
     """Inside the handler of a KeyboardInterrupt: the record of a generation evaluated but
     not yet recorded, and the stop reason ``interrupted``; re-raised before any evaluation."""
     if problem.n_evaluations == 0:
@@ -217,7 +237,7 @@ def _interrupted(problem: PlacementProblem, start: float, records: list[Generati
         not records or records[-1].evaluations < problem.n_evaluations
     ):
         records.append(_record(len(records) + 1, problem, problem.last.fitness, start))
-    return "interrupted"
+    return StopReason.INTERRUPTED
 
 
 def _record(

@@ -35,6 +35,7 @@ from trackplan.search.driver import (
     GenerationRecord,
     ProgressCallback,
     SearchHistory,
+    StopReason,
     run_search,
     run_seeds,
 )
@@ -122,7 +123,7 @@ class SearchResult:
     history: SearchHistory
     evaluations: int
     generations: int
-    stop_reason: str
+    stop_reason: StopReason
     wall_time_s: float
     method: str
     seed: int
@@ -234,7 +235,7 @@ def optimize(
     planner = _Planner(case, law.timing, geometries, background)
     before = planner.submit(space.anchor, None, fitness.seam_spins(space.anchor))
     records: list[GenerationRecord] = []
-    stop_reason = ""
+    stop_reason = StopReason.BUDGET
     runs = 0
     for run_seed in run_seeds(seed, restarts):
         if chosen is None:
@@ -244,12 +245,12 @@ def optimize(
         driver = (budget, progress, start, records)
         stop_reason = run_search(search, problem, termination, chosen, run_seed, driver)
         runs += 1
-        if stop_reason in ("budget", "interrupted"):
+        if stop_reason in (StopReason.BUDGET, StopReason.INTERRUPTED):
             break
     initial = planner.result(before, space.anchor, None, fitness.seam_spins(space.anchor))
     final, kept, branches, rejected = _final_plan(problem, fitness, planner)
     unreachable = fitness.unreachable_seams()
-    status = Status.INTERRUPTED if stop_reason == "interrupted" else final.status
+    status = Status.INTERRUPTED if stop_reason is StopReason.INTERRUPTED else final.status
     return SearchResult(
         success=status is Status.FEASIBLE,
         status=status,
