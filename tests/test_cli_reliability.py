@@ -263,7 +263,7 @@ def test_trajectory_header_is_what_check_reads() -> None:
 def test_sigterm_during_the_search_writes_the_best_result(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import trackplan.search.optimize as optimize
+    import trackplan.search.driver as optimize
 
     record = optimize._record
 

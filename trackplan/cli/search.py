@@ -309,9 +309,9 @@ def _write_and_print(  # type: ignore[no-untyped-def]
     """
     from trackplan.cli.summaries import print_search
     from trackplan.outputs import write_cycle_run, write_search_run
-    from trackplan.planning.cycle import CycleResult
+    from trackplan.planning.result import PlanResult
 
-    if not isinstance(result.final, CycleResult):
+    if isinstance(result.final, PlanResult):
         write_search_run(out, result, case, report=report, extra=extra, plot_worker=worker)
         print_search(console(), result, out, rated_speed=case.task.rated_speed)
         return

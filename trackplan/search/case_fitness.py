@@ -31,11 +31,9 @@ import numpy as np
 
 from trackplan.case import Case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.sequence import best_sequence
 from trackplan.search.fitness import SCREEN_POSES, PlacementFitness
 from trackplan.search.screening import Screening, SeamScreen, evaluate_seams
 from trackplan.search.space import N_VAR, SearchSpace
-from trackplan.timing.airmove import air_time_estimate
 
 POSE_SPACING = 0.005
 """Screening grid spacing along each seam of a case with several seams, m (about that of a
@@ -192,6 +190,8 @@ class CaseFitness:
     def air_cost(self, seams: SeamScreen, b: int) -> float:
         """Estimated cost of the moves of candidate ``b`` in its best sequence: per move
         ``Σ C_i |Δq_i| + w · T``."""
+        from trackplan.planning.sequence import best_sequence
+
         ends = np.stack([seams.q_first[:, b], seams.q_last[:, b]], axis=1)  # (m, 2, n)
         q_in = ends  # forward starts at the first end, reversed at the last
         q_out = ends[:, ::-1]
@@ -211,6 +211,8 @@ class CaseFitness:
         travel = np.sum(self.weights * np.abs(q_to - q_from), axis=-1)
         if self.time_weight == 0.0:
             return np.asarray(travel)
+        from trackplan.timing.airmove import air_time_estimate
+
         duration = air_time_estimate(q_from, q_to, robot.v_max, robot.a_max, robot.j_max)
         return np.asarray(travel + self.time_weight * duration)
 

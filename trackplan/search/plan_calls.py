@@ -8,16 +8,20 @@ the search reaches the planner through this module only.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, TypeAlias
+
 import numpy as np
 
 from trackplan.case import Case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.cycle import CycleResult, plan_cycle
-from trackplan.planning.cycle import seam_geometries as _seam_geometries
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
+from trackplan.timing import time_law
 
-CasePlan = PlanResult | CycleResult
+if TYPE_CHECKING:  # the cycle planner (and ruckig) are imported for cases with moves only
+    from trackplan.planning.cycle import CycleResult
+
+CasePlan: TypeAlias = "PlanResult | CycleResult"
 """The plan of a case at one placement: every seam, sequenced, checked."""
 SeamGeometries = dict[tuple[int, bool], PathGeometry]
 """Paths of each seam direction ``(seam index, reversed)`` for one time law's path mode."""
@@ -26,7 +30,11 @@ SeamGeometries = dict[tuple[int, bool], PathGeometry]
 def seam_geometries(case: Case, timing: str) -> SeamGeometries:
     """The paths of every seam of the case in each direction it may be welded, built once
     in the path mode of the time law ``timing``."""
-    return _seam_geometries(case, timing)
+    if case.cycle is None:  # one seam, welded as written
+        return {(0, False): PathGeometry.from_case(case, time_law(timing).path_mode)}
+    from trackplan.planning.cycle import seam_geometries as cycle_geometries
+
+    return cycle_geometries(case, timing)
 
 
 def sequencing_home(case: Case) -> np.ndarray | None:
@@ -70,6 +78,8 @@ def plan_case(
             geometry=geometries[0, False],
             spin=None if spins is None else spins[0],
         )
+    from trackplan.planning.cycle import plan_cycle
+
     return plan_cycle(case, X, timing=timing, geometries=geometries, branches=branches, spins=spins)
 
 
