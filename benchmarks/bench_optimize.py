@@ -356,7 +356,7 @@ def _case_names() -> list[str]:
     if chosen:
         return [name.strip() for name in chosen.split(",") if name.strip()]
     others = sorted(f.stem for f in CASES.glob("*.yaml") if f.stem not in PAPER_CASES)
-    several = [name for name in others if load_case(CASES / f"{name}.yaml").cycle is not None]
+    several = [name for name in others if len(load_case(CASES / f"{name}.yaml").seams) > 1]
     if several:
         print(
             f"(cases with several seams, measured apart: {', '.join(several)}; "

@@ -32,6 +32,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.search.fitness import SCREEN_POSES, PlacementFitness
+from trackplan.search.plan_calls import sequencing_home
 from trackplan.search.screening import Screening, SeamScreen, evaluate_seams
 from trackplan.search.space import N_VAR, SearchSpace
 
@@ -88,7 +89,7 @@ class CaseFitness:
         Its search space (:meth:`SearchSpace.from_case`: the placement, then each seam's
         spin).
     geometries
-        The seams' paths (:func:`trackplan.planning.cycle.seam_geometries`); the forward
+        The seams' paths (:func:`trackplan.search.plan_calls.seam_geometries`); the forward
         direction of each is screened.
     timing
         The time law.
@@ -134,7 +135,7 @@ class CaseFitness:
         self.time_weight = float(case.objective.time_weight)
         self.weights = np.asarray(case.objective.weights, dtype=float)
         self.reversible = np.array([seam.reversible for seam in case.seams])
-        self.home = None if case.cycle is None else case.cycle.home
+        self.home = sequencing_home(case)
         self.feasible_count = np.zeros(len(case.seams), dtype=int)
         self.slices = spin_slices(case)
         if space.n_var != self.slices[-1].stop:
