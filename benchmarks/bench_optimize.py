@@ -46,8 +46,8 @@ from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
-from trackplan.search import optimize
 from trackplan.search.fitness import screening_grid
+from trackplan.search.optimize import optimize
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 PAPER_CASES = ("paper-line", "paper-circle", "paper-corner")

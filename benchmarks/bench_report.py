@@ -40,7 +40,7 @@ from trackplan.io.case_file import load_case
 from trackplan.planning.plan import plan_placement
 from trackplan.report.plot_worker import PlotWorker
 from trackplan.report.run_report import can_fork, write_run_report
-from trackplan.search import optimize
+from trackplan.search.optimize import optimize
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 CASE = "paper-corner"

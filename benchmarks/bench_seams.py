@@ -34,7 +34,7 @@ from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_robot
 from trackplan.planning.cycle import plan_cycle, seam_geometries
 from trackplan.planning.sequence import best_sequence, given_sequence, sequence_cost
-from trackplan.search import optimize
+from trackplan.search.optimize import optimize
 from trackplan.timing.airmove import air_time_estimate, plan_air_move, trapezoid_time
 
 ROBOT = "kuka_kr10_r1420"

@@ -20,8 +20,8 @@ import numpy as np
 
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import optimize
 from trackplan.search.fitness import PlacementFitness
+from trackplan.search.optimize import optimize
 from trackplan.search.space import SearchSpace
 
 CASES = Path(__file__).resolve().parent.parent / "cases"

@@ -55,12 +55,12 @@ def test_optimize_refuses_bad_arguments_before_searching(
     args: tuple[str, ...],
     expected: str,
 ) -> None:
-    import trackplan.search
+    import trackplan.search.optimize as search
 
     def no_search(*_args: object, **_kwargs: object) -> None:
         pytest.fail("the search started before the arguments were checked")
 
-    monkeypatch.setattr(trackplan.search, "optimize", no_search)
+    monkeypatch.setattr(search, "optimize", no_search)
     file = tmp_path / "taken"
     file.write_text("not a folder")
     args = tuple(arg.format(file=file) for arg in args)

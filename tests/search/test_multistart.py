@@ -12,8 +12,9 @@ import pytest
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import multistart, optimize
+from trackplan.search import multistart
 from trackplan.search.multistart import LocalRun, MultiStartSearch
+from trackplan.search.optimize import optimize
 from trackplan.search.space import SearchSpace
 
 
@@ -102,7 +103,7 @@ def test_the_search_imports_neither_cma_nor_matplotlib_nor_scipy_stats() -> None
     code = (
         "import sys; import trackplan.cli.app; "
         "from trackplan.io.case_file import load_case; "
-        "from trackplan.search import optimize, multistart; "
+        "from trackplan.search import multistart; from trackplan.search.optimize import optimize; "
         f"case = load_case({str(CASES / 'paper-line.yaml')!r}); "
         "r = optimize(case, budget=multistart.MULTISTART_SAMPLES + 30); "
         "assert r.history.evaluations[-1] > multistart.MULTISTART_SAMPLES; "

@@ -21,8 +21,9 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
-from trackplan.search import GenerationRecord, SearchResult, optimize
+from trackplan.search import GenerationRecord, SearchResult
 from trackplan.search.fitness import PlacementFitness
+from trackplan.search.optimize import optimize
 from trackplan.search.screening import SeamScreen, code
 from trackplan.search.space import SearchSpace
 from trackplan.status import Status

@@ -10,8 +10,8 @@ from trackplan.cli import main
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import optimize
-from trackplan.search.optimize import run_seeds
+from trackplan.search.driver import run_seeds
+from trackplan.search.optimize import optimize
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,7 @@ from tests.conftest import CASES
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case
 from trackplan.planning.plan import check_case_trajectory, plan_placement
-from trackplan.search import optimize
+from trackplan.search.optimize import optimize
 from trackplan.search.spin import optimize_spin
 from trackplan.status import Status
 

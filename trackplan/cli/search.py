@@ -352,7 +352,7 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
     recorded in ``signals`` stops it after the current generation."""
     from rich.console import Console
 
-    from trackplan.search import optimize
+    from trackplan.search.optimize import optimize
 
     err = Console(stderr=True)
     if not err.is_terminal:

@@ -132,7 +132,7 @@ def run_job(job: Job, out_dir: str | Path, report: bool = True) -> JobRow:
         The job's summary row (read back from the files written), or a failed row.
     """
     from trackplan.outputs import write_search_run
-    from trackplan.search import optimize
+    from trackplan.search.optimize import optimize
 
     start = time.perf_counter()
     jobs_dir = Path(out_dir) / JOBS_DIR

@@ -40,7 +40,7 @@ PROFILER_CALLBACKS = ("profile", "profile-cycle")
 def warm_up() -> None:
     """Run a tiny placement search per IK family (compiles or loads the numba kernels)."""
     from trackplan.io.case_file import load_case_text
-    from trackplan.search import optimize
+    from trackplan.search.optimize import optimize
 
     for robot in WARM_UP_ROBOTS:
         optimize(load_case_text(WARM_UP_CASE.format(robot=robot), file="warm-up"))
