@@ -14,7 +14,7 @@ Run with ``python -m benchmarks seams``. Prints, in one run:
   against the order as written; and the heuristic's gap to the optimum at m = 8, on such
   instances and on independent random costs;
 - the shipped case ``cases/bracket-4-fillets.yaml`` (four fillets, one placement): the
-  placement search (:func:`trackplan.search.optimize`, CPU time), then
+  placement search (:func:`trackplan.search.optimize.optimize`, CPU time), then
   at its placement the cycle time with the optimised sequence against the order and
   directions as written (:func:`trackplan.planning.cycle.plan_cycle`), and the air time of
   each.
