@@ -46,8 +46,8 @@ from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.plan import plan_placement
-from trackplan.search import optimize_placement
 from trackplan.search.fitness import screening_grid
+from trackplan.search.optimize import optimize
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 PAPER_CASES = ("paper-line", "paper-circle", "paper-corner")
@@ -111,7 +111,7 @@ def _reference(case, geometry, method: str, budget: int) -> dict:  # type: ignor
     evaluations: list[np.ndarray] = []
     start = time.perf_counter()
     while used < budget:
-        result = optimize_placement(
+        result = optimize(
             case,
             method=method,
             seed=REFERENCE_SEED + runs,
@@ -221,7 +221,7 @@ print(json.dumps({"marks": marks, "spans": spans, "code": int(code)}))
 trackplan.cli.exit_process(code)
 """
 """Runs ``trackplan optimize`` in one process and times its phases (the functions wrapped
-are those :func:`~trackplan.search.optimize_placement` and the command call), and ends as
+are those :func:`~trackplan.search.optimize` and the command call), and ends as
 the command does (:func:`trackplan.cli.exit_process`). The plans'
 times are the waits for them: with a second core they are made beside the search."""
 
@@ -292,7 +292,7 @@ def _corner_seeds() -> None:
     )
     for seed in SEEDS:
         start = time.process_time()
-        result = optimize_placement(case, seed=seed, geometry=geometry)
+        result = optimize(case, seed=seed, geometry=geometry)
         cpu = time.process_time() - start
         gap = result.objective / best - 1.0 if result.success else math.inf
         print(
@@ -357,10 +357,10 @@ def _case_names() -> list[str]:
     if chosen:
         return [name.strip() for name in chosen.split(",") if name.strip()]
     others = sorted(f.stem for f in CASES.glob("*.yaml") if f.stem not in PAPER_CASES)
-    several = [name for name in others if load_case(CASES / f"{name}.yaml").cycle is not None]
+    several = [name for name in others if len(load_case(CASES / f"{name}.yaml").seams) > 1]
     if several:
         print(
-            f"(cases with several seams, searched by optimize_cycle: {', '.join(several)}; "
+            f"(cases with several seams, measured apart: {', '.join(several)}; "
             "python -m benchmarks seams)"
         )
     return [*PAPER_CASES, *(name for name in others if name not in several)]
@@ -423,10 +423,10 @@ def main() -> None:
     for name in names:
         case = load_case(CASES / f"{name}.yaml")
         geometry = PathGeometry.from_case(case)
-        optimize_placement(case, budget=30, geometry=geometry)  # warm-up: JIT and imports
+        optimize(case, budget=30, geometry=geometry)  # warm-up: JIT and imports
         rows = []
         for seed in SEEDS:
-            result = optimize_placement(case, seed=seed, geometry=geometry)
+            result = optimize(case, seed=seed, geometry=geometry)
             rows.append((seed, result))
             searched += result.evaluations
             search_seconds += float(result.history.wall_time[-1])
@@ -458,7 +458,7 @@ def main() -> None:
 
     rate = searched / search_seconds
     if not placements:  # the corner case was not among those run
-        placements = [optimize_placement(corner, budget=300, seed=s).X for s in range(3)]
+        placements = [optimize(corner, budget=300, seed=s).X for s in range(3)]
     geometry = PathGeometry.from_case(corner)
     rtb_rate, n_poses = _rtb_rate(corner, geometry, np.array(placements[-RTB_PLACEMENTS:]))
     print("\nThroughput (the searches above, fitness evaluation and pymoo overhead included)")

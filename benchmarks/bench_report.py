@@ -40,7 +40,7 @@ from trackplan.io.case_file import load_case
 from trackplan.planning.plan import plan_placement
 from trackplan.report.plot_worker import PlotWorker
 from trackplan.report.run_report import can_fork, write_run_report
-from trackplan.search import optimize_placement
+from trackplan.search.optimize import optimize
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 CASE = "paper-corner"
@@ -110,7 +110,7 @@ def _process_seconds(args: list[str], runs: int = PROCESS_RUNS) -> tuple[float, 
 
 def _in_process() -> None:
     case = load_case(CASES / f"{CASE}.yaml")
-    search = optimize_placement(case)
+    search = optimize(case)
     result = search.final
     history = {search.method: search.history.as_columns()}
     plan = best_time(lambda: plan_placement(case, search.X))

@@ -14,7 +14,7 @@ Run with ``python -m benchmarks seams``. Prints, in one run:
   against the order as written; and the heuristic's gap to the optimum at m = 8, on such
   instances and on independent random costs;
 - the shipped case ``cases/bracket-4-fillets.yaml`` (four fillets, one placement): the
-  placement search (:func:`trackplan.search.cycle_search.optimize_cycle`, CPU time), then
+  placement search (:func:`trackplan.search.optimize.optimize`, CPU time), then
   at its placement the cycle time with the optimised sequence against the order and
   directions as written (:func:`trackplan.planning.cycle.plan_cycle`), and the air time of
   each.
@@ -34,7 +34,7 @@ from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_robot
 from trackplan.planning.cycle import plan_cycle, seam_geometries
 from trackplan.planning.sequence import best_sequence, given_sequence, sequence_cost
-from trackplan.search.cycle_search import optimize_cycle
+from trackplan.search.optimize import optimize
 from trackplan.timing.airmove import air_time_estimate, plan_air_move, trapezoid_time
 
 ROBOT = "kuka_kr10_r1420"
@@ -150,9 +150,9 @@ def sequencing() -> None:
 def cycle() -> None:
     """The shipped four-fillet case: search, then the optimised sequence against the given."""
     case = load_case(SHIPPED_CASE)
-    assert case.cycle is not None
+    assert case.cycle is not None and len(case.seams) > 1
     start = time.process_time()
-    search = optimize_cycle(case)
+    search = optimize(case)
     search_cpu = time.process_time() - start
     X = search.X
     geometries = seam_geometries(case)

@@ -20,8 +20,8 @@ import numpy as np
 
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import optimize_placement
 from trackplan.search.fitness import PlacementFitness
+from trackplan.search.optimize import optimize
 from trackplan.search.space import SearchSpace
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
@@ -37,7 +37,7 @@ def compare_spin() -> None:
     print(f"{'case':<18} {'spin':<6} {'feasible':<9} {'J':>8} {'duration s':>11} {'evals':>6}")
     for name in ("seam-weld-fixed", "seam-weld-free"):
         case = load_case(CASES / f"{name}.yaml")
-        result = optimize_placement(case)
+        result = optimize(case)
         final = result.final
         print(
             f"{name:<18} {case.task.tool.spin:<6} {result.success!s:<9} "

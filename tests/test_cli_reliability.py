@@ -55,12 +55,12 @@ def test_optimize_refuses_bad_arguments_before_searching(
     args: tuple[str, ...],
     expected: str,
 ) -> None:
-    import trackplan.search
+    import trackplan.search.optimize as search
 
     def no_search(*_args: object, **_kwargs: object) -> None:
         pytest.fail("the search started before the arguments were checked")
 
-    monkeypatch.setattr(trackplan.search, "optimize_placement", no_search)
+    monkeypatch.setattr(search, "optimize", no_search)
     file = tmp_path / "taken"
     file.write_text("not a folder")
     args = tuple(arg.format(file=file) for arg in args)
@@ -263,7 +263,7 @@ def test_trajectory_header_is_what_check_reads() -> None:
 def test_sigterm_during_the_search_writes_the_best_result(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import trackplan.search.optimize as optimize
+    import trackplan.search.driver as optimize
 
     record = optimize._record
 

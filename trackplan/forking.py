@@ -4,7 +4,7 @@ A forked process starts with everything the caller has already imported and comp
 that nothing is imported twice; it runs on the machine's second core while the caller goes
 on. :func:`can_fork` says when that is possible, :func:`forked_pool` gives a one-process
 executor (:class:`concurrent.futures.ProcessPoolExecutor` with the ``fork`` start method)
-for :func:`~trackplan.search.optimize_placement`'s ``background`` argument.
+for :func:`~trackplan.search.optimize`'s ``background`` argument.
 """
 
 from __future__ import annotations

@@ -20,8 +20,7 @@ from trackplan.robots.describe import robot_info
 if TYPE_CHECKING:  # the search (pymoo) is not needed to write a plan
     from trackplan.planning.cycle import CycleResult
     from trackplan.report.plot_worker import PlotWorker
-    from trackplan.search import OptimizeResult
-    from trackplan.search.cycle_search import CycleSearchResult
+    from trackplan.search import SearchResult
 
 
 def write_run(
@@ -32,7 +31,7 @@ def write_run(
     history: dict | None = None,
     extra: dict | None = None,
     report: bool = True,
-    search: OptimizeResult | None = None,
+    search: SearchResult | None = None,
     plot_worker: PlotWorker | None = None,
 ) -> dict:
     """Write trajectory.csv, result.json and, with ``report``, the plots and report.html.
@@ -53,7 +52,7 @@ def write_run(
     report
         Also write the plots and the HTML report (which embeds them).
     search
-        The :class:`~trackplan.search.optimize.OptimizeResult` whose ``history.csv`` to
+        The :class:`~trackplan.search.optimize.SearchResult` whose ``history.csv`` to
         write, or None.
     plot_worker
         A :class:`~trackplan.report.plot_worker.PlotWorker` to draw the plots, or None.
@@ -91,7 +90,7 @@ def write_run(
 
 def write_search_run(
     out_dir: Path,
-    result: OptimizeResult,
+    result: SearchResult,
     case: Case,
     *,
     report: bool,
@@ -106,7 +105,7 @@ def write_search_run(
     out_dir
         Output folder (created); written as a whole like :func:`write_run`.
     result
-        The search (:class:`~trackplan.search.optimize.OptimizeResult`).
+        The search (:class:`~trackplan.search.optimize.SearchResult`).
     case
         Its case.
     report
@@ -127,7 +126,7 @@ def write_search_run(
     blocks = {**optimizer_summary(result, case.robot.joint_names), **(extra or {})}
     return write_run(
         out_dir,
-        result.final,
+        result.final,  # type: ignore[arg-type]  # one seam: a PlanResult, until the one PlanResult
         case,
         history=history,
         extra=blocks,
@@ -144,7 +143,7 @@ def write_cycle_run(
     *,
     extra: dict | None = None,
     report: bool = True,
-    search: CycleSearchResult | None = None,
+    search: SearchResult | None = None,
 ) -> dict:
     """Write a cycle of several seams: trajectory.csv (with ``segment``), result.json and,
     with ``report``, cycle.png and report.html; history.csv after a search.
@@ -163,7 +162,7 @@ def write_cycle_run(
     report
         Also write the plot and the HTML report.
     search
-        The :class:`~trackplan.search.cycle_search.CycleSearchResult` the cycle came from.
+        The :class:`~trackplan.search.optimize.SearchResult` the cycle came from.
 
     Returns
     -------

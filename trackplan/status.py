@@ -38,6 +38,10 @@ class Status(enum.Enum):
     """Stopped by a signal; the result is the best found until then."""
     FAILED = "failed"
     """The computation raised (a study job: or lost its workers); the message says why."""
+    REACH = "reach"
+    """The placement lies outside the reach interval (Eq. 32): no pose is solved."""
+    HOLDING_TORQUE = "holding_torque"
+    """Holding a pose still against gravity needs more than a torque limit (no speed helps)."""
 
     @property
     def success(self) -> bool:

@@ -11,7 +11,7 @@ import pytest
 
 from trackplan.cli import main
 from trackplan.io.case_file import load_case
-from trackplan.search.optimize import optimize_placement
+from trackplan.search.optimize import optimize
 from trackplan.status import Status
 
 REPO = Path(__file__).resolve().parents[2]
@@ -52,7 +52,7 @@ def test_plan_at_the_unconstrained_optimum_reports_the_collision(
 @pytest.mark.slow
 def test_optimize_finds_a_collision_free_placement() -> None:
     case = load_case(CELL_CASE)
-    result = optimize_placement(case)
+    result = optimize(case)
     plan = result.final
     assert plan.feasible and plan.status is Status.FEASIBLE
     cell = plan.check.cell

@@ -19,7 +19,8 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
 from trackplan.robots.builtin import puma560, ur5
 from trackplan.robots.kinematics import forward_kinematics, joint_frames
-from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search.fitness import PlacementFitness
+from trackplan.search.screening import code
 from trackplan.search.space import SearchSpace
 from trackplan.status import Status
 
@@ -165,7 +166,7 @@ def test_search_grades_colliding_candidates() -> None:
     ).evaluate(optimum)
     assert without.feasible[0]
     assert not with_cell.feasible[0]
-    assert with_cell.finding[0] == Finding.COLLISION
+    assert with_cell.finding[0] == code(Status.COLLISION)
     assert 0.25 < with_cell.violation[0] < 0.5
 
 

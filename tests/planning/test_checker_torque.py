@@ -12,8 +12,10 @@ from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
 from trackplan.planning.plan import plan_placement
-from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search.fitness import PlacementFitness
+from trackplan.search.screening import code
 from trackplan.search.space import SearchSpace
+from trackplan.status import Status
 
 from .conftest import CASES
 
@@ -80,6 +82,6 @@ def test_search_screens_holding_torque(payload_case, corner_case):
         geometry = PathGeometry.from_case(case)
         fitness = PlacementFitness(case, SearchSpace.from_case(case), geometry, "smooth")
         found.append(fitness.evaluate(X))
-    assert found[0].finding[0] == Finding.HOLDING_TORQUE and not found[0].feasible[0]
+    assert found[0].finding[0] == code(Status.HOLDING_TORQUE) and not found[0].feasible[0]
     assert found[1].feasible[0]
     assert 0.5 < found[0].violation[0] < 1.5

@@ -18,8 +18,10 @@ from trackplan.planning.checker import (
 )
 from trackplan.planning.plan import plan_placement, tracking_reference
 from trackplan.robots.families import detect
-from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search.fitness import PlacementFitness
+from trackplan.search.screening import code
 from trackplan.search.space import SearchSpace
+from trackplan.status import Status
 from trackplan.tool import ToolOrientation
 
 
@@ -49,7 +51,7 @@ def test_a_placement_the_search_counts_feasible_passes_the_final_check(numeric_k
     geometry = PathGeometry.from_case(case)
     fitness = PlacementFitness(case, SearchSpace.from_case(case), geometry, "smooth")
     screened = fitness.evaluate(X[None])
-    assert screened.finding[0] == Finding.FEASIBLE  # the search's verdict
+    assert screened.finding[0] == code(Status.FEASIBLE)  # the search's verdict
     plan = plan_placement(case, X, geometry=geometry, branch=int(screened.branch[0]))
     rated = case.task.rated_speed
     peak = float(plan.trajectory.speed.max())

@@ -12,7 +12,7 @@ from tests.conftest import CASES
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case
 from trackplan.report.html import report_page
-from trackplan.search.optimize import optimize_placement
+from trackplan.search.optimize import optimize
 from trackplan.search.space import BOUND_SHARE, BoundHit, SearchSpace, bounds_note
 
 CORNER = CASES / "paper-corner.yaml"
@@ -74,7 +74,7 @@ def test_optimize_says_which_variable_lies_on_which_bound(
 
 def test_the_report_says_it_under_the_verdict() -> None:
     case = load_case(CORNER)
-    result = optimize_placement(case, budget=int(BUDGET))
+    result = optimize(case, budget=int(BUDGET))
     assert result.on_bounds
     info = {"optimizer": {"on_bounds": [hit.as_dict() for hit in result.on_bounds]}}
     page = report_page(result.final, case, [], "", None, info)

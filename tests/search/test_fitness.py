@@ -17,11 +17,12 @@ from trackplan.planning.plan import plan_placement
 from trackplan.robots.path_ik import solve_path_ik, solve_path_ik_branches
 from trackplan.search.fitness import (
     CURVED_POSES,
-    Finding,
     PlacementFitness,
     screening_grid,
 )
+from trackplan.search.screening import code
 from trackplan.search.space import SearchSpace
+from trackplan.status import Status
 
 PAPER_X = np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522])
 """The paper's Case 3 optimum (Section 4)."""
@@ -106,8 +107,8 @@ def test_every_feasible_ranks_before_every_infeasible(case: Case, geometry: Path
     assert np.all(result.fitness[~feasible] > case.objective.flat_penalty)
     assert np.all(np.isnan(result.objective[~feasible]))
     assert np.all(result.violation[feasible] == 0.0) and np.all(result.violation[~feasible] > 0)
-    reach = result.finding == Finding.REACH
-    geometric = np.isin(result.finding, [Finding.UNREACHABLE, Finding.BRANCH_SWITCH])
+    reach = result.finding == code(Status.REACH)
+    geometric = np.isin(result.finding, [code(Status.UNREACHABLE), code(Status.BRANCH_SWITCH)])
     assert reach.any() and geometric.any()
     assert result.fitness[geometric].max() < result.fitness[reach].min()
 
@@ -121,7 +122,7 @@ def test_graded_violation_grows_away_from_feasibility(case: Case, geometry: Path
     assert result.feasible[0] and not result.feasible[1:].any()
     assert np.all(np.diff(result.fitness[1:]) > 0)
     outside = fitness.evaluate(np.array([[0.7, 0.7, 0.0, 0, 0, 0], [0.8, 0.8, 0.0, 0, 0, 0]]))
-    assert np.all(outside.finding == Finding.REACH) and outside.fitness[0] < outside.fitness[1]
+    assert np.all(outside.finding == code(Status.REACH)) and outside.fitness[0] < outside.fitness[1]
 
 
 def test_flat_penalty_is_the_papers_constant(case: Case, geometry: PathGeometry, rng) -> None:

@@ -12,8 +12,9 @@ import pytest
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import algorithms, optimize_placement
-from trackplan.search.algorithms import LocalRun, MultiStartSearch
+from trackplan.search import multistart
+from trackplan.search.multistart import LocalRun, MultiStartSearch
+from trackplan.search.optimize import optimize
 from trackplan.search.space import SearchSpace
 
 
@@ -30,7 +31,7 @@ def _descend(run: LocalRun, centre: np.ndarray) -> list[np.ndarray]:
 def test_the_cma_class_is_cmaes_own() -> None:
     import cmaes
 
-    assert algorithms.cmaes_cma() is cmaes.CMA
+    assert multistart.cmaes_cma() is cmaes.CMA
 
 
 def test_local_run_descends_a_sphere_inside_the_unit_box() -> None:
@@ -38,8 +39,8 @@ def test_local_run_descends_a_sphere_inside_the_unit_box() -> None:
     run = LocalRun(np.full(6, 0.35), seed=3)
     asked = _descend(run, centre)
     assert all(np.all((Z >= 0.0) & (Z <= 1.0)) for Z in asked)
-    assert run.evaluations <= algorithms.LOCAL_EVALUATIONS
-    assert run.evaluations == algorithms.LOCAL_POPULATION * len(asked)
+    assert run.evaluations <= multistart.LOCAL_EVALUATIONS
+    assert run.evaluations == multistart.LOCAL_POPULATION * len(asked)
     # from a start 0.15 off in every variable (f = 0.135) to the floor
     assert run.best < 1e-6
 
@@ -56,19 +57,19 @@ def test_local_run_stops_when_the_fitness_is_flat() -> None:
     run = LocalRun(np.full(6, 0.5), seed=1)
     while not run.stopped:
         run.ask()
-        run.tell(np.full(algorithms.LOCAL_POPULATION, 0.25))
-    assert run.evaluations < algorithms.LOCAL_EVALUATIONS
+        run.tell(np.full(multistart.LOCAL_POPULATION, 0.25))
+    assert run.evaluations < multistart.LOCAL_EVALUATIONS
 
 
 def test_the_race_stops_the_runs_that_fell_behind() -> None:
     search = MultiStartSearch(SearchSpace.from_case(load_case(CASES / "paper-corner.yaml")))
     runs = [LocalRun(np.full(6, 0.5), seed=s) for s in range(4)]
-    margin = algorithms.RACE_MARGIN
+    margin = multistart.RACE_MARGIN
     # leader, close behind, far behind, far behind but too young to judge
     for run, best, generations in zip(
         runs,
         (1.0, 1.0 + 0.5 * margin, 1.0 + 2 * margin, 1.0 + 2 * margin),
-        (9, 9, algorithms.RACE_GENERATIONS, algorithms.RACE_GENERATIONS - 1),
+        (9, 9, multistart.RACE_GENERATIONS, multistart.RACE_GENERATIONS - 1),
         strict=True,
     ):
         run.best, run.generations = best, generations
@@ -85,9 +86,9 @@ def test_a_pymoo_termination_runs_the_same_search_as_a_pymoo_algorithm() -> None
     termination stops it."""
     case = load_case(CASES / "paper-corner.yaml")
     geometry = PathGeometry.from_case(case)
-    n_gen = algorithms.MULTISTART_SAMPLES // algorithms.MULTISTART_BATCH + 4  # 4 local ones
-    alone = optimize_placement(case, seed=3, geometry=geometry)
-    stopped = optimize_placement(case, seed=3, geometry=geometry, termination=("n_gen", n_gen))
+    n_gen = multistart.MULTISTART_SAMPLES // multistart.MULTISTART_BATCH + 4  # 4 local ones
+    alone = optimize(case, seed=3, geometry=geometry)
+    stopped = optimize(case, seed=3, geometry=geometry, termination=("n_gen", n_gen))
     assert stopped.stop_reason == "custom" and stopped.generations == n_gen < alone.generations
     for key in ("evaluations", "best", "mean", "feasible_share"):
         np.testing.assert_array_equal(
@@ -102,12 +103,27 @@ def test_the_search_imports_neither_cma_nor_matplotlib_nor_scipy_stats() -> None
     code = (
         "import sys; import trackplan.cli.app; "
         "from trackplan.io.case_file import load_case; "
-        "from trackplan.search import optimize_placement, algorithms; "
+        "from trackplan.search import multistart; from trackplan.search.optimize import optimize; "
         f"case = load_case({str(CASES / 'paper-line.yaml')!r}); "
-        "r = optimize_placement(case, budget=algorithms.MULTISTART_SAMPLES + 30); "
-        "assert r.history.evaluations[-1] > algorithms.MULTISTART_SAMPLES; "
+        "r = optimize(case, budget=multistart.MULTISTART_SAMPLES + 30); "
+        "assert r.history.evaluations[-1] > multistart.MULTISTART_SAMPLES; "
         "print(sorted(m for m in ('cma', 'matplotlib', 'scipy.stats') if m in sys.modules))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+def test_the_method_modules_import_one_way() -> None:
+    """algorithms.py may reach pymoo_algorithms.py (for CMA-ES), never the reverse: no cycle."""
+    import ast
+    import inspect
+
+    from trackplan.search import pymoo_algorithms
+
+    tree = ast.parse(inspect.getsource(pymoo_algorithms))
+    imported = {
+        node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module
+    }
+    assert "trackplan.search.algorithms" not in imported
+    assert "trackplan.search.multistart" in imported

@@ -1,4 +1,4 @@
-"""optimize_placement: reproducibility, budget, Ctrl-C, the final re-check, impossible cases."""
+"""optimize: reproducibility, budget, Ctrl-C, the final re-check, impossible cases."""
 
 from __future__ import annotations
 
@@ -21,8 +21,10 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
 from trackplan.planning.plan import plan_placement
 from trackplan.planning.result import PlanResult
-from trackplan.search import GenerationRecord, OptimizeResult, optimize_placement
-from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search import GenerationRecord, SearchResult
+from trackplan.search.fitness import PlacementFitness
+from trackplan.search.optimize import optimize
+from trackplan.search.screening import SeamScreen, code
 from trackplan.search.space import SearchSpace
 from trackplan.status import Status
 
@@ -38,19 +40,19 @@ def geometry(case: Case) -> PathGeometry:
 
 
 def test_same_seed_same_history_and_result(case: Case, geometry: PathGeometry) -> None:
-    runs = [optimize_placement(case, seed=7, budget=400, geometry=geometry) for _ in range(2)]
+    runs = [optimize(case, seed=7, budget=400, geometry=geometry) for _ in range(2)]
     first, second = runs
     for key, column in first.history.as_columns().items():
         if key != "wall_time":
             assert np.array_equal(column, second.history.as_columns()[key]), key
     assert np.array_equal(first.X, second.X) and first.branch == second.branch
     assert first.objective == second.objective
-    other = optimize_placement(case, seed=8, budget=400, geometry=geometry)
+    other = optimize(case, seed=8, budget=400, geometry=geometry)
     assert not np.array_equal(other.X, first.X)
 
 
 def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeometry) -> None:
-    result = optimize_placement(case, method="ga", budget=100, geometry=geometry)
+    result = optimize(case, method="ga", budget=100, geometry=geometry)
     assert result.evaluations == 100 and result.stop_reason == "budget"
     assert result.history.evaluations.tolist() == [30, 58, 86, 100]
     assert result.generations == 4 and result.method == "ga" and result.seed == 0
@@ -66,8 +68,7 @@ def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeomet
 def test_other_methods_are_reproducible(case: Case, geometry: PathGeometry, method: str) -> None:
     budget = 2150 if method == "multistart" else 150  # multistart: into its first local run
     first, second = (
-        optimize_placement(case, method=method, seed=3, budget=budget, geometry=geometry)
-        for _ in range(2)
+        optimize(case, method=method, seed=3, budget=budget, geometry=geometry) for _ in range(2)
     )
     assert first.method == method and first.evaluations == budget
     assert first.success and first.final.check.success
@@ -78,9 +79,9 @@ def test_other_methods_are_reproducible(case: Case, geometry: PathGeometry, meth
 def test_time_weight_with_an_executor(case: Case, geometry: PathGeometry) -> None:
     """Timing candidates in threads gives the same search as timing them in turn."""
     timed = replace(case, objective=replace(case.objective, time_weight=0.1))
-    serial = optimize_placement(timed, budget=58, geometry=geometry)
+    serial = optimize(timed, budget=58, geometry=geometry)
     with ThreadPoolExecutor(2) as executor:
-        threaded = optimize_placement(timed, budget=58, geometry=geometry, executor=executor)
+        threaded = optimize(timed, budget=58, geometry=geometry, executor=executor)
     assert np.array_equal(serial.history.best, threaded.history.best)
     assert serial.success and np.array_equal(serial.X, threaded.X)
     assert serial.fitness == pytest.approx(serial.objective + 0.1 * serial.final.duration, rel=1e-3)
@@ -94,7 +95,7 @@ def test_ctrl_c_keeps_the_best_placement(case: Case, geometry: PathGeometry) -> 
         if record.generation == 3:
             raise KeyboardInterrupt
 
-    result = optimize_placement(case, method="ga", progress=progress, geometry=geometry)
+    result = optimize(case, method="ga", progress=progress, geometry=geometry)
     assert result.stop_reason == "interrupted"
     assert [r.generation for r in seen] == [1, 2, 3] and result.generations == 3
     assert result.evaluations == seen[-1].evaluations == 86
@@ -110,8 +111,8 @@ def _same_plan(a: PlanResult, b: PlanResult) -> None:
 
 
 @pytest.fixture(scope="module")
-def serial_ga(case: Case, geometry: PathGeometry) -> OptimizeResult:
-    return optimize_placement(case, method="ga", budget=100, geometry=geometry)
+def serial_ga(case: Case, geometry: PathGeometry) -> SearchResult:
+    return optimize(case, method="ga", budget=100, geometry=geometry)
 
 
 def _worker_pids() -> list[int]:
@@ -121,7 +122,7 @@ def _worker_pids() -> list[int]:
 @pytest.mark.skipif(not can_fork(), reason="no second core or no fork here")
 @pytest.mark.parametrize("signum", [None, signal.SIGINT, signal.SIGTERM])
 def test_plans_in_the_background_are_the_same(
-    case: Case, geometry: PathGeometry, serial_ga: OptimizeResult, signum: int | None
+    case: Case, geometry: PathGeometry, serial_ga: SearchResult, signum: int | None
 ) -> None:
     """The before and final plans made in a forked process while the search runs are those
     made here after it. The process ignores Ctrl-C; killed (SIGTERM) during the search, the
@@ -139,7 +140,7 @@ def test_plans_in_the_background_are_the_same(
 
     with forked_pool() as pool:
         assert pool is not None
-        result = optimize_placement(
+        result = optimize(
             case, method="ga", budget=100, geometry=geometry, background=pool, progress=progress
         )
         alive = _worker_pids()
@@ -154,7 +155,7 @@ def test_plans_in_the_background_are_the_same(
 
 
 def test_a_broken_background_plans_here(
-    case: Case, geometry: PathGeometry, serial_ga: OptimizeResult
+    case: Case, geometry: PathGeometry, serial_ga: SearchResult
 ) -> None:
     class Broken(Executor):
         def submit(self, fn, /, *args, **kwargs):  # type: ignore[no-untyped-def]
@@ -162,9 +163,7 @@ def test_a_broken_background_plans_here(
             job.set_exception(BrokenExecutor("gone"))
             return job
 
-    result = optimize_placement(
-        case, method="ga", budget=100, geometry=geometry, background=Broken()
-    )
+    result = optimize(case, method="ga", budget=100, geometry=geometry, background=Broken())
     _same_plan(result.initial, serial_ga.initial)
     _same_plan(result.final, serial_ga.final)
 
@@ -176,15 +175,20 @@ def test_final_recheck_catches_a_wrong_screening(
     re-check at full Ts rejects it and the next best distinct candidate is returned."""
     planted = np.array([0.8, 0.2, 0.0, 0.0, 0.0, 0.0])  # the path leaves the workspace
     assert not plan_placement(case, planted, geometry=geometry).feasible
-    screen = PlacementFitness._screen
+    screen = PlacementFitness.screen_seam
 
-    def lying(self: PlacementFitness, X: np.ndarray):  # type: ignore[no-untyped-def]
-        objective, branch, violation, finding, bound = screen(self, X)
-        liar = np.all(np.isclose(X, planted), axis=1)
-        objective[liar], violation[liar], finding[liar] = 1e-3, 0.0, int(Finding.FEASIBLE)
-        return objective, branch, violation, finding, bound
+    def lying(self: PlacementFitness, X: np.ndarray) -> SeamScreen:
+        seam = screen(self, X)
+        liar = np.all(np.isclose(X[:, :6], planted), axis=1)[None]
+        return replace(
+            seam,
+            ok=seam.ok | liar,
+            objective=np.where(liar, 1e-3, seam.objective),
+            violation=np.where(liar, 0.0, seam.violation),
+            finding=np.where(liar, code(Status.FEASIBLE), seam.finding),
+        )
 
-    monkeypatch.setattr(PlacementFitness, "_screen", lying)
+    monkeypatch.setattr(PlacementFitness, "screen_seam", lying)
     sample = SearchSpace.sample
 
     def planting(self: SearchSpace, rng: np.random.Generator, n: int) -> np.ndarray:
@@ -193,7 +197,7 @@ def test_final_recheck_catches_a_wrong_screening(
         return drawn
 
     monkeypatch.setattr(SearchSpace, "sample", planting)
-    result = optimize_placement(case, budget=60, geometry=geometry)
+    result = optimize(case, budget=60, geometry=geometry)
     assert result.rejected.shape == (1, 6) and np.allclose(result.rejected[0], planted)
     assert result.success and result.final.check.success
     assert not np.allclose(result.X, planted)
@@ -204,24 +208,28 @@ def test_no_candidate_passing_the_check_gives_infeasible(
     case: Case, geometry: PathGeometry, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Every screened-feasible candidate fails the check: the result says infeasible."""
-    screen = PlacementFitness._screen
+    screen = PlacementFitness.screen_seam
 
-    def everything_feasible(self: PlacementFitness, X: np.ndarray):  # type: ignore[no-untyped-def]
-        objective, branch, violation, finding, bound = screen(self, X)
-        lie = finding != Finding.FEASIBLE
-        objective[lie], violation[lie], finding[lie] = 1e-3, 0.0, int(Finding.FEASIBLE)
-        objective[~lie] = 10.0  # the truly feasible rank last and stay out of the archive
-        return objective, branch, violation, finding, bound
+    def everything_feasible(self: PlacementFitness, X: np.ndarray) -> SeamScreen:
+        seam = screen(self, X)
+        return replace(
+            seam,
+            ok=np.ones_like(seam.ok),
+            # the truly feasible rank last and stay out of the archive
+            objective=np.where(seam.ok, 10.0, 1e-3),
+            violation=np.zeros_like(seam.violation),
+            finding=np.full_like(seam.finding, code(Status.FEASIBLE)),
+        )
 
-    monkeypatch.setattr(PlacementFitness, "_screen", everything_feasible)
-    result = optimize_placement(case, budget=30, seed=1, geometry=geometry)
+    monkeypatch.setattr(PlacementFitness, "screen_seam", everything_feasible)
+    result = optimize(case, budget=30, seed=1, geometry=geometry)
     assert not result.success and result.status is not Status.FEASIBLE
     assert not result.final.feasible and len(result.rejected) >= 1
 
 
 def test_impossible_case_explains_the_closest_candidate(case: Case) -> None:
     long_line = replace(case, segments=(LineSpec(np.array([3.0, 0.0, 0.0])),))
-    result = optimize_placement(long_line, budget=120)
+    result = optimize(long_line, budget=120)
     assert not result.success and result.status is not Status.FEASIBLE
     assert result.final.status.value == "unreachable"
     assert "no feasible placement in 120 evaluations" in result.message
@@ -238,7 +246,7 @@ def test_empty_reach_is_bad_input(case: Case) -> None:
         bounds.reach,
     )
     with pytest.raises(CaseError, match="no placement satisfies the reach constraint"):
-        optimize_placement(replace(case, bounds=far))
+        optimize(replace(case, bounds=far))
 
 
 @pytest.mark.parametrize(
@@ -247,7 +255,7 @@ def test_empty_reach_is_bad_input(case: Case) -> None:
 )
 def test_bad_options(case: Case, options: dict, match: str) -> None:
     with pytest.raises(CaseError, match=match):
-        optimize_placement(case, **options)
+        optimize(case, **options)
 
 
 @pytest.mark.slow
@@ -256,7 +264,7 @@ def test_corner_beats_the_papers_optimum(case: Case, geometry: PathGeometry) -> 
     paper = plan_placement(
         case, np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522]), geometry=geometry
     )
-    result = optimize_placement(case, geometry=geometry)
+    result = optimize(case, geometry=geometry)
     assert result.success and result.stop_reason == "converged"
     assert result.objective < paper.objective
     assert result.objective == pytest.approx(result.fitness, rel=5e-3)
@@ -266,14 +274,14 @@ def test_multistart_descends_from_its_best_distinct_samples(
     case: Case, geometry: PathGeometry
 ) -> None:
     """Local runs start from mutually distant good samples and improve on the sampling."""
-    from trackplan.search import algorithms
+    from trackplan.search import multistart
 
-    result = optimize_placement(case, method="multistart", seed=2, geometry=geometry)
-    sampled = result.history.evaluations <= algorithms.MULTISTART_SAMPLES
+    result = optimize(case, method="multistart", seed=2, geometry=geometry)
+    sampled = result.history.evaluations <= multistart.MULTISTART_SAMPLES
     assert result.success and result.stop_reason == "converged"
     assert result.history.best[~sampled].min() < result.history.best[sampled].min()
-    assert result.evaluations <= algorithms.MULTISTART_SAMPLES + algorithms.MULTISTART_STARTS * (
-        algorithms.LOCAL_EVALUATIONS + algorithms.LOCAL_POPULATION
+    assert result.evaluations <= multistart.MULTISTART_SAMPLES + multistart.MULTISTART_STARTS * (
+        multistart.LOCAL_EVALUATIONS + multistart.LOCAL_POPULATION
     )
 
 
@@ -282,7 +290,7 @@ def test_a_pymoo_algorithm_and_termination_can_be_passed_in(
 ) -> None:
     from pymoo.algorithms.soo.nonconvex.ga import GA
 
-    result = optimize_placement(
+    result = optimize(
         case, method=GA(pop_size=20), termination=("n_gen", 4), seed=1, geometry=geometry
     )
     assert result.method == "GA" and result.runs == 1 and result.stop_reason == "custom"
@@ -298,7 +306,7 @@ def test_a_fixed_coordinate_stays_fixed(
     lower, upper = case.bounds.lower.copy(), case.bounds.upper.copy()
     lower[0] = upper[0] = 0.25  # x fixed
     fixed = replace(case, bounds=replace(case.bounds, lower=lower, upper=upper))
-    result = optimize_placement(fixed, method=method, budget=budget, geometry=geometry)
+    result = optimize(fixed, method=method, budget=budget, geometry=geometry)
     assert result.X[0] == 0.25
     assert result.evaluations == budget
 

@@ -70,3 +70,24 @@ def test_the_api_refuses_it_too() -> None:
     case = load_case(CASE)
     with pytest.raises(CaseError, match=f"expected at most {MAX_MAP_POINTS} grid points"):
         placement_map(case, [0, 0, 0, 0, 0, 0], n_points=MAX_MAP_POINTS + 1)
+
+
+def test_every_outcome_of_the_screening_has_a_map_class(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A placement too heavy to hold (Status.HOLDING_TORQUE) is a map point like any other:
+    the map classes cover every outcome code of the screening, not a hand-picked few."""
+    import numpy as np
+
+    from trackplan.search.fitness import PlacementFitness
+    from trackplan.search.screening import code
+    from trackplan.status import Status
+
+    evaluate = PlacementFitness.evaluate
+
+    def heavy(self: PlacementFitness, X: np.ndarray, incumbent: float = np.inf):  # type: ignore[no-untyped-def]
+        screening = evaluate(self, X, incumbent)
+        screening.finding[:] = code(Status.HOLDING_TORQUE)
+        return screening
+
+    monkeypatch.setattr(PlacementFitness, "evaluate", heavy)
+    result = placement_map(load_case(CASE), np.zeros(6), n_points=3)
+    assert (result.reason == placement_map_module.REASONS.index("joint limit")).all()

@@ -10,8 +10,8 @@ from trackplan.cli import main
 from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search import optimize_placement
-from trackplan.search.optimize import run_seeds
+from trackplan.search.driver import run_seeds
+from trackplan.search.optimize import optimize
 
 
 @pytest.fixture(scope="module")
@@ -32,26 +32,26 @@ def test_run_seeds_start_with_the_seed_and_are_stable():
 
 
 def test_restarts_contain_the_single_run_and_never_do_worse(case, geometry):
-    single = optimize_placement(case, seed=2, restarts=1, geometry=geometry)
-    several = optimize_placement(case, seed=2, restarts=3, geometry=geometry)
+    single = optimize(case, seed=2, restarts=1, geometry=geometry)
+    several = optimize(case, seed=2, restarts=3, geometry=geometry)
     assert single.runs == 1 and several.runs == 3
     n = len(single.history)
     np.testing.assert_array_equal(several.history.best[:n], single.history.best)
     assert several.fitness <= single.fitness
     assert several.evaluations > single.evaluations
     assert np.all(np.diff(several.history.best) <= 0)  # the best so far, over all runs
-    again = optimize_placement(case, seed=2, restarts=3, geometry=geometry)
+    again = optimize(case, seed=2, restarts=3, geometry=geometry)
     np.testing.assert_array_equal(again.X, several.X)
 
 
 def test_budget_spans_the_runs(case, geometry):
-    result = optimize_placement(case, seed=0, restarts=50, budget=700, geometry=geometry)
+    result = optimize(case, seed=0, restarts=50, budget=700, geometry=geometry)
     assert result.evaluations == 700 and result.stop_reason == "budget"
 
 
 def test_bad_restarts(case, tmp_path, capsys):
     with pytest.raises(CaseError, match="restarts"):
-        optimize_placement(case, restarts=0)
+        optimize(case, restarts=0)
     text = (CASES / "paper-circle.yaml").read_text().replace("seed: 0", "seed: 0\n  restarts: 0")
     file = tmp_path / "bad.yaml"
     file.write_text(text)

@@ -12,7 +12,7 @@ from tests.conftest import CASES
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case
 from trackplan.planning.plan import check_case_trajectory, plan_placement
-from trackplan.search import optimize_placement
+from trackplan.search.optimize import optimize
 from trackplan.search.spin import optimize_spin
 from trackplan.status import Status
 
@@ -121,7 +121,7 @@ def test_spin_given_to_a_fixed_spin_is_bad_input(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_optimize_free_varying_finds_a_feasible_placement(free_case):
-    result = optimize_placement(free_case, budget=600, restarts=1)
+    result = optimize(free_case, budget=600, restarts=1)
     assert result.success, result.message
     check = check_case_trajectory(
         free_case, result.X, result.final.trajectory.q, free_case.task.sample_time
@@ -131,7 +131,7 @@ def test_optimize_free_varying_finds_a_feasible_placement(free_case):
 
 @pytest.mark.slow
 def test_optimize_fixed_is_verified_or_explains_the_turn(fixed_case):
-    result = optimize_placement(fixed_case, budget=600, restarts=1)
+    result = optimize(fixed_case, budget=600, restarts=1)
     if result.success:
         check = check_case_trajectory(
             fixed_case, result.X, result.final.trajectory.q, fixed_case.task.sample_time
@@ -162,7 +162,7 @@ def test_part_frame_cases_get_no_tool_figure():
 def test_seam_weld_on_an_industrial_robot_optimises_with_a_free_spin():
     case = load_case(CASES / "seam-weld-free.yaml")
     assert case.robot.name == "kuka_kr6_r700_sixx" and case.task.tool.n_spin == 1
-    result = optimize_placement(case, budget=2000, restarts=1)
+    result = optimize(case, budget=2000, restarts=1)
     assert result.success, result.message
     spin = result.final.joint_path.tool.spin
     assert len(spin.coefficients) == 1

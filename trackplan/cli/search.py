@@ -21,6 +21,7 @@ from trackplan.cli.common import (
 )
 from trackplan.cli.signals import SignalLog, stop_on_signals
 from trackplan.errors import CaseError
+from trackplan.status import Status
 
 if TYPE_CHECKING:
     from contextlib import AbstractContextManager
@@ -137,19 +138,11 @@ def _optimize(
         from trackplan.planning.objectives import with_objective
 
         loaded = with_objective(loaded, objective)
-    if loaded.cycle is not None:  # several seams: docs/seams.md
-        from trackplan.cli.cycle import optimize_cycle_command, refuse_options
-
-        refuse_options(pareto=pareto)
-        return optimize_cycle_command(
-            loaded,
-            out,
-            report=report,
-            method=method,
-            seed=seed,
-            budget=budget,
-            restarts=restarts,
-            timing=timing,
+    if pareto is not None and len(loaded.seams) > 1:
+        raise CaseError(
+            "--pareto applies to a single path; a case with several seams (paths:) "
+            "does not take it",
+            key="--pareto",
         )
     if pareto is not None:
         return _pareto(loaded, pareto, out, seed=seed, timing=timing, report=report)
@@ -281,38 +274,69 @@ def _search_and_write(  # type: ignore[no-untyped-def]
 ) -> ExitCode:
     """Search (SIGINT and SIGTERM stop it), write the run (its plots by ``worker`` when
     there is one), print it; the exit code."""
-    from trackplan.cli.summaries import print_search
     from trackplan.cli.warmup import compile_shared, late_compiles
     from trackplan.forking import forked_pool
-    from trackplan.outputs import write_search_run
-    from trackplan.paths.path_geometry import PathGeometry
+    from trackplan.search.plan_calls import seam_geometries
     from trackplan.timing import time_law
 
-    # built first (numba's start), so that the processes forked below share it, with the
+    # built first (numba's start), so that the processes forked below share them, with the
     # kernels the search and the plans both start with (compiled once on a first run)
-    mode = time_law(options.get("timing") or case.task.timing).path_mode
-    geometry = PathGeometry.from_case(case, mode)
+    timing = time_law(options.get("timing") or case.task.timing).timing
+    geometries = seam_geometries(case, timing)
     compile_shared(case)
     # a second signal while writing stops the writing
     with late_compiles(), stop_on_signals() as signals:
         signals.deferring = True  # the search polls after each generation
         with forked_pool() as background:  # the plans at full Ts, beside the search
-            result = _search(case, signals, geometry=geometry, background=background, **options)
+            result = _search(case, signals, geometries=geometries, background=background, **options)
         signals.deferring = False
-        interrupted = result.stop_reason == "interrupted" or signals.first is not None
+        interrupted = result.status is Status.INTERRUPTED or signals.first is not None
         marks = _interrupted_marks(result, signals) if interrupted else None
-        write_search_run(out, result, case, report=report, extra=marks, plot_worker=worker)
-    print_search(console(), result, out, rated_speed=case.task.rated_speed)
+        _write_and_print(out, result, case, report=report, worker=worker, extra=marks)
     if interrupted:
         return ExitCode(signals.exit_code)
     return ExitCode.OK if result.success else ExitCode.INFEASIBLE
+
+
+def _write_and_print(  # type: ignore[no-untyped-def]
+    out: Path, result, case: Case, *, report: bool, worker: PlotWorker | None, extra
+) -> None:
+    """Write the search's run folder and print its summary.
+
+    The writers still take the two plan types apart: the plan of several seams (a
+    ``CycleResult``) goes to ``write_cycle_run``, until the one run-folder writer of
+    issue 27 takes every plan.
+    """
+    from trackplan.cli.summaries import print_search
+    from trackplan.outputs import write_cycle_run, write_search_run
+    from trackplan.planning.result import PlanResult
+
+    if isinstance(result.final, PlanResult):
+        write_search_run(out, result, case, report=report, extra=extra, plot_worker=worker)
+        print_search(console(), result, out, rated_speed=case.task.rated_speed)
+        return
+    from rich.markup import escape
+
+    from trackplan.cli.cycle import print_cycle
+    from trackplan.search.space import bounds_note
+
+    write_cycle_run(out, result.final, case, report=report, search=result, extra=extra)
+    text = console()
+    text.print(
+        f"{escape(result.message)} ({result.evaluations} evaluations, "
+        f"{result.wall_time_s:.2f} s, seed {result.seed})"
+    )
+    note = bounds_note(result.on_bounds)
+    if note:
+        text.print(f"  note: {escape(note)}")
+    print_cycle(text, result.final, out)
 
 
 def _interrupted_marks(result, signals: SignalLog) -> dict:  # type: ignore[no-untyped-def]
     """The keys of result.json that mark a search stopped by a signal."""
     name = "SIGTERM" if signals.exit_code == ExitCode.TERMINATED else "SIGINT"
     return {
-        "status": "interrupted",
+        "status": Status.INTERRUPTED.value,
         "plan_status": result.final.status.value,
         "interrupted": {
             "signal": name,
@@ -328,11 +352,11 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
     recorded in ``signals`` stops it after the current generation."""
     from rich.console import Console
 
-    from trackplan.search import optimize_placement
+    from trackplan.search.optimize import optimize
 
     err = Console(stderr=True)
     if not err.is_terminal:
-        return optimize_placement(case, progress=lambda _: signals.raise_if_stopped(), **options)
+        return optimize(case, progress=lambda _: signals.raise_if_stopped(), **options)
     import numpy as np
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
@@ -355,4 +379,4 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
             )
             signals.raise_if_stopped()
 
-        return optimize_placement(case, progress=show, **options)
+        return optimize(case, progress=show, **options)

@@ -12,7 +12,7 @@ import numpy as np
 from trackplan.errors import CaseError
 from trackplan.io.results import result_summary
 from trackplan.run_files import HISTORY_FILE, HISTORY_KEYS
-from trackplan.search.optimize import OptimizeResult, SearchHistory
+from trackplan.search.optimize import SearchHistory, SearchResult
 
 
 def write_history_csv(history: SearchHistory, file: Path) -> None:
@@ -62,7 +62,7 @@ def read_history_csv(file: Path) -> SearchHistory:
     )
 
 
-def optimizer_summary(result: OptimizeResult, joint_names: tuple[str, ...]) -> dict:
+def optimizer_summary(result: SearchResult, joint_names: tuple[str, ...]) -> dict:
     """The ``optimizer`` and ``initial`` blocks of an optimize run's ``result.json``.
 
     Parameters
@@ -79,7 +79,8 @@ def optimizer_summary(result: OptimizeResult, joint_names: tuple[str, ...]) -> d
         wall_time_s, ..., on_bounds}, "initial": {placement, feasible, status, message, objective,
         violations}}`` in plain JSON types.
     """
-    initial = result_summary(result.initial, joint_names)
+    # a one-seam search's plans are PlanResults; the one PlanResult of issue 27 ends the union
+    initial = result_summary(result.initial, joint_names)  # type: ignore[arg-type]
     return {
         "optimizer": {
             "method": result.method,
@@ -102,7 +103,7 @@ def optimizer_summary(result: OptimizeResult, joint_names: tuple[str, ...]) -> d
     }
 
 
-def write_history(result: OptimizeResult, out_dir: Path) -> Path:
+def write_history(result: SearchResult, out_dir: Path) -> Path:
     """Write the search history of a result as ``history.csv`` into ``out_dir``."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

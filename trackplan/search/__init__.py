@@ -1,21 +1,19 @@
-"""Placement search: where to put the workpiece so the path is feasible and cheap.
+"""Placement search: where to put the workpiece so that every seam is feasible and cheap.
 
-:func:`optimize_placement` runs a pymoo search (the paper's GA, CMA-ES, DE or random
-sampling) over X = (x, y, z, roll, pitch, yaw) with a batched, geometrically screened
-fitness (Eq. 30) and returns an :class:`OptimizeResult` whose final plan has been
-re-planned at the full sample time and re-checked.
+:func:`trackplan.search.optimize.optimize` runs a search (multi-start local CMA-ES, the
+paper's GA, CMA-ES, DE or random sampling) over X = (x, y, z, roll, pitch, yaw, spins...)
+with a batched, geometrically screened fitness summed over the case's seams plus the moves
+between them (Eq. 30), and returns a :class:`SearchResult` whose final plan has been
+re-planned at the full sample time and re-checked. The function is not re-exported here:
+``trackplan.search.optimize`` names its module (``trackplan.optimize`` is the function).
 """
 
-from trackplan.search.optimize import (
-    GenerationRecord,
-    OptimizeResult,
-    SearchHistory,
-    optimize_placement,
-)
+from trackplan.search.driver import GenerationRecord, SearchHistory, StopReason
+from trackplan.search.optimize import SearchResult
 
 __all__ = [
     "GenerationRecord",
-    "OptimizeResult",
     "SearchHistory",
-    "optimize_placement",
+    "SearchResult",
+    "StopReason",
 ]

@@ -48,7 +48,6 @@ curved zones) and every joint at least ``|Δq_i| / q̇max_i``.
 
 from __future__ import annotations
 
-import enum
 from collections.abc import Callable, Iterable
 from concurrent.futures import Executor
 from dataclasses import dataclass
@@ -60,14 +59,23 @@ from trackplan.case import Case, Objective
 from trackplan.choices import Penalty
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.objectives import ScreenInput, plan_objective, screen_objective
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.objectives import ScreenInput, screen_objective
 from trackplan.planning.result import PlanResult
 from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.robots.thread_sharing import ThreadSharing
-from trackplan.search.space import SearchSpace
+from trackplan.search.plan_calls import plan_seam
+from trackplan.search.screening import (
+    FEASIBLE,
+    GEOMETRY_LEVEL,
+    Screening,
+    SeamScreen,
+    code,
+    evaluate_seams,
+)
+from trackplan.search.space import N_VAR, SearchSpace
+from trackplan.status import Status
 from trackplan.timing import time_law
 from trackplan.tool import ToolOrientation, spin_rotations, spin_values
 
@@ -81,12 +89,6 @@ GA, the free-spin circle ends 3.5 % higher (seeds 1, 2) and the payload case's h
 torque peaks slip between poses (every screened optimum failed the final torque check)."""
 CURVED_POSES = 9
 """Poses at least in every curved zone (arcs, corner blends) of the screening grid."""
-REACH_LEVEL = 4.0
-"""Graded violation of a placement outside the reach interval, before its excess."""
-REACH_SCALE = 0.1
-"""Reach excess that adds 1 to the graded violation, m."""
-GEOMETRY_LEVEL = 0.5
-"""Graded violation of a geometrically infeasible placement, before its shares."""
 CLEARANCE_LEVEL = 0.25
 """Graded violation of a placement whose only problem is the clearance, before its shortfall."""
 CLEARANCE_SCALE = 0.05
@@ -98,61 +100,6 @@ CELL_STRIDE = 3
 """The clearance is screened on every third pose of the screening grid (about 2 cm apart on
 the paper's corner path): the search's cost of the cell stays within 2× (``python -m
 benchmarks collision``); the final plan is checked exactly at every sample."""
-
-
-class Finding(enum.IntEnum):
-    """What decided a candidate's feasibility (the first check it fails)."""
-
-    FEASIBLE = 0
-    REACH = 1  # translation outside the reach interval
-    UNREACHABLE = 2  # some pose has no IK solution on every branch
-    BRANCH_SWITCH = 3  # every reaching branch crosses a singularity or jumps
-    POSITION_LIMITS = 4  # every continuous branch leaves the joint range
-    CHECK = 5  # the planned trajectory fails the checker
-    COLLISION = 6  # every geometrically feasible branch breaks the cell clearance
-    HOLDING_TORQUE = 7  # holding still against gravity exceeds a torque limit somewhere
-
-
-@dataclass(frozen=True, eq=False)
-class Screening:
-    """Fitness of a batch of B placements.
-
-    Attributes
-    ----------
-    X
-        Variables, shape (B, 6 + k): placements (metres and radians), then the k spin
-        variables of the tool (:meth:`trackplan.tool.ToolSpec.spin_coefficients`).
-    fitness
-        Eq. 30 as above, shape (B,).
-    objective
-        The case's objective (``objective.kind``, Eq. 8 by default) on the screening grid
-        of the chosen branch (paper timing: of the planned trajectory), shape (B,), NaN
-        when infeasible.
-    duration
-        Duration of the planned trajectory, s, shape (B,); NaN when not planned.
-    duration_bound
-        Lower bound of the duration from the screening grid, s, shape (B,); NaN when the
-        candidate is infeasible before timing.
-    feasible
-        Shape (B,), bool.
-    branch
-        The chosen IK branch, shape (B,), int: the feasible branch with the smallest J, or
-        the branch with the smallest violation.
-    violation
-        Graded violation v, shape (B,), 0 when feasible.
-    finding
-        :class:`Finding` code per candidate, shape (B,), int.
-    """
-
-    X: np.ndarray
-    fitness: np.ndarray
-    objective: np.ndarray
-    duration: np.ndarray
-    duration_bound: np.ndarray
-    feasible: np.ndarray
-    branch: np.ndarray
-    violation: np.ndarray
-    finding: np.ndarray
 
 
 def screening_grid(geometry: PathGeometry, n_poses: int = SCREEN_POSES) -> np.ndarray:
@@ -171,10 +118,10 @@ def screening_grid(geometry: PathGeometry, n_poses: int = SCREEN_POSES) -> np.nd
 def plan_candidate(
     args: tuple[Case, np.ndarray, str, int, PathGeometry],
 ) -> PlanResult:
-    """:func:`plan_placement` of one ``(case, X, timing, branch, geometry)`` (for executors);
-    X holds the placement, then the spin variables."""
+    """The plan of one ``(case, X, timing, branch, geometry)`` (for executors); X holds the
+    placement, then the spin variables."""
     case, X, timing, branch, geometry = args
-    return plan_placement(case, X[:6], timing=timing, branch=branch, geometry=geometry, spin=X[6:])
+    return plan_seam(case, X, timing=timing, branch=branch, geometry=geometry)
 
 
 @dataclass(frozen=True, eq=False)
@@ -193,7 +140,7 @@ class BranchScreen:
     violation
         Graded violation, 0 where ``ok``, shape (B, K).
     finding
-        :class:`Finding` code, shape (B, K), int.
+        Outcome code (:func:`~trackplan.search.screening.outcome`), shape (B, K), int.
     """
 
     grid: ScreenInput
@@ -275,7 +222,8 @@ class PlacementFitness:
         self.sharing = ThreadSharing()  # whether the path IK's threads pay, call after call
 
     def evaluate(self, X: np.ndarray, incumbent: float = np.inf) -> Screening:
-        """Fitness of a batch of placements.
+        """Fitness of a batch of placements on this seam alone: the case fitness
+        (:func:`~trackplan.search.screening.evaluate_seams`) of one seam, no moves.
 
         Parameters
         ----------
@@ -294,35 +242,9 @@ class PlacementFitness:
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         tool = self.case.task.tool
-        if X.shape[1] == 6 and tool.n_spin:  # placements alone: the middle of the spin range
+        if X.shape[1] == N_VAR and tool.n_spin:  # placements alone: the middle of the spin range
             X = np.hstack([X, np.tile(tool.default_variables(), (len(X), 1))])
-        n = len(X)
-        fitness = np.full(n, np.nan)
-        objective = np.full(n, np.nan)
-        duration = np.full(n, np.nan)
-        bound = np.full(n, np.nan)
-        branch = np.zeros(n, dtype=int)
-        excess = self.space.reach_excess(X)
-        violation = REACH_LEVEL + excess / REACH_SCALE
-        finding = np.full(n, int(Finding.REACH))
-        inside = np.flatnonzero(excess == 0.0)
-        if len(inside):
-            geometric = self._screen(X[inside])
-            objective[inside], branch[inside], violation[inside], finding[inside] = geometric[:4]
-            bound[inside] = geometric[4]
-        feasible = finding == Finding.FEASIBLE
-        violation[feasible] = 0.0
-        fitness[feasible] = objective[feasible] + self.time_weight * bound[feasible]
-        if not self.law.follows_joint_path or self.time_weight > 0.0:
-            self._time(X, incumbent, fitness, objective, duration, branch, violation, finding)
-            feasible = finding == Finding.FEASIBLE
-        infeasible = ~feasible
-        fitness[infeasible] = self.penalty + (0.0 if self.flat else violation[infeasible])
-        objective[infeasible] = np.nan
-        bound[~np.isin(finding, [Finding.FEASIBLE, Finding.CHECK])] = np.nan
-        return Screening(
-            X, fitness, objective, duration, bound, feasible, branch, violation, finding
-        )
+        return evaluate_seams(self.space, [self], [slice(N_VAR, None)], X, incumbent)[0]
 
     def screen_branches(self, X: np.ndarray) -> BranchScreen:
         """Every IK branch of placements inside the reach interval, on the screening grid.
@@ -354,12 +276,12 @@ class PlacementFitness:
         finding = np.select(
             [ok, too_heavy, unreachable > 0.0, paths.n_switches > 0],
             [
-                int(Finding.FEASIBLE),
-                int(Finding.HOLDING_TORQUE),
-                int(Finding.UNREACHABLE),
-                int(Finding.BRANCH_SWITCH),
+                FEASIBLE,
+                code(Status.HOLDING_TORQUE),
+                code(Status.UNREACHABLE),
+                code(Status.BRANCH_SWITCH),
             ],
-            int(Finding.POSITION_LIMITS),
+            code(Status.POSITION_LIMITS),
         )
         # the joints' least interval times on the usable branches only (few of them while
         # sampling); the others keep the tool's
@@ -395,8 +317,54 @@ class PlacementFitness:
         -------
         tuple of numpy.ndarray
             Values ``(B, len(objectives))`` (NaN when infeasible), branch ``(B,)``, graded
-            violation ``(B,)``, :class:`Finding` ``(B,)`` and duration bound ``(B,)`` (s).
+            violation ``(B,)``, outcome code ``(B,)`` and duration bound ``(B,)`` (s).
         """
+        branches, values, choice, any_ok, violation, finding = self._choose(X, objectives)
+        rows = np.arange(len(X))
+        chosen = np.stack([np.where(any_ok, v[rows, choice], np.nan) for v in values], axis=1)
+        return (
+            chosen,
+            branches.branches[choice],
+            np.where(any_ok, 0.0, violation[rows, choice]),
+            np.where(any_ok, FEASIBLE, finding[rows, choice]),
+            branches.grid.dt[rows, choice].sum(axis=1),
+        )
+
+    def screen_seam(self, X: np.ndarray) -> SeamScreen:
+        """This seam of placements inside the reach interval on its chosen branch
+        (:meth:`screen_objectives` with the case's objective, and the branch's ends).
+
+        Parameters
+        ----------
+        X
+            Variables, shape (B, 6 + k).
+
+        Returns
+        -------
+        SeamScreen
+            With one seam (m = 1); the objective is inf where no branch is feasible.
+        """
+        branches, values, choice, ok, violation, finding = self._choose(X, (self.case.objective,))
+        rows = np.arange(len(X))
+        q = branches.grid.q[rows, choice]  # (B, M, n)
+        columns = (
+            ok,
+            np.where(ok, values[0][rows, choice], np.inf),
+            branches.grid.dt[rows, choice].sum(axis=1),
+            branches.branches[choice],
+            np.where(ok, 0.0, violation[rows, choice]),
+            np.where(ok, FEASIBLE, finding[rows, choice]),
+            q[:, 0],
+            q[:, -1],
+        )
+        return SeamScreen(*(column[None] for column in columns))
+
+    def _choose(
+        self, X: np.ndarray, objectives: tuple[Objective, ...]
+    ) -> tuple[BranchScreen, list[np.ndarray], np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every branch screened, the cell's clearance on the feasible ones; per placement
+        the objectives (B, K) each, the chosen branch's column (B,), whether it is feasible
+        (B,), and the graded violations and outcome codes (B, K)."""
         branches = self.screen_branches(X)
         values = [branches.values(objective) for objective in objectives]
         violation = branches.violation
@@ -405,28 +373,10 @@ class PlacementFitness:
             first, violation = self._screen_cell(X[:, :6], branches.grid.q, values[0], violation)
             blocked = np.isinf(first) & branches.ok
             values = [np.where(blocked, np.inf, v) for v in values]
-            finding = np.where(blocked, int(Finding.COLLISION), finding)
+            finding = np.where(blocked, code(Status.COLLISION), finding)
         any_ok = np.isfinite(values[0]).any(axis=1)
         choice = np.where(any_ok, np.argmin(values[0], axis=1), np.argmin(violation, axis=1))
-        rows = np.arange(len(X))
-        chosen = np.stack([np.where(any_ok, v[rows, choice], np.nan) for v in values], axis=1)
-        return (
-            chosen,
-            branches.branches[choice],
-            np.where(any_ok, 0.0, violation[rows, choice]),
-            np.where(any_ok, int(Finding.FEASIBLE), finding[rows, choice]),
-            branches.grid.dt[rows, choice].sum(axis=1),
-        )
-
-    def _screen(
-        self, X: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Objective, branch, graded violation, finding and duration bound of placements
-        inside the reach interval."""
-        values, branch, violation, finding, bound = self.screen_objectives(
-            X, (self.case.objective,)
-        )
-        return values[:, 0], branch, violation, finding, bound
+        return branches, values, choice, any_ok, violation, finding
 
     def _screen_cell(
         self, X: np.ndarray, q: np.ndarray, J: np.ndarray, graded: np.ndarray
@@ -498,33 +448,11 @@ class PlacementFitness:
         coefficients = tool.spin_coefficients(spin, length)
         return spin_rotations(self.R_base, spin_values(coefficients, self.s_grid, length))
 
-    def _time(
-        self,
-        X: np.ndarray,
-        incumbent: float,
-        fitness: np.ndarray,
-        objective: np.ndarray,
-        duration: np.ndarray,
-        branch: np.ndarray,
-        violation: np.ndarray,
-        finding: np.ndarray,
-    ) -> None:
-        """Plan and check the candidates whose time matters; update the arrays in place."""
-        candidates = finding == Finding.FEASIBLE
-        if self.law.follows_joint_path:
-            candidates &= fitness < incumbent
-        index = np.flatnonzero(candidates)
-        if not len(index):
-            return
-        jobs = [(self.case, X[i], self.timing, int(branch[i]), self.geometry) for i in index]
-        for i, plan in zip(index, self._map(plan_candidate, jobs), strict=True):
-            duration[i] = plan.duration
-            if plan.success:
-                if not self.law.follows_joint_path:
-                    objective[i] = plan_objective(self.case.objective, plan)
-                fitness[i] = objective[i] + self.time_weight * plan.duration
-            else:
-                finding[i] = int(Finding.CHECK)
-                worst = -plan.check.worst_margin() if plan.check.joint_margins else 1.0
-                level = np.log1p(max(worst, 1e-9))
-                violation[i] = GEOMETRY_LEVEL * level / (1.0 + level)
+    def plan_candidates(self, X: np.ndarray, branch: np.ndarray) -> list[PlanResult]:
+        """This seam planned with the time law and checked at candidates X (B, 6 + k), each
+        on its branch (B,): concurrently on the executor when one was given."""
+        jobs = [
+            (self.case, x, self.timing, int(b), self.geometry)
+            for x, b in zip(X, branch, strict=True)
+        ]
+        return list(self._map(plan_candidate, jobs))

@@ -26,12 +26,8 @@ from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.objectives import OBJECTIVES
 from trackplan.planning.result import PlanResult
-from trackplan.search.fitness import (
-    REACH_LEVEL,
-    REACH_SCALE,
-    PlacementFitness,
-    plan_candidate,
-)
+from trackplan.search.fitness import PlacementFitness, plan_candidate
+from trackplan.search.screening import REACH_LEVEL, REACH_SCALE
 from trackplan.search.space import N_VAR, SearchSpace
 from trackplan.status import Status
 from trackplan.timing import time_law

@@ -18,20 +18,25 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search.fitness import PlacementFitness
+from trackplan.search.screening import OUTCOMES
 from trackplan.search.space import SearchSpace
+from trackplan.status import Status
 
 REASONS = ("feasible", "reach", "joint limit", "collision")
 """Map classes, by code 0..3."""
 _CODE = {
-    Finding.FEASIBLE: 0,
-    Finding.REACH: 1,
-    Finding.UNREACHABLE: 1,
-    Finding.BRANCH_SWITCH: 2,
-    Finding.POSITION_LIMITS: 2,
-    Finding.CHECK: 2,
-    Finding.COLLISION: 3,
+    Status.FEASIBLE: 0,
+    Status.REACH: 1,
+    Status.UNREACHABLE: 1,
+    Status.BRANCH_SWITCH: 2,
+    Status.POSITION_LIMITS: 2,
+    Status.LIMITS_VIOLATED: 2,
+    Status.HOLDING_TORQUE: 2,
+    Status.COLLISION: 3,
 }
+_CLASS = np.array([_CODE.get(status, 2) for status in OUTCOMES])
+"""Map class of every outcome code of the screening."""
 CHUNK = 256
 """Placements screened per batch (bounds the IK arrays' memory)."""
 
@@ -161,7 +166,7 @@ def placement_map(
     for start in range(0, len(X), CHUNK):
         # an incumbent of -inf: no candidate is timed, the map is about geometry
         screening = fitness.evaluate(X[start : start + CHUNK], incumbent=-np.inf)
-        reason[start : start + CHUNK] = [_CODE[Finding(f)] for f in screening.finding]
+        reason[start : start + CHUNK] = _CLASS[screening.finding]
         objective[start : start + CHUNK] = screening.objective
     return PlacementMap(
         case.name,

@@ -87,7 +87,7 @@ class Archive:
 
 class Fitness(Protocol):
     """What the problem evaluates: :class:`~trackplan.search.fitness.PlacementFitness`, or
-    the several-seam fitness of :mod:`trackplan.search.cycle_search`."""
+    the case fitness of :mod:`trackplan.search.case_fitness`."""
 
     penalty: float
 
@@ -133,7 +133,7 @@ class PlacementProblem(Problem):
         """Evaluate a batch of candidates, shape (B, 6 + k), and record it; its fitness (B,).
 
         What pymoo's evaluator calls (through ``_evaluate``), and what the driver calls
-        for a search that asks for arrays (:class:`~trackplan.search.algorithms.MultiStartSearch`).
+        for a search that asks for arrays (:class:`~trackplan.search.multistart.MultiStartSearch`).
         """
         screening = self.fitness.evaluate(X, incumbent=self.best_fitness)
         self.n_evaluations += len(screening.X)

@@ -3,7 +3,7 @@ them only (pymoo's ``Algorithm`` brings its default terminations and their indic
 about 0.1 s of a start).
 
 - :class:`CMAESearch`: the ``cmaes`` method, CMA-ES of the ``cma`` package;
-- :class:`AskTellAlgorithm`: :class:`~trackplan.search.algorithms.MultiStartSearch`, which
+- :class:`AskTellAlgorithm`: :class:`~trackplan.search.multistart.MultiStartSearch`, which
   asks for arrays, as a pymoo Algorithm, for a search given a pymoo termination.
 """
 
@@ -16,15 +16,18 @@ import numpy as np
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.population import Population
 
-from trackplan.search.algorithms import CMA_SIGMA, MultiStartSearch
+from trackplan.search.multistart import MultiStartSearch
 from trackplan.search.space import SearchSpace
+
+CMA_SIGMA = 0.3
+"""Initial CMA-ES step size, as a share of each variable's range."""
 
 
 class CMAESearch(Algorithm):
     """CMA-ES (the ``cma`` package) on the bounds scaled to [0, 1], behind ask/tell.
 
     The start is a uniform admissible sample, the step size
-    :data:`~trackplan.search.algorithms.CMA_SIGMA`; cma draws
+    :data:`CMA_SIGMA`; cma draws
     its normal samples from the algorithm's seeded generator (its ``randn`` option), so no
     global random state is touched.
 
@@ -85,7 +88,7 @@ class CMAESearch(Algorithm):
 
 
 class AskTellAlgorithm(Algorithm):
-    """A :class:`~trackplan.search.algorithms.MultiStartSearch` behind pymoo's ask/tell: what
+    """A :class:`~trackplan.search.multistart.MultiStartSearch` behind pymoo's ask/tell: what
     it asks as a population, the population's fitness told back; its draws from the seed
     of ``setup(problem, seed=...)``, as without pymoo.
 

@@ -165,18 +165,20 @@ class SearchSpace:
 
     @classmethod
     def from_case(cls, case: Case) -> SearchSpace:
-        """The search space of a case: placement (see :meth:`from_bounds`) and tool spin."""
+        """The search space of a case: the placement (see :meth:`from_bounds`), then each
+        seam's spin variables in the order written (:meth:`ToolSpec.spin_bounds` of the
+        seam's tool: one for ``spin: free``, the profile's for ``free-varying``, none for
+        ``fixed``)."""
         space = cls.from_bounds(case.bounds, case.source)
-        tool = case.task.tool
-        if not tool.n_spin:
+        tools = [seam.task.tool for seam in case.seams if seam.task.tool.n_spin]
+        if not tools:
             return space
-        lower, upper = tool.spin_bounds()
-        anchor = np.concatenate([space.anchor, tool.default_variables()])
+        bounds = [tool.spin_bounds() for tool in tools]
         return cls(
-            np.concatenate([space.lower, lower]),
-            np.concatenate([space.upper, upper]),
+            np.concatenate([space.lower, *(lower for lower, _ in bounds)]),
+            np.concatenate([space.upper, *(upper for _, upper in bounds)]),
             space.reach,
-            anchor,
+            np.concatenate([space.anchor, *(tool.default_variables() for tool in tools)]),
         )
 
     @property

@@ -132,7 +132,7 @@ def run_job(job: Job, out_dir: str | Path, report: bool = True) -> JobRow:
         The job's summary row (read back from the files written), or a failed row.
     """
     from trackplan.outputs import write_search_run
-    from trackplan.search import optimize_placement
+    from trackplan.search.optimize import optimize
 
     start = time.perf_counter()
     jobs_dir = Path(out_dir) / JOBS_DIR
@@ -140,7 +140,7 @@ def run_job(job: Job, out_dir: str | Path, report: bool = True) -> JobRow:
     partial = jobs_dir / f".{job.key}.{uuid.uuid4().hex[:8]}{PARTIAL_SUFFIX}"
     worker = worker_name()
     try:
-        result = optimize_placement(job.case, seed=job.seed)
+        result = optimize(job.case, seed=job.seed)
         if result.status is Status.INTERRUPTED:
             raise KeyboardInterrupt  # a search cut short is not a result to keep
         write_search_run(partial, result, job.case, report=report)

@@ -40,10 +40,10 @@ PROFILER_CALLBACKS = ("profile", "profile-cycle")
 def warm_up() -> None:
     """Run a tiny placement search per IK family (compiles or loads the numba kernels)."""
     from trackplan.io.case_file import load_case_text
-    from trackplan.search import optimize_placement
+    from trackplan.search.optimize import optimize
 
     for robot in WARM_UP_ROBOTS:
-        optimize_placement(load_case_text(WARM_UP_CASE.format(robot=robot), file="warm-up"))
+        optimize(load_case_text(WARM_UP_CASE.format(robot=robot), file="warm-up"))
 
 
 def stop_profiler(worker: Any) -> None:

@@ -17,16 +17,18 @@ from tests.planning.test_cycle import CASE, X, spun_case
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case, load_case_text
 from trackplan.planning.cycle import seam_geometries
-from trackplan.search.cycle_search import CycleFitness, cycle_space
-from trackplan.search.fitness import Finding, PlacementFitness
+from trackplan.search.case_fitness import CaseFitness
+from trackplan.search.fitness import PlacementFitness
+from trackplan.search.screening import code, outcome
 from trackplan.search.space import SearchSpace
+from trackplan.status import Status
 
 
 @pytest.fixture(scope="module")
-def fitness() -> CycleFitness:
+def fitness() -> CaseFitness:
     case = load_case_text(yaml.safe_dump(CASE, sort_keys=False))
     space = SearchSpace.from_bounds(case.bounds, case.source)
-    return CycleFitness(case, space, seam_geometries(case), "smooth")
+    return CaseFitness(case, space, seam_geometries(case), "smooth")
 
 
 @pytest.fixture(scope="module")
@@ -36,16 +38,16 @@ def batch() -> np.ndarray:
     return np.vstack([X, near, [0.5, 0.5, 0.5, 0.0, 0.0, 0.0], [2.0, 0.0, 0.0, 0.0, 0.0, 0.0]])
 
 
-def test_the_batch_is_the_loop_of_singles(fitness: CycleFitness, batch: np.ndarray) -> None:
+def test_the_batch_is_the_loop_of_singles(fitness: CaseFitness, batch: np.ndarray) -> None:
     together = fitness.evaluate(batch)
     alone = [fitness.evaluate(row[None]) for row in batch]
     assert np.array_equal(together.feasible, [a.feasible[0] for a in alone])
     assert np.allclose(together.fitness, [a.fitness[0] for a in alone], rtol=1e-12, atol=0.0)
     assert together.feasible[0] and not together.feasible[-1]
-    assert together.finding[-1] == Finding.REACH
+    assert together.finding[-1] == code(Status.REACH)
 
 
-def test_feasible_only_when_every_seam_is(fitness: CycleFitness, batch: np.ndarray) -> None:
+def test_feasible_only_when_every_seam_is(fitness: CaseFitness, batch: np.ndarray) -> None:
     together = fitness.evaluate(batch)
     each = [
         PlacementFitness(
@@ -86,7 +88,7 @@ def test_a_seam_unreachable_everywhere_makes_optimize_exit_3_naming_it(
     assert result["feasible"] is False
     # the placement's variables on a bound of the box (z's range is 2 cm wide)
     X = [result["placement"][k] for k in ("x", "y", "z", "roll", "pitch", "yaw")]
-    hits = cycle_space(load_case(file)).bound_hits(np.array(X))
+    hits = SearchSpace.from_case(load_case(file)).bound_hits(np.array(X))
     assert result["optimizer"]["on_bounds"] == [hit.as_dict() for hit in hits]
     assert ("note: the placement lies on a bound" in out) == bool(hits)
 
@@ -120,23 +122,24 @@ def test_the_shipped_bracket_optimizes_rechecks_and_exports(
 
 
 @pytest.fixture(scope="module")
-def spun() -> CycleFitness:
+def spun() -> CaseFitness:
     """Seam ``left`` with ``spin: free``, ``corner`` fixed."""
     case = spun_case({"spin": "free", "spin_range": [-np.pi, np.pi]}, {})
-    return CycleFitness(case, cycle_space(case), seam_geometries(case), "smooth")
+    return CaseFitness(case, SearchSpace.from_case(case), seam_geometries(case), "smooth")
 
 
-def test_the_vector_is_the_placement_then_each_free_seams_spin(spun: CycleFitness) -> None:
+def test_the_vector_is_the_placement_then_each_free_seams_spin(spun: CaseFitness) -> None:
     space = spun.space
     assert space.n_var == 6 + 1
     assert space.lower[6] == -np.pi and space.upper[6] == np.pi and space.anchor[6] == 0.0
     assert spun.slices == (slice(6, 7), slice(7, 7))
-    assert cycle_space(load_case_text(yaml.safe_dump(CASE))).n_var == 6  # fixed spins add none
+    fixed = load_case_text(yaml.safe_dump(CASE))
+    assert SearchSpace.from_case(fixed).n_var == 6  # fixed spins add none
     candidate = np.r_[X, 0.7]
     assert spun.seam_spins(candidate)[0].tolist() == [0.7] and spun.seam_spins(candidate)[1] is None
 
 
-def test_each_seam_is_screened_with_its_own_spin(spun: CycleFitness, batch: np.ndarray) -> None:
+def test_each_seam_is_screened_with_its_own_spin(spun: CaseFitness, batch: np.ndarray) -> None:
     rng = np.random.default_rng(3)
     spins = np.r_[np.linspace(-np.pi, np.pi, 9), rng.uniform(-np.pi, np.pi, len(batch) - 9)]
     candidates = np.vstack(
@@ -213,3 +216,23 @@ def test_only_a_spun_circle_beside_a_line_is_feasible(
     placement = [str(result["placement"][k]) for k in ("x", "y", "z", "roll", "pitch", "yaw")]
     file = tmp_path / "free-varying.yaml"
     assert main(["check", str(file), str(run), "--placement", *placement]) == ExitCode.OK
+
+
+def test_a_case_of_one_seam_is_the_same_fitness_with_no_move() -> None:
+    """One mechanism: the case fitness of a single-path case is its seam's screening, the
+    moves between seams adding nothing (one seam, no home)."""
+    case = load_case(CASES / "paper-corner.yaml")
+    space = SearchSpace.from_case(case)
+    geometries = seam_geometries(case)
+    whole = CaseFitness(case, space, geometries, "smooth")
+    seam = PlacementFitness(case, space, geometries[0, False], "smooth")
+    rng = np.random.default_rng(3)
+    batch = np.vstack([space.sample(rng, 40), [[2.0, 0.0, 0.0, 0.0, 0.0, 0.0]]])
+    together, alone = whole.evaluate(batch), seam.evaluate(batch)
+    assert together.feasible.any() and not together.feasible.all()
+    assert np.array_equal(together.feasible, alone.feasible)
+    assert np.array_equal(together.finding, alone.finding)
+    assert np.allclose(together.fitness, alone.fitness, rtol=1e-12, atol=0.0)
+    screens = whole.screen_seams(batch[together.feasible])
+    assert np.all(whole.air_costs(screens, np.ones(int(together.feasible.sum()), bool)) == 0.0)
+    assert outcome(together.finding[-1]) is Status.REACH
