@@ -45,7 +45,7 @@ from trackplan.choices import Method
 from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.search import optimize_placement
 from trackplan.search.fitness import screening_grid
 
@@ -401,9 +401,9 @@ def main() -> None:
     print("Corner case (Case 3): the paper's published optimum planned by trackplan")
     print(f"  X = {_vector(PAPER_CORNER_X)} (the paper reports fitness 0.9433)")
     for timing in ("smooth", "paper"):
-        plan = plan_placement(corner, PAPER_CORNER_X, timing=timing)
-        state = "feasible" if plan.feasible else f"infeasible ({plan.status.value})"
-        print(f"  {timing:<6} timing: J = {plan.objective:.4f}, {state}")
+        planned = plan(corner, PAPER_CORNER_X, timing=timing)
+        state = "feasible" if planned.feasible else f"infeasible ({planned.status.value})"
+        print(f"  {timing:<6} timing: J = {planned.objective:.4f}, {state}")
     print(
         f"\nQuality: the case's own settings vs J* = the best of the known values and of "
         f"{', '.join(REFERENCE_METHODS)} with {REFERENCE_FACTOR}× the mean evaluations "

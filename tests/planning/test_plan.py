@@ -13,7 +13,7 @@ from trackplan.io.case_file import load_case
 from trackplan.io.results import read_trajectory_csv, write_trajectory_csv
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import plan_placement, tracking_reference
+from trackplan.planning.plan import plan, tracking_reference
 from trackplan.status import Status
 
 from .conftest import CASES
@@ -22,7 +22,7 @@ from .conftest import CASES
 @pytest.mark.parametrize("name", ["paper-line", "paper-circle", "paper-corner"])
 def test_paper_cases_plan_feasibly_in_smooth_mode(name):
     case = load_case(CASES / f"{name}.yaml")
-    result = plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     assert result.feasible, result.message
     # every output trajectory re-checked by the one checker, independently of the planner
     geometry = PathGeometry.from_case(case)
@@ -79,7 +79,7 @@ def test_random_reachable_placements_always_meet_rate_limits(corner_case, corner
         X = rng.uniform(lower, upper)
         if not reach_min <= np.linalg.norm(X[:3]) <= reach_max:
             continue
-        result = plan_placement(corner_case, X, geometry=corner_geometry)
+        result = plan(corner_case, X, geometries={(0, False): corner_geometry})
         if result.status in (Status.UNREACHABLE, Status.POSITION_LIMITS):
             continue
         planned += 1
@@ -87,7 +87,9 @@ def test_random_reachable_placements_always_meet_rate_limits(corner_case, corner
 
 
 def test_unreachable_placement_reports_why(corner_case, corner_geometry):
-    result = plan_placement(corner_case, np.array([2.0, 0, 0, 0, 0, 0]), geometry=corner_geometry)
+    result = plan(
+        corner_case, np.array([2.0, 0, 0, 0, 0, 0]), geometries={(0, False): corner_geometry}
+    )
     assert not result.feasible
     assert result.status is Status.UNREACHABLE
     assert "out of reach" in result.message
@@ -178,7 +180,7 @@ def test_full_reversal_is_a_stop_and_go(tmp_path):
     file = tmp_path / "reversal.yaml"
     file.write_text(text)
     case = load_case(file)
-    result = plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     assert result.feasible, result.message  # the checker follows the path back along itself
     traj = result.trajectory
     at_turn = np.argmin(np.abs(traj.s - 0.5))
@@ -189,7 +191,7 @@ def test_a_time_law_too_long_to_sample_says_where(corner_case, corner_geometry, 
     import trackplan.timing.smooth as smooth
 
     monkeypatch.setattr(smooth, "MAX_SAMPLES", 1000)
-    result = plan_placement(corner_case, corner_case.bounds.example, geometry=corner_geometry)
+    result = plan(corner_case, corner_case.bounds.example, geometries={(0, False): corner_geometry})
     assert result.status is Status.LIMITS_VIOLATED and not result.feasible
     assert "would need" in result.message and "m/s at s =" in result.message
     assert result.trajectory.n_samples == 0

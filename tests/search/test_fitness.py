@@ -12,8 +12,8 @@ from trackplan.case import Case
 from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.objective import joint_travel
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.objectives import joint_travel
+from trackplan.planning.plan import plan as plan_placement
 from trackplan.robots.path_ik import solve_path_ik, solve_path_ik_branches
 from trackplan.search.fitness import (
     CURVED_POSES,

@@ -19,7 +19,7 @@ from trackplan.forking import can_fork, forked_pool
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan as plan_placement
 from trackplan.planning.result import PlanResult
 from trackplan.search import GenerationRecord, OptimizeResult, optimize_placement
 from trackplan.search.fitness import Finding, PlacementFitness
@@ -175,7 +175,7 @@ def test_final_recheck_catches_a_wrong_screening(
     """Screening that calls an unreachable placement feasible with the best J: the final
     re-check at full Ts rejects it and the next best distinct candidate is returned."""
     planted = np.array([0.8, 0.2, 0.0, 0.0, 0.0, 0.0])  # the path leaves the workspace
-    assert not plan_placement(case, planted, geometry=geometry).feasible
+    assert not plan_placement(case, planted, geometries={(0, False): geometry}).feasible
     screen = PlacementFitness._screen
 
     def lying(self: PlacementFitness, X: np.ndarray):  # type: ignore[no-untyped-def]
@@ -254,7 +254,9 @@ def test_bad_options(case: Case, options: dict, match: str) -> None:
 def test_corner_beats_the_papers_optimum(case: Case, geometry: PathGeometry) -> None:
     """The default search finds a lower J than the paper's published X planned by us."""
     paper = plan_placement(
-        case, np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522]), geometry=geometry
+        case,
+        np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522]),
+        geometries={(0, False): geometry},
     )
     result = optimize_placement(case, geometry=geometry)
     assert result.success and result.stop_reason == "converged"

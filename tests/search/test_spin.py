@@ -11,7 +11,8 @@ import pytest
 from tests.conftest import CASES
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import check_case_trajectory, plan_placement
+from trackplan.planning.plan import check as check_case_trajectory
+from trackplan.planning.plan import plan as plan_placement
 from trackplan.search import optimize_placement
 from trackplan.search.spin import optimize_spin
 from trackplan.status import Status

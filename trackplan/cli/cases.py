@@ -108,8 +108,8 @@ def _show_value(value: object) -> str:
 
 @app.command()
 def cases() -> ExitCode:
-    """List the cases shipped in the repository's cases/ folder; a case with several seams
-    gets a row per seam below its own."""
+    """List the cases shipped in the repository's cases/ folder: one row a case, its seams'
+    segments and lengths summed, the corners of each seam separated by ``;``."""
     from rich.markup import escape
     from rich.table import Table
 
@@ -135,26 +135,14 @@ def cases() -> ExitCode:
         def corners(path: NominalPath) -> str:
             return ", ".join(f"{angle:.1f}°" for _, angle in segment_corners(path)) or "none"
 
-        several = case.cycle is not None
         table.add_row(
             escape(case.name),
             escape(case.robot.name),
             str(len(seams)),
             str(sum(len(seam.segments) for seam, _ in seams)),
             f"{sum(path.length for _, path in seams):.4f}",
-            "per seam below" if several else corners(seams[0][1]),
+            "; ".join(corners(path) for _, path in seams),
             escape(file.name),
         )
-        if several:
-            for seam, path in seams:
-                table.add_row(
-                    f"· {escape(seam.name)}",
-                    "",
-                    "",
-                    str(len(seam.segments)),
-                    f"{path.length:.4f}",
-                    corners(path),
-                    "",
-                )
     console().print(table)
     return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT

@@ -137,9 +137,8 @@ def _optimize(
         from trackplan.planning.objectives import with_objective
 
         loaded = with_objective(loaded, objective)
-    if loaded.cycle is not None:  # several seams: docs/seams.md
-        from trackplan.cli.cycle import optimize_cycle_command, refuse_options
-
+    sequencing = loaded.sequencing
+    if len(loaded.seams) > 1 or sequencing.approach > 0 or sequencing.home is not None:
         refuse_options(pareto=pareto)
         return optimize_cycle_command(
             loaded,
@@ -356,3 +355,80 @@ def _search(case: Case, signals: SignalLog, **options):  # type: ignore[no-untyp
             signals.raise_if_stopped()
 
         return optimize_placement(case, progress=show, **options)
+
+
+# moved from cli/cycle.py (the search's part of issue 27 replaces it)
+def refuse_options(**given: object) -> None:
+    """Options of a single path that a cycle does not take: one clear line.
+
+    Raises
+    ------
+    CaseError
+        Naming the first option given.
+    """
+    for name, value in given.items():
+        if value not in (None, False):
+            option = "--" + name.replace("_", "-")
+            raise CaseError(
+                f"{option} applies to a single path; a case with several seams (paths:) "
+                "does not take it",
+                key=option,
+            )
+
+
+def optimize_cycle_command(case: Case, out: Path, *, report: bool, **options: object) -> ExitCode:
+    """Search one placement for every seam (SIGINT and SIGTERM stop it), write the cycle,
+    print it; the exit code."""
+    from rich.markup import escape
+
+    from trackplan.cli.summaries import print_plan
+    from trackplan.outputs import write_run
+    from trackplan.search.cycle_search import optimize_cycle
+
+    with stop_on_signals() as signals:
+        signals.deferring = True
+        result = optimize_cycle(
+            case,
+            progress=lambda _: signals.raise_if_stopped(),
+            **options,  # type: ignore[arg-type]
+        )
+        signals.deferring = False
+        interrupted = result.stop_reason == "interrupted" or signals.first is not None
+        marks = (
+            {"status": "interrupted", "plan_status": result.final.status.value}
+            if interrupted
+            else None
+        )
+        blocks = {
+            "optimizer": {
+                "method": result.method,
+                "seed": int(result.seed),
+                "evaluations": int(result.evaluations),
+                "generations": int(result.generations),
+                "stop_reason": result.stop_reason,
+                "runs": int(result.runs),
+                "wall_time_s": float(result.wall_time_s),
+                "status": result.status.value,
+                "message": result.message,
+                "fitness": float(result.fitness),
+                "unreachable_seams": list(result.unreachable),
+                "rejected_candidates": [list(map(float, X)) for X in result.rejected],
+                "on_bounds": [hit.as_dict() for hit in result.on_bounds],
+            },
+            **(marks or {}),
+        }
+        write_run(out, result.final, case, report=report, search=result, extra=blocks)
+    text = console()
+    text.print(
+        f"{escape(result.message)} ({result.evaluations} evaluations, "
+        f"{result.wall_time_s:.2f} s, seed {result.seed})"
+    )
+    from trackplan.search.space import bounds_note
+
+    note = bounds_note(result.on_bounds)
+    if note:
+        text.print(f"  note: {escape(note)}")
+    print_plan(text, result.final, out, rated_speed=case.task.rated_speed)
+    if interrupted:
+        return ExitCode(signals.exit_code)
+    return ExitCode.OK if result.success else ExitCode.INFEASIBLE

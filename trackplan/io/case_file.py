@@ -20,14 +20,14 @@ from pydantic_core import PydanticCustomError
 from trackplan.case import (
     PLACEMENT_KEYS,
     Case,
-    Cycle,
     Objective,
     OptimizerSettings,
     PlacementBounds,
     Seam,
+    Sequencing,
     Task,
 )
-from trackplan.choices import Method, Penalty, Timing
+from trackplan.choices import OBJECTIVE_KINDS, Method, Penalty, Timing
 from trackplan.io.cell_file import CellModel, build_cell, cell_problems
 from trackplan.io.points_file import MIN_POINTS, load_points_csv
 from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
@@ -55,7 +55,6 @@ from trackplan.io.yaml_input import (
 )
 from trackplan.paths import NominalPath, check_segments
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
-from trackplan.planning.objectives import OBJECTIVES
 from trackplan.robots.model import Robot
 
 PAPER_WEIGHTS = (0.3, 0.2, 0.2, 0.1, 0.1, 0.1)
@@ -383,7 +382,7 @@ def load_case_data(
         robot = dataclasses.replace(robot, dynamics=dynamics)
     case = _case(model, robot, start, segments, file)
     if model.paths is not None:
-        case = _with_cycle(case, model, paths)
+        case = _with_seams(case, model, paths)
     if model.cell is None:
         return case
     return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
@@ -544,10 +543,10 @@ def _home_problems(home: list[float] | None, robot: Robot) -> list[Problem]:
     ]
 
 
-def _with_cycle(
+def _with_seams(
     case: Case, model: CaseModel, paths: list[tuple[np.ndarray, tuple[SegmentSpec, ...]]]
 ) -> Case:
-    """The case with its seams (``paths``), their tasks and the cycle settings."""
+    """The case with its seams (``paths``), their tasks and the sequencing settings."""
     assert model.paths is not None
     seams = []
     for seam, (start, segments) in zip(model.paths, paths, strict=True):
@@ -578,15 +577,19 @@ def _with_cycle(
                 reversible=seam.reversible,
             )
         )
-    cycle = Cycle(
-        seams=tuple(seams),
+    sequencing = Sequencing(
         sequence=model.sequence or "optimize",
         approach=0.0 if model.approach is None else model.approach,
         home=None if model.home is None else _array(model.home),
     )
-    first = cycle.seams[0]
+    first = seams[0]
     return dataclasses.replace(
-        case, start=first.start, segments=first.segments, task=first.task, cycle=cycle
+        case,
+        start=first.start,
+        segments=first.segments,
+        task=first.task,
+        seams=tuple(seams),
+        sequencing=sequencing,
     )
 
 
@@ -735,11 +738,11 @@ def _objective_kind_problems(objective: ObjectiveModel, robot: Robot) -> list[Pr
                 (("objective", "kind"), "weighted needs objective.mix, e.g. {travel: 1, time: 0.5}")
             )
         for name in objective.mix or {}:
-            if name not in OBJECTIVES:
+            if name not in OBJECTIVE_KINDS:
                 problems.append(
                     (
                         ("objective", "mix", name),
-                        f"unknown objective {name!r}: use {', '.join(OBJECTIVES)}",
+                        f"unknown objective {name!r}: use {', '.join(OBJECTIVE_KINDS)}",
                     )
                 )
     elif objective.mix is not None:
@@ -747,7 +750,7 @@ def _objective_kind_problems(objective: ObjectiveModel, robot: Robot) -> list[Pr
     if not problems and robot.dynamics is None:
         names = (objective.mix or {}) if objective.kind == "weighted" else [objective.kind]
         for name in names:
-            if OBJECTIVES[name].needs_dynamics:
+            if OBJECTIVE_KINDS[name]:
                 problems.append(
                     (
                         ("objective", "kind"),

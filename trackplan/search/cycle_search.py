@@ -40,13 +40,9 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.choices import Method, choose
 from trackplan.errors import CaseError
-from trackplan.planning.cycle import (
-    CycleResult,
-    SeamGeometries,
-    SeamSpin,
-    plan_cycle,
-    seam_geometries,
-)
+from trackplan.planning.plan import plan as plan_cycle
+from trackplan.planning.result import PlanResult as CycleResult
+from trackplan.planning.seams import SeamGeometries, SeamSpin, seam_geometries
 from trackplan.planning.sequence import best_sequence
 from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm
 from trackplan.search.fitness import (
@@ -172,7 +168,7 @@ class CycleFitness:
         self.time_weight = float(case.objective.time_weight)
         self.weights = np.asarray(case.objective.weights, dtype=float)
         self.reversible = np.array([seam.reversible for seam in case.seams])
-        self.home = None if case.cycle is None else case.cycle.home
+        self.home = case.sequencing.home
         self.feasible_count = np.zeros(len(case.seams), dtype=int)
         self.slices = spin_slices(case)
         if space.n_var != self.slices[-1].stop:

@@ -61,7 +61,7 @@ from trackplan.choices import Penalty
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.objectives import ScreenInput, plan_objective, screen_objective
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan as plan_case
 from trackplan.planning.result import PlanResult
 from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.robots.kinematics import joint_frames
@@ -173,7 +173,8 @@ def plan_candidate(
     """:func:`plan_placement` of one ``(case, X, timing, branch, geometry)`` (for executors);
     X holds the placement, then the spin variables."""
     case, X, timing, branch, geometry = args
-    return plan_placement(case, X[:6], timing=timing, branch=branch, geometry=geometry, spin=X[6:])
+    geometries = None if geometry is None else {(0, False): geometry}
+    return plan_case(case, X[:6], timing=timing, branch=branch, geometries=geometries, spin=X[6:])
 
 
 @dataclass(frozen=True, eq=False)

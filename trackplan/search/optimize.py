@@ -25,7 +25,7 @@ from trackplan.case import Case
 from trackplan.choices import Method, choose
 from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.planning.result import PlanResult
 from trackplan.run_files import HISTORY_KEYS
 from trackplan.search.algorithms import (
@@ -265,7 +265,8 @@ def optimize_placement(
         inside the reach interval, or a case with several seams
         (:func:`trackplan.search.cycle_search.optimize_cycle` searches those).
     """
-    if case.cycle is not None:
+    sequencing = case.sequencing  # adapter until the one search (issue 27)
+    if len(case.seams) > 1 or sequencing.approach > 0 or sequencing.home is not None:
         raise CaseError(
             f"case {case.name} has several seams (paths): search it with "
             "trackplan.search.cycle_search.optimize_cycle (docs/seams.md)",
@@ -493,9 +494,7 @@ class _Planner:
         if self.background is None:
             return None
         try:
-            return self.background.submit(
-                plan_placement, self.case, X[:6], **self._options(X, branch)
-            )
+            return self.background.submit(plan, self.case, X[:6], **self._options(X, branch))
         except BrokenExecutor:
             self.background = None
             return None
@@ -509,14 +508,15 @@ class _Planner:
                 return job.result()
             except BrokenExecutor:
                 self.background = None
-        return plan_placement(self.case, X[:6], **self._options(X, branch))
+        return plan(self.case, X[:6], **self._options(X, branch))
 
     def plan(self, X: np.ndarray, branch: int | None = None) -> PlanResult:
         """The plan of ``X``, waited for."""
         return self.result(self.submit(X, branch), X, branch)
 
     def _options(self, X: np.ndarray, branch: int | None) -> dict:
-        return {"timing": self.timing, "branch": branch, "geometry": self.geometry, "spin": X[6:]}
+        geometries = None if self.geometry is None else {(0, False): self.geometry}
+        return {"timing": self.timing, "branch": branch, "geometries": geometries, "spin": X[6:]}
 
 
 def _final_plan(
