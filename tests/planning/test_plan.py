@@ -8,12 +8,18 @@ import numpy as np
 import pytest
 
 from trackplan.cli import main
+from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.io.case_file import load_case
-from trackplan.io.results import read_trajectory_csv, write_trajectory_csv
+from trackplan.io.results import (
+    read_segments,
+    read_trajectory_csv,
+    write_plan_files,
+    write_trajectory_csv,
+)
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import plan, tracking_reference
+from trackplan.planning.plan import check, plan, tracking_reference
 from trackplan.status import Status
 
 from .conftest import CASES
@@ -207,3 +213,49 @@ def test_worst_margin_of_a_feasible_plan_is_its_least_unused_limit(corner_plan):
     assert 0.0 < worst < 1.0
     joint_least = min(float(np.min(m)) for m in check.joint_margins.values())
     assert worst <= joint_least
+
+
+def test_one_seam_is_checked_the_same_with_or_without_its_labels(corner_case, corner_plan):
+    q, sample_time = corner_plan.trajectory.q, corner_case.task.sample_time
+    unlabelled = check(corner_case, corner_plan.placement, q, sample_time)
+    labelled = check(
+        corner_case, corner_plan.placement, q, sample_time, segment=corner_plan.segment
+    )
+    assert unlabelled.success and labelled.success
+    assert labelled.max_tracking_error == unlabelled.max_tracking_error
+    assert labelled.max_tracking_error == pytest.approx(
+        corner_plan.check.max_tracking_error, rel=1e-12
+    )
+
+
+def test_a_single_seam_run_gains_the_seam_keys_and_the_segment_column(
+    corner_case, corner_plan, tmp_path
+):
+    summary = write_plan_files(corner_plan, corner_case, tmp_path)
+    written = json.loads((tmp_path / "result.json").read_text())
+    assert written["path_length"] == pytest.approx(corner_plan.path_length, rel=1e-12)
+    assert written["cycle_time"] == written["duration"] == summary["duration"]
+    assert (written["air_time"], written["moves"], written["sequence_mode"]) == (0.0, [], "given")
+    assert [seam["name"] for seam in written["seams"]] == ["paper-corner"]
+    assert read_segments(tmp_path / "trajectory.csv").tolist() == ["paper-corner"] * len(
+        corner_plan.trajectory.q
+    )
+
+
+BRACKET_X = np.array([0.2223, -0.5, -0.2999, 0.05, 0.0499, -2.7271])
+"""A placement of the shipped four-fillet bracket."""
+
+
+def test_plan_refuses_a_spin_or_two_branch_options_it_cannot_apply(corner_case):
+    two = load_case(CASES / "bracket-4-fillets.yaml")
+    with pytest.raises(CaseError, match="4 seams: give one spin per seam"):
+        plan(two, BRACKET_X, spin=np.array([0.1]))
+    with pytest.raises(CaseError, match=r"branch \(every seam\) or branches"):
+        plan(corner_case, corner_case.bounds.example, branch=0, branches=(0,))
+
+
+def test_check_of_several_seams_needs_their_labels():
+    case = load_case(CASES / "bracket-4-fillets.yaml")
+    q = np.zeros((3, case.robot.n_dof))
+    with pytest.raises(CaseError, match="4 seams: the trajectory needs its segment column"):
+        check(case, BRACKET_X, q, case.task.sample_time)

@@ -49,7 +49,8 @@ def joint_travel(q: np.ndarray, weights: np.ndarray) -> np.ndarray:
         J, shape (...), rad (weighted).
     """
     steps = np.abs(np.diff(np.asarray(q, dtype=float), axis=-2))
-    return np.einsum("...kn,n->...", steps, np.asarray(weights, dtype=float))
+    travel: np.ndarray = np.einsum("...kn,n->...", steps, np.asarray(weights, dtype=float))
+    return travel
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,12 +114,14 @@ def _screen_travel(data: ScreenInput) -> np.ndarray:
 
 
 def _screen_time(data: ScreenInput) -> np.ndarray:
-    return data.dt.sum(axis=-1)
+    time: np.ndarray = data.dt.sum(axis=-1)
+    return time
 
 
 def _screen_energy(data: ScreenInput) -> np.ndarray:
     tau, qd = _quasi_static_torque(data)
-    return np.sum(np.maximum(tau * qd, 0.0).sum(axis=-1) * data.dt, axis=-1)
+    energy: np.ndarray = np.sum(np.maximum(tau * qd, 0.0).sum(axis=-1) * data.dt, axis=-1)
+    return energy
 
 
 def _screen_copper(data: ScreenInput) -> np.ndarray:
@@ -127,7 +130,8 @@ def _screen_copper(data: ScreenInput) -> np.ndarray:
     tau, _ = _quasi_static_torque(data)
     k_m = 1.0 if dynamics.motor_constant is None else dynamics.motor_constant
     motor = tau / (np.asarray(dynamics.gear_ratio) * k_m)
-    return np.sum(np.square(motor).sum(axis=-1) * data.dt, axis=-1)
+    copper: np.ndarray = np.sum(np.square(motor).sum(axis=-1) * data.dt, axis=-1)
+    return copper
 
 
 def _energy_value(plan: PlanResult, key: str) -> float:
