@@ -18,7 +18,7 @@ Run with ``python -m benchmarks plan``. Prints three tables:
    each seam of a case with several seams counts as a case),
    drawn uniformly in the case's placement bounds and reach with each seed of :data:`SEEDS`: the
    same ratios, their median and worst, every output re-checked by
-   :func:`trackplan.check`.
+   :func:`trackplan.planning.plan.check`.
 
 Targets printed alongside: plan ≤ 10 ms, duration / TOPP3 median ≤ 1.02 and worst ≤ 1.04.
 TOPP3 is a linearised SOCP: where its duration comes out above a feasible smooth law's, it
@@ -40,7 +40,7 @@ import trackplan
 from trackplan.choices import Timing
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import plan
+from trackplan.planning.plan import check, plan
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.timing.references import (
     ReferenceResult,
@@ -191,7 +191,7 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
     the stages add up to the whole.
     """
     import trackplan.motion as motion_module
-    import trackplan.planning.plan as plan_module
+    import trackplan.planning.seam_plan as plan_module
     from trackplan.jointpath import JointPath
     from trackplan.timing import TIME_LAWS
     from trackplan.timing.sample_checks import RateLimits
@@ -336,7 +336,7 @@ def _random_table(seed: int) -> None:
     print()
     print(
         f"{RANDOM_PER_CASE} random feasible placements of every shipped case (seed {seed}),"
-        " each output re-checked by trackplan.check"
+        " each output re-checked by trackplan.planning.plan.check"
     )
     print(HEADER)
     print("-" * len(HEADER))
@@ -348,7 +348,7 @@ def _random_table(seed: int) -> None:
     paths = [whole.seam_case(i) for whole in shipped for i in range(len(whole.seams))]
     for case in paths:
         for X, result in _random_placements(case, RANDOM_PER_CASE, rng):
-            report = trackplan.check(case, X, result.trajectory.q, result.trajectory.sample_time)
+            report = check(case, X, result.trajectory.q, result.trajectory.sample_time)
             rechecked_bad += not report.success
             second, third = _references(result, case.task)
             print(_row(case.name, X, result, second, third))
