@@ -108,8 +108,8 @@ def _show_value(value: object) -> str:
 
 @app.command()
 def cases() -> ExitCode:
-    """List the cases shipped in the repository's cases/ folder: one row a case, its seams'
-    segments and lengths summed, the corners of each seam separated by ``;``."""
+    """List the cases shipped in the repository's cases/ folder: a row per case (its seams'
+    segments and lengths summed), then a row per seam (segments, length, corners)."""
     from rich.markup import escape
     from rich.table import Table
 
@@ -141,8 +141,18 @@ def cases() -> ExitCode:
             str(len(seams)),
             str(sum(len(seam.segments) for seam, _ in seams)),
             f"{sum(path.length for _, path in seams):.4f}",
-            "; ".join(corners(path) for _, path in seams),
+            "per seam below",
             escape(file.name),
         )
+        for seam, path in seams:
+            table.add_row(
+                f"· {escape(seam.name)}",
+                "",
+                "",
+                str(len(seam.segments)),
+                f"{path.length:.4f}",
+                corners(path),
+                "",
+            )
     console().print(table)
     return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT

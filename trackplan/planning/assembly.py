@@ -36,7 +36,7 @@ from trackplan.planning.result import (
     Span,
     Trajectory,
 )
-from trackplan.planning.seam_plan import cell_geometry, motion_trajectory
+from trackplan.planning.seam_plan import CELL_KINDS, cell_geometry, motion_trajectory
 from trackplan.planning.seams import SeamStage, approach_configuration
 from trackplan.planning.sequence import Sequence, given_sequence
 from trackplan.planning.trajectory_check import check_spans
@@ -273,7 +273,7 @@ def _status(check: CheckReport) -> tuple[Status, str]:
     if check.success:
         return Status.FEASIBLE, "feasible: every seam and every move meets every limit"
     kinds = {v.limit for v in check.violations}
-    status = Status.COLLISION if kinds <= {"collision", "clearance"} else Status.LIMITS_VIOLATED
+    status = Status.COLLISION if kinds <= set(CELL_KINDS) else Status.LIMITS_VIOLATED
     return status, check.violations[0].message
 
 
