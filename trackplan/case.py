@@ -167,6 +167,20 @@ class Seam:
     reversible: bool = True
 
 
+CSV_UNSAFE = ',"\t\r\n'
+"""Characters a seam label may not hold: it is a field of trajectory.csv's ``segment``."""
+FORMULA_START = "=+-@"
+"""First characters a spreadsheet runs as a formula."""
+
+
+def seam_label(name: str) -> str:
+    """The name of a single-path case's seam: the case name as a trajectory.csv field
+    (each of :data:`CSV_UNSAFE` replaced by ``_``, and ``_`` put before a first
+    character of :data:`FORMULA_START`), as the case file asks of ``paths[i].name``."""
+    label = "".join("_" if c in CSV_UNSAFE else c for c in name)
+    return "_" + label if label[:1] in FORMULA_START and label else label
+
+
 SEQUENCE_MODES = ("optimize", "given")
 """How the seams of a case are ordered: chosen (order and direction), or as written."""
 
@@ -219,9 +233,9 @@ class Case:
     cell
         The work cell (obstacles, workpiece, tool and link bodies), or None to plan
         without collision checks.
-    seams
-        The seams, at least one. Left empty, the one seam of ``start``, ``segments``
-        and ``task``; :meth:`seam_case` gives the single-seam case of every seam.
+    paths
+        The seams of a case file's ``paths:``, or empty for the one path of ``start``,
+        ``segments`` and ``task``; read them as :attr:`seams`.
     sequencing
         The sequence mode, approach distance and home configuration of the cycle.
     """
@@ -236,17 +250,18 @@ class Case:
     optimizer: OptimizerSettings = field(default_factory=OptimizerSettings)
     source: str | None = None
     cell: Cell | None = None
-    seams: tuple[Seam, ...] = ()
+    paths: tuple[Seam, ...] = ()
     sequencing: Sequencing = field(default_factory=Sequencing)
 
-    def __post_init__(self) -> None:
-        # one seam is always the case's own path (also after dataclasses.replace of
-        # start, segments or task)
-        if len(self.seams) <= 1:
-            name = self.seams[0].name if self.seams else self.name
-            reversible = self.seams[0].reversible if self.seams else False
-            own = Seam(name, self.start, self.segments, self.task, reversible=reversible)
-            object.__setattr__(self, "seams", (own,))
+    @property
+    def seams(self) -> tuple[Seam, ...]:
+        """The seams, at least one: ``paths``, or the one seam of ``start``, ``segments``
+        and ``task`` (named :func:`seam_label` of the case name, not reversible);
+        :meth:`seam_case` gives the single-seam case of every seam."""
+        if self.paths:
+            return self.paths
+        own = Seam(seam_label(self.name), self.start, self.segments, self.task, reversible=False)
+        return (own,)
 
     @property
     def seam_names(self) -> tuple[str, ...]:
@@ -270,6 +285,6 @@ class Case:
             start=seam.start,
             segments=seam.segments,
             task=seam.task,
-            seams=(),
+            paths=(),
             sequencing=Sequencing(),
         )

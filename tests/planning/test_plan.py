@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -14,12 +15,14 @@ from trackplan.io.case_file import load_case
 from trackplan.io.results import (
     read_segments,
     read_trajectory_csv,
+    write_plan_csv,
     write_plan_files,
     write_trajectory_csv,
 )
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import check, plan, tracking_reference
+from trackplan.planning.plan import check, make_trajectory, plan, tracking_reference
+from trackplan.planning.trajectory_check import spans_from_segments
 from trackplan.status import Status
 
 from .conftest import CASES
@@ -259,3 +262,23 @@ def test_check_of_several_seams_needs_their_labels():
     q = np.zeros((3, case.robot.n_dof))
     with pytest.raises(CaseError, match="4 seams: the trajectory needs its segment column"):
         check(case, BRACKET_X, q, case.task.sample_time)
+
+
+def test_a_case_name_that_is_no_csv_field_labels_its_seam_safely(
+    corner_case, corner_plan, tmp_path
+):
+    renamed = dataclasses.replace(corner_case, name='=weld, "left"')
+    assert renamed.seam_names == ("_=weld_ _left_",)
+    result = dataclasses.replace(corner_plan, segment=np.full(3, renamed.seams[0].name))
+    result = dataclasses.replace(
+        result,
+        trajectory=make_trajectory(renamed.robot, corner_plan.trajectory.q[:3], np.zeros(3), 0.001),
+    )
+    write_plan_csv(result, tmp_path / "trajectory.csv")
+    t, q = read_trajectory_csv(tmp_path / "trajectory.csv", renamed.robot.n_dof)
+    assert t.tolist() == pytest.approx([0.0, 0.001, 0.002], abs=1e-15)
+    assert q.shape == (3, renamed.robot.n_dof)
+    segment = read_segments(tmp_path / "trajectory.csv")
+    assert segment.tolist() == ["_=weld_ _left_"] * 3
+    spans = spans_from_segments(renamed, corner_plan.placement, q, segment)
+    assert [(span.kind, span.seam, span.first, span.last) for span in spans] == [("seam", 0, 0, 2)]

@@ -411,7 +411,7 @@ def _with_seams(
         start=first.start,
         segments=first.segments,
         task=first.task,
-        seams=tuple(seams),
+        paths=tuple(seams),
         sequencing=sequencing,
     )
 
