@@ -91,7 +91,9 @@ def test_screened_travel_matches_the_full_plan(
     case: Case, geometry: PathGeometry, X: np.ndarray
 ) -> None:
     screened = _fitness(case, geometry).evaluate(X[None])
-    plan = plan_placement(case, X, branch=int(screened.branch[0]), geometry=geometry)
+    plan = plan_placement(
+        case, X, branch=int(screened.branch[0]), geometries={(0, False): geometry}
+    )
     assert plan.feasible
     assert screened.objective[0] == pytest.approx(plan.objective, rel=5e-3)
 
