@@ -231,7 +231,7 @@ def test_one_seam_is_checked_the_same_with_or_without_its_labels(corner_case, co
     )
 
 
-def test_a_single_seam_run_gains_the_seam_keys_and_the_segment_column(
+def test_a_single_seam_run_gains_the_seam_keys_and_keeps_its_numeric_table(
     corner_case, corner_plan, tmp_path
 ):
     summary = write_plan_files(corner_plan, corner_case, tmp_path)
@@ -240,9 +240,9 @@ def test_a_single_seam_run_gains_the_seam_keys_and_the_segment_column(
     assert written["cycle_time"] == written["duration"] == summary["duration"]
     assert (written["air_time"], written["moves"], written["sequence_mode"]) == (0.0, [], "given")
     assert [seam["name"] for seam in written["seams"]] == ["paper-corner"]
-    assert read_segments(tmp_path / "trajectory.csv").tolist() == ["paper-corner"] * len(
-        corner_plan.trajectory.q
-    )
+    assert read_segments(tmp_path / "trajectory.csv") is None
+    table = np.loadtxt(tmp_path / "trajectory.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert table.shape == (corner_plan.trajectory.n_samples, 1 + 4 * 6 + 5)
 
 
 BRACKET_X = np.array([0.2223, -0.5, -0.2999, 0.05, 0.0499, -2.7271])

@@ -85,7 +85,7 @@ def test_plan_cli_fixed_exits_3_and_free_writes_the_spin(tmp_path, capsys):
     assert summary["tool"]["frame"] == "seam" and summary["tool"]["spin"] == "free-varying"
     assert len(summary["spin"]["coefficients"]) == 6 and len(summary["spin"]["knots"]) == 10
     header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
-    assert header[-2:] == ["spin", "segment"]
+    assert header[-1] == "spin"
     # the profile written is the one a plan given --spin-profile reproduces
     again = tmp_path / "again"
     code = main(

@@ -337,8 +337,11 @@ def plan_summary(result: PlanResult, case: Case) -> dict:
 def write_plan_files(
     result: PlanResult, case: Case, out_dir: Path, extra: dict | None = None
 ) -> dict:
-    """Write ``trajectory.csv`` (with ``segment``) and ``result.json`` of a plan into
-    ``out_dir``.
+    """Write ``trajectory.csv`` and ``result.json`` of a plan into ``out_dir``.
+
+    trajectory.csv has the ``segment`` column when the case names its seams (``paths:``)
+    or the plan has more than one span (moves): the table of a single path stays the
+    all-numeric one that scripts read with ``numpy.loadtxt``.
 
     Returns
     -------
@@ -347,7 +350,8 @@ def write_plan_files(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_plan_csv(result, out_dir / TRAJECTORY_FILE)
+    labels = bool(case.paths) or len(result.spans) > 1
+    write_plan_csv(result, out_dir / TRAJECTORY_FILE, labels=labels)
     summary = {
         **plan_summary(result, case),
         **(extra or {}),
@@ -361,14 +365,17 @@ SEGMENT_COLUMN = "segment"
 """Last column of trajectory.csv: the seam's name, or approach/retract/air."""
 
 
-def write_plan_csv(result: PlanResult, file: Path) -> None:
-    """Write one row per sample: the trajectory's columns, then ``segment`` (a plan made
-    without labels has the case name on every sample)."""
+def write_plan_csv(result: PlanResult, file: Path, *, labels: bool = True) -> None:
+    """Write one row per sample: the trajectory's columns, then, with ``labels``,
+    ``segment`` (a plan made without labels has the case name on every sample)."""
+    if not labels:
+        write_trajectory_csv(result.trajectory, file)
+        return
     lines = format_table(trajectory_table(result.trajectory)).decode("ascii").splitlines()
-    labels = result.segment
-    if len(labels) != len(lines):
-        labels = np.full(len(lines), result.case_name, dtype=object)
-    rows = [f"{line},{label}" for line, label in zip(lines, labels, strict=True)]
+    labels_ = result.segment
+    if len(labels_) != len(lines):
+        labels_ = np.full(len(lines), result.case_name, dtype=object)
+    rows = [f"{line},{label}" for line, label in zip(lines, labels_, strict=True)]
     n_dof = result.trajectory.q.shape[1]
     header = ",".join([*trajectory_header(n_dof), SEGMENT_COLUMN])
     Path(file).write_text("\n".join([header, *rows]) + "\n", encoding="utf-8")
