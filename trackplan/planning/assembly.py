@@ -224,7 +224,7 @@ def _one_seam(case: Case, stage: SeamStage, sequence: Sequence) -> PlanResult:
     return replace(
         plan,
         case_name=case.name,
-        segment=np.full(n, name, dtype=object),
+        segment=np.full(n, name),
         spans=(span,),
         seams=(seam,),
         sequence=sequence,
