@@ -45,7 +45,7 @@ from trackplan.choices import Method
 from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.search.fitness import screening_grid
 from trackplan.search.optimize import optimize
 
@@ -116,7 +116,7 @@ def _reference(case, geometry, method: str, budget: int) -> dict:  # type: ignor
             method=method,
             seed=REFERENCE_SEED + runs,
             budget=budget - used,
-            geometry=geometry,
+            geometries={(0, False): geometry},
         )
         bests.append(np.minimum.accumulate(result.history.best))
         evaluations.append(used + result.history.evaluations)
@@ -292,7 +292,7 @@ def _corner_seeds() -> None:
     )
     for seed in SEEDS:
         start = time.process_time()
-        result = optimize(case, seed=seed, geometry=geometry)
+        result = optimize(case, seed=seed, geometries={(0, False): geometry})
         cpu = time.process_time() - start
         gap = result.objective / best - 1.0 if result.success else math.inf
         print(
@@ -402,9 +402,9 @@ def main() -> None:
     print("Corner case (Case 3): the paper's published optimum planned by trackplan")
     print(f"  X = {_vector(PAPER_CORNER_X)} (the paper reports fitness 0.9433)")
     for timing in ("smooth", "paper"):
-        plan = plan_placement(corner, PAPER_CORNER_X, timing=timing)
-        state = "feasible" if plan.feasible else f"infeasible ({plan.status.value})"
-        print(f"  {timing:<6} timing: J = {plan.objective:.4f}, {state}")
+        planned = plan(corner, PAPER_CORNER_X, timing=timing)
+        state = "feasible" if planned.feasible else f"infeasible ({planned.status.value})"
+        print(f"  {timing:<6} timing: J = {planned.objective:.4f}, {state}")
     print(
         f"\nQuality: the case's own settings vs J* = the best of the known values and of "
         f"{', '.join(REFERENCE_METHODS)} with {REFERENCE_FACTOR}× the mean evaluations "
@@ -423,10 +423,10 @@ def main() -> None:
     for name in names:
         case = load_case(CASES / f"{name}.yaml")
         geometry = PathGeometry.from_case(case)
-        optimize(case, budget=30, geometry=geometry)  # warm-up: JIT and imports
+        optimize(case, budget=30, geometries={(0, False): geometry})  # warm-up: JIT and imports
         rows = []
         for seed in SEEDS:
-            result = optimize(case, seed=seed, geometry=geometry)
+            result = optimize(case, seed=seed, geometries={(0, False): geometry})
             rows.append((seed, result))
             searched += result.evaluations
             search_seconds += float(result.history.wall_time[-1])

@@ -3,7 +3,7 @@
 Run with ``python -m benchmarks plan``. Prints three tables:
 
 1. Planning one placement of the corner case at Ts = 1 ms in-process,
-   ``trackplan.plan_placement(case, case.bounds.example)`` (warm: the first call, with its
+   ``plan(case, case.bounds.example)`` (warm: the first call, with its
    JIT compilation, imports and the case's paths, is excluded; median of :data:`PLAN_RUNS`
    runs; CPU time, the target's measure, with the wall time beside it), toppra's and
    copp-py's compute on that joint path, and the plan's poses solved one by one with
@@ -18,7 +18,7 @@ Run with ``python -m benchmarks plan``. Prints three tables:
    each seam of a case with several seams counts as a case),
    drawn uniformly in the case's placement bounds and reach with each seed of :data:`SEEDS`: the
    same ratios, their median and worst, every output re-checked by
-   :func:`trackplan.check_case_trajectory`.
+   :func:`trackplan.planning.plan.check`.
 
 Targets printed alongside: plan ≤ 10 ms, duration / TOPP3 median ≤ 1.02 and worst ≤ 1.04.
 TOPP3 is a linearised SOCP: where its duration comes out above a feasible smooth law's, it
@@ -40,6 +40,7 @@ import trackplan
 from trackplan.choices import Timing
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
+from trackplan.planning.plan import check, plan
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.timing.references import (
     ReferenceResult,
@@ -190,7 +191,7 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
     the stages add up to the whole.
     """
     import trackplan.motion as motion_module
-    import trackplan.planning.plan as plan_module
+    import trackplan.planning.seam_plan as plan_module
     from trackplan.jointpath import JointPath
     from trackplan.timing import TIME_LAWS
     from trackplan.timing.sample_checks import RateLimits
@@ -204,12 +205,12 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
         "fk": (motion_module, "forward_kinematics"),
         "check": (plan_module, "check_motion"),
     }
-    trackplan.plan_placement(case, X)  # warm
+    plan(case, X)  # warm
     rows = []
     for _ in range(runs):
         with _StageClocks(targets) as clocks:
             start = time.process_time()
-            result = trackplan.plan_placement(case, X)
+            result = plan(case, X)
             whole = time.process_time() - start
         rows.append((whole, clocks.totals))
     rows.sort(key=lambda row: row[0])
@@ -235,8 +236,8 @@ def _breakdown(case, X: np.ndarray, runs: int = 3 * PLAN_RUNS) -> list[tuple[str
 def _speed_table() -> None:
     case = _load("paper-corner")
     X = np.asarray(case.bounds.example, dtype=float)
-    plan_time, plan_cpu = _median_time(lambda: trackplan.plan_placement(case, X))
-    result = trackplan.plan_placement(case, X)
+    plan_time, plan_cpu = _median_time(lambda: plan(case, X))
+    result = plan(case, X)
     s_grid, q_grid, caps = reference_inputs(result.joint_path, case.task)
     Ts = case.task.sample_time
     toppra_reference(case.robot, s_grid, q_grid, caps, Ts)  # warm: imports, first-call set-up
@@ -254,7 +255,7 @@ def _speed_table() -> None:
     plan_ms = 1e3 * plan_cpu
     print(f"Planning one placement of paper-corner at Ts = 1 ms ({len(poses)} samples)")
     print(
-        f"  trackplan.plan_placement(case, case.bounds.example) (warm, median of {PLAN_RUNS}):"
+        f"  plan(case, case.bounds.example) (warm, median of {PLAN_RUNS}):"
         f" {plan_ms:.1f} ms CPU ({1e3 * plan_time:.1f} ms wall)"
         f"   target ≤ {TARGET_PLAN_MS:.0f} ms: {'MET' if plan_ms <= TARGET_PLAN_MS else 'MISSED'}"
     )
@@ -305,7 +306,7 @@ def _paper_table() -> None:
     for name in PAPER_CASES:
         case = _load(name)
         X = np.asarray(case.bounds.example, dtype=float)
-        result = trackplan.plan_placement(case, X)
+        result = plan(case, X)
         if result.trajectory.t.size == 0:
             print(f"{name:<13} no trajectory: {result.message}")
             continue
@@ -323,7 +324,7 @@ def _random_placements(case, count: int, rng: np.random.Generator):  # type: ign
         X = rng.uniform(lower, upper)
         if not reach_min <= np.linalg.norm(X[:3]) <= reach_max:
             continue
-        result = trackplan.plan_placement(case, X, geometry=geometry)
+        result = plan(case, X, geometries={(0, False): geometry})
         if result.success:
             found.append((X, result))
             if len(found) == count:
@@ -335,7 +336,7 @@ def _random_table(seed: int) -> None:
     print()
     print(
         f"{RANDOM_PER_CASE} random feasible placements of every shipped case (seed {seed}),"
-        " each output re-checked by trackplan.check_case_trajectory"
+        " each output re-checked by trackplan.planning.plan.check"
     )
     print(HEADER)
     print("-" * len(HEADER))
@@ -347,9 +348,7 @@ def _random_table(seed: int) -> None:
     paths = [whole.seam_case(i) for whole in shipped for i in range(len(whole.seams))]
     for case in paths:
         for X, result in _random_placements(case, RANDOM_PER_CASE, rng):
-            report = trackplan.check_case_trajectory(
-                case, X, result.trajectory.q, result.trajectory.sample_time
-            )
+            report = check(case, X, result.trajectory.q, result.trajectory.sample_time)
             rechecked_bad += not report.success
             second, third = _references(result, case.task)
             print(_row(case.name, X, result, second, third))

@@ -37,7 +37,6 @@ from pathlib import Path
 
 from benchmarks import best_time
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import plan_placement
 from trackplan.report.plot_worker import PlotWorker
 from trackplan.report.run_report import can_fork, write_run_report
 from trackplan.search.optimize import optimize
@@ -113,12 +112,12 @@ def _in_process() -> None:
     search = optimize(case)
     result = search.final
     history = {search.method: search.history.as_columns()}
-    plan = best_time(lambda: plan_placement(case, search.X))
+    plan = best_time(lambda: plan(case, search.X))
     print(
         f"{CASE}: {result.trajectory.n_samples} samples at Ts = "
         f"{1e3 * case.task.sample_time:.3g} ms, found by {search.method}"
     )
-    print(f"  plan_placement (reference, CPU, warm): {1e3 * plan:.1f} ms")
+    print(f"  plan (reference, CPU, warm): {1e3 * plan:.1f} ms")
     print(f"\n  {'report (plots + report.html), warm':<44}{'wall s':>8}{'CPU s':>8}", end="")
     print(f"{'forked CPU s':>14}{'longest / plan':>16}")
     modes = ("worker", "two processes", "alone") if can_fork() else ("alone",)

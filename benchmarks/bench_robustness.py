@@ -28,7 +28,7 @@ import numpy as np
 from trackplan.io.case_file import load_case
 from trackplan.io.csv_table import write_csv_table
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.run_files import TRAJECTORY_FILE
 from trackplan.status import Status
 
@@ -173,7 +173,7 @@ def placements() -> None:
             if not case.bounds.reach[0] <= np.linalg.norm(X[:3]) <= case.bounds.reach[1]:
                 continue
             planned += 1
-            result = plan_placement(case, X, geometry=geometry)
+            result = plan(case, X, geometries={(0, False): geometry})
             if result.status in GEOMETRIC:
                 counts["geometry"] += 1
             elif result.feasible:

@@ -16,7 +16,7 @@ Run with ``python -m benchmarks seams``. Prints, in one run:
 - the shipped case ``cases/bracket-4-fillets.yaml`` (four fillets, one placement): the
   placement search (:func:`trackplan.search.optimize.optimize`, CPU time), then
   at its placement the cycle time with the optimised sequence against the order and
-  directions as written (:func:`trackplan.planning.cycle.plan_cycle`), and the air time of
+  directions as written (:func:`trackplan.planning.plan.plan`), and the air time of
   each.
 
 Compute times are the least CPU time of several repeats (one thread).
@@ -32,7 +32,8 @@ import numpy as np
 from benchmarks import best_time
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_robot
-from trackplan.planning.cycle import plan_cycle, seam_geometries
+from trackplan.planning.plan import plan
+from trackplan.planning.seams import seam_geometries
 from trackplan.planning.sequence import best_sequence, given_sequence, sequence_cost
 from trackplan.search.optimize import optimize
 from trackplan.timing.airmove import air_time_estimate, plan_air_move, trapezoid_time
@@ -150,16 +151,17 @@ def sequencing() -> None:
 def cycle() -> None:
     """The shipped four-fillet case: search, then the optimised sequence against the given."""
     case = load_case(SHIPPED_CASE)
-    assert case.cycle is not None and len(case.seams) > 1
+    assert len(case.seams) > 1
     start = time.process_time()
     search = optimize(case)
     search_cpu = time.process_time() - start
     X = search.X
     geometries = seam_geometries(case)
     optimised = search.final
-    given = plan_cycle(case, X, sequence=given_sequence(len(case.seams)), geometries=geometries)
+    given = plan(case, X, sequence=given_sequence(len(case.seams)), geometries=geometries)
     order = ", ".join(f"{s.name}{' (reversed)' if s.reversed else ''}" for s in optimised.seams)
-    print(f"cycle: {SHIPPED_CASE.name}, {len(case.seams)} seams, approach {case.cycle.approach} m")
+    approach = case.sequencing.approach
+    print(f"cycle: {SHIPPED_CASE.name}, {len(case.seams)} seams, approach {approach} m")
     print(
         f"  search: {search.evaluations} evaluations, {search_cpu:.1f} s CPU, "
         f"{search.status.value}; X = ({', '.join(f'{v:.4f}' for v in X)})"

@@ -10,13 +10,14 @@ import trackplan
 from tests.conftest import CASES
 from trackplan.frames import tool_poses
 from trackplan.jointpath import _rotations
+from trackplan.planning.plan import plan
 from trackplan.robots.path_ik import branch_joints
 from trackplan.tool import SpinProfile, ToolOrientation
 
 
 def test_poses_of_a_tool_in_one_orientation_equal_those_of_every_point():
     case = trackplan.load_case(CASES / "paper-corner.yaml")
-    joint_path = trackplan.plan_placement(case, case.bounds.example).joint_path
+    joint_path = plan(case, case.bounds.example).joint_path
     s = np.linspace(0.0, joint_path.length, 501)
     sample = joint_path.geometry.planned.sample(s)
     every = joint_path.tool.rotations(sample.s, sample.tangent)
@@ -31,8 +32,8 @@ def test_a_held_rotation_is_computed_once_per_spec_and_spin():
     """Plans of a case with a tool held in the part frame read one rotation; another spin
     value has its own, that of a rotation computed at every point with that spin."""
     case = trackplan.load_case(CASES / "paper-corner.yaml")
-    first = trackplan.plan_placement(case, case.bounds.example).joint_path
-    second = trackplan.plan_placement(case, case.bounds.example + 0.01).joint_path
+    first = plan(case, case.bounds.example).joint_path
+    second = plan(case, case.bounds.example + 0.01).joint_path
     s = np.linspace(0.0, first.length, 11)
     sample = first.geometry.planned.sample(s)
     held = _rotations(first.tool, sample.s, sample.tangent)
@@ -47,7 +48,7 @@ def test_a_held_rotation_is_computed_once_per_spec_and_spin():
 
 def test_a_seam_frame_tool_turns_with_the_path():
     case = trackplan.load_case(CASES / "paper-circle-seam-fixed.yaml")
-    joint_path = trackplan.plan_placement(case, case.bounds.example).joint_path
+    joint_path = plan(case, case.bounds.example).joint_path
     s = np.linspace(0.0, joint_path.length, 101)
     sample = joint_path.geometry.planned.sample(s)
     rotations = _rotations(joint_path.tool, sample.s, sample.tangent)
@@ -61,7 +62,7 @@ def test_joints_are_the_branch_ik_of_the_poses():
     wound near the interpolated grid, for a tool in one orientation and a turning one."""
     for name in ("paper-corner", "paper-circle-seam-fixed"):
         case = trackplan.load_case(CASES / f"{name}.yaml")
-        joint_path = trackplan.plan_placement(case, case.bounds.example).joint_path
+        joint_path = plan(case, case.bounds.example).joint_path
         s = np.linspace(0.0, joint_path.length, 777)[::-1]
         expected = branch_joints(
             case.robot, joint_path.poses(s), joint_path.branch, joint_path.interpolate(s)

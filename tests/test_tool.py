@@ -15,6 +15,7 @@ from tests.conftest import CASES
 from trackplan.frames import rpy_matrix
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.plan import plan
 from trackplan.planning.tool_zones import nominal_tangents, transition_zones
 from trackplan.planning.tracking import locate_on_nominal
 from trackplan.tool import (
@@ -304,17 +305,17 @@ def test_a_normal_jump_is_blended_smoothly(two_faces_geometry, collinear_geometr
 
 
 def test_two_faces_case_plans_feasibly_and_checks():
-    from trackplan.planning.plan import check_case_trajectory, plan_placement
+    from trackplan.planning.plan import check
 
     case = load_case(TWO_FACES)
     assert case.task.tool.normals is not None and len(case.task.tool.normals) == 2
     X = case.bounds.example
-    result = plan_placement(case, X, spin=np.array([-2.3905]))
+    result = plan(case, X, spin=np.array([-2.3905]))
     assert result.success, result.message
-    check = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
-    assert check.success
+    report = check(case, X, result.trajectory.q, case.task.sample_time)
+    assert report.success
     # the tool turns from one face's normal to the other's: about 90° across the bend
-    assert 1.0 < check.max_orientation_error < 1.5
+    assert 1.0 < report.max_orientation_error < 1.5
 
 
 def test_spinning_rotations_elementwise_is_the_matrix_product():

@@ -135,41 +135,54 @@ class Seam:
     reversible: bool = True
 
 
+CSV_UNSAFE = ',"\t\r\n'
+"""Characters a seam label may not hold: it is a field of trajectory.csv's ``segment``."""
+FORMULA_START = "=+-@"
+"""First characters a spreadsheet runs as a formula."""
+
+
+def seam_label(name: str) -> str:
+    """The name of a single-path case's seam: the case name as a trajectory.csv field
+    (each of :data:`CSV_UNSAFE` replaced by ``_``, and ``_`` put before a first
+    character of :data:`FORMULA_START`), as the case file asks of ``paths[i].name``."""
+    label = "".join("_" if c in CSV_UNSAFE else c for c in name)
+    return "_" + label if label[:1] in FORMULA_START and label else label
+
+
 SEQUENCE_MODES = ("optimize", "given")
-"""How the seams of a cycle are ordered: chosen (order and direction), or as written."""
+"""How the seams of a case are ordered: chosen (order and direction), or as written."""
 
 
 @dataclass(frozen=True, eq=False)
-class Cycle:
-    """Several seams welded at one placement, with the moves between them (``docs/seams.md``).
+class Sequencing:
+    """How the seams of a case are joined into one cycle (``docs/seams.md``).
 
     Attributes
     ----------
-    seams
-        The seams as written, at least one.
     sequence
-        ``optimize`` (order and directions chosen) or ``given`` (as written, forward).
+        ``given`` (as written, forward; the default) or ``optimize`` (order and
+        directions chosen).
     approach
-        Approach and retract distance along the tool axis at each seam end, m (≥ 0).
+        Approach and retract distance along the tool axis at each seam end, m (≥ 0;
+        0: the seam ends are the cycle's ends).
     home
         Joint configuration the cycle starts from and returns to, shape (n,), rad, or
         None to start at the first approach pose and end at the last retract pose.
     """
 
-    seams: tuple[Seam, ...]
-    sequence: str = "optimize"
+    sequence: str = "given"
     approach: float = 0.0
     home: np.ndarray | None = None
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        """Seam names in the order written."""
-        return tuple(seam.name for seam in self.seams)
 
 
 @dataclass(frozen=True, eq=False)
 class Case:
-    """Everything needed to plan and optimize one path-following task.
+    """Everything needed to plan and optimize a path-following task: a set of seams.
+
+    A case built from ``start``, ``segments`` and ``task`` is one seam (named after the
+    case, not reversible); a case with several seams (``paths:`` in the case file) gives
+    them in ``seams``, and then ``start``, ``segments`` and ``task`` are those of its first
+    seam.
 
     Attributes
     ----------
@@ -178,20 +191,21 @@ class Case:
     robot
         The robot.
     start
-        First point of the path in the definition frame, shape (3,), m.
+        First point of the (first) path in the definition frame, shape (3,), m.
     segments
-        The path segments, in order.
+        The (first) path's segments, in order.
     task, bounds, objective, optimizer
         See the classes.
+    source
+        The case file, if the case came from one.
     cell
         The work cell (obstacles, workpiece, tool and link bodies), or None to plan
         without collision checks.
-    source
-        The case file, if the case came from one.
-    cycle
-        Several seams (``paths:``), or None for the one path above. With a cycle,
-        ``start``, ``segments`` and ``task`` are those of its first seam, and
-        :meth:`seam_case` gives the single-path case of every seam.
+    paths
+        The seams of a case file's ``paths:``, or empty for the one path of ``start``,
+        ``segments`` and ``task``; read them as :attr:`seams`.
+    sequencing
+        The sequence mode, approach distance and home configuration of the cycle.
     """
 
     name: str
@@ -204,20 +218,34 @@ class Case:
     optimizer: OptimizerSettings = field(default_factory=OptimizerSettings)
     source: str | None = None
     cell: Cell | None = None
-    cycle: Cycle | None = None
+    paths: tuple[Seam, ...] = ()
+    sequencing: Sequencing = field(default_factory=Sequencing)
 
     @property
     def seams(self) -> tuple[Seam, ...]:
-        """The seams: the cycle's, or the one path of a single-path case."""
-        if self.cycle is not None:
-            return self.cycle.seams
-        return (Seam(self.name, self.start, self.segments, self.task, reversible=False),)
+        """The seams, at least one: ``paths``, or the one seam of ``start``, ``segments``
+        and ``task`` (named :func:`seam_label` of the case name, not reversible);
+        :meth:`seam_case` gives the single-seam case of every seam."""
+        if self.paths:
+            return self.paths
+        own = Seam(seam_label(self.name), self.start, self.segments, self.task, reversible=False)
+        return (own,)
+
+    @property
+    def seam_names(self) -> tuple[str, ...]:
+        """Seam names in the order written."""
+        return tuple(seam.name for seam in self.seams)
 
     def seam_case(self, index: int) -> Case:
-        """The single-path case of seam ``index`` (its path and task, the case's robot,
-        cell, bounds, objective and optimizer; named after the seam)."""
+        """The single-seam case of seam ``index`` (its path and task, the case's robot,
+        cell, bounds, objective and optimizer; named after the seam; given sequence, no
+        approach, no home)."""
         seam = self.seams[index]
-        if self.cycle is None:
+        if (
+            len(self.seams) == 1
+            and self.sequencing.approach == 0.0
+            and self.sequencing.home is None
+        ):
             return self
         return replace(
             self,
@@ -225,5 +253,6 @@ class Case:
             start=seam.start,
             segments=seam.segments,
             task=seam.task,
-            cycle=None,
+            paths=(),
+            sequencing=Sequencing(),
         )

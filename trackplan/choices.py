@@ -72,4 +72,10 @@ def choose(kind: type[ChoiceT], value: object, key: str) -> ChoiceT:
         raise CaseError(f"{key} must be one of {allowed}, got {value!r}", key=key) from None
 
 
-__all__ = ["Method", "Penalty", "Timing", "choose"]
+OBJECTIVE_KINDS: dict[str, bool] = {"travel": False, "time": False, "energy": True, "copper": True}
+"""The single search objectives by name (``objective.kind``), each mapped to whether it
+needs the robot's dynamics; :data:`trackplan.planning.objectives.OBJECTIVES` implements
+them."""
+
+
+__all__ = ["OBJECTIVE_KINDS", "Method", "Penalty", "Timing", "choose"]

@@ -18,9 +18,8 @@ from trackplan.planning.result import PlanResult
 from trackplan.robots.describe import robot_info
 
 if TYPE_CHECKING:  # the search (pymoo) is not needed to write a plan
-    from trackplan.planning.cycle import CycleResult
     from trackplan.report.plot_worker import PlotWorker
-    from trackplan.search import SearchResult
+    from trackplan.search.optimize import SearchResult
 
 
 def write_run(
@@ -34,7 +33,8 @@ def write_run(
     search: SearchResult | None = None,
     plot_worker: PlotWorker | None = None,
 ) -> dict:
-    """Write trajectory.csv, result.json and, with ``report``, the plots and report.html.
+    """Write trajectory.csv, result.json and, with ``report``, the plots and report.html of
+    any plan (one seam or several: :func:`~trackplan.io.results.write_plan_files`).
 
     Parameters
     ----------
@@ -52,8 +52,8 @@ def write_run(
     report
         Also write the plots and the HTML report (which embeds them).
     search
-        The :class:`~trackplan.search.optimize.SearchResult` whose ``history.csv`` to
-        write, or None.
+        The search (:class:`~trackplan.search.optimize.SearchResult`) whose
+        ``history.csv`` to write, or None.
     plot_worker
         A :class:`~trackplan.report.plot_worker.PlotWorker` to draw the plots, or None.
 
@@ -67,10 +67,11 @@ def write_run(
 
     def write_files(folder: Path) -> None:
         if search is not None:
-            from trackplan.io.history import write_history
+            from trackplan.io.history import write_history_csv
+            from trackplan.run_files import HISTORY_FILE
 
-            write_history(search, folder)
-        written.update(write_plan_files(result, case.robot.joint_names, folder, extra))
+            write_history_csv(search.history, folder / HISTORY_FILE)
+        written.update(write_plan_files(result, case, folder, extra))
 
     def write(folder: Path) -> None:
         if not report:
@@ -126,7 +127,7 @@ def write_search_run(
     blocks = {**optimizer_summary(result, case.robot.joint_names), **(extra or {})}
     return write_run(
         out_dir,
-        result.final,  # type: ignore[arg-type]  # one seam: a PlanResult, until the one PlanResult
+        result.final,
         case,
         history=history,
         extra=blocks,
@@ -134,74 +135,3 @@ def write_search_run(
         search=result,
         plot_worker=plot_worker,
     )
-
-
-def write_cycle_run(
-    out_dir: Path,
-    result: CycleResult,
-    case: Case,
-    *,
-    extra: dict | None = None,
-    report: bool = True,
-    search: SearchResult | None = None,
-) -> dict:
-    """Write a cycle of several seams: trajectory.csv (with ``segment``), result.json and,
-    with ``report``, cycle.png and report.html; history.csv after a search.
-
-    Parameters
-    ----------
-    out_dir
-        Output folder (created), written as a whole like :func:`write_run`.
-    result
-        The cycle (:class:`~trackplan.planning.cycle.CycleResult`).
-    case
-        Its case.
-    extra
-        More keys for ``result.json``; the ``robot`` block is always added, and the
-        ``optimizer`` block after a search.
-    report
-        Also write the plot and the HTML report.
-    search
-        The :class:`~trackplan.search.optimize.SearchResult` the cycle came from.
-
-    Returns
-    -------
-    dict
-        The ``result.json`` content.
-    """
-    from trackplan.io.cycle_results import write_cycle_files
-
-    blocks = {"robot": robot_info(case.robot)}
-    if search is not None:
-        blocks["optimizer"] = {
-            "method": search.method,
-            "seed": int(search.seed),
-            "evaluations": int(search.evaluations),
-            "generations": int(search.generations),
-            "stop_reason": search.stop_reason,
-            "runs": int(search.runs),
-            "wall_time_s": float(search.wall_time_s),
-            "status": search.status.value,
-            "message": search.message,
-            "fitness": float(search.fitness),
-            "unreachable_seams": list(search.unreachable),
-            "rejected_candidates": [list(map(float, X)) for X in search.rejected],
-            "on_bounds": [hit.as_dict() for hit in search.on_bounds],
-        }
-    blocks.update(extra or {})
-    written: dict = {}
-
-    def write(folder: Path) -> None:
-        if search is not None:
-            from trackplan.io.history import write_history_csv
-            from trackplan.run_files import HISTORY_FILE
-
-            write_history_csv(search.history, folder / HISTORY_FILE)
-        written.update(write_cycle_files(result, case, folder, blocks))
-        if report:
-            from trackplan.report.cycle import write_cycle_report
-
-            write_cycle_report(result, case, folder, written)
-
-    write_run_folder(Path(out_dir), write)
-    return written

@@ -11,7 +11,7 @@ import pytest
 
 from trackplan.cli import main
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.report.figures import plot_figures
 from trackplan.report.robot_view import CAPSULES_TRACE, CLOSEST_TRACE, robot_view_figure
 from trackplan.search.placement_map import REASONS, placement_map
@@ -77,7 +77,7 @@ def test_map_command_writes_png_csv_and_panel(tmp_path: Path, capsys) -> None:
 
 
 def test_report_draws_the_cell(case) -> None:
-    result = plan_placement(case, OPTIMUM)
+    result = plan(case, OPTIMUM)
     assert result.check.cell is not None and not result.check.cell.success
     assert "clearance.png" in plot_figures(result, case)
     figure = robot_view_figure(result, case, n_frames=5)

@@ -14,7 +14,7 @@ from trackplan.cell.screening import CellGeometry
 from trackplan.frames import pose_matrix
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_names, builtin_robot, load_robot
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.robots.kinematics import joint_frames
 
 REPO = Path(__file__).resolve().parents[2]
@@ -164,7 +164,7 @@ SHIPPED_PLANS = {
 @pytest.mark.parametrize("case_name", sorted(SHIPPED_PLANS))
 def test_shipped_plans_keep_clear_of_self_collision(case_name: str) -> None:
     case = load_case(REPO / "cases" / f"{case_name}.yaml")
-    result = plan_placement(case, np.array(SHIPPED_PLANS[case_name]))
+    result = plan(case, np.array(SHIPPED_PLANS[case_name]))
     assert result.success
     robot = case.robot
     geometry = CellGeometry.from_cell(Cell(), robot)

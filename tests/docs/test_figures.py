@@ -90,19 +90,19 @@ def test_dynamics_page_torque_limit_example():
     import dataclasses
 
     from trackplan import load_case
-    from trackplan.planning.plan import plan_placement
+    from trackplan.planning.plan import plan
 
     text = _text("dynamics.md")
     case = load_case(console.REPO / "cases" / "paper-corner.yaml")
     X = case.bounds.example
-    base = plan_placement(case, X)
+    base = plan(case, X)
 
     def limited(newton_metres: float):
         torque_max = np.array(case.robot.dynamics.torque_max)
         torque_max[0] = newton_metres
         dynamics = dataclasses.replace(case.robot.dynamics, torque_max=torque_max)
         robot = dataclasses.replace(case.robot, dynamics=dynamics)
-        return plan_placement(dataclasses.replace(case, robot=robot), X)
+        return plan(dataclasses.replace(case, robot=robot), X)
 
     at_35, at_30 = limited(35.0), limited(30.0)
     assert at_35.success and at_30.success
@@ -123,12 +123,12 @@ def test_cell_page_least_self_distances():
     from trackplan.cell.check import check_cell
     from trackplan.cell.model import Cell
     from trackplan.cell.screening import CellGeometry
-    from trackplan.planning.plan import plan_placement
+    from trackplan.planning.plan import plan
 
     text = _text("cell.md")
     for name, placement in SHIPPED_PLANS.items():
         case = load_case(console.REPO / "cases" / f"{name}.yaml")
-        plan = plan_placement(case, np.array(placement))
+        planned = plan(case, np.array(placement))
         geometry = CellGeometry.from_cell(Cell(), case.robot)
-        report = check_cell(geometry, case.robot, plan.trajectory.q, TS, np.eye(4))
+        report = check_cell(geometry, case.robot, planned.trajectory.q, TS, np.eye(4))
         assert f"{name} {report.min_clearance * 1e3:.1f} mm" in text, name

@@ -10,7 +10,7 @@ import pytest
 import yaml
 from pydantic import BaseModel
 
-from trackplan.io.case_file import ArcModel, CaseModel, LineModel, PointsFileModel
+from trackplan.io.case_schema import ArcModel, CaseModel, LineModel, PointsFileModel
 from trackplan.io.robot_file import RobotFileModel
 
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "files.md"

@@ -41,9 +41,9 @@ def write(folder: Path, data: dict[str, Any]) -> Path:
 
 def test_paths_load_into_a_cycle_with_per_seam_tasks() -> None:
     case = load_case_text(yaml.safe_dump(SEAMS, sort_keys=False))
-    assert case.cycle is not None
-    assert case.cycle.names == ("a", "b")
-    assert (case.cycle.sequence, case.cycle.approach, case.cycle.home) == ("optimize", 0.02, None)
+    assert case.seam_names == ("a", "b")
+    sequencing = case.sequencing
+    assert (sequencing.sequence, sequencing.approach, sequencing.home) == ("optimize", 0.02, None)
     a, b = case.seams
     assert (a.task.rated_speed, b.task.rated_speed) == (0.02, 0.01)
     assert (a.task.corner_speed, b.task.corner_speed) == (0.015, 0.015)
@@ -52,21 +52,22 @@ def test_paths_load_into_a_cycle_with_per_seam_tasks() -> None:
     # the case's own path and task are the first seam's; seam_case gives each seam's
     assert case.start is a.start and case.task is a.task
     single = case.seam_case(1)
-    assert (single.name, single.cycle, single.task.rated_speed) == ("b", None, 0.01)
+    assert (single.name, len(single.seams), single.task.rated_speed) == ("b", 1, 0.01)
     assert np.allclose(single.start, [0, 0.05, 0])
 
 
 def test_a_single_path_case_is_one_seam_without_cycle() -> None:
     case = load_case(CASES / "bracket-weld.yaml")
-    assert case.cycle is None
+    assert case.seam_names == (case.name,)
+    assert (case.sequencing.sequence, case.sequencing.approach) == ("given", 0.0)
     assert len(case.seams) == 1 and case.seam_case(0) is case
 
 
 def test_the_shipped_case_has_four_seams_and_a_closed_loop() -> None:
     case = load_case(CASES / "bracket-4-fillets.yaml")
-    assert case.cycle is not None and len(case.seams) == 4
-    assert case.cycle.sequence == "optimize" and case.cell is not None
-    boss = case.seams[case.cycle.names.index("boss")]
+    assert len(case.seams) == 4
+    assert case.sequencing.sequence == "optimize" and case.cell is not None
+    boss = case.seams[case.seam_names.index("boss")]
     assert abs(abs(boss.segments[0].angle) - 2 * np.pi) < 1e-12  # closed loop
 
 

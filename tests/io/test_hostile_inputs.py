@@ -14,7 +14,7 @@ from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import robot_to_yaml
 from trackplan.io.sizes import MAX_SAMPLE_TIME, max_samples
 from trackplan.io.yaml_input import MAX_ALIAS_EXPANSION, MAX_DEPTH, MAX_YAML_VALUES, show
-from trackplan.planning.objective import joint_travel
+from trackplan.planning.objectives import joint_travel
 from trackplan.robots.builtin import puma560
 
 BILLION_LAUGHS = "name: x\na: &a [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n" + "".join(

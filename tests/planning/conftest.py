@@ -8,7 +8,7 @@ import pytest
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 
 
 @pytest.fixture(scope="session")
@@ -26,7 +26,7 @@ def corner_geometry(corner_case):
 @pytest.fixture(scope="session")
 def corner_plan(corner_case, corner_geometry):
     """The corner case planned at its example placement (smooth timing)."""
-    return plan_placement(corner_case, corner_case.bounds.example, geometry=corner_geometry)
+    return plan(corner_case, corner_case.bounds.example, geometries={(0, False): corner_geometry})
 
 
 @pytest.fixture(scope="session")

@@ -8,7 +8,7 @@ import pytest
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import plan_placement, tracking_reference
+from trackplan.planning.plan import plan, tracking_reference
 from trackplan.robots.path_ik import solve_path_ik
 from trackplan.status import Status
 
@@ -82,7 +82,7 @@ def test_skipped_segment_is_caught(three_segment_case):
     case = three_segment_case
     geometry = PathGeometry.from_case(case)
     X = case.bounds.example
-    result = plan_placement(case, X, geometry=geometry)
+    result = plan(case, X, geometries={(0, False): geometry})
     assert result.feasible, result.message
     nominal = geometry.nominal
     s_nominal, _ = nominal.project(

@@ -8,7 +8,7 @@ import pytest
 from tests.conftest import CASES
 from trackplan.check_report import CellReport, CheckReport, Violation, violations_status
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.status import Status
 
 
@@ -93,7 +93,7 @@ def test_an_infeasible_plan_and_its_check_say_the_same() -> None:
     (docs/paper.md): the plan, its check and each violation say LIMITS_VIOLATED."""
     case = load_case(CASES / "paper-line.yaml")
     X = np.array([-0.2230, 0.1029, 0.1829, 0.0312, -0.4124, 0.5020])
-    plan = plan_placement(case, X, timing="paper")
-    assert plan.status is plan.check.status is Status.LIMITS_VIOLATED
-    assert plan.check.violations
-    assert {v.status for v in plan.check.violations} == {Status.LIMITS_VIOLATED}
+    planned = plan(case, X, timing="paper")
+    assert planned.status is planned.check.status is Status.LIMITS_VIOLATED
+    assert planned.check.violations
+    assert {v.status for v in planned.check.violations} == {Status.LIMITS_VIOLATED}

@@ -11,7 +11,7 @@ from tests.oracles import rtb_robot_from
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.screening import code
 from trackplan.search.space import SearchSpace
@@ -65,13 +65,13 @@ def test_robot_without_dynamics_has_no_torque_check(ur):
 
 def test_payload_case_is_infeasible_at_the_papers_optimum(payload_case):
     """The 5 kg end effector: joint 5 cannot hold it at the paper's placement."""
-    plan = plan_placement(payload_case, payload_case.bounds.example)
-    assert not plan.feasible
-    torque = [v for v in plan.check.violations if v.limit == "torque"]
+    planned = plan(payload_case, payload_case.bounds.example)
+    assert not planned.feasible
+    torque = [v for v in planned.check.violations if v.limit == "torque"]
     assert [v.joint for v in torque] == [5]
     assert torque[0].message.startswith("joint 5 torque")
     assert "infeasible at any speed" in torque[0].message
-    assert "joint 5 torque" in plan.message
+    assert "joint 5 torque" in planned.message
 
 
 def test_search_screens_holding_torque(payload_case, corner_case):

@@ -14,31 +14,26 @@ import pytest
 import yaml
 
 from tests.conftest import CASES
+from trackplan.case import Sequencing
 from trackplan.cell.check import check_cell
 from trackplan.cell.screening import CellGeometry
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.io.case_file import load_case, load_case_text
-from trackplan.io.cycle_results import (
+from trackplan.io.results import (
     read_segments,
-    write_cycle_files,
-    write_cycle_trajectory_csv,
+    read_trajectory_csv,
+    write_plan_csv,
+    write_plan_files,
 )
-from trackplan.io.results import read_trajectory_csv
 from trackplan.paths import NominalPath
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec
-from trackplan.planning.cycle import (
-    AIR,
-    APPROACH,
-    RETRACT,
-    VIA_LIFT,
-    check_cycle_trajectory,
-    pieces_from_segments,
-    plan_cycle,
-    reversed_segments,
-)
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.assembly import VIA_LIFT
+from trackplan.planning.plan import check, plan
+from trackplan.planning.result import AIR, APPROACH, RETRACT
+from trackplan.planning.seams import reversed_segments
 from trackplan.planning.sequence import Sequence, Visit
+from trackplan.planning.trajectory_check import spans_from_segments
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.timing.airmove import plan_air_move
 
@@ -83,7 +78,7 @@ def case():
 
 @pytest.fixture(scope="module")
 def cycle(case):
-    return plan_cycle(case, X, sequence=FORCED)
+    return plan(case, X, sequence=FORCED)
 
 
 def _placed(point: np.ndarray) -> np.ndarray:
@@ -120,23 +115,23 @@ def test_reversed_segments_trace_the_same_path_backwards(segments) -> None:
 
 def test_the_cycle_is_feasible_and_labelled(cycle, case) -> None:
     assert cycle.success, cycle.message
-    kinds = [piece.kind for piece in cycle.pieces]
+    kinds = [piece.kind for piece in cycle.spans]
     # home → (air, approach, seam, retract) per seam → home
     assert kinds == [AIR, APPROACH, "seam", RETRACT] * 3 + [AIR]
-    for piece in cycle.pieces:
+    for piece in cycle.spans:
         labels = set(cycle.segment[piece.first + 1 : piece.last + 1])
         assert labels == {piece.label}
     assert [s.name for s in cycle.seams] == ["corner", "left", "right"]
     assert cycle.duration == pytest.approx(cycle.seam_time + cycle.air_time)
     assert cycle.seam_time == pytest.approx(sum(s.plan.duration for s in cycle.seams))
     # the first and last samples are home
-    assert np.array_equal(cycle.trajectory.q[0], case.cycle.home)
-    assert np.array_equal(cycle.trajectory.q[-1], case.cycle.home)
+    assert np.array_equal(cycle.trajectory.q[0], case.sequencing.home)
+    assert np.array_equal(cycle.trajectory.q[-1], case.sequencing.home)
 
 
 def test_each_air_move_ends_exactly_at_the_next_approach_pose(cycle, case) -> None:
     q = cycle.trajectory.q
-    pieces = cycle.pieces
+    pieces = cycle.spans
     seams = iter(cycle.seams)
     for before, after in itertools.pairwise(pieces):
         if before.kind != AIR:
@@ -163,18 +158,18 @@ def test_every_sample_is_within_every_joint_limit(cycle, case) -> None:
 
 def test_reversing_a_seam_reverses_its_travel_in_the_output(cycle, case) -> None:
     position = cycle.trajectory.tool_position
-    corner = next(p for p in cycle.pieces if p.label == "corner")
-    left = next(p for p in cycle.pieces if p.label == "left")
+    corner = next(p for p in cycle.spans if p.label == "corner")
+    left = next(p for p in cycle.spans if p.label == "left")
     assert corner.reversed and not left.reversed
     # reversed: the corner seam starts at its written end and ends at its written start
     assert np.linalg.norm(position[corner.first] - _placed(np.array([0.20, 0.15, 0]))) < 1e-6
     assert np.linalg.norm(position[corner.last] - _placed(np.array([0.05, 0.20, 0]))) < 1e-6
     assert np.linalg.norm(position[left.first] - _placed(np.array([0.05, 0.08, 0]))) < 1e-6
     # the same seam forward: the travel direction flips
-    again = plan_cycle(
+    again = plan(
         case, X, sequence=replace(FORCED, visits=(Visit(2, False), Visit(0, True), Visit(1, False)))
     )
-    forward = next(p for p in again.pieces if p.label == "corner")
+    forward = next(p for p in again.spans if p.label == "corner")
     assert not forward.reversed
     travel = (
         again.trajectory.tool_position[forward.last] - again.trajectory.tool_position[forward.first]
@@ -185,41 +180,39 @@ def test_reversing_a_seam_reverses_its_travel_in_the_output(cycle, case) -> None
 
 def test_the_written_cycle_rechecks_from_its_segment_column(cycle, case, tmp_path: Path) -> None:
     file = tmp_path / "trajectory.csv"
-    write_cycle_trajectory_csv(cycle, file)
+    write_plan_csv(cycle, file)
     t, q = read_trajectory_csv(file, case.robot.n_dof)
     segment = read_segments(file)
     assert np.array_equal(q, cycle.trajectory.q)
     assert list(segment) == list(cycle.segment)
-    report = check_cycle_trajectory(case, X, q, float(t[1] - t[0]), segment)
+    report = check(case, X, q, float(t[1] - t[0]), segment=segment)
     assert report.success
     assert report.max_tracking_error == pytest.approx(cycle.check.max_tracking_error)
     # a seam missing from the labels is a coverage violation naming it
     relabelled = np.where(segment == "left", "air", segment)
-    report = check_cycle_trajectory(case, X, q, float(t[1] - t[0]), relabelled)
+    report = check(case, X, q, float(t[1] - t[0]), segment=relabelled)
     assert not report.success
     assert any("seam left is not welded" in v.message for v in report.violations)
 
 
 def test_the_checker_names_the_seam_whose_tracking_fails(cycle, case) -> None:
     q = cycle.trajectory.q.copy()
-    left = next(p for p in cycle.pieces if p.label == "left")
+    left = next(p for p in cycle.spans if p.label == "left")
     middle = (left.first + left.last) // 2
     q[middle - 2 : middle + 3, 1] += 2e-3  # about 1 mm off the seam, vertically
-    report = check_cycle_trajectory(case, X, q, cycle.trajectory.sample_time, cycle.segment)
+    report = check(case, X, q, cycle.trajectory.sample_time, segment=cycle.segment)
     tracking = [v for v in report.violations if v.limit == "tracking"]
     assert tracking and tracking[0].message.startswith("seam left: ")
     assert left.first * cycle.trajectory.sample_time <= tracking[0].t_first
 
 
 def test_optimize_never_reverses_a_seam_that_may_not_be_reversed(case) -> None:
-    cycle = plan_cycle(case, X)
+    cycle = plan(case, X)
     assert cycle.success, cycle.message
     assert cycle.sequence.exact
     right = next(v for v in cycle.sequence.visits if v.seam == 1)
     assert not right.reversed
-    given = plan_cycle(
-        case, X, sequence=Sequence(tuple(Visit(i, False) for i in range(3)), 0.0, False)
-    )
+    given = plan(case, X, sequence=Sequence(tuple(Visit(i, False) for i in range(3)), 0.0, False))
     assert cycle.duration <= given.duration + 1e-9
 
 
@@ -233,9 +226,9 @@ def test_a_colliding_air_move_goes_through_a_via_above_the_seam_it_leaves() -> N
     data["cell"] = {"clearance": 0.005, "workpiece": [{"name": "fence", "box": fence}]}
     fenced = load_case_text(yaml.safe_dump(data, sort_keys=False))
     given = Sequence((Visit(0, False), Visit(1, False)), 0.0, False)
-    cycle = plan_cycle(fenced, X, sequence=given)
+    cycle = plan(fenced, X, sequence=given)
     robot = fenced.robot
-    between = cycle.pieces[4]
+    between = cycle.spans[4]
     assert between.kind == AIR and between.via is not None
     # the direct move would have gone through the fence
     near = cycle.seams[0]
@@ -253,16 +246,29 @@ def test_a_colliding_air_move_goes_through_a_via_above_the_seam_it_leaves() -> N
     assert np.max(np.abs(T_via[:3, 3] - lifted)) < 1e-9
 
 
-def test_a_single_path_case_is_the_one_seam_cycle_of_its_plan() -> None:
+def test_a_single_path_case_is_one_seam_span_of_its_plan() -> None:
+    single = load_case(CASES / "bracket-weld.yaml")
+    planned = plan(single, single.bounds.example)
+    assert planned.success, planned.message
+    n = planned.trajectory.n_samples
+    assert [(p.kind, p.first, p.last) for p in planned.spans] == [("seam", 0, n - 1)]
+    assert planned.seam_time == planned.duration and planned.air_time == 0.0
+    assert set(planned.segment) == {"bracket-weld"} and len(planned.segment) == n
+    assert planned.seams[0].plan.trajectory is planned.trajectory
+    assert planned.seam_checks == (planned.check,)
+
+
+def test_an_approach_joins_one_seam_with_moves() -> None:
     single = load_case(CASES / "bracket-weld.yaml")
     X_single = single.bounds.example
-    plan = plan_placement(single, X_single)
-    cycle = plan_cycle(single, X_single)
-    assert plan.success and cycle.success
-    assert np.array_equal(cycle.trajectory.q, plan.trajectory.q)
-    assert cycle.duration == plan.duration and cycle.air_time == 0.0
-    assert [p.kind for p in cycle.pieces] == [APPROACH, "seam", RETRACT]
-    assert set(cycle.segment[1:]) == {"bracket-weld"}
+    alone = plan(single, X_single)
+    moved = plan(replace(single, sequencing=Sequencing(approach=0.01)), X_single)
+    assert moved.success, moved.message
+    assert [p.kind for p in moved.spans] == [APPROACH, "seam", RETRACT]
+    seam = moved.spans[1]
+    assert np.allclose(moved.trajectory.q[seam.first : seam.last + 1], alone.trajectory.q)
+    assert moved.seam_time == pytest.approx(alone.duration, abs=1e-9)
+    assert moved.air_time > 0.0
 
 
 def spun_case(left: dict, corner: dict):
@@ -278,7 +284,7 @@ def spun_case(left: dict, corner: dict):
 
 def _written_spins(cycle, case, out: Path) -> tuple[dict, np.ndarray, np.ndarray]:
     """result.json, the spin column and the segment column of a cycle written to ``out``."""
-    write_cycle_files(cycle, case, out)
+    write_plan_files(cycle, case, out)
     header = (out / "trajectory.csv").read_text(encoding="utf-8").splitlines()[0].split(",")
     table = np.loadtxt(
         out / "trajectory.csv", delimiter=",", skiprows=1, usecols=range(len(header) - 1)
@@ -294,7 +300,7 @@ LEFT_FIRST = Sequence(visits=(Visit(0, False), Visit(1, False)), cost=0.0, exact
 def test_a_chosen_constant_spin_reaches_the_trajectory_and_result(reverse, tmp_path: Path) -> None:
     case = spun_case({"spin": "free", "spin_range": [-0.4, 0.4]}, {"spin_value": -0.1})
     order = Sequence(visits=(Visit(0, reverse), Visit(1, False)), cost=0.0, exact=False)
-    cycle = plan_cycle(case, X, sequence=order, spins=(np.array([0.25]), None))
+    cycle = plan(case, X, sequence=order, spins=(np.array([0.25]), None))
     assert cycle.success, cycle.message
     summary, spin, segment = _written_spins(cycle, case, tmp_path)
     # a constant spin is the same in both directions; the fixed seam keeps its spin_value
@@ -305,7 +311,7 @@ def test_a_chosen_constant_spin_reaches_the_trajectory_and_result(reverse, tmp_p
     assert seams["left"]["spin"] == {"value": 0.25} and seams["left"]["reversed"] is reverse
     assert seams["corner"]["spin"] == {"value": -0.1}
     # the middle of the range by default
-    middle = plan_cycle(case, X, sequence=LEFT_FIRST)
+    middle = plan(case, X, sequence=LEFT_FIRST)
     assert np.all(middle.trajectory.spin[middle.segment == "left"] == 0.0)
 
 
@@ -316,7 +322,7 @@ def test_a_spin_profile_is_reversed_with_its_seam() -> None:
     runs = {}
     for reverse in (False, True):
         order = Sequence(visits=(Visit(0, False), Visit(1, reverse)), cost=0.0, exact=False)
-        cycle = plan_cycle(case, X, sequence=order, spins=(None, variables))
+        cycle = plan(case, X, sequence=order, spins=(None, variables))
         assert cycle.success, cycle.message
         corner = cycle.segment == "corner"  # (its first sample is the approach's last)
         runs[reverse] = (cycle.trajectory.s[corner], cycle.trajectory.spin[corner])
@@ -334,7 +340,7 @@ def test_a_spin_profile_is_reversed_with_its_seam() -> None:
 def test_one_spin_per_seam_or_a_clear_error() -> None:
     case = spun_case({"spin": "free"}, {})
     with pytest.raises(CaseError, match="one spin per seam"):
-        plan_cycle(case, X, spins=(np.array([0.1]),))
+        plan(case, X, spins=(np.array([0.1]),))
 
 
 @pytest.mark.parametrize("reverse", [False, True])
@@ -348,12 +354,12 @@ def test_a_closed_seam_rechecks_in_the_direction_it_was_welded(reverse, tmp_path
     data["paths"] = [data["paths"][0], loop]
     case = load_case_text(yaml.safe_dump(data, sort_keys=False))
     order = Sequence(visits=(Visit(0, False), Visit(1, reverse)), cost=0.0, exact=False)
-    cycle = plan_cycle(case, X, sequence=order)
+    cycle = plan(case, X, sequence=order)
     assert cycle.success, cycle.message
     file = tmp_path / "trajectory.csv"
-    write_cycle_trajectory_csv(cycle, file)
+    write_plan_csv(cycle, file)
     _, q = read_trajectory_csv(file, case.robot.n_dof)
     segment = read_segments(file)
-    pieces = pieces_from_segments(case, X, q, segment)
+    pieces = spans_from_segments(case, X, q, segment)
     assert [p.reversed for p in pieces if p.kind == "seam"] == [False, reverse]
-    assert check_cycle_trajectory(case, X, q, case.task.sample_time, segment).success
+    assert check(case, X, q, case.task.sample_time, segment=segment).success

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from trackplan.derivatives import backward_derivatives
-from trackplan.planning.objective import joint_travel
+from trackplan.planning.objectives import joint_travel
 
 
 def test_joint_travel_matches_definition(rng):

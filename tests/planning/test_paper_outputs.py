@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 
 from .conftest import CASES
 
@@ -24,7 +24,7 @@ PINNED = {
 @pytest.mark.parametrize("name", sorted(PINNED))
 def test_paper_case_outputs_are_unchanged(name):
     case = load_case(CASES / f"{name}.yaml")
-    result = plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     duration, objective = PINNED[name]
     assert result.feasible, result.message
     assert result.trajectory.t[-1] == pytest.approx(duration, rel=1e-9, abs=0.0)

@@ -2,18 +2,27 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
 import pytest
 
 from trackplan.cli import main
+from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.io.case_file import load_case
-from trackplan.io.results import read_trajectory_csv, write_trajectory_csv
+from trackplan.io.results import (
+    read_segments,
+    read_trajectory_csv,
+    write_plan_csv,
+    write_plan_files,
+    write_trajectory_csv,
+)
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import plan_placement, tracking_reference
+from trackplan.planning.plan import check, make_trajectory, plan, tracking_reference
+from trackplan.planning.trajectory_check import spans_from_segments
 from trackplan.status import Status
 
 from .conftest import CASES
@@ -22,7 +31,7 @@ from .conftest import CASES
 @pytest.mark.parametrize("name", ["paper-line", "paper-circle", "paper-corner"])
 def test_paper_cases_plan_feasibly_in_smooth_mode(name):
     case = load_case(CASES / f"{name}.yaml")
-    result = plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     assert result.feasible, result.message
     # every output trajectory re-checked by the one checker, independently of the planner
     geometry = PathGeometry.from_case(case)
@@ -79,7 +88,7 @@ def test_random_reachable_placements_always_meet_rate_limits(corner_case, corner
         X = rng.uniform(lower, upper)
         if not reach_min <= np.linalg.norm(X[:3]) <= reach_max:
             continue
-        result = plan_placement(corner_case, X, geometry=corner_geometry)
+        result = plan(corner_case, X, geometries={(0, False): corner_geometry})
         if result.status in (Status.UNREACHABLE, Status.POSITION_LIMITS):
             continue
         planned += 1
@@ -87,7 +96,9 @@ def test_random_reachable_placements_always_meet_rate_limits(corner_case, corner
 
 
 def test_unreachable_placement_reports_why(corner_case, corner_geometry):
-    result = plan_placement(corner_case, np.array([2.0, 0, 0, 0, 0, 0]), geometry=corner_geometry)
+    result = plan(
+        corner_case, np.array([2.0, 0, 0, 0, 0, 0]), geometries={(0, False): corner_geometry}
+    )
     assert not result.feasible
     assert result.status is Status.UNREACHABLE
     assert "out of reach" in result.message
@@ -178,7 +189,7 @@ def test_full_reversal_is_a_stop_and_go(tmp_path):
     file = tmp_path / "reversal.yaml"
     file.write_text(text)
     case = load_case(file)
-    result = plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     assert result.feasible, result.message  # the checker follows the path back along itself
     traj = result.trajectory
     at_turn = np.argmin(np.abs(traj.s - 0.5))
@@ -189,7 +200,7 @@ def test_a_time_law_too_long_to_sample_says_where(corner_case, corner_geometry, 
     import trackplan.timing.smooth as smooth
 
     monkeypatch.setattr(smooth, "MAX_SAMPLES", 1000)
-    result = plan_placement(corner_case, corner_case.bounds.example, geometry=corner_geometry)
+    result = plan(corner_case, corner_case.bounds.example, geometries={(0, False): corner_geometry})
     assert result.status is Status.LIMITS_VIOLATED and not result.feasible
     assert "would need" in result.message and "m/s at s =" in result.message
     assert result.trajectory.n_samples == 0
@@ -205,3 +216,69 @@ def test_worst_margin_of_a_feasible_plan_is_its_least_unused_limit(corner_plan):
     assert 0.0 < worst < 1.0
     joint_least = min(float(np.min(m)) for m in check.joint_margins.values())
     assert worst <= joint_least
+
+
+def test_one_seam_is_checked_the_same_with_or_without_its_labels(corner_case, corner_plan):
+    q, sample_time = corner_plan.trajectory.q, corner_case.task.sample_time
+    unlabelled = check(corner_case, corner_plan.placement, q, sample_time)
+    labelled = check(
+        corner_case, corner_plan.placement, q, sample_time, segment=corner_plan.segment
+    )
+    assert unlabelled.success and labelled.success
+    assert labelled.max_tracking_error == unlabelled.max_tracking_error
+    assert labelled.max_tracking_error == pytest.approx(
+        corner_plan.check.max_tracking_error, rel=1e-12
+    )
+
+
+def test_a_single_seam_run_gains_the_seam_keys_and_keeps_its_numeric_table(
+    corner_case, corner_plan, tmp_path
+):
+    summary = write_plan_files(corner_plan, corner_case, tmp_path)
+    written = json.loads((tmp_path / "result.json").read_text())
+    assert written["path_length"] == pytest.approx(corner_plan.path_length, rel=1e-12)
+    assert written["cycle_time"] == written["duration"] == summary["duration"]
+    assert (written["air_time"], written["moves"], written["sequence_mode"]) == (0.0, [], "given")
+    assert [seam["name"] for seam in written["seams"]] == ["paper-corner"]
+    assert read_segments(tmp_path / "trajectory.csv") is None
+    table = np.loadtxt(tmp_path / "trajectory.csv", delimiter=",", skiprows=1, ndmin=2)
+    assert table.shape == (corner_plan.trajectory.n_samples, 1 + 4 * 6 + 5)
+
+
+BRACKET_X = np.array([0.2223, -0.5, -0.2999, 0.05, 0.0499, -2.7271])
+"""A placement of the shipped four-fillet bracket."""
+
+
+def test_plan_refuses_a_spin_or_two_branch_options_it_cannot_apply(corner_case):
+    two = load_case(CASES / "bracket-4-fillets.yaml")
+    with pytest.raises(CaseError, match="4 seams: give one spin per seam"):
+        plan(two, BRACKET_X, spin=np.array([0.1]))
+    with pytest.raises(CaseError, match=r"branch \(every seam\) or branches"):
+        plan(corner_case, corner_case.bounds.example, branch=0, branches=(0,))
+
+
+def test_check_of_several_seams_needs_their_labels():
+    case = load_case(CASES / "bracket-4-fillets.yaml")
+    q = np.zeros((3, case.robot.n_dof))
+    with pytest.raises(CaseError, match="4 seams: the trajectory needs its segment column"):
+        check(case, BRACKET_X, q, case.task.sample_time)
+
+
+def test_a_case_name_that_is_no_csv_field_labels_its_seam_safely(
+    corner_case, corner_plan, tmp_path
+):
+    renamed = dataclasses.replace(corner_case, name='=weld, "left"')
+    assert renamed.seam_names == ("_=weld_ _left_",)
+    result = dataclasses.replace(corner_plan, segment=np.full(3, renamed.seams[0].name))
+    result = dataclasses.replace(
+        result,
+        trajectory=make_trajectory(renamed.robot, corner_plan.trajectory.q[:3], np.zeros(3), 0.001),
+    )
+    write_plan_csv(result, tmp_path / "trajectory.csv")
+    t, q = read_trajectory_csv(tmp_path / "trajectory.csv", renamed.robot.n_dof)
+    assert t.tolist() == pytest.approx([0.0, 0.001, 0.002], abs=1e-15)
+    assert q.shape == (3, renamed.robot.n_dof)
+    segment = read_segments(tmp_path / "trajectory.csv")
+    assert segment.tolist() == ["_=weld_ _left_"] * 3
+    spans = spans_from_segments(renamed, corner_plan.placement, q, segment)
+    assert [(span.kind, span.seam, span.first, span.last) for span in spans] == [("seam", 0, 0, 2)]

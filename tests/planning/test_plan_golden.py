@@ -66,7 +66,7 @@ def figures(name: str) -> dict[str, Any]:
     """What a plan of the case at its golden placement gives: outcome and every figure."""
     case = trackplan.load_case(CASES / f"{name}.yaml")
     X = PLACEMENTS[name]
-    result = trackplan.plan_placement(case, case.bounds.example if X is None else X)
+    result = trackplan.plan(case, case.bounds.example if X is None else X)
     trajectory = result.trajectory
     energy = result.energy
     return {

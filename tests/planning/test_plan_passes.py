@@ -8,9 +8,10 @@ import numpy as np
 import trackplan
 import trackplan.motion as motion
 import trackplan.planning.checker as checker
-import trackplan.planning.plan as plan
+import trackplan.planning.seam_plan as seam_plan
 import trackplan.timing.sample_checks as sample_checks
 from tests.conftest import CASES
+from trackplan.planning.plan import plan
 
 
 def test_a_plan_makes_one_derivative_fk_and_rne_pass_over_its_samples(monkeypatch):
@@ -30,7 +31,7 @@ def test_a_plan_makes_one_derivative_fk_and_rne_pass_over_its_samples(monkeypatc
         for name in ("backward_derivatives", "forward_kinematics", "inverse_dynamics"):
             if hasattr(module, name):
                 monkeypatch.setattr(module, name, counted(name, getattr(module, name)))
-    result = trackplan.plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     assert result.success, result.message
     assert result.energy is not None
     n = result.trajectory.n_samples
@@ -47,9 +48,9 @@ def test_a_plan_makes_one_derivative_fk_and_rne_pass_over_its_samples(monkeypatc
 
 def test_every_plan_of_a_case_shares_its_paths():
     case = trackplan.load_case(CASES / "paper-corner.yaml")
-    first = trackplan.plan_placement(case, case.bounds.example)
-    second = trackplan.plan_placement(case, case.bounds.example + 0.01)
+    first = plan(case, case.bounds.example)
+    second = plan(case, case.bounds.example + 0.01)
     assert first.joint_path.geometry is second.joint_path.geometry
-    assert plan.case_geometry(case) is first.joint_path.geometry
+    assert seam_plan.case_geometry(case) is first.joint_path.geometry
     other = trackplan.load_case(CASES / "paper-corner.yaml")
-    assert plan.case_geometry(other) is not first.joint_path.geometry
+    assert seam_plan.case_geometry(other) is not first.joint_path.geometry

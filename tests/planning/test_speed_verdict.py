@@ -16,7 +16,7 @@ from trackplan.planning.checker import (
     check_trajectory,
     speed_slack,
 )
-from trackplan.planning.plan import plan_placement, tracking_reference
+from trackplan.planning.plan import plan, tracking_reference
 from trackplan.robots.families import detect
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.screening import code
@@ -52,14 +52,14 @@ def test_a_placement_the_search_counts_feasible_passes_the_final_check(numeric_k
     fitness = PlacementFitness(case, SearchSpace.from_case(case), geometry, "smooth")
     screened = fitness.evaluate(X[None])
     assert screened.finding[0] == code(Status.FEASIBLE)  # the search's verdict
-    plan = plan_placement(case, X, geometry=geometry, branch=int(screened.branch[0]))
+    planned = plan(case, X, geometries={(0, False): geometry}, branch=int(screened.branch[0]))
     rated = case.task.rated_speed
-    peak = float(plan.trajectory.speed.max())
+    peak = float(planned.trajectory.speed.max())
     # the numeric IK's error (≤ 1e-10 m a sample) does lift the sampled speed above the
     # rated speed the law plans exactly (by 2.5e-8 m/s here): the slack covers it
     assert rated < peak <= rated + speed_slack(case.task.sample_time)
-    assert plan.feasible, plan.message
-    assert plan.check.task_margins["speed"] == 0.0
+    assert planned.feasible, planned.message
+    assert planned.check.task_margins["speed"] == 0.0
 
 
 KR6_FEASIBLE = np.array([0.3147, -0.0547, 0.0967, 0.046, -0.1904, -0.014])

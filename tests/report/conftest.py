@@ -18,7 +18,7 @@ from trackplan.derivatives import backward_derivatives
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import make_trajectory, plan_placement, tracking_reference
+from trackplan.planning.plan import make_trajectory, plan, tracking_reference
 from trackplan.planning.result import LIMIT_KINDS, CheckReport, PlanResult, Trajectory
 from trackplan.robots.builtin import puma560
 from trackplan.robots.model import Robot
@@ -71,7 +71,7 @@ def plan_corner(case: Case) -> PlanResult:
     and reference durations are added so that every part of the report has content.
     """
     robot = case.robot
-    planned = plan_placement(case, PAPER_PLACEMENT)
+    planned = plan(case, PAPER_PLACEMENT)
     t, q = planned.trajectory.t, planned.trajectory.q.copy()
     bump = np.exp(-0.5 * ((t - PLANTED_TIME) / 0.02) ** 2)
     bump_jerk = backward_derivatives(bump, SAMPLE_TIME)[2]
@@ -142,7 +142,7 @@ def empty_result(case: Case) -> PlanResult:
         min_corner_speed=0.0,
         slowdowns=(),
         references={},
-        joint_path=plan_placement(case, UNREACHABLE_PLACEMENT).joint_path,
+        joint_path=plan(case, UNREACHABLE_PLACEMENT).joint_path,
     )
 
 

@@ -16,7 +16,7 @@ from tests.conftest import CASES
 from tests.planning.test_cycle import CASE, X, spun_case
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case, load_case_text
-from trackplan.planning.cycle import seam_geometries
+from trackplan.planning.seams import seam_geometries
 from trackplan.search.case_fitness import CaseFitness
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.screening import code, outcome
@@ -104,7 +104,9 @@ def test_the_shipped_bracket_optimizes_rechecks_and_exports(
     assert "feasible placement for all 4 seams" in out
     result = json.loads((run / "result.json").read_text(encoding="utf-8"))
     case = load_case(case_file)
-    assert result["feasible"] and {s["name"] for s in result["seams"]} == set(case.cycle.names)
+    assert result["feasible"] and {s["name"] for s in result["seams"]} == {
+        seam.name for seam in case.seams
+    }
     assert result["cycle_time"] == pytest.approx(result["seam_time"] + result["air_time"])
     assert result["sequence_exact"] is True and len(result["sequence"]) == 4
     assert all(s["max_tracking_error"] <= case.task.tolerance for s in result["seams"])

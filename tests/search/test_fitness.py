@@ -12,8 +12,8 @@ from trackplan.case import Case
 from trackplan.frames import tool_poses
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.objective import joint_travel
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.objectives import joint_travel
+from trackplan.planning.plan import plan as plan_placement
 from trackplan.robots.path_ik import solve_path_ik, solve_path_ik_branches
 from trackplan.search.fitness import (
     CURVED_POSES,
@@ -92,7 +92,9 @@ def test_screened_travel_matches_the_full_plan(
     case: Case, geometry: PathGeometry, X: np.ndarray
 ) -> None:
     screened = _fitness(case, geometry).evaluate(X[None])
-    plan = plan_placement(case, X, branch=int(screened.branch[0]), geometry=geometry)
+    plan = plan_placement(
+        case, X, branch=int(screened.branch[0]), geometries={(0, False): geometry}
+    )
     assert plan.feasible
     assert screened.objective[0] == pytest.approx(plan.objective, rel=5e-3)
 

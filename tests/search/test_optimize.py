@@ -19,7 +19,7 @@ from trackplan.forking import can_fork, forked_pool
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.specs import LineSpec
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.planning.result import PlanResult
 from trackplan.search import GenerationRecord, SearchResult
 from trackplan.search.fitness import PlacementFitness
@@ -40,19 +40,19 @@ def geometry(case: Case) -> PathGeometry:
 
 
 def test_same_seed_same_history_and_result(case: Case, geometry: PathGeometry) -> None:
-    runs = [optimize(case, seed=7, budget=400, geometry=geometry) for _ in range(2)]
+    runs = [optimize(case, seed=7, budget=400, geometries={(0, False): geometry}) for _ in range(2)]
     first, second = runs
     for key, column in first.history.as_columns().items():
         if key != "wall_time":
             assert np.array_equal(column, second.history.as_columns()[key]), key
     assert np.array_equal(first.X, second.X) and first.branch == second.branch
     assert first.objective == second.objective
-    other = optimize(case, seed=8, budget=400, geometry=geometry)
+    other = optimize(case, seed=8, budget=400, geometries={(0, False): geometry})
     assert not np.array_equal(other.X, first.X)
 
 
 def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeometry) -> None:
-    result = optimize(case, method="ga", budget=100, geometry=geometry)
+    result = optimize(case, method="ga", budget=100, geometries={(0, False): geometry})
     assert result.evaluations == 100 and result.stop_reason == "budget"
     assert result.history.evaluations.tolist() == [30, 58, 86, 100]
     assert result.generations == 4 and result.method == "ga" and result.seed == 0
@@ -68,7 +68,8 @@ def test_budget_is_exact_and_the_result_checked(case: Case, geometry: PathGeomet
 def test_other_methods_are_reproducible(case: Case, geometry: PathGeometry, method: str) -> None:
     budget = 2150 if method == "multistart" else 150  # multistart: into its first local run
     first, second = (
-        optimize(case, method=method, seed=3, budget=budget, geometry=geometry) for _ in range(2)
+        optimize(case, method=method, seed=3, budget=budget, geometries={(0, False): geometry})
+        for _ in range(2)
     )
     assert first.method == method and first.evaluations == budget
     assert first.success and first.final.check.success
@@ -79,9 +80,9 @@ def test_other_methods_are_reproducible(case: Case, geometry: PathGeometry, meth
 def test_time_weight_with_an_executor(case: Case, geometry: PathGeometry) -> None:
     """Timing candidates in threads gives the same search as timing them in turn."""
     timed = replace(case, objective=replace(case.objective, time_weight=0.1))
-    serial = optimize(timed, budget=58, geometry=geometry)
+    serial = optimize(timed, budget=58, geometries={(0, False): geometry})
     with ThreadPoolExecutor(2) as executor:
-        threaded = optimize(timed, budget=58, geometry=geometry, executor=executor)
+        threaded = optimize(timed, budget=58, geometries={(0, False): geometry}, executor=executor)
     assert np.array_equal(serial.history.best, threaded.history.best)
     assert serial.success and np.array_equal(serial.X, threaded.X)
     assert serial.fitness == pytest.approx(serial.objective + 0.1 * serial.final.duration, rel=1e-3)
@@ -95,7 +96,7 @@ def test_ctrl_c_keeps_the_best_placement(case: Case, geometry: PathGeometry) -> 
         if record.generation == 3:
             raise KeyboardInterrupt
 
-    result = optimize(case, method="ga", progress=progress, geometry=geometry)
+    result = optimize(case, method="ga", progress=progress, geometries={(0, False): geometry})
     assert result.stop_reason == "interrupted"
     assert [r.generation for r in seen] == [1, 2, 3] and result.generations == 3
     assert result.evaluations == seen[-1].evaluations == 86
@@ -112,7 +113,7 @@ def _same_plan(a: PlanResult, b: PlanResult) -> None:
 
 @pytest.fixture(scope="module")
 def serial_ga(case: Case, geometry: PathGeometry) -> SearchResult:
-    return optimize(case, method="ga", budget=100, geometry=geometry)
+    return optimize(case, method="ga", budget=100, geometries={(0, False): geometry})
 
 
 def _worker_pids() -> list[int]:
@@ -141,7 +142,12 @@ def test_plans_in_the_background_are_the_same(
     with forked_pool() as pool:
         assert pool is not None
         result = optimize(
-            case, method="ga", budget=100, geometry=geometry, background=pool, progress=progress
+            case,
+            method="ga",
+            budget=100,
+            geometries={(0, False): geometry},
+            background=pool,
+            progress=progress,
         )
         alive = _worker_pids()
     if signum is None:
@@ -163,7 +169,9 @@ def test_a_broken_background_plans_here(
             job.set_exception(BrokenExecutor("gone"))
             return job
 
-    result = optimize(case, method="ga", budget=100, geometry=geometry, background=Broken())
+    result = optimize(
+        case, method="ga", budget=100, geometries={(0, False): geometry}, background=Broken()
+    )
     _same_plan(result.initial, serial_ga.initial)
     _same_plan(result.final, serial_ga.final)
 
@@ -174,7 +182,7 @@ def test_final_recheck_catches_a_wrong_screening(
     """Screening that calls an unreachable placement feasible with the best J: the final
     re-check at full Ts rejects it and the next best distinct candidate is returned."""
     planted = np.array([0.8, 0.2, 0.0, 0.0, 0.0, 0.0])  # the path leaves the workspace
-    assert not plan_placement(case, planted, geometry=geometry).feasible
+    assert not plan(case, planted, geometries={(0, False): geometry}).feasible
     screen = PlacementFitness.screen_seam
 
     def lying(self: PlacementFitness, X: np.ndarray) -> SeamScreen:
@@ -197,7 +205,7 @@ def test_final_recheck_catches_a_wrong_screening(
         return drawn
 
     monkeypatch.setattr(SearchSpace, "sample", planting)
-    result = optimize(case, budget=60, geometry=geometry)
+    result = optimize(case, budget=60, geometries={(0, False): geometry})
     assert result.rejected.shape == (1, 6) and np.allclose(result.rejected[0], planted)
     assert result.success and result.final.check.success
     assert not np.allclose(result.X, planted)
@@ -222,7 +230,7 @@ def test_no_candidate_passing_the_check_gives_infeasible(
         )
 
     monkeypatch.setattr(PlacementFitness, "screen_seam", everything_feasible)
-    result = optimize(case, budget=30, seed=1, geometry=geometry)
+    result = optimize(case, budget=30, seed=1, geometries={(0, False): geometry})
     assert not result.success and result.status is not Status.FEASIBLE
     assert not result.final.feasible and len(result.rejected) >= 1
 
@@ -261,10 +269,12 @@ def test_bad_options(case: Case, options: dict, match: str) -> None:
 @pytest.mark.slow
 def test_corner_beats_the_papers_optimum(case: Case, geometry: PathGeometry) -> None:
     """The default search finds a lower J than the paper's published X planned by us."""
-    paper = plan_placement(
-        case, np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522]), geometry=geometry
+    paper = plan(
+        case,
+        np.array([0.0902, 0.2090, 0.2020, 0.3263, 0.3016, -0.2522]),
+        geometries={(0, False): geometry},
     )
-    result = optimize(case, geometry=geometry)
+    result = optimize(case, geometries={(0, False): geometry})
     assert result.success and result.stop_reason == "converged"
     assert result.objective < paper.objective
     assert result.objective == pytest.approx(result.fitness, rel=5e-3)
@@ -276,7 +286,7 @@ def test_multistart_descends_from_its_best_distinct_samples(
     """Local runs start from mutually distant good samples and improve on the sampling."""
     from trackplan.search import multistart
 
-    result = optimize(case, method="multistart", seed=2, geometry=geometry)
+    result = optimize(case, method="multistart", seed=2, geometries={(0, False): geometry})
     sampled = result.history.evaluations <= multistart.MULTISTART_SAMPLES
     assert result.success and result.stop_reason == "converged"
     assert result.history.best[~sampled].min() < result.history.best[sampled].min()
@@ -291,7 +301,11 @@ def test_a_pymoo_algorithm_and_termination_can_be_passed_in(
     from pymoo.algorithms.soo.nonconvex.ga import GA
 
     result = optimize(
-        case, method=GA(pop_size=20), termination=("n_gen", 4), seed=1, geometry=geometry
+        case,
+        method=GA(pop_size=20),
+        termination=("n_gen", 4),
+        seed=1,
+        geometries={(0, False): geometry},
     )
     assert result.method == "GA" and result.runs == 1 and result.stop_reason == "custom"
     assert result.evaluations == 80 and result.generations == 4
@@ -306,7 +320,7 @@ def test_a_fixed_coordinate_stays_fixed(
     lower, upper = case.bounds.lower.copy(), case.bounds.upper.copy()
     lower[0] = upper[0] = 0.25  # x fixed
     fixed = replace(case, bounds=replace(case.bounds, lower=lower, upper=upper))
-    result = optimize(fixed, method=method, budget=budget, geometry=geometry)
+    result = optimize(fixed, method=method, budget=budget, geometries={(0, False): geometry})
     assert result.X[0] == 0.25
     assert result.evaluations == budget
 

@@ -70,7 +70,7 @@ def test_weighted_objective_of_a_plan(corner, corner_plan_for_objectives):
 
 @pytest.fixture(scope="module")
 def corner_plan_for_objectives(corner):
-    from trackplan.planning.plan import plan_placement
+    from trackplan.planning.plan import plan as plan_placement
 
     return plan_placement(corner, corner.bounds.example)
 

@@ -11,7 +11,7 @@ import pytest
 from tests.conftest import CASES
 from trackplan.cli import ExitCode, main
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import check_case_trajectory, plan_placement
+from trackplan.planning.plan import check, plan
 from trackplan.search.optimize import optimize
 from trackplan.search.spin import optimize_spin
 from trackplan.status import Status
@@ -35,7 +35,7 @@ def free_plan(free_case):
 
 
 def test_fixed_spin_at_the_example_explains_the_full_turn(fixed_case):
-    result = plan_placement(fixed_case, fixed_case.bounds.example)
+    result = plan(fixed_case, fixed_case.bounds.example)
     assert result.status is Status.POSITION_LIMITS
     assert "joint 6" in result.message and "leaves [-2.356, 2.356]" in result.message
     assert TURN in result.message
@@ -48,10 +48,10 @@ def test_free_varying_spin_plans_the_example_and_the_checker_agrees(free_case, f
     # the spin counter-rotates: it changes by more than the 4.7 rad that joint 6 could absorb
     # on its own were the wrist to make the full turn
     assert np.ptp(free_plan.trajectory.spin) > 2 * np.pi - 1.5 * np.pi
-    check = check_case_trajectory(
+    report = check(
         free_case, free_plan.placement, free_plan.trajectory.q, free_case.task.sample_time
     )
-    assert check.success and check.max_orientation_error < 1e-6
+    assert report.success and report.max_orientation_error < 1e-6
     lo, hi = free_case.task.tool.spin_range
     assert (
         lo - 1e-9 <= free_plan.trajectory.spin.min() <= free_plan.trajectory.spin.max() <= hi + 1e-9
@@ -64,8 +64,8 @@ def test_free_varying_spin_plans_the_example_and_the_checker_agrees(free_case, f
 def test_a_plan_with_a_wrong_spin_fails_the_spin_check(free_case, free_plan):
     q = free_plan.trajectory.q.copy()
     q[:, 5] += 0.5 * np.linspace(0.0, 1.0, len(q)) ** 3  # the spin now leaves its range
-    check = check_case_trajectory(free_case, free_plan.placement, q, free_case.task.sample_time)
-    assert {v.limit for v in check.violations} & {"spin", "spin rate"}
+    report = check(free_case, free_plan.placement, q, free_case.task.sample_time)
+    assert {v.limit for v in report.violations} & {"spin", "spin rate"}
 
 
 def test_plan_cli_fixed_exits_3_and_free_writes_the_spin(tmp_path, capsys):
@@ -123,20 +123,16 @@ def test_spin_given_to_a_fixed_spin_is_bad_input(tmp_path, capsys):
 def test_optimize_free_varying_finds_a_feasible_placement(free_case):
     result = optimize(free_case, budget=600, restarts=1)
     assert result.success, result.message
-    check = check_case_trajectory(
-        free_case, result.X, result.final.trajectory.q, free_case.task.sample_time
-    )
-    assert check.success
+    report = check(free_case, result.X, result.final.trajectory.q, free_case.task.sample_time)
+    assert report.success
 
 
 @pytest.mark.slow
 def test_optimize_fixed_is_verified_or_explains_the_turn(fixed_case):
     result = optimize(fixed_case, budget=600, restarts=1)
     if result.success:
-        check = check_case_trajectory(
-            fixed_case, result.X, result.final.trajectory.q, fixed_case.task.sample_time
-        )
-        assert check.success
+        report = check(fixed_case, result.X, result.final.trajectory.q, fixed_case.task.sample_time)
+        assert report.success
     else:
         assert TURN in result.message
 
@@ -167,5 +163,5 @@ def test_seam_weld_on_an_industrial_robot_optimises_with_a_free_spin():
     spin = result.final.joint_path.tool.spin
     assert len(spin.coefficients) == 1
     assert np.ptp(result.final.trajectory.spin) == 0.0  # one constant spin
-    check = check_case_trajectory(case, result.X, result.final.trajectory.q, case.task.sample_time)
-    assert check.success and check.max_orientation_error < 0.06
+    report = check(case, result.X, result.final.trajectory.q, case.task.sample_time)
+    assert report.success and report.max_orientation_error < 0.06

@@ -24,7 +24,7 @@ from tests.study.conftest import six_jobs
 from tests.study.test_cli_batch import free_port
 from trackplan.io.results import read_trajectory_csv
 from trackplan.io.study_file import load_study
-from trackplan.planning.plan import check_case_trajectory
+from trackplan.planning.plan import check
 from trackplan.study import read_summary_csv
 
 pytestmark = pytest.mark.slow
@@ -108,7 +108,7 @@ def test_batch_on_a_cluster_survives_a_killed_worker(cluster, tmp_path: Path) ->
         row = next(row for row in rows if row.job == job.key)
         placement = json.loads((folder / "result.json").read_text())["placement"]
         X = [placement[key] for key in ("x", "y", "z", "roll", "pitch", "yaw")]
-        report = check_case_trajectory(job.case, np.array(X), q, float(t[1] - t[0]))
+        report = check(job.case, np.array(X), q, float(t[1] - t[0]))
         assert report.success == row.success, (job.key, [v.message for v in report.violations])
         assert report.max_tracking_error == pytest.approx(row.tracking_error_m, rel=1e-9)
 

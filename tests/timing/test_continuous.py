@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
-from trackplan.planning.plan import check_case_trajectory, plan_placement
+from trackplan.planning.plan import check, plan
 from trackplan.timing import continuous, curve_nodes, curve_program, smooth
 from trackplan.timing.profile import SpeedProfile, speed_change_phases, speed_change_time
 from trackplan.timing.sample_checks import robot_checks
@@ -57,7 +57,7 @@ def _divided_differences(s: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.n
 @pytest.fixture(scope="module")
 def wrist():
     case = load_case(CASES / "paper-line.yaml")
-    return case, plan_placement(case, WRIST_X)
+    return case, plan(case, WRIST_X)
 
 
 def test_near_a_wrist_singularity_the_law_is_within_4_percent_of_topp3(wrist):
@@ -65,7 +65,7 @@ def test_near_a_wrist_singularity_the_law_is_within_4_percent_of_topp3(wrist):
     assert result.feasible, result.message
     assert result.duration <= 1.04 * WRIST_TOPP3
     assert result.duration < 0.7 * WINDOWS_ONLY
-    report = check_case_trajectory(case, WRIST_X, result.trajectory.q, case.task.sample_time)
+    report = check(case, WRIST_X, result.trajectory.q, case.task.sample_time)
     assert report.success, report.violations[:3]
     assert any("joint 4" in d.limit or "joint 6" in d.limit for d in result.slowdowns)
 
@@ -252,10 +252,10 @@ def _assert_planned_within(name: str, X: np.ndarray, duration: float) -> None:
     """The case ``name`` plans feasible at X within ``duration`` (s), and its trajectory
     passes the checker sample by sample."""
     case = load_case(CASES / f"{name}.yaml")
-    result = plan_placement(case, X)
+    result = plan(case, X)
     assert result.feasible, result.message
     assert result.duration <= duration
-    report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
+    report = check(case, X, result.trajectory.q, case.task.sample_time)
     assert report.success, report.violations[:3]
 
 
@@ -265,7 +265,7 @@ def test_no_node_inside_a_stretch_comes_to_rest_in_a_short_blend():
     window plan's plateau); with nodes 1 mm apart across the 5 mm blend and Σ x as
     objective, nodes came to rest there."""
     case = load_case(CASES / "paper-corner.yaml")
-    joint_path = plan_placement(case, CORNER_X).joint_path
+    joint_path = plan(case, CORNER_X).joint_path
     robot = case.robot
     (stretch,) = curve_nodes.split_stretches(joint_path, case.task)
     limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, robot.j_max])[:, None, :]
@@ -318,7 +318,7 @@ def test_the_nodes_see_the_seam_frame_start_turning_between_grid_points():
     its two neighbouring nodes asks (it was 5.7 times with the grid's derivatives
     interpolated: a speed cap 1.8 times too high)."""
     case = load_case(CASES / "bracket-two-faces.yaml")
-    joint_path = plan_placement(case, SEAM_X).joint_path
+    joint_path = plan(case, SEAM_X).joint_path
     (stretch,) = curve_nodes.split_stretches(joint_path, case.task)
     blend = joint_path.geometry.zones()[0][1]
     points = np.arange(blend - 0.022, blend, 2e-5)
@@ -349,13 +349,13 @@ def test_once_the_rebuilds_are_spent_the_curve_runs_slower_instead_of_being_give
     ratio (1.36^(1/3) = 1.11) until its samples pass, instead of being given up; every
     sample re-checked."""
     case = load_case(CASES / "paper-corner.yaml")
-    joint_path = plan_placement(case, REST_X).joint_path
+    joint_path = plan(case, REST_X).joint_path
     checks = robot_checks(case.robot)
     monkeypatch.setattr(continuous, "MAX_REBUILDS", 1)
     curve = continuous.plan_speed_curve(joint_path, case.task, checks, LIMIT_SHARE)
     assert curve is not None and 1 < curve.rebuilds <= 1 + continuous.SLOW_DOWNS
     assert curve.duration <= 1.112 * 7.992
-    report = check_case_trajectory(case, REST_X, curve.motion.q, case.task.sample_time)
+    report = check(case, REST_X, curve.motion.q, case.task.sample_time)
     assert report.success, report.violations[:3]
 
 
@@ -376,7 +376,7 @@ def test_a_lowered_jerk_limit_lowers_the_path_jerk_at_a_wrist_flip(rows, monkeyp
     lowered limit; with the rows that term itself stays within CANCEL_ROOM times it."""
     room = curve_program.CANCEL_ROOM
     case = load_case(CASES / "bracket-two-faces.yaml")
-    joint_path = plan_placement(case, WRIST_FLIP_X).joint_path
+    joint_path = plan(case, WRIST_FLIP_X).joint_path
     robot = case.robot
     (stretch,) = curve_nodes.split_stretches(joint_path, case.task)
     limits = LIMIT_SHARE * np.stack([robot.v_max, robot.a_max, 0.25 * robot.j_max])[:, None, :]

@@ -14,7 +14,7 @@ from trackplan.errors import CaseError
 from trackplan.io.case_file import load_case
 from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.status import Status
 from trackplan.timing import smooth, zones
 from trackplan.timing.airmove import plan_air_move
@@ -44,7 +44,7 @@ def axis_case_file(tmp_path_factory):
 
 def test_a_joint_path_that_jumps_at_the_start_is_a_verdict_not_a_zero_division(axis_case_file):
     case = load_case(axis_case_file)
-    result = plan_placement(case, ON_THE_AXIS)
+    result = plan(case, ON_THE_AXIS)
     assert result.status is Status.LIMITS_VIOLATED
     message = result.message
     assert "joint 1" in message
@@ -122,13 +122,13 @@ def test_a_task_built_in_code_with_no_speed_is_bad_input(name, value):
     case = load_case(CASES / "kuka-weld.yaml")
     bad = replace(case, task=replace(case.task, **{name: value}))
     with pytest.raises(CaseError, match=rf"task\.{name}: must be a finite number > 0"):
-        plan_placement(bad, KR6_FEASIBLE)
+        plan(bad, KR6_FEASIBLE)
 
 
 def test_a_tiny_task_speed_is_not_blamed_on_a_singularity():
     case = load_case(CASES / "kuka-weld.yaml")
     slow = replace(case, task=replace(case.task, rated_speed=1e-9))
-    result = plan_placement(slow, KR6_FEASIBLE)
+    result = plan(slow, KR6_FEASIBLE)
     assert result.status is Status.LIMITS_VIOLATED
     assert "rated speed holds the speed to 1e-09 m/s" in result.message
     assert "singularity" not in result.message

@@ -9,7 +9,7 @@ from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.status import Status
 from trackplan.timing import paper
 from trackplan.tool import ToolOrientation
@@ -33,12 +33,12 @@ def corner_case():
 
 @pytest.fixture(scope="module")
 def line_result(line_case):
-    return plan_placement(line_case, LINE_MOVED_OUT, timing="paper")
+    return plan(line_case, LINE_MOVED_OUT, timing="paper")
 
 
 @pytest.fixture(scope="module")
 def corner_result(corner_case):
-    return plan_placement(corner_case, CORNER_PUBLISHED, timing="paper")
+    return plan(corner_case, CORNER_PUBLISHED, timing="paper")
 
 
 def kinds(result) -> set[str]:
@@ -48,7 +48,7 @@ def kinds(result) -> set[str]:
 def test_published_line_placement_is_out_of_reach(line_case):
     # The start (x, y) is 0.146 m from joint 1's axis, inside the 0.15 m shoulder offset d3.
     assert np.hypot(*LINE_PUBLISHED[:2]) < line_case.robot.dh[2, 0]
-    result = plan_placement(line_case, LINE_PUBLISHED, timing="paper")
+    result = plan(line_case, LINE_PUBLISHED, timing="paper")
     assert result.status is Status.UNREACHABLE
     assert result.trajectory.n_samples == 0
     assert "out of reach" in result.message
@@ -108,7 +108,7 @@ def test_corner_arc_is_a_whole_number_of_periods(corner_case):
 
 def test_arc_started_at_constant_speed_steps_the_velocity():
     case = load_case(CASES / "paper-circle.yaml")
-    result = plan_placement(case, CIRCLE, timing="paper")
+    result = plan(case, CIRCLE, timing="paper")
     assert result.trajectory.n_samples > 0
     first = [v for v in result.check.violations if v.limit == "acceleration"]
     assert first, "the step from rest to v_t at the start must break the acceleration limit"
@@ -130,7 +130,7 @@ def test_forced_branch_is_used_or_refused(corner_case):
     assert joint_path.branch == 3 and law.success and law.message == ""
     assert law.q.shape == (len(law.s), 6)
     assert np.all(np.diff(law.s) >= -1e-6)
-    refused = plan_placement(corner_case, CORNER_PUBLISHED, timing="paper", branch=0)
+    refused = plan(corner_case, CORNER_PUBLISHED, timing="paper", branch=0)
     assert refused.branch == 0 and refused.status is Status.POSITION_LIMITS
     assert refused.trajectory.q.shape == (0, 6) and refused.message
 
@@ -143,7 +143,7 @@ def test_via_spacing_keeps_the_ramp_from_stalling(line_case):
     joint_path = JointPath.solve(line_case.robot, geometry, LINE_MOVED_OUT, tool, branch=2)
     planner = paper._PaperPlanner(line_case.robot, line_case.task, joint_path)
     piece = geometry.planned.pieces[0]
-    q_start = plan_placement(line_case, LINE_MOVED_OUT, timing="paper").trajectory.q[0]
+    q_start = plan(line_case, LINE_MOVED_OUT, timing="paper").trajectory.q[0]
     rated = line_case.task.rated_speed
     _, fine = planner._via_points(piece, paper.MIN_VIA_SPACING, q_start)
     stalled = planner._ramp(fine, np.zeros(6), rated)

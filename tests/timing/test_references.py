@@ -8,7 +8,7 @@ import pytest
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.planning.checker import check_trajectory
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.timing.references import (
     reference_durations,
     reference_inputs,
@@ -26,7 +26,7 @@ LINE = np.array([-0.2230, 0.1029, 0.1829, 0.0312, -0.4124, 0.5020])
 @pytest.fixture(scope="module")
 def line():
     case = load_case(CASES / "paper-line.yaml")
-    result = plan_placement(case, LINE, timing="smooth")
+    result = plan(case, LINE, timing="smooth")
     assert result.joint_path.success
     s_grid, q_grid, caps = reference_inputs(result.joint_path, case.task)
     return case, result, s_grid, q_grid, caps

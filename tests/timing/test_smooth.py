@@ -10,7 +10,7 @@ import pytest
 from tests.conftest import CASES
 from trackplan.io.case_file import load_case
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import check_case_trajectory, plan_placement
+from trackplan.planning.plan import check, plan
 from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.timing.sample_checks import LIMIT_MARGIN, RateLimits, run_checks
 from trackplan.timing.smooth import plan_smooth_time_law
@@ -78,7 +78,7 @@ def test_a_joint_limit_forces_a_reported_slow_down(tmp_path):
     case = load_case(CASES / "paper-corner.yaml")
     slow_robot = replace(case.robot, v_max=case.robot.v_max * np.array([1, 1, 1, 0.1, 1, 1]))
     slow_case = replace(case, robot=slow_robot)
-    result = plan_placement(slow_case, case.bounds.example)
+    result = plan(slow_case, case.bounds.example)
     assert result.feasible, result.message
     assert result.slowdowns, "joint 4 at 0.5 rad/s cannot keep 0.15 m/s on the whole path"
     assert any("joint 4 velocity" in d.limit for d in result.slowdowns)
@@ -92,7 +92,7 @@ def test_a_joint_limit_forces_a_reported_slow_down(tmp_path):
 
 def test_rated_speed_held_exactly_elsewhere(tmp_path):
     case = load_case(CASES / "paper-line.yaml")
-    result = plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     traj = result.trajectory
     path_speed = np.diff(traj.s) / traj.sample_time
     assert path_speed.max() == pytest.approx(case.task.rated_speed, rel=1e-12)
@@ -116,7 +116,7 @@ def test_rebuilds_until_the_sampled_trajectory_meets_every_limit(monkeypatch):
     spec = dataclasses.replace(smooth.LAW, plan=spy)
     monkeypatch.setitem(timing.TIME_LAWS, smooth.LAW.timing, spec)
     case = load_case(CASES / "paper-corner.yaml")
-    result = plan_placement(case, case.bounds.example)
+    result = plan(case, case.bounds.example)
     assert laws[-1].iterations > 1 and laws[-1].success
     assert result.feasible, result.message
 
@@ -139,12 +139,12 @@ def test_random_placements_of_every_case_pass_the_checker(name, seam):
         X = rng.uniform(lower, upper)
         if not reach_min <= np.linalg.norm(X[:3]) <= reach_max:
             continue
-        result = plan_placement(case, X, geometry=geometry)
+        result = plan(case, X, geometries={(0, False): geometry})
         if not result.joint_path.success:
             continue
         if case.robot.dynamics and holding_torque_ratio(case.robot, result.joint_path.q) > 1:
             continue  # the robot cannot hold the path still: no time law helps
-        report = check_case_trajectory(case, X, result.trajectory.q, case.task.sample_time)
+        report = check(case, X, result.trajectory.q, case.task.sample_time)
         timing_violations = [v for v in report.violations if v.limit not in CELL_LIMITS]
         if len(timing_violations) < len(report.violations):
             continue  # the placement collides with the cell: no time law helps
@@ -165,7 +165,7 @@ def test_planned_speed_stays_under_the_corner_cap_by_the_margin():
     rng = np.random.default_rng(8)
     for _ in range(2000):
         X = rng.uniform(case.bounds.lower, case.bounds.upper)
-        result = plan_placement(fine, X, geometry=geometry)
+        result = plan(fine, X, geometries={(0, False): geometry})
         if result.joint_path.success:
             break
     traj = result.trajectory
@@ -180,7 +180,7 @@ def test_planned_speed_stays_under_the_corner_cap_by_the_margin():
 def test_a_sample_check_handed_to_the_law_is_met():
     """Another limit joins the rebuild loop as one more check, without touching the law."""
     case = load_case(CASES / "paper-corner.yaml")
-    free = plan_placement(case, case.bounds.example)
+    free = plan(case, case.bounds.example)
     cap = 0.5 * np.abs(free.trajectory.qd[:, 0]).max()
 
     def joint_1_speed(q, sample_time):

@@ -69,11 +69,11 @@ def test_the_smooth_law_slows_down_where_torque_binds():
     from tests.conftest import CASES
     from trackplan.io.case_file import load_case
     from trackplan.planning.checker import check_trajectory
-    from trackplan.planning.plan import plan_placement
+    from trackplan.planning.plan import plan
 
     case = load_case(CASES / "paper-corner.yaml")
     X = case.bounds.example
-    base = plan_placement(case, X)
+    base = plan(case, X)
     torque_max = np.array(case.robot.dynamics.torque_max)
     torque_max[0] = 35.0
     robot = dataclasses.replace(
@@ -82,7 +82,7 @@ def test_the_smooth_law_slows_down_where_torque_binds():
     weak = dataclasses.replace(case, robot=robot)
     before = check_trajectory(robot, base.trajectory.q, TS)
     assert [v.joint for v in before.violations if v.limit == "torque"] == [1]
-    plan = plan_placement(weak, X)
-    assert plan.success, plan.message
-    assert 0.0 <= plan.check.joint_margins["torque"][0] < 0.05
-    assert plan.duration > base.duration + 0.1
+    planned = plan(weak, X)
+    assert planned.success, planned.message
+    assert 0.0 <= planned.check.joint_margins["torque"][0] < 0.05
+    assert planned.duration > base.duration + 0.1

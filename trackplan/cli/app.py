@@ -16,7 +16,7 @@ code. It raises ``CaseError`` for bad input and lets :func:`run` report it::
         \"\"\"Plan the trajectory of one placement.\"\"\"
         out = output_folder(out)
         loaded = load_case(case)
-        result = plan_placement(loaded, loaded.bounds.example)
+        result = plan(loaded, loaded.bounds.example)
         write_run(out, result, loaded)
         return ExitCode.OK if result.success else ExitCode.INFEASIBLE
 """

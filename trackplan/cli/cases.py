@@ -108,8 +108,8 @@ def _show_value(value: object) -> str:
 
 @app.command()
 def cases() -> ExitCode:
-    """List the cases shipped in the repository's cases/ folder; a case with several seams
-    gets a row per seam below its own."""
+    """List the cases shipped in the repository's cases/ folder: a row per case (its seams'
+    segments and lengths summed), then a row per seam (segments, length, corners)."""
     from rich.markup import escape
     from rich.table import Table
 
@@ -135,26 +135,24 @@ def cases() -> ExitCode:
         def corners(path: NominalPath) -> str:
             return ", ".join(f"{angle:.1f}°" for _, angle in segment_corners(path)) or "none"
 
-        several = case.cycle is not None
         table.add_row(
             escape(case.name),
             escape(case.robot.name),
             str(len(seams)),
             str(sum(len(seam.segments) for seam, _ in seams)),
             f"{sum(path.length for _, path in seams):.4f}",
-            "per seam below" if several else corners(seams[0][1]),
+            "per seam below",
             escape(file.name),
         )
-        if several:
-            for seam, path in seams:
-                table.add_row(
-                    f"· {escape(seam.name)}",
-                    "",
-                    "",
-                    str(len(seam.segments)),
-                    f"{path.length:.4f}",
-                    corners(path),
-                    "",
-                )
+        for seam, path in seams:
+            table.add_row(
+                f"· {escape(seam.name)}",
+                "",
+                "",
+                str(len(seam.segments)),
+                f"{path.length:.4f}",
+                corners(path),
+                "",
+            )
     console().print(table)
     return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT

@@ -58,7 +58,7 @@ def plan(
     from trackplan.cli.summaries import print_plan
     from trackplan.io.case_file import load_case
     from trackplan.outputs import write_run
-    from trackplan.planning.plan import plan_placement
+    from trackplan.planning.plan import plan as plan_case
     from trackplan.search.spin import optimize_spin
     from trackplan.tool import SpinProfile
 
@@ -67,11 +67,6 @@ def plan(
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
     X = placement(loaded, X_given)
-    if loaded.cycle is not None:  # several seams: docs/seams.md
-        from trackplan.cli.cycle import plan_cycle_command, refuse_options
-
-        refuse_options(branch=branch, reference=reference, spin=spin, spin_profile=spin_profile)
-        return plan_cycle_command(loaded, X, out, timing=timing, report=report)
     if spin is not None and spin_profile is not None:
         raise CaseError("give --spin or --spin-profile, not both", key="--spin")
     given = None
@@ -81,10 +76,10 @@ def plan(
         from trackplan.io.tool_file import load_spin_profile
 
         given = load_spin_profile(spin_profile)
-    if given is None and loaded.task.tool.n_spin and branch is None:
+    if given is None and loaded.task.tool.n_spin and branch is None and len(loaded.seams) == 1:
         result = optimize_spin(loaded, X, timing=timing)
     else:
-        result = plan_placement(loaded, X, timing=timing, branch=branch, spin=given)
+        result = plan_case(loaded, X, timing=timing, branch=branch, spin=given)
     if reference and result.trajectory.n_samples:
         from trackplan.timing.references import reference_durations
 
@@ -112,24 +107,20 @@ def check(
     """
     from trackplan.cli.summaries import print_check
     from trackplan.io.case_file import load_case
-    from trackplan.io.results import read_trajectory_csv
+    from trackplan.io.results import read_segments, read_trajectory_csv
     from trackplan.io.run_folder import verified_trajectory
-    from trackplan.planning.plan import check_case_trajectory
+    from trackplan.planning.plan import check as check_case
 
     X_given = placement_option(placement_values)
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
     csv = verified_trajectory(run)
     X = placement(loaded, X_given if X_given is not None else run_placement(run))
-    if loaded.cycle is not None:  # several seams: docs/seams.md
-        from trackplan.cli.cycle import check_cycle_command, refuse_options
-
-        refuse_options(timing=timing)
-        return check_cycle_command(loaded, X, csv)
     t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
     sample_time = loaded.task.sample_time
     check_sample_times(t, sample_time, str(csv))
-    report = check_case_trajectory(loaded, X, q, sample_time, timing=timing)
+    segment = read_segments(csv)
+    report = check_case(loaded, X, q, sample_time, timing=timing, segment=segment)
     print_check(console(), str(csv), len(t), sample_time, report)
     return ExitCode.OK if report.success else ExitCode.INFEASIBLE
 

@@ -301,35 +301,12 @@ def _search_and_write(  # type: ignore[no-untyped-def]
 def _write_and_print(  # type: ignore[no-untyped-def]
     out: Path, result, case: Case, *, report: bool, worker: PlotWorker | None, extra
 ) -> None:
-    """Write the search's run folder and print its summary.
-
-    The writers still take the two plan types apart: the plan of several seams (a
-    ``CycleResult``) goes to ``write_cycle_run``, until the one run-folder writer of
-    issue 27 takes every plan.
-    """
+    """Write the search's run folder and print its summary (one seam or several)."""
     from trackplan.cli.summaries import print_search
-    from trackplan.outputs import write_cycle_run, write_search_run
-    from trackplan.planning.result import PlanResult
+    from trackplan.outputs import write_search_run
 
-    if isinstance(result.final, PlanResult):
-        write_search_run(out, result, case, report=report, extra=extra, plot_worker=worker)
-        print_search(console(), result, out, rated_speed=case.task.rated_speed)
-        return
-    from rich.markup import escape
-
-    from trackplan.cli.cycle import print_cycle
-    from trackplan.search.space import bounds_note
-
-    write_cycle_run(out, result.final, case, report=report, search=result, extra=extra)
-    text = console()
-    text.print(
-        f"{escape(result.message)} ({result.evaluations} evaluations, "
-        f"{result.wall_time_s:.2f} s, seed {result.seed})"
-    )
-    note = bounds_note(result.on_bounds)
-    if note:
-        text.print(f"  note: {escape(note)}")
-    print_cycle(text, result.final, out)
+    write_search_run(out, result, case, report=report, extra=extra, plot_worker=worker)
+    print_search(console(), result, out, rated_speed=case.task.rated_speed)
 
 
 def _interrupted_marks(result, signals: SignalLog) -> dict:  # type: ignore[no-untyped-def]

@@ -19,36 +19,34 @@ if TYPE_CHECKING:  # rich's tables only for the commands that print one
 
 
 def describe_case(case: Case, file: Path | str) -> list[str]:
-    """Summary lines of a valid case: name, robot, path length, segments, corner angles."""
-    path = NominalPath.from_specs(case.start, case.segments)
+    """Summary lines of a valid case: name, robot, its seams (each path's segments, length
+    and corner angles), the task and the sequencing."""
     task = case.task
-    corners = "; ".join(
-        f"{angle:.1f}° between segments[{segment - 1}] and segments[{segment}]"
-        for segment, angle in segment_corners(path)
-    )
-    if case.cycle is not None:
-        seams = ", ".join(
-            f"{seam.name} ({NominalPath.from_specs(seam.start, seam.segments).length:.4f} m"
-            f"{'' if seam.reversible else ', not reversible'})"
-            for seam in case.seams
-        )
-        return [
-            f"{file}: ok",
-            f"  name      {case.name}",
-            f"  robot     {case.robot.name} ({case.robot.n_dof} joints)",
-            f"  seams     {len(case.seams)}: {seams}",
-            f"  cycle     sequence {case.cycle.sequence}, approach {case.cycle.approach:g} m, "
-            f"home {'none' if case.cycle.home is None else 'given'}",
-        ]
-    return [
+    sequencing = case.sequencing
+    lines = [
         f"{file}: ok",
         f"  name      {case.name}",
         f"  robot     {case.robot.name} ({case.robot.n_dof} joints)",
-        f"  path      {_count(len(case.segments), 'segment')}, length {path.length:.4f} m",
-        f"  corners   {corners or 'none'}",
+        f"  seams     {len(case.seams)}: {', '.join(case.seam_names)}",
+    ]
+    for seam in case.seams:
+        path = NominalPath.from_specs(seam.start, seam.segments)
+        corners = "; ".join(
+            f"{angle:.1f}° between segments[{segment - 1}] and segments[{segment}]"
+            for segment, angle in segment_corners(path)
+        )
+        lines += [
+            f"  path      {seam.name}: {_count(len(seam.segments), 'segment')}, length "
+            f"{path.length:.4f} m{'' if seam.reversible else ', not reversible'}",
+            f"  corners   {corners or 'none'}",
+        ]
+    return [
+        *lines,
         f"  task      rated speed {task.rated_speed:g} m/s, corner speed "
         f"{task.corner_speed:g} m/s, tolerance {task.tolerance * 1e3:g} mm, "
         f"sample time {task.sample_time * 1e3:g} ms, timing {task.timing}",
+        f"  sequence  {sequencing.sequence}, approach {sequencing.approach:g} m, "
+        f"home {'none' if sequencing.home is None else 'given'}",
     ]
 
 
@@ -131,7 +129,8 @@ def print_check(
 def print_plan(
     console: Console, result: PlanResult, out: Path, *, rated_speed: float | None = None
 ) -> None:
-    """A few lines on what a plan achieved and where its files are; ``rated_speed`` (m/s,
+    """A few lines on what a plan achieved and where its files are: the verdict, the whole
+    trajectory's figures, the cycle time and sequence, each seam's; ``rated_speed`` (m/s,
     the case's) for :func:`rated_speed_text`."""
     violations = result.check.violations
     if result.feasible:
@@ -177,6 +176,22 @@ def print_plan(
             )
         for key, value in result.references.items():
             console.print(f"  {key} = {value:.4f} s")
+        order = ", ".join(
+            f"{escape(seam.name)} {'reversed' if seam.reversed else 'forward'}"
+            for seam in result.seams
+        )
+        console.print(
+            f"  cycle time = {result.duration:.3f} s (welding {result.seam_time:.3f} s, "
+            f"approach, retract and air {result.air_time:.3f} s)  J = {result.objective:.4f}"
+        )
+        console.print(f"  sequence: {order}")
+        console.print(f"  placement X = ({', '.join(f'{v:.4f}' for v in result.placement)})")
+        for seam, own in zip(result.seams, result.seam_checks, strict=True):
+            console.print(
+                f"  {escape(seam.name)}: {seam.plan.duration:.3f} s, "
+                f"max tracking error {1e3 * own.max_tracking_error:.4f} mm, "
+                f"{len(seam.plan.slowdowns)} slow-downs"
+            )
     for violation in violations[:8]:
         console.print(f"  VIOLATION {escape(violation.message)}")
     if len(violations) > 8:

@@ -11,41 +11,41 @@ from __future__ import annotations
 import dataclasses
 import math
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
-from pydantic_core import PydanticCustomError
 
 from trackplan.case import (
     PLACEMENT_KEYS,
     Case,
-    Cycle,
     Objective,
     OptimizerSettings,
     PlacementBounds,
     Seam,
+    Sequencing,
     Task,
 )
-from trackplan.choices import Method, Penalty, Timing
-from trackplan.io.cell_file import CellModel, build_cell, cell_problems
-from trackplan.io.points_file import MIN_POINTS, load_points_csv
+from trackplan.choices import OBJECTIVE_KINDS, Method, Penalty, Timing
+from trackplan.io.case_schema import (
+    CaseModel,
+    ObjectiveModel,
+    PathModel,
+    PlacementModel,
+    PointsFileModel,
+    SeamModel,
+    SeamTaskModel,
+    SegmentModel,
+    SinglePathCaseModel,
+)
+from trackplan.io.cell_file import build_cell, cell_problems
+from trackplan.io.points_file import load_points_csv
 from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
-from trackplan.io.sizes import MAX_SAMPLE_TIME, size_problems
-from trackplan.io.tool_file import ToolModel, as_spec, tool_problems
+from trackplan.io.sizes import size_problems
+from trackplan.io.tool_file import as_spec, tool_problems
 from trackplan.io.yaml_input import (
-    Coordinate,
     Loc,
-    NonEmptyStr,
-    NonNegative,
-    Positive,
     Problem,
-    Range,
-    StrictModel,
-    Vec3,
-    Vec6,
     key_path,
-    list_default,
     parse_key_path,
     parse_yaml,
     raise_first,
@@ -55,188 +55,10 @@ from trackplan.io.yaml_input import (
 )
 from trackplan.paths import NominalPath, check_segments
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
-from trackplan.planning.objectives import OBJECTIVES
 from trackplan.robots.model import Robot
 
 PAPER_WEIGHTS = (0.3, 0.2, 0.2, 0.1, 0.1, 0.1)
 """C_i of the paper's Eq. 8 for a 6-joint arm (the paper prints five; the sixth is 0.1)."""
-
-ANGLE_RANGE = (-1.57, 1.57)
-"""Default search range of roll, pitch, yaw, rad (the paper's Eq. 31)."""
-
-
-# --------------------------------------------------------------------------- schema
-
-
-class LineModel(StrictModel):
-    """``line: {to: [x, y, z]}``, m."""
-
-    to: Vec3
-
-
-class ArcModel(StrictModel):
-    """``arc: {center, normal, angle}``: rotation of the current point by ``angle`` (rad)."""
-
-    center: Vec3
-    normal: Vec3
-    angle: float
-
-
-class PointsFileModel(StrictModel):
-    """``points: {file: seam.csv}``: x, y, z rows, relative to the case file."""
-
-    file: NonEmptyStr
-
-
-def _points_kind(value: Any) -> str | None:
-    if isinstance(value, list):
-        return "<list>"
-    if isinstance(value, dict):
-        return "<file>"
-    return None
-
-
-PointsModel = Annotated[
-    Annotated[list[Vec3], Field(min_length=MIN_POINTS), Tag("<list>")]
-    | Annotated[PointsFileModel, Tag("<file>")],
-    Discriminator(
-        _points_kind,
-        custom_error_type="points_type",
-        custom_error_message="expected a list of [x, y, z] points or {file: name.csv}",
-    ),
-]
-
-
-class SegmentModel(StrictModel):
-    """One path segment: exactly one of ``line``, ``arc``, ``points``."""
-
-    line: LineModel | None = None
-    arc: ArcModel | None = None
-    points: PointsModel | None = None
-
-    @model_validator(mode="after")
-    def _one_kind(self) -> SegmentModel:
-        given = [kind for kind in ("line", "arc", "points") if getattr(self, kind) is not None]
-        if len(given) != 1:
-            raise PydanticCustomError(
-                "segment_kind",
-                "expected exactly one of line, arc, points, got {given}",
-                {"given": ", ".join(given) or "none"},
-            )
-        return self
-
-
-class PathModel(StrictModel):
-    """``path``: start point and segments in the definition frame, m."""
-
-    start: Vec3
-    segments: Annotated[list[SegmentModel], Field(min_length=1)]
-
-
-MIN_TOLERANCE = 1e-6
-"""Smallest path tolerance, m: a micrometre, below the repeatability of any industrial arm
-(0.02 mm and more). Corner blends and the checker's grid refine with the tolerance, so a
-tolerance far below it (1e-300) would ask for more memory than any machine has."""
-Tolerance = Annotated[float, Field(ge=MIN_TOLERANCE)]
-
-
-class TaskModel(StrictModel):
-    """``task``: speeds (m/s), tolerance (m), sample time (s), tool orientation (rad)."""
-
-    rated_speed: Positive
-    corner_speed: Positive | None = None
-    tolerance: Tolerance = 0.001
-    sample_time: Annotated[float, Field(gt=0, le=MAX_SAMPLE_TIME)] = 0.001
-    tool_rpy: Vec3 | None = None
-    tool: ToolModel | None = None
-    timing: Literal["smooth", "paper"] = "smooth"
-
-
-class SeamTaskModel(StrictModel):
-    """A seam's ``task``: overrides of the case's speeds (m/s), tolerance (m) and tool."""
-
-    rated_speed: Positive | None = None
-    corner_speed: Positive | None = None
-    tolerance: Tolerance | None = None
-    tool_rpy: Vec3 | None = None
-    tool: ToolModel | None = None
-
-
-def _csv_safe_name(name: str) -> str:
-    """A seam name that ``trajectory.csv``'s ``segment`` column can hold as it is."""
-    if any(mark in name for mark in ',"') or not name.isprintable() or name[0] in "=+-@":
-        raise PydanticCustomError(
-            "seam_name",
-            "a seam name labels the rows of trajectory.csv: no commas, quotes, tabs or line "
-            "breaks, and no =, +, - or @ first (a spreadsheet would run it as a formula)",
-        )
-    return name
-
-
-class SeamModel(PathModel):
-    """One entry of ``paths``: a named path, its task overrides, whether it may be reversed."""
-
-    name: Annotated[NonEmptyStr, AfterValidator(_csv_safe_name)]
-    task: SeamTaskModel | None = None
-    reversible: bool = True
-
-
-class PlacementModel(StrictModel):
-    """``placement``: search ranges [min, max] of X and the reach range, m and rad."""
-
-    x: Range | None = None  # default: position_range(robot)
-    y: Range | None = None
-    z: Range | None = None
-    roll: Range = list_default(*ANGLE_RANGE)
-    pitch: Range = list_default(*ANGLE_RANGE)
-    yaw: Range = list_default(*ANGLE_RANGE)
-    reach: Range | None = None  # default: the robot's default_placement_reach
-    example: Vec6 | None = None
-
-
-class ObjectiveModel(StrictModel):
-    """``objective``: kind, joint weights of Eq. 8, time weight (1/s), mix and penalty."""
-
-    kind: Literal["travel", "energy", "copper", "time", "weighted"] = "travel"
-    mix: dict[str, NonNegative] | None = None
-    weights: list[NonNegative] | None = None
-    time_weight: NonNegative = 0.0
-    penalty: Literal["graded", "flat"] = "graded"
-    flat_penalty: Positive = 1.0e6
-
-
-class OptimizerModel(StrictModel):
-    """``optimizer``: method, population, seed, evaluation budget and independent runs."""
-
-    method: Literal["multistart", "ga", "cmaes", "de", "random"] = "multistart"
-    population: Annotated[int, Field(ge=2)] = 30
-    seed: Annotated[int, Field(ge=0)] = 0
-    budget: Annotated[int, Field(ge=1)] | None = None
-    restarts: Annotated[int, Field(ge=1)] | None = None
-
-
-class CaseModel(StrictModel):
-    """Schema of a case file."""
-
-    name: NonEmptyStr
-    robot: NonEmptyStr = "puma560"
-    payload: PayloadModel | None = None
-    path: PathModel | None = None
-    paths: Annotated[list[SeamModel], Field(min_length=1)] | None = None
-    sequence: Literal["optimize", "given"] | None = None
-    approach: NonNegative | None = None
-    home: Annotated[list[Coordinate], Field(min_length=1)] | None = None
-    task: TaskModel
-    placement: PlacementModel = Field(default_factory=PlacementModel)
-    objective: ObjectiveModel = Field(default_factory=ObjectiveModel)
-    optimizer: OptimizerModel = Field(default_factory=OptimizerModel)
-    cell: CellModel | None = None
-
-
-class SinglePathCaseModel(CaseModel):
-    """A case file without ``paths``: its ``path`` is required (reported like any missing key)."""
-
-    path: PathModel
 
 
 # --------------------------------------------------------------------------- loading
@@ -383,7 +205,7 @@ def load_case_data(
         robot = dataclasses.replace(robot, dynamics=dynamics)
     case = _case(model, robot, start, segments, file)
     if model.paths is not None:
-        case = _with_cycle(case, model, paths)
+        case = _with_seams(case, model, paths)
     if model.cell is None:
         return case
     return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
@@ -544,10 +366,10 @@ def _home_problems(home: list[float] | None, robot: Robot) -> list[Problem]:
     ]
 
 
-def _with_cycle(
+def _with_seams(
     case: Case, model: CaseModel, paths: list[tuple[np.ndarray, tuple[SegmentSpec, ...]]]
 ) -> Case:
-    """The case with its seams (``paths``), their tasks and the cycle settings."""
+    """The case with its seams (``paths``), their tasks and the sequencing settings."""
     assert model.paths is not None
     seams = []
     for seam, (start, segments) in zip(model.paths, paths, strict=True):
@@ -578,15 +400,19 @@ def _with_cycle(
                 reversible=seam.reversible,
             )
         )
-    cycle = Cycle(
-        seams=tuple(seams),
+    sequencing = Sequencing(
         sequence=model.sequence or "optimize",
         approach=0.0 if model.approach is None else model.approach,
         home=None if model.home is None else _array(model.home),
     )
-    first = cycle.seams[0]
+    first = seams[0]
     return dataclasses.replace(
-        case, start=first.start, segments=first.segments, task=first.task, cycle=cycle
+        case,
+        start=first.start,
+        segments=first.segments,
+        task=first.task,
+        paths=tuple(seams),
+        sequencing=sequencing,
     )
 
 
@@ -735,11 +561,11 @@ def _objective_kind_problems(objective: ObjectiveModel, robot: Robot) -> list[Pr
                 (("objective", "kind"), "weighted needs objective.mix, e.g. {travel: 1, time: 0.5}")
             )
         for name in objective.mix or {}:
-            if name not in OBJECTIVES:
+            if name not in OBJECTIVE_KINDS:
                 problems.append(
                     (
                         ("objective", "mix", name),
-                        f"unknown objective {name!r}: use {', '.join(OBJECTIVES)}",
+                        f"unknown objective {name!r}: use {', '.join(OBJECTIVE_KINDS)}",
                     )
                 )
     elif objective.mix is not None:
@@ -747,7 +573,7 @@ def _objective_kind_problems(objective: ObjectiveModel, robot: Robot) -> list[Pr
     if not problems and robot.dynamics is None:
         names = (objective.mix or {}) if objective.kind == "weighted" else [objective.kind]
         for name in names:
-            if OBJECTIVES[name].needs_dynamics:
+            if OBJECTIVE_KINDS[name]:
                 problems.append(
                     (
                         ("objective", "kind"),

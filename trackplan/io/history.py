@@ -79,8 +79,7 @@ def optimizer_summary(result: SearchResult, joint_names: tuple[str, ...]) -> dic
         wall_time_s, ..., on_bounds}, "initial": {placement, feasible, status, message, objective,
         violations}}`` in plain JSON types.
     """
-    # a one-seam search's plans are PlanResults; the one PlanResult of issue 27 ends the union
-    initial = result_summary(result.initial, joint_names)  # type: ignore[arg-type]
+    initial = result_summary(result.initial, joint_names)
     return {
         "optimizer": {
             "method": result.method,
@@ -93,6 +92,7 @@ def optimizer_summary(result: SearchResult, joint_names: tuple[str, ...]) -> dic
             "status": result.status.value,
             "message": result.message,
             "fitness": float(result.fitness),
+            "unreachable_seams": list(result.unreachable),
             "rejected_candidates": [list(map(float, X)) for X in result.rejected],
             "on_bounds": [hit.as_dict() for hit in result.on_bounds],
         },

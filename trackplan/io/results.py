@@ -1,4 +1,5 @@
-"""Run outputs (trajectory.csv, result.json, history.csv) and reading a trajectory back."""
+"""Run outputs of every plan (trajectory.csv with its ``segment`` column, result.json) and
+reading a trajectory back."""
 
 from __future__ import annotations
 
@@ -11,12 +12,12 @@ from typing import Any
 
 import numpy as np
 
-from trackplan.case import PLACEMENT_KEYS
+from trackplan.case import PLACEMENT_KEYS, Case
 from trackplan.errors import CaseError
-from trackplan.io.csv_table import write_csv_table
+from trackplan.io.csv_table import format_table, write_csv_table
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.io.sizes import MAX_TRAJECTORY_BYTES, max_samples
-from trackplan.planning.result import CheckReport, PlanResult, Trajectory
+from trackplan.planning.result import SEAM, CheckReport, PlanResult, Trajectory
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 from trackplan.timing.protocol import SlowDown
 
@@ -326,10 +327,21 @@ def write_result_json(summary: dict, file: Path) -> None:
     Path(file).write_text(json.dumps(cleaned, indent=2, allow_nan=False) + "\n")
 
 
+def plan_summary(result: PlanResult, case: Case) -> dict:
+    """The ``result.json`` content of a plan (plain JSON types; ``docs/files.md``): the
+    plan's figures (:func:`result_summary`), then its seams, moves and sequence
+    (:func:`seams_summary`)."""
+    return {**result_summary(result, case.robot.joint_names), **seams_summary(result, case)}
+
+
 def write_plan_files(
-    result: PlanResult, joint_names: tuple[str, ...], out_dir: Path, extra: dict | None = None
+    result: PlanResult, case: Case, out_dir: Path, extra: dict | None = None
 ) -> dict:
     """Write ``trajectory.csv`` and ``result.json`` of a plan into ``out_dir``.
+
+    trajectory.csv has the ``segment`` column when the case names its seams (``paths:``)
+    or the plan has more than one span (moves): the table of a single path stays the
+    all-numeric one that scripts read with ``numpy.loadtxt``.
 
     Returns
     -------
@@ -338,11 +350,105 @@ def write_plan_files(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_trajectory_csv(result.trajectory, out_dir / TRAJECTORY_FILE)
+    labels = bool(case.paths) or len(result.spans) > 1
+    write_plan_csv(result, out_dir / TRAJECTORY_FILE, labels=labels)
     summary = {
-        **result_summary(result, joint_names),
+        **plan_summary(result, case),
         **(extra or {}),
         HASH_KEY: file_sha256(out_dir / TRAJECTORY_FILE),
     }
     write_result_json(summary, out_dir / RESULT_FILE)
     return summary
+
+
+SEGMENT_COLUMN = "segment"
+"""Last column of trajectory.csv: the seam's name, or approach/retract/air."""
+
+
+def write_plan_csv(result: PlanResult, file: Path, *, labels: bool = True) -> None:
+    """Write one row per sample: the trajectory's columns, then, with ``labels``,
+    ``segment`` (a plan made without labels has the case name on every sample)."""
+    if not labels:
+        write_trajectory_csv(result.trajectory, file)
+        return
+    lines = format_table(trajectory_table(result.trajectory)).decode("ascii").splitlines()
+    labels_ = result.segment
+    if len(labels_) != len(lines):
+        labels_ = np.full(len(lines), result.case_name, dtype=object)
+    rows = [f"{line},{label}" for line, label in zip(lines, labels_, strict=True)]
+    n_dof = result.trajectory.q.shape[1]
+    header = ",".join([*trajectory_header(n_dof), SEGMENT_COLUMN])
+    Path(file).write_text("\n".join([header, *rows]) + "\n", encoding="utf-8")
+
+
+def seams_summary(result: PlanResult, case: Case) -> dict:
+    """The ``result.json`` keys of the seams, the moves and the sequence of a plan (plain
+    JSON types; ``docs/files.md``)."""
+    joint_names = case.robot.joint_names
+    sample_time = result.trajectory.sample_time
+    seams = []
+    for seam, own in zip(result.seams, result.seam_checks, strict=True):
+        span = next(p for p in result.spans if p.kind == SEAM and p.seam == seam.index)
+        plan = seam.plan
+        seams.append(
+            {
+                "name": seam.name,
+                "reversed": seam.reversed,
+                "t_start": span.first * sample_time,
+                "t_end": span.last * sample_time,
+                "duration": float(plan.duration),
+                "objective": float(plan.objective),
+                "path_length": float(plan.path_length),
+                "rated_speed": float(case.seams[seam.index].task.rated_speed),
+                "rated_speed_fraction": float(plan.rated_speed_fraction),
+                "min_corner_speed": float(plan.min_corner_speed),
+                "max_tracking_error": float(own.max_tracking_error),
+                "max_orientation_error": float(own.max_orientation_error),
+                "branch": int(plan.branch),
+                "spin": plan.joint_path.tool.spin.as_dict(),
+                "feasible": bool(own.success),
+                "slowdowns": [slowdown_record(d) for d in plan.slowdowns],
+            }
+        )
+    moves = [
+        {
+            "kind": span.kind,
+            "t_start": span.first * sample_time,
+            "t_end": span.last * sample_time,
+            "duration": (span.last - span.first) * sample_time,
+            "via": None if span.via is None else list(map(float, span.via)),
+        }
+        for span in result.spans
+        if span.kind != SEAM
+    ]
+    sequencing = case.sequencing
+    return {
+        "cycle_time": float(result.duration),
+        "seam_time": float(result.seam_time),
+        "air_time": float(result.air_time),
+        "approach": float(sequencing.approach),
+        "approach_deviation": float(result.approach_deviation),
+        "sequence_mode": sequencing.sequence,
+        "sequence": [
+            {"seam": case.seams[v.seam].name, "reversed": bool(v.reversed)}
+            for v in result.sequence.visits
+        ],
+        "sequence_exact": bool(result.sequence.exact),
+        "home": None
+        if sequencing.home is None
+        else dict(zip(joint_names, map(float, sequencing.home), strict=True)),
+        "seams": seams,
+        "moves": moves,
+        "unplanned": {name: plan.message for name, plan in result.unplanned.items()},
+    }
+
+
+def read_segments(file: Path) -> np.ndarray | None:
+    """The ``segment`` column of a trajectory.csv, shape (N,), str, or None when the file
+    has none (a trajectory written elsewhere: every sample on the case's one seam)."""
+    lines = Path(file).read_text(encoding="utf-8").splitlines()
+    header = lines[0].split(",") if lines else []
+    if SEGMENT_COLUMN not in header:
+        return None
+    column = header.index(SEGMENT_COLUMN)
+    return np.array([line.split(",")[column] for line in lines[1:] if line.strip()])

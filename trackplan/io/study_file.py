@@ -31,7 +31,8 @@ from pydantic import BaseModel, Field
 
 from trackplan.case import Case
 from trackplan.errors import CaseError
-from trackplan.io.case_file import CaseModel, load_case_data
+from trackplan.io.case_file import load_case_data
+from trackplan.io.case_schema import CaseModel
 from trackplan.io.input_text import read_text
 from trackplan.io.robot_file import is_robot_file
 from trackplan.io.yaml_input import (

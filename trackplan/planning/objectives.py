@@ -9,8 +9,9 @@ Each objective has two forms:
   speed almost everywhere, so this is close to the planned time.
 - ``exact``: the value on a planned, checked trajectory (:class:`PlanResult`).
 
-``travel`` is the paper's Eq. 8 and the default. The case's ``objective.kind`` is one of
-these or ``weighted``: ``Σ mix[name] · objective[name]`` over the names in ``objective.mix``.
+``travel`` is the paper's Eq. 8 (:func:`joint_travel`) and the default. The case's
+``objective.kind`` is one of these or ``weighted``: ``Σ mix[name] · objective[name]`` over
+the names in ``objective.mix``.
 ``energy`` and ``copper`` need a robot with dynamics; their screening form is quasi-static
 (inverse dynamics at the grid's joint velocities, no acceleration): the holding torque
 against gravity and friction dominate at process speeds (``docs/dynamics.md``).
@@ -25,11 +26,31 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.case import Case, Objective
+from trackplan.choices import OBJECTIVE_KINDS
 from trackplan.errors import CaseError
-from trackplan.planning.objective import joint_travel
 from trackplan.planning.result import PlanResult
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.model import Robot
+
+
+def joint_travel(q: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """``J = Σ_k Σ_i C_i |q_i(k) − q_i(k−1)|`` (Eq. 8).
+
+    Parameters
+    ----------
+    q
+        Joint paths, shape (..., N, n), rad.
+    weights
+        C_i, shape (n,).
+
+    Returns
+    -------
+    numpy.ndarray
+        J, shape (...), rad (weighted).
+    """
+    steps = np.abs(np.diff(np.asarray(q, dtype=float), axis=-2))
+    travel: np.ndarray = np.einsum("...kn,n->...", steps, np.asarray(weights, dtype=float))
+    return travel
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,12 +114,14 @@ def _screen_travel(data: ScreenInput) -> np.ndarray:
 
 
 def _screen_time(data: ScreenInput) -> np.ndarray:
-    return data.dt.sum(axis=-1)
+    time: np.ndarray = data.dt.sum(axis=-1)
+    return time
 
 
 def _screen_energy(data: ScreenInput) -> np.ndarray:
     tau, qd = _quasi_static_torque(data)
-    return np.sum(np.maximum(tau * qd, 0.0).sum(axis=-1) * data.dt, axis=-1)
+    energy: np.ndarray = np.sum(np.maximum(tau * qd, 0.0).sum(axis=-1) * data.dt, axis=-1)
+    return energy
 
 
 def _screen_copper(data: ScreenInput) -> np.ndarray:
@@ -107,7 +130,8 @@ def _screen_copper(data: ScreenInput) -> np.ndarray:
     tau, _ = _quasi_static_torque(data)
     k_m = 1.0 if dynamics.motor_constant is None else dynamics.motor_constant
     motor = tau / (np.asarray(dynamics.gear_ratio) * k_m)
-    return np.sum(np.square(motor).sum(axis=-1) * data.dt, axis=-1)
+    copper: np.ndarray = np.sum(np.square(motor).sum(axis=-1) * data.dt, axis=-1)
+    return copper
 
 
 def _energy_value(plan: PlanResult, key: str) -> float:
@@ -117,19 +141,23 @@ def _energy_value(plan: PlanResult, key: str) -> float:
 OBJECTIVES: dict[str, ObjectiveSpec] = {
     spec.name: spec
     for spec in (
-        ObjectiveSpec("travel", "rad", False, _screen_travel, lambda plan: plan.objective),
-        ObjectiveSpec("time", "s", False, _screen_time, lambda plan: plan.duration),
+        ObjectiveSpec(
+            "travel", "rad", OBJECTIVE_KINDS["travel"], _screen_travel, lambda plan: plan.objective
+        ),
+        ObjectiveSpec(
+            "time", "s", OBJECTIVE_KINDS["time"], _screen_time, lambda plan: plan.duration
+        ),
         ObjectiveSpec(
             "energy",
             "J",
-            True,
+            OBJECTIVE_KINDS["energy"],
             _screen_energy,
             lambda plan: _energy_value(plan, "mechanical_energy"),
         ),
         ObjectiveSpec(
             "copper",
             "W·s ((N·m)²·s without motor constants)",
-            True,
+            OBJECTIVE_KINDS["copper"],
             _screen_copper,
             lambda plan: _energy_value(plan, "copper_loss"),
         ),

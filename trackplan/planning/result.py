@@ -17,6 +17,7 @@ from trackplan.check_report import (  # noqa: F401
 from trackplan.jointpath import JointPath
 from trackplan.paths import NominalPath, Path
 from trackplan.planning.energy import EnergyFigures
+from trackplan.planning.sequence import Sequence
 from trackplan.robots.model import LIMIT_KINDS
 from trackplan.status import Status
 from trackplan.timing.protocol import SlowDown
@@ -85,9 +86,87 @@ class Trajectory:
         return float(self.t[-1])
 
 
+SEAM = "seam"
+APPROACH = "approach"
+RETRACT = "retract"
+AIR = "air"
+MOVE_KINDS = (APPROACH, RETRACT, AIR)
+"""Labels of the moves between seams (a seam's samples carry its name)."""
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class Span:
+    """One time span of a plan: a seam, or a move between configurations.
+
+    Attributes
+    ----------
+    kind
+        ``seam``, ``approach``, ``retract`` or ``air``.
+    label
+        The ``segment`` value of its samples: the seam name, or the kind.
+    first, last
+        Indices of its first and last sample in the plan's trajectory (inclusive; a span
+        shares its first sample with the previous span's last).
+    seam
+        Index of the seam (as written) for seam, approach and retract spans, else None.
+    reversed
+        For a seam span: run end to start.
+    via
+        The via configuration of an air move through one, shape (n,), rad, else None.
+    """
+
+    kind: str
+    label: str
+    first: int
+    last: int
+    seam: int | None = None
+    reversed: bool = False
+    via: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SeamPlan:
+    """One seam as planned at the plan's placement.
+
+    Attributes
+    ----------
+    index
+        The seam's index as written.
+    name
+        Its name.
+    reversed
+        Welded end to start.
+    plan
+        Its own single-seam plan (trajectory from rest to rest, its check).
+    q_approach, q_retract
+        Approach and retract configurations, shape (n,), rad (the seam's first and last
+        configuration when the approach distance is 0).
+    """
+
+    index: int
+    name: str
+    reversed: bool
+    plan: PlanResult
+    q_approach: np.ndarray
+    q_retract: np.ndarray
+
+
+def _no_labels() -> np.ndarray:
+    return np.zeros(0, dtype=object)
+
+
+def _no_sequence() -> Sequence:
+    return Sequence(visits=(), cost=float("nan"), exact=False)
+
+
 @dataclass(frozen=True, eq=False, kw_only=True)
 class PlanResult:
-    """One placement planned end to end.
+    """A case planned end to end at one placement: every seam, the moves between them, the
+    whole trajectory and its check.
+
+    With one seam, given sequence, no approach and no home, the trajectory is the seam's
+    and every figure is that seam's. With several seams, the per-seam figures are stated
+    below for the whole plan.
 
     Attributes
     ----------
@@ -100,36 +179,66 @@ class PlanResult:
     status
         See :class:`trackplan.status.Status`.
     message
-        One line saying what happened (the first violation when infeasible).
+        One line saying what happened (the first violation when infeasible; with several
+        seams it names the seam).
     timing
         The time law (``smooth`` or ``paper``).
     branch
-        IK branch used (closed form: 0-7; numeric: the seed index).
+        IK branch used (closed form: 0-7; numeric: the seed index): the first welded
+        seam's (the branch may differ from seam to seam, see :attr:`seams`).
     trajectory
-        The sampled trajectory (empty arrays when no trajectory could be built).
+        The sampled trajectory from rest to rest (empty arrays when no trajectory could be
+        built); ``s`` is the arc length along the seam being welded (0 on moves).
     check
-        The checker's report on ``trajectory``.
+        The checker's report on ``trajectory``: joint limits and clearance at every
+        sample, each seam's task checks (with several seams, violation messages name the
+        seam, times in the whole trajectory).
     objective
-        J of Eq. 8 from the written q.
+        J of Eq. 8 from the written q (the whole trajectory).
     duration
-        s.
+        s (the whole cycle).
     path_length
-        Length of the nominal path, m.
+        Length of the nominal paths, m: the sum over the seams.
     rated_speed_fraction
-        Share of the straight-piece length run at the rated speed.
+        Share of the straight-piece length run at the rated speed: length-weighted over
+        the seams.
     min_corner_speed
-        Lowest plateau speed on arcs and blends, m/s (rated speed when there are none).
+        Lowest plateau speed on arcs and blends, m/s (rated speed when there are none):
+        the lowest over the seams.
     slowdowns
-        Where straight pieces run below the rated speed.
+        Where straight pieces run below the rated speed: every seam's in welding order
+        (``s`` along its own seam).
     references
-        Reference durations when computed: ``toppra_duration``, ``topp3_duration`` (s).
+        Reference durations when computed: ``toppra_duration``, ``topp3_duration`` (s);
+        one seam only.
     joint_path
         The placed path's poses and IK on the planning grid
-        (:class:`trackplan.jointpath.JointPath`).
+        (:class:`trackplan.jointpath.JointPath`): the first welded seam's (with several
+        seams, each seam's is in :attr:`seams`); the first unplanned seam's when some
+        seam could not be planned.
     energy
         Mechanical energy, copper loss and peak torque ratio
-        (:class:`trackplan.planning.energy.EnergyFigures`) when the robot has dynamics and
-        a trajectory was built, else None.
+        (:class:`trackplan.planning.energy.EnergyFigures`) of the whole trajectory when the
+        robot has dynamics and a trajectory was built, else None.
+    segment
+        Label of every sample, shape (N,), str: the seam's name, or ``approach``,
+        ``retract``, ``air``. The sample two spans share (at rest) carries the earlier
+        span's label.
+    spans
+        The spans (seams and moves) in time order.
+    seams
+        The seams in the order welded (:class:`SeamPlan`).
+    sequence
+        The order and directions, and their estimated cost.
+    seam_checks
+        Each seam's own check (tracking, orientation, speed, coverage) in welding order.
+    seam_time, air_time
+        Time spent welding, and on approach, retract and air moves, s.
+    approach_deviation
+        Largest distance of the tool point from the tool axis line during approach and
+        retract moves, m (0 without moves).
+    unplanned
+        Seam plans that failed (seam name → plan), when the seams could not be joined.
     """
 
     case_name: str
@@ -150,15 +259,24 @@ class PlanResult:
     references: dict[str, float]
     joint_path: JointPath
     energy: EnergyFigures | None = None
+    segment: np.ndarray = field(default_factory=_no_labels)
+    spans: tuple[Span, ...] = ()
+    seams: tuple[SeamPlan, ...] = ()
+    sequence: Sequence = field(default_factory=_no_sequence)
+    seam_checks: tuple[CheckReport, ...] = ()
+    seam_time: float = float("nan")
+    air_time: float = float("nan")
+    approach_deviation: float = 0.0
+    unplanned: dict[str, PlanResult] = field(default_factory=dict)
 
     @property
     def planned_path(self) -> Path:
-        """The planned (blended) path."""
+        """The planned (blended) path (the first welded seam's)."""
         return self.joint_path.geometry.planned
 
     @property
     def nominal_path(self) -> NominalPath:
-        """The path as the user gave it."""
+        """The path as the user gave it (the first welded seam's)."""
         return self.joint_path.geometry.nominal
 
     @property
@@ -168,11 +286,18 @@ class PlanResult:
 
 
 __all__ = [
+    "AIR",
+    "APPROACH",
     "LIMIT_KINDS",
+    "MOVE_KINDS",
+    "RETRACT",
+    "SEAM",
     "TASK_KINDS",
     "CellReport",
     "CheckReport",
     "PlanResult",
+    "SeamPlan",
+    "Span",
     "Trajectory",
     "Violation",
 ]

@@ -217,7 +217,8 @@ class _Costs:
     def tour_cost(self, states: np.ndarray) -> np.ndarray:
         """Cost of tours given as states, shape (C, m) -> (C,)."""
         inner = self.step[states[:, :-1], states[:, 1:]].sum(axis=1)
-        return self.first[states[:, 0]] + inner + self.last[states[:, -1]]
+        cost: np.ndarray = self.first[states[:, 0]] + inner + self.last[states[:, -1]]
+        return cost
 
 
 def _held_karp(costs: _Costs) -> tuple[np.ndarray, float]:

@@ -1,5 +1,5 @@
-"""The plot and report of a workpiece with several seams: the cycle seen from above and
-its timeline.
+"""The plot and report of a plan whose seams are joined by moves: the cycle seen from above
+and its timeline.
 
 ``cycle.png``: left, the tool point's path in the robot base frame seen from above, every
 seam in its own colour (an arrow half-way shows the welding direction) and the
@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from trackplan.case import Case
-from trackplan.planning.cycle import AIR, APPROACH, RETRACT, CycleResult
+from trackplan.planning.result import AIR, APPROACH, RETRACT, PlanResult
 from trackplan.report.figures import _new_figure
 from trackplan.report.html import _esc, _grid, html_page
 from trackplan.run_files import REPORT_FILE
@@ -28,7 +28,7 @@ MOVE_COLORS = {APPROACH: "0.45", RETRACT: "0.65", AIR: "0.2"}
 """Grey levels of the moves between seams."""
 
 
-def cycle_figure(result: CycleResult, case: Case) -> Figure:
+def cycle_figure(result: PlanResult, case: Case) -> Figure:
     """The cycle from above (seams colour-coded, moves dashed) and its timeline.
 
     Parameters
@@ -50,7 +50,7 @@ def cycle_figure(result: CycleResult, case: Case) -> Figure:
     sample_time = result.trajectory.sample_time
     names = [seam.name for seam in case.seams]
     colors = {name: f"C{k % 10}" for k, name in enumerate(names)}
-    for piece in result.pieces:
+    for piece in result.spans:
         xy = position[piece.first : piece.last + 1, :2]
         t0, t1 = piece.first * sample_time, piece.last * sample_time
         if piece.kind == "seam":
@@ -88,8 +88,17 @@ def cycle_figure(result: CycleResult, case: Case) -> Figure:
     return figure
 
 
-def write_cycle_report(
-    result: CycleResult, case: Case, out_dir: Path, info: dict | None = None
+def has_moves(result: PlanResult, case: Case) -> bool:
+    """Whether the plan joins its seams with moves (approach, retract or air spans, or a
+    case of several seams, an approach or a home, planned or not): its report is the
+    cycle's (:func:`write_seams_report`)."""
+    sequencing = case.sequencing
+    joined = len(case.seams) > 1 or sequencing.approach > 0 or sequencing.home is not None
+    return joined or any(span.kind in MOVE_COLORS for span in result.spans)
+
+
+def write_seams_report(
+    result: PlanResult, case: Case, out_dir: Path, info: dict | None = None
 ) -> list[Path]:
     """Write ``cycle.png`` and ``report.html`` (self-contained: the plot as a data URI).
 
@@ -185,4 +194,4 @@ def _sequence_text(info: dict) -> str:
     return ", ".join(f"{s['seam']} {'←' if s['reversed'] else '→'}" for s in steps) or "-"
 
 
-__all__ = ["CYCLE_PLOT", "cycle_figure", "write_cycle_report"]
+__all__ = ["CYCLE_PLOT", "cycle_figure", "has_moves", "write_seams_report"]

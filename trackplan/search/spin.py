@@ -6,7 +6,7 @@ still has the spin to choose. Only the k spin variables vary, so one batched scr
 profiles that counter-rotate a share of the tool's own turn about its axis (the turn a
 fixed spin would force on the wrist), random ones, then a few rounds of perturbations
 around the best. The best is planned and checked by
-:func:`~trackplan.planning.plan.plan_placement`.
+:func:`~trackplan.planning.plan.plan`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.frames import as_placement
 from trackplan.paths.path_geometry import PathGeometry
-from trackplan.planning.plan import plan_placement
+from trackplan.planning.plan import plan
 from trackplan.planning.result import PlanResult
 from trackplan.search.fitness import PlacementFitness
 from trackplan.search.space import SearchSpace
@@ -97,7 +97,7 @@ def optimize_spin(
     if geometry is None or geometry.mode != law.path_mode:
         geometry = PathGeometry.from_case(case, law.path_mode)
     if not case.task.tool.n_spin:
-        return plan_placement(case, X, timing=law.timing, geometry=geometry)
+        return plan(case, X, timing=law.timing, geometries={(0, False): geometry})
     space = SearchSpace.from_case(case)
     fitness = PlacementFitness(case, space, geometry, law.timing)
     rng = np.random.default_rng(case.optimizer.seed if seed is None else seed)
@@ -112,7 +112,7 @@ def optimize_spin(
         candidate, value = _best(fitness, X, trial)
         if value < best_fitness:
             best, best_fitness = candidate, value
-    return plan_placement(case, X, timing=law.timing, geometry=geometry, spin=best)
+    return plan(case, X, timing=law.timing, geometries={(0, False): geometry}, spin=best)
 
 
 def _best(fitness: PlacementFitness, X: np.ndarray, spins: np.ndarray) -> tuple[np.ndarray, float]:
