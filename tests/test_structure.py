@@ -206,3 +206,36 @@ def test_every_result_spells_success_the_same_way():
     assert result.success is result.feasible is result.check.success is True
     assert result.status is trackplan.Status.FEASIBLE and result.status.success
     assert result.joint_path.success and result.joint_path.ik.success.all()
+
+
+def _layer_names() -> set[str]:
+    """Every module or package named in the layer contract of pyproject.toml."""
+    import re
+    import tomllib
+
+    config = tomllib.loads((REPO / "pyproject.toml").read_text(encoding="utf-8"))
+    (layers,) = [
+        contract["layers"]
+        for contract in config["tool"]["importlinter"]["contracts"]
+        if contract["type"] == "layers"
+    ]
+    return {name for layer in layers for name in re.split(r"[\s:|()]+", layer) if name}
+
+
+def test_every_module_sits_in_a_layer_of_the_contract():
+    # a module in no layer is never checked by lint-imports: a new module must be placed
+    named = _layer_names()
+    unplaced = []
+    for file in sorted((REPO / "trackplan").rglob("*.py")):
+        parts = file.relative_to(REPO).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        if len(parts) == 1 or parts == ("trackplan", "__main__"):
+            continue  # the package itself, and `python -m trackplan`
+        prefixes = {".".join(parts[:k]) for k in range(2, len(parts) + 1)}
+        split = file.name == "__init__.py" and any(
+            name.startswith(".".join(parts) + ".") for name in named
+        )  # a package whose modules sit in several layers: its modules are placed
+        if not (prefixes & named or split):
+            unplaced.append(".".join(parts))
+    assert unplaced == []
