@@ -8,6 +8,9 @@ PIP    := $(PY) -m pip
 OUT    ?= runs/demo
 LOCK   := requirements/lock.txt
 EXTRAS := test,reference,dev
+# the core packages, type-checked with --strict by `make lint`
+STRICT := trackplan/paths trackplan/robots trackplan/timing trackplan/planning \
+          trackplan/profiles trackplan/tool
 
 .PHONY: run test test-fast test-latest test-lowest bench lint lock browser docs clean
 
@@ -74,11 +77,12 @@ browser:
 bench: $(VENV)/.installed-test
 	$(PY) -m benchmarks
 
-## lint: ruff (lint and format), mypy and the layer contract (lint-imports), as CI runs them
+## lint: ruff (lint and format), mypy (--strict on the core) and the layer contract, as CI runs them
 lint: $(VENV)/.installed-test
 	$(VENV)/bin/ruff check trackplan tests benchmarks
 	$(VENV)/bin/ruff format --check trackplan tests benchmarks
 	$(VENV)/bin/mypy trackplan
+	$(VENV)/bin/mypy --strict --follow-imports=silent $(STRICT)
 	$(VENV)/bin/lint-imports
 
 ## docs: re-run every command the docs quote and rewrite their figures and screenshots

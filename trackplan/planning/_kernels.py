@@ -199,7 +199,7 @@ def _tool_point(T: np.ndarray, tail: np.ndarray, r: int, b: int) -> float:  # pr
     """Kernel: row r of the tool point of configuration b of a :func:`chain_block` block,
     summed as :func:`~trackplan.robots._kernels.fk_flat` sums it."""
     point = T[4 * r, b] * tail[0, 3] + T[4 * r + 1, b] * tail[1, 3] + T[4 * r + 2, b] * tail[2, 3]
-    return point + T[4 * r + 3, b]
+    return float(point + T[4 * r + 3, b])
 
 
 @njit(cache=True)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.case import Case, Task
+from trackplan.case import Case
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform, vector_norms
 from trackplan.jointpath import JointPath
@@ -26,6 +26,7 @@ from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.planning.tool_zones import transition_zones
 from trackplan.robots.model import Robot
 from trackplan.status import Status
+from trackplan.task import Task
 from trackplan.timing import TimedPath, time_law
 from trackplan.tool import (
     SpinMode,
