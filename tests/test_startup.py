@@ -97,8 +97,9 @@ def test_input_schemas_are_built_when_a_file_is_validated():
     corner case builds the one it validates, not the cell, robot-file or tool schemas."""
     probe = (
         "import json, pydantic\n"
-        "from trackplan.io import case_file, cell_file, robot_file, tool_file\n"
-        "modules = (case_file, cell_file, robot_file, tool_file)\n"
+        "from trackplan.io import case_file, case_schema, cell_file, robot_file, robot_schema\n"
+        "from trackplan.io import tool_file\n"
+        "modules = (case_file, case_schema, cell_file, robot_file, robot_schema, tool_file)\n"
         "models = [m for mod in modules for m in vars(mod).values() if isinstance(m, type)\n"
         "          and issubclass(m, pydantic.BaseModel) and m.__module__ == mod.__name__]\n"
         "def built():\n"

@@ -114,7 +114,7 @@ _DEPRECATED = {
     "JointPath": ("trackplan.jointpath", "JointPath", ""),
     "TIME_LAWS": ("trackplan.timing", "TIME_LAWS", ""),
     "time_law": ("trackplan.timing", "time_law", ""),
-    "TimeLaw": ("trackplan.timing", "TimedPath", "trackplan.timing.TimedPath"),
+    "TimeLaw": ("trackplan.timing", "TimedPath", ""),
     "AirMove": ("trackplan.timing.airmove", "AirMove", ""),
     "plan_air_move": ("trackplan.timing.airmove", "plan_air_move", ""),
     "air_time_estimate": ("trackplan.timing.airmove", "air_time_estimate", ""),

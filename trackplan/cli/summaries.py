@@ -231,12 +231,7 @@ def print_search(  # type: ignore[no-untyped-def]
         f"last run stopped: {escape(result.stop_reason)}"
     )
     console.print(f"  before (centre of the bounds, X = {_vector(initial.placement)}): {before}")
-    after = (
-        escape(result.message)
-        if result.success
-        else f"no feasible placement in {_count(result.evaluations, 'evaluation')}; "
-        "the closest one is planned below"
-    )
+    after = escape(result.message)  # on failure: which seam, how close; planned below
     console.print(f"  after  (X = {_vector(result.X)}): {after}")
     from trackplan.search.space import bounds_note
 

@@ -20,7 +20,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.cell.check import check_cell
 from trackplan.frames import placement_transform
 from trackplan.motion import JointSamples
 from trackplan.planning.energy import motion_energy
@@ -41,7 +40,6 @@ from trackplan.planning.seams import SeamStage, approach_configuration
 from trackplan.planning.sequence import Sequence, given_sequence
 from trackplan.planning.trajectory_check import check_spans
 from trackplan.status import Status
-from trackplan.timing.airmove import AirMove, plan_air_move
 from trackplan.timing.sample_checks import robot_checks
 
 VIA_LIFT = 0.1
@@ -63,6 +61,10 @@ def join_seams(case: Case, X: np.ndarray, stage: SeamStage, sequence: Sequence) 
     """
     if not has_moves(case, sequence):
         return _one_seam(case, stage, sequence)
+    # the moves' planner (ruckig) and the cell's exact check only where there are moves
+    from trackplan.cell.check import check_cell
+    from trackplan.timing.airmove import AirMove, plan_air_move
+
     plans, ends = stage.plans, stage.ends
     approach, home = case.sequencing.approach, case.sequencing.home
     geometries = {key: plans[key].joint_path.geometry for key in plans}

@@ -15,7 +15,6 @@ from trackplan.case import Case
 from trackplan.planning.result import PlanResult
 from trackplan.planning.seams import SeamStage
 from trackplan.planning.sequence import Sequence, best_sequence, given_sequence
-from trackplan.timing.airmove import air_time_estimate
 
 UNPLANNED_COST = 1e12
 """Sequencing cost of a seam direction that could not be planned (never chosen)."""
@@ -32,6 +31,8 @@ def order_seams(case: Case, stage: SeamStage) -> Sequence:
 def _move_cost(case: Case, q_from: np.ndarray, q_to: np.ndarray) -> np.ndarray:
     """Estimated cost of air moves, shape of the leading axes: seconds, or J + w·T."""
     robot = case.robot
+    from trackplan.timing.airmove import air_time_estimate  # ruckig: only with moves
+
     time = air_time_estimate(q_from, q_to, robot.v_max, robot.a_max, robot.j_max)
     weight = case.objective.time_weight
     if weight == 0.0:

@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.cell.check import check_cell
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform
 from trackplan.paths.nominal import NominalPath
@@ -83,7 +82,9 @@ def check_spans(
     cell_report = None
     violations = list(whole.violations)
     task_margins: dict[str, float] = {}
-    if cell is not None:
+    if cell is not None:  # the cell's exact check (coal) only for a case with a cell
+        from trackplan.cell.check import check_cell
+
         cell_report = check_cell(cell, case.robot, q, sample_time, placement_transform(X))
         violations += list(cell_report.violations)
         task_margins["clearance"] = cell_report.margin
