@@ -74,7 +74,6 @@ def test_the_scan_leaves_enum_comparisons_and_written_words(source: str) -> None
     assert status_word_comparisons(source) == []
 
 
-@pytest.mark.xfail(strict=False, reason="other helpers' files until the merge")
 def test_no_module_compares_against_a_status_word() -> None:
     found = [
         f"{file.relative_to(PACKAGE.parent)}:{line}: {text}"
