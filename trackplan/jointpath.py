@@ -10,19 +10,19 @@ search's final plan read it; only the trajectory samples themselves need the IK 
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
+from trackplan.derived import derived
 from trackplan.frames import placement_transform, tool_pose_parts, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import PathIK, branch_joints_along, solve_path_ik
 from trackplan.status import Status
 from trackplan.stencils import stencil_derivatives, stencil_points
-from trackplan.tool import ToolFrame, ToolOrientation, ToolSpec
+from trackplan.tool import ToolFrame, ToolOrientation
 
 STENCIL_FRACTION = 0.1
 """Stencil spacing as a share of the grid step: small against the scale on which the
@@ -216,26 +216,21 @@ class JointPath:
         return stencil_derivatives(q, offset, spacing)
 
 
-_HELD_ROTATIONS: weakref.WeakKeyDictionary[ToolSpec, dict[float, np.ndarray]] = (
-    weakref.WeakKeyDictionary()
-)
-"""The one ``R_part_tool`` of a tool held in the part frame, per spec and spin value
-(read-only): every plan of a case with such a tool reads the same rotation."""
-
-
 def _rotations(tool: ToolOrientation, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:
     """``R_part_tool`` at arc lengths ``s`` (M,) with planned tangents (M, 3): shape
     (M, 3, 3), or one (3, 3) where the tool holds one orientation along the whole path
     (part frame, constant spin): the rotation every row would repeat, computed once per
     spec and spin value (it depends on nothing else)."""
     if tool.spec.frame is ToolFrame.PART and len(tool.spin.coefficients) == 1 and len(s):
-        held = _HELD_ROTATIONS.setdefault(tool.spec, {})
         spin = float(tool.spin.coefficients[0])
-        if spin not in held:
+
+        def held() -> np.ndarray:
             rotation = tool.rotations(s[:1], tangent[:1])[0]
             rotation.flags.writeable = False
-            held[spin] = rotation
-        return held[spin]
+            return rotation
+
+        # the one rotation of the held tool, kept on its spec (read-only)
+        return derived(tool.spec, ("held rotation", spin), held)
     return tool.rotations(s, tangent)
 
 
@@ -265,25 +260,24 @@ class _PlanningGrid:
     tangents: np.ndarray
 
 
-_GRIDS: weakref.WeakKeyDictionary[PathGeometry, _PlanningGrid] = weakref.WeakKeyDictionary()
-"""Planning grids of the geometries alive (a search plans many placements on one)."""
-
-
 def _planning_grid(geometry: PathGeometry) -> _PlanningGrid:
     """The geometry's planning grid (:meth:`PathGeometry.zone_grids`), built once per geometry."""
-    if geometry not in _GRIDS:
-        grids = geometry.zone_grids()
-        zones = geometry.zones()
-        s = np.concatenate(grids)
-        zone = np.repeat(np.arange(len(grids)), [len(g) for g in grids])
-        lo = np.array([z[0] for z in zones])[zone]
-        hi = np.array([z[1] for z in zones])[zone]
-        steps = np.array([(g[-1] - g[0]) / max(len(g) - 1, 1) for g in grids])
-        h = STENCIL_FRACTION * steps[zone]
-        points, offset = stencil_points(s, lo, hi, h)
-        sample = geometry.planned.sample(points.ravel())
-        positions, tangents = sample.position, sample.tangent
-        for array in (s, zone, points, offset, h, positions, tangents):
-            array.flags.writeable = False
-        _GRIDS[geometry] = _PlanningGrid(s, zone, points, offset, h, positions, tangents)
-    return _GRIDS[geometry]
+    return derived(geometry, "planning grid", lambda: _build_grid(geometry))
+
+
+def _build_grid(geometry: PathGeometry) -> _PlanningGrid:
+    """The planning grid of a geometry, its arrays read-only."""
+    grids = geometry.zone_grids()
+    zones = geometry.zones()
+    s = np.concatenate(grids)
+    zone = np.repeat(np.arange(len(grids)), [len(g) for g in grids])
+    lo = np.array([z[0] for z in zones])[zone]
+    hi = np.array([z[1] for z in zones])[zone]
+    steps = np.array([(g[-1] - g[0]) / max(len(g) - 1, 1) for g in grids])
+    h = STENCIL_FRACTION * steps[zone]
+    points, offset = stencil_points(s, lo, hi, h)
+    sample = geometry.planned.sample(points.ravel())
+    positions, tangents = sample.position, sample.tangent
+    for array in (s, zone, points, offset, h, positions, tangents):
+        array.flags.writeable = False
+    return _PlanningGrid(s, zone, points, offset, h, positions, tangents)

@@ -8,12 +8,12 @@ here depends on which law runs.
 from __future__ import annotations
 
 import math
-import weakref
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.derived import derived
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform, vector_norms
 from trackplan.jointpath import JointPath
@@ -43,38 +43,26 @@ CELL_KINDS = ("collision", "clearance")
 """Violation kinds of the cell check."""
 
 
-_GEOMETRIES: weakref.WeakKeyDictionary[Case, dict[str, PathGeometry]] = weakref.WeakKeyDictionary()
-"""The paths of the cases alive, per path mode: placement-independent, built once."""
-
-_TOOL_ZONES: weakref.WeakKeyDictionary[PathGeometry, list[tuple[ToolSpec, float, np.ndarray]]] = (
-    weakref.WeakKeyDictionary()
-)
-"""Transition zones per geometry, tool spec and tolerance: placement-independent."""
-
-
 def case_geometry(case: Case, mode: PathMode = "g2") -> PathGeometry:
     """The case's paths in a path mode (:meth:`PathGeometry.from_case`), built once per case.
 
     The case is immutable: every plan of it shares one geometry (and the planning grid
     cached on it).
     """
-    built = _GEOMETRIES.setdefault(case, {})
-    if mode not in built:
-        built[mode] = PathGeometry.from_case(case, mode)
-    return built[mode]
+    return derived(case, ("paths", mode), lambda: PathGeometry.from_case(case, mode))
 
 
 def _transition_zones(spec: ToolSpec, geometry: PathGeometry, tolerance: float) -> np.ndarray:
     """:func:`~trackplan.planning.tool_zones.transition_zones`, computed once per geometry,
     tool spec and tolerance (read-only)."""
-    known = _TOOL_ZONES.setdefault(geometry, [])
-    for known_spec, known_tolerance, zones in known:
-        if known_spec is spec and known_tolerance == tolerance:
-            return zones
-    zones = transition_zones(spec, geometry, tolerance)
-    zones.flags.writeable = False
-    known.append((spec, tolerance, zones))
-    return zones
+
+    def build() -> tuple[ToolSpec, np.ndarray]:
+        zones = transition_zones(spec, geometry, tolerance)
+        zones.flags.writeable = False
+        return spec, zones  # the spec kept alive with its zones: its id stays its own
+
+    # the spec by identity (a frozen ToolSpec compares its arrays), the tolerance by value
+    return derived(geometry, ("tool zones", id(spec), tolerance), build)[1]
 
 
 def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> TrackingReference:

@@ -6,10 +6,9 @@ inertia and friction, as roboticstoolbox computes it for its DH robots (``rne``)
 
 from __future__ import annotations
 
-from weakref import WeakKeyDictionary
-
 import numpy as np
 
+from trackplan.derived import derived
 from trackplan.robots.dynamics import _kernels as kernels
 from trackplan.robots.dynamics_parameters import (
     JointChain,
@@ -203,19 +202,16 @@ def inverse_dynamics(
     )
 
 
-_CONSTANTS: WeakKeyDictionary[Robot, dict[bool, np.ndarray]] = WeakKeyDictionary()
-"""Kernel constants of each robot object (robots are immutable), with and without friction."""
-
-
 def _robot_constants(robot: Robot, friction: bool) -> np.ndarray:
     """The kernel constants of a robot with dynamics, computed once per robot object."""
-    per_robot = _CONSTANTS.setdefault(robot, {})
-    if friction not in per_robot:
+
+    def build() -> np.ndarray:
         chain = robot_chain(robot)
-        per_robot[friction] = kernel_constants(
+        return kernel_constants(
             chain, _require(robot), chain.T_last_flange @ robot.T_flange_tool, friction
         )
-    return per_robot[friction]
+
+    return derived(robot, ("rne constants", friction), build)
 
 
 def gravity_load(robot: Robot, q: np.ndarray) -> np.ndarray:

@@ -2,18 +2,15 @@
 
 from __future__ import annotations
 
-import weakref
-
 import numpy as np
 
+from trackplan.derived import derived
 from trackplan.errors import CaseError
 from trackplan.robots.families.base import N_BRANCHES, ClosedFormIK, IKFamily
 from trackplan.robots.families.numeric import NumericFamily
 from trackplan.robots.families.opw import OPWFamily, opw_from_chain
 from trackplan.robots.families.ur import URFamily, ur_from_chain
 from trackplan.robots.model import Robot
-
-_FAMILIES: weakref.WeakKeyDictionary[Robot, IKFamily] = weakref.WeakKeyDictionary()
 
 
 def ik_family(robot: Robot) -> IKFamily:
@@ -29,16 +26,16 @@ def ik_family(robot: Robot) -> IKFamily:
     IKFamily
         :class:`OPWFamily`, :class:`URFamily` or :class:`NumericFamily`.
     """
-    family = _FAMILIES.get(robot)
-    if family is None:
-        opw = opw_from_chain(robot)
-        if opw is not None:
-            family = OPWFamily(robot, opw)
-        else:
-            ur = ur_from_chain(robot)
-            family = URFamily(robot, ur) if ur is not None else NumericFamily(robot.n_dof)
-        _FAMILIES[robot] = family
-    return family
+    return derived(robot, "ik family", lambda: _detect(robot))
+
+
+def _detect(robot: Robot) -> IKFamily:
+    """OPW, else UR, else numeric."""
+    opw = opw_from_chain(robot)
+    if opw is not None:
+        return OPWFamily(robot, opw)
+    ur = ur_from_chain(robot)
+    return URFamily(robot, ur) if ur is not None else NumericFamily(robot.n_dof)
 
 
 def solve_ik(robot: Robot, T_base_tool: np.ndarray) -> ClosedFormIK:
