@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -97,3 +99,12 @@ def test_an_infeasible_plan_and_its_check_say_the_same() -> None:
     assert planned.status is planned.check.status is Status.LIMITS_VIOLATED
     assert planned.check.violations
     assert {v.status for v in planned.check.violations} == {Status.LIMITS_VIOLATED}
+
+
+def test_a_plan_without_trajectory_carries_its_status_into_its_check():
+    case = load_case(CASES / "paper-corner.yaml")
+    # joints held within ±0.05 rad: every IK branch leaves the range (not "unreachable")
+    narrow = dataclasses.replace(case.robot, q_min=np.full(6, -0.05), q_max=np.full(6, 0.05))
+    planned = plan(dataclasses.replace(case, robot=narrow), case.bounds.example)
+    assert not planned.trajectory.n_samples
+    assert planned.check.status is planned.status is Status.POSITION_LIMITS

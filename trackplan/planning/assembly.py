@@ -295,6 +295,7 @@ def unplanned(case: Case, X: np.ndarray, failed: dict[str, PlanResult]) -> PlanR
         violations=(),
         max_tracking_error=float("nan"),
         max_orientation_error=float("nan"),
+        unchecked=status,  # why there is nothing to check
     )
     return replace(
         plan,

@@ -245,6 +245,7 @@ def _unplanned(
         violations=(),
         max_tracking_error=float("nan"),
         max_orientation_error=float("nan"),
+        unchecked=status,  # why there is nothing to check
     )
     return PlanResult(
         case_name=case.name,
