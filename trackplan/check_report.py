@@ -173,6 +173,19 @@ class CheckReport:
     cell: CellReport | None = None
     unchecked: Status = Status.UNREACHABLE
 
+    @classmethod
+    def of_nothing(cls, status: Status) -> CheckReport:
+        """The report on no trajectory: nothing checked, because of ``status``."""
+        return cls(
+            success=False,
+            joint_margins={},
+            task_margins={},
+            violations=(),
+            max_tracking_error=float("nan"),
+            max_orientation_error=float("nan"),
+            unchecked=status,
+        )
+
     @property
     def status(self) -> Status:
         """The outcome of the check (:func:`violations_status` of the violations).

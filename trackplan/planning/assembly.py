@@ -288,15 +288,7 @@ def unplanned(case: Case, X: np.ndarray, failed: dict[str, PlanResult]) -> PlanR
     n = case.robot.n_dof
     trajectory = Trajectory.empty(n, case.task.sample_time)
     status = plan.status if plan.status is not Status.FEASIBLE else Status.UNREACHABLE
-    check = CheckReport(
-        success=False,
-        joint_margins={},
-        task_margins={},
-        violations=(),
-        max_tracking_error=float("nan"),
-        max_orientation_error=float("nan"),
-        unchecked=status,  # why there is nothing to check
-    )
+    check = CheckReport.of_nothing(status)
     return replace(
         plan,
         case_name=case.name,

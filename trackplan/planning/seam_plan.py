@@ -238,15 +238,7 @@ def _unplanned(
     """The result of a placement that has no trajectory."""
     n_dof = case.robot.n_dof
     trajectory = Trajectory.empty(n_dof, case.task.sample_time)
-    check = CheckReport(
-        success=False,
-        joint_margins={},
-        task_margins={},
-        violations=(),
-        max_tracking_error=float("nan"),
-        max_orientation_error=float("nan"),
-        unchecked=status,  # why there is nothing to check
-    )
+    check = CheckReport.of_nothing(status)
     return PlanResult(
         case_name=case.name,
         placement=joint_path.placement,
