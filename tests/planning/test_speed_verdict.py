@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import CASES
+from trackplan.derived import derived
 from trackplan.io.case_file import load_case
 from trackplan.jointpath import JointPath
 from trackplan.paths.path_geometry import PathGeometry
@@ -40,9 +41,10 @@ def numeric_kr10(tmp_path_factory):
     file = tmp_path_factory.mktemp("kr10") / "kr10.yaml"
     file.write_text(text.replace("robot: kuka_kr6_r700_sixx", "robot: kuka_kr10_r1420"))
     case = load_case(file)
-    detect._FAMILIES[case.robot] = detect.NumericFamily(case.robot.n_dof)
-    yield case
-    del detect._FAMILIES[case.robot]
+    # the robot's IK family, derived once and kept on it: numeric here
+    derived(case.robot, "ik family", lambda: detect.NumericFamily(case.robot.n_dof))
+    assert isinstance(detect.ik_family(case.robot), detect.NumericFamily)
+    return case
 
 
 def test_a_placement_the_search_counts_feasible_passes_the_final_check(numeric_kr10):

@@ -22,6 +22,7 @@ BELOW = {
     "trackplan.frames",
     "trackplan.stencils",
     "trackplan.derivatives",
+    "trackplan.derived",
 }
 """The modules below the robots layer that it may import."""
 
