@@ -37,6 +37,7 @@ from pathlib import Path
 
 from benchmarks import best_time
 from trackplan.io.case_file import load_case
+from trackplan.planning.plan import plan
 from trackplan.report.plot_worker import PlotWorker
 from trackplan.report.run_report import can_fork, write_run_report
 from trackplan.search.optimize import optimize
@@ -112,12 +113,12 @@ def _in_process() -> None:
     search = optimize(case)
     result = search.final
     history = {search.method: search.history.as_columns()}
-    plan = best_time(lambda: plan(case, search.X))
+    plan_time = best_time(lambda: plan(case, search.X))
     print(
         f"{CASE}: {result.trajectory.n_samples} samples at Ts = "
         f"{1e3 * case.task.sample_time:.3g} ms, found by {search.method}"
     )
-    print(f"  plan (reference, CPU, warm): {1e3 * plan:.1f} ms")
+    print(f"  plan (reference, CPU, warm): {1e3 * plan_time:.1f} ms")
     print(f"\n  {'report (plots + report.html), warm':<44}{'wall s':>8}{'CPU s':>8}", end="")
     print(f"{'forked CPU s':>14}{'longest / plan':>16}")
     modes = ("worker", "two processes", "alone") if can_fork() else ("alone",)
@@ -144,7 +145,7 @@ def _in_process() -> None:
             wall, cpu, children = _report_seconds(write, prepare)
             label = labels[mode]
             # the worker draws in two processes, sharing the work about equally
-            longest = max(cpu, children / 2 if mode == "worker" else children) / plan
+            longest = max(cpu, children / 2 if mode == "worker" else children) / plan_time
             print(f"  {label:<44}{wall:>8.2f}{cpu:>8.2f}{children:>14.2f}{longest:>15.0f}×")
     print("  longest: the CPU time of the busier process, the wall time on an idle 2-core machine")
     print("  (the worker's forked CPU time is its drawing, without its warm-up, in two processes)")
