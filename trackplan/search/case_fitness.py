@@ -32,7 +32,6 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.search.fitness import SCREEN_POSES, PlacementFitness
-from trackplan.search.plan_calls import sequencing_home
 from trackplan.search.screening import Screening, SeamScreen, evaluate_seams
 from trackplan.search.space import N_VAR, SearchSpace
 
@@ -135,7 +134,7 @@ class CaseFitness:
         self.time_weight = float(case.objective.time_weight)
         self.weights = np.asarray(case.objective.weights, dtype=float)
         self.reversible = np.array([seam.reversible for seam in case.seams])
-        self.home = sequencing_home(case)
+        self.home = case.sequencing.home
         self.feasible_count = np.zeros(len(case.seams), dtype=int)
         self.slices = spin_slices(case)
         if space.n_var != self.slices[-1].stop:

@@ -29,6 +29,7 @@ from trackplan.case import Case
 from trackplan.choices import Method, choose
 from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import PathGeometry
+from trackplan.planning.result import PlanResult
 from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm
 from trackplan.search.case_fitness import CaseFitness, SeamSpin
 from trackplan.search.driver import (
@@ -39,7 +40,7 @@ from trackplan.search.driver import (
     run_search,
     run_seeds,
 )
-from trackplan.search.plan_calls import CasePlan, SeamGeometries, plan_case, seam_geometries
+from trackplan.search.plan_calls import SeamGeometries, plan_case, seam_geometries
 from trackplan.search.problem import PlacementProblem
 from trackplan.search.space import N_VAR, BoundHit, SearchSpace
 from trackplan.status import Status
@@ -118,8 +119,8 @@ class SearchResult:
     branch: int
     fitness: float
     objective: float
-    final: CasePlan
-    initial: CasePlan
+    final: PlanResult
+    initial: PlanResult
     history: SearchHistory
     evaluations: int
     generations: int
@@ -308,7 +309,7 @@ class _Planner:
 
     def submit(
         self, X: np.ndarray, branches: tuple[int, ...] | None, spins: tuple[SeamSpin, ...]
-    ) -> Future[CasePlan] | None:
+    ) -> Future[PlanResult] | None:
         """Start planning ``X`` in the background; None without one (or a broken one)."""
         if self.background is None:
             return None
@@ -320,11 +321,11 @@ class _Planner:
 
     def result(
         self,
-        job: Future[CasePlan] | None,
+        job: Future[PlanResult] | None,
         X: np.ndarray,
         branches: tuple[int, ...] | None,
         spins: tuple[SeamSpin, ...],
-    ) -> CasePlan:
+    ) -> PlanResult:
         """The plan of ``X`` submitted as ``job``, made here when the background broke."""
         if job is not None:
             try:
@@ -335,13 +336,13 @@ class _Planner:
 
     def plan(
         self, X: np.ndarray, branches: tuple[int, ...], spins: tuple[SeamSpin, ...]
-    ) -> CasePlan:
+    ) -> PlanResult:
         """The plan of ``X``, waited for."""
         return self.result(self.submit(X, branches, spins), X, branches, spins)
 
     def _job(
         self, X: np.ndarray, branches: tuple[int, ...] | None, spins: tuple[SeamSpin, ...]
-    ) -> functools.partial[CasePlan]:
+    ) -> functools.partial[PlanResult]:
         return functools.partial(
             plan_case,
             self.case,
@@ -355,7 +356,7 @@ class _Planner:
 
 def _final_plan(
     problem: PlacementProblem, fitness: CaseFitness, planner: _Planner
-) -> tuple[CasePlan, int, tuple[int, ...], list[np.ndarray]]:
+) -> tuple[PlanResult, int, tuple[int, ...], list[np.ndarray]]:
     """Plan the archive's candidates best first at full Ts until one passes the checker.
 
     Returns the first feasible plan, or the plan of the best candidate when none passes;
@@ -364,7 +365,7 @@ def _final_plan(
     """
     archive = problem.archive
     rejected: list[np.ndarray] = []
-    first: tuple[CasePlan, int, tuple[int, ...]] | None = None
+    first: tuple[PlanResult, int, tuple[int, ...]] | None = None
     for row, (X, feasible) in enumerate(zip(archive.X, archive.feasible, strict=True)):
         if first is not None and not feasible:
             break
@@ -382,7 +383,7 @@ def _final_plan(
 
 def _message(
     case: Case,
-    final: CasePlan,
+    final: PlanResult,
     problem: PlacementProblem,
     rejected: list[np.ndarray],
     space: SearchSpace,

@@ -2,9 +2,9 @@
 
 The search plans a candidate of a case (the final plans and the "before" plan) with
 :func:`trackplan.planning.plan.plan`, plans one seam with the time law while screening
-(paper timing, or a time weight) with the seam stage of that pipeline, builds the seams'
-paths once, and reads the case's sequencing settings. Each is one function here, so that
-the search reaches the planner through this module only.
+(paper timing, or a time weight) with the seam stage of that pipeline, and builds the seams'
+paths once. Each is one function here, so that the search reaches the planner through this
+module only.
 """
 
 from __future__ import annotations
@@ -19,20 +19,11 @@ from trackplan.planning.seam_plan import plan_seam as plan_one_seam
 from trackplan.planning.seams import SeamGeometries
 from trackplan.planning.seams import seam_geometries as planning_geometries
 
-CasePlan = PlanResult
-"""The plan of a case at one placement: every seam, sequenced, checked."""
-
 
 def seam_geometries(case: Case, timing: str) -> SeamGeometries:
     """The paths of every seam of the case in each direction it may be welded, built once
     in the path mode of the time law ``timing``."""
     return planning_geometries(case, timing)
-
-
-def sequencing_home(case: Case) -> np.ndarray | None:
-    """The joint configuration the case's cycle starts from and returns to (n,), rad, or
-    None."""
-    return case.sequencing.home
 
 
 def plan_case(
