@@ -246,3 +246,19 @@ def test_validate_takes_assume_limits_as_its_message_says(
     assert code == ExitCode.BAD_INPUT and "or pass --assume-limits" in err
     code, out, err = run(capsys, "validate", str(tmp_path / "case.yaml"), "--assume-limits")
     assert (code, err) == (0, "") and "ur5e" in out
+
+
+def test_the_plan_summary_has_a_cycle_block_only_where_moves_join_seams(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    corner = str(CASES / "paper-corner.yaml")
+    single = run(capsys, "plan", corner, "--no-report", "--out", str(tmp_path / "one"))
+    X = ("0.2149", "-0.4997", "-0.2996", "0.0463", "-0.0083", "-2.6086")  # docs/seams.md
+    joined = run(
+        capsys,
+        *("plan", str(CASES / "bracket-4-fillets.yaml"), "--placement", *X),
+        *("--no-report", "--out", str(tmp_path / "four")),
+    )
+    assert single[0] == joined[0] == 0
+    assert "J = " in single[1] and "cycle time" not in single[1] and "sequence:" not in single[1]
+    assert "cycle time = " in joined[1] and "sequence: " in joined[1]

@@ -130,8 +130,8 @@ def print_plan(
     console: Console, result: PlanResult, out: Path, *, rated_speed: float | None = None
 ) -> None:
     """A few lines on what a plan achieved and where its files are: the verdict, the whole
-    trajectory's figures, the cycle time and sequence, each seam's; ``rated_speed`` (m/s,
-    the case's) for :func:`rated_speed_text`."""
+    trajectory's figures, and for seams joined by moves the cycle time, sequence and each
+    seam's; ``rated_speed`` (m/s, the case's) for :func:`rated_speed_text`."""
     violations = result.check.violations
     if result.feasible:
         console.print(f"{escape(result.case_name)}: {escape(result.message)}")
@@ -176,6 +176,7 @@ def print_plan(
             )
         for key, value in result.references.items():
             console.print(f"  {key} = {value:.4f} s")
+    if result.trajectory.n_samples and len(result.spans) > 1:  # seams joined by moves
         order = ", ".join(
             f"{escape(seam.name)} {'reversed' if seam.reversed else 'forward'}"
             for seam in result.seams
