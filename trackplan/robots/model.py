@@ -25,6 +25,7 @@ from trackplan._kernels import read_only
 from trackplan.errors import CaseError
 from trackplan.robots._kernels import fk_flat
 from trackplan.robots.collision import Capsules
+from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics_parameters import RobotDynamics
 
 LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk")
@@ -115,6 +116,10 @@ class Robot:
     collision
         Link capsules on frames 0 (base) to n (:mod:`trackplan.robots.collision`), or None
         when the robot has no link geometry (then a cell case must give ``cell.links``).
+    controller
+        How the robot's controller counts the joints and where its world frame is
+        (:class:`~trackplan.robots.controller.ControllerConvention`); None: as the model
+        (:attr:`convention` gives the identity then).
     """
 
     name: str
@@ -134,6 +139,7 @@ class Robot:
     dynamics: RobotDynamics | None = None
     placement_reach: tuple[float, float] | None = None
     collision: Capsules | None = None
+    controller: ControllerConvention | None = None
 
     def __post_init__(self) -> None:
         origins = np.array(self.origins, dtype=float)
@@ -173,6 +179,11 @@ class Robot:
             )
         if self.collision is not None and np.any(self.collision.frame > n):
             raise CaseError(f"link capsules must be on frames 0..{n}", key="collision")
+        if self.controller is not None and self.controller.n_dof != n:
+            raise CaseError(
+                f"the controller convention must have {n} joints, got {self.controller.n_dof}",
+                key="controller",
+            )
 
     @classmethod
     def from_dh(
@@ -235,6 +246,13 @@ class Robot:
     def n_dof(self) -> int:
         """Number of joints."""
         return int(self.origins.shape[0])
+
+    @property
+    def convention(self) -> ControllerConvention:
+        """The controller convention: :attr:`controller`, or the identity when None."""
+        if self.controller is not None:
+            return self.controller
+        return ControllerConvention.identity(self.n_dof)
 
     @property
     def has_tool(self) -> bool:
