@@ -44,6 +44,9 @@ class ControllerConvention:
         (4, 4), m: e.g. the FANUC world at J2 height, a UR base turned by π about z.
     source
         Where the convention comes from (shown in the program headers and docs).
+    cycle
+        The controller's interpolation (servo) step, s, when it matters to a program
+        (URScript ``servoj``: 0.002 on UR e-Series, 0.008 on CB3), else None.
     """
 
     vendor: str = "generic"
@@ -52,6 +55,7 @@ class ControllerConvention:
     coupling: tuple[int, int, float] | None = None
     world: np.ndarray = field(default_factory=lambda: np.eye(4))
     source: str = ""
+    cycle: float | None = None
 
     @classmethod
     def identity(
