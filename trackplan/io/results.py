@@ -331,7 +331,20 @@ def plan_summary(result: PlanResult, case: Case) -> dict:
     """The ``result.json`` content of a plan (plain JSON types; ``docs/files.md``): the
     plan's figures (:func:`result_summary`), then its seams, moves and sequence
     (:func:`seams_summary`)."""
-    return {**result_summary(result, case.robot.joint_names), **seams_summary(result, case)}
+    return {
+        **result_summary(result, case.robot.joint_names),
+        "case_file": case_file(case),
+        **seams_summary(result, case),
+    }
+
+
+def case_file(case: Case) -> str | None:
+    """The absolute path of the case file a case was read from, or None for a case built in
+    Python (``result.json``'s ``case_file``: what :func:`trackplan.programs.replay.replay_run`
+    re-plans a run from)."""
+    if case.source is None:
+        return None
+    return str(Path(case.source).resolve())
 
 
 def write_plan_files(
