@@ -18,10 +18,11 @@ import yaml
 from tests.conftest import CASES
 from trackplan.cli import main
 from trackplan.errors import CaseError
-from trackplan.io.export import TrajectoryTable, read_trajectory_table
+from trackplan.io.export import read_trajectory_table
 from trackplan.io.results import read_trajectory_csv
 from trackplan.writers import (
     WRITERS,
+    ExportSource,
     Writer,
     export,
     export_trajectory,
@@ -137,9 +138,10 @@ def writers() -> Iterator[dict[str, Writer]]:
 
 
 def test_the_writers_are_registered_by_name_and_suffix() -> None:
-    assert list(WRITERS) == ["csv", "json", "ros"]
+    assert list(WRITERS)[:3] == ["csv", "json", "ros"]  # then the program writers
     for writer in WRITERS.values():
-        assert isinstance(writer, Writer) and writer.default_file.endswith(writer.suffix)
+        assert isinstance(writer, Writer)
+        assert writer.folder or writer.default_file.endswith(writer.suffix)
     assert writer_named("ROS") is WRITERS["ros"]
     assert writer_for_file(Path("a/b.Json")) is WRITERS["json"]
     assert writer_for_file(Path("motion.ros.yaml")) is WRITERS["ros"]
@@ -171,11 +173,14 @@ class _LinesWriter:
     name: str = "lines"
     suffix: str = ".lines"
     default_file: str = "trajectory.lines"
+    folder: bool = False
 
-    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+        table = source.table
         rows = np.column_stack([table.t, table.q]).tolist()
         body = "\n".join(" ".join(map(repr, row)) for row in rows)
-        output.write_text(f"# {options.get('comment', '')}\n{body}\n")
+        (folder / options["file_name"]).write_text(f"# {options.get('comment', '')}\n{body}\n")
+        return (options["file_name"],)
 
 
 def test_a_registered_writer_serves_export_and_the_cli(
@@ -195,10 +200,229 @@ def test_a_registered_writer_serves_export_and_the_cli(
 
 
 def test_a_writer_name_or_suffix_is_registered_once(writers: dict[str, Writer]) -> None:
+    before = list(WRITERS)
     with pytest.raises(ValueError, match="a writer named 'csv' is registered already"):
         register_writer(_LinesWriter(name="csv"))
     with pytest.raises(ValueError, match=r"the suffix '\.json' belongs to the 'json' writer"):
         register_writer(_LinesWriter(suffix=".json", default_file="t.json"))
     with pytest.raises(ValueError, match="does not end with"):
         register_writer(_LinesWriter(default_file="trajectory.txt"))
-    assert list(WRITERS) == ["csv", "json", "ros"]
+    assert list(WRITERS) == before
+
+
+@pytest.fixture(scope="module")
+def paper_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One run of paper-line, shared: tests that write into it copy it first."""
+    run = tmp_path_factory.mktemp("export") / "run"
+    assert main(["plan", str(CASES / "paper-line.yaml"), "--out", str(run), "--no-report"]) == 0
+    return run
+
+
+def _copied(run: Path, tmp_path: Path) -> Path:
+    import shutil
+
+    return Path(shutil.copytree(run, tmp_path / "run"))
+
+
+@dataclass(frozen=True)
+class _FolderWriter:
+    """A program format of two files: ``NAME.prog`` (the samples) and ``NAME.dat`` (the
+    options it was given); with ``fail``, it raises after writing the first."""
+
+    name: str = "twofiles"
+    suffix: str = ".prog"
+    default_file: str = "twofiles"
+    folder: bool = True
+    fail: bool = False
+    names: tuple[str, ...] = ()
+
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+        stem = options.get("name") or "main"
+        main_file, data_file = self.names or (f"{stem}.prog", f"{stem}.dat")
+        (folder / main_file).write_text(f"{len(source.table.t)} samples\n")
+        if self.fail:
+            raise CaseError("the robot cannot be driven by this format", key="robot")
+        options.pop("file_name", None)
+        (folder / data_file).write_text(json.dumps(options, sort_keys=True, default=str))
+        return (main_file, data_file)
+
+
+def _staging_left(*folders: Path) -> list[Path]:
+    return [p for folder in folders if folder.exists() for p in folder.glob(".trackplan-*")]
+
+
+def test_a_folder_writer_writes_its_files_into_a_folder(
+    paper_run: Path, tmp_path: Path, writers: dict[str, Writer], capsys: pytest.CaptureFixture[str]
+) -> None:
+    run = _copied(paper_run, tmp_path)
+    register_writer(_FolderWriter())
+    main_file = export(run, format="twofiles", name="weld")
+    assert main_file == run / "twofiles" / "weld.prog"
+    assert main_file.read_text() == f"{len(read_trajectory_table(run).t)} samples\n"
+    assert sorted(p.name for p in (run / "twofiles").iterdir()) == ["weld.dat", "weld.prog"]
+    # --output names the folder (created with its parents); the CLI prints every file
+    out = tmp_path / "cell" / "robot1"
+    capsys.readouterr()
+    assert main(["export", str(run), "--format", "twofiles", "--output", str(out)]) == 0
+    assert capsys.readouterr().out == f"wrote {out / 'main.prog'}\nwrote {out / 'main.dat'}\n"
+    assert _staging_left(run, out, out.parent) == []
+    # a folder writer is picked by name only, never by a file's suffix
+    with pytest.raises(CaseError, match=r"no export format for 'a\.prog'"):
+        writer_for_file(Path("a.prog"))
+    file = tmp_path / "taken"
+    file.write_text("x")
+    with pytest.raises(CaseError, match=r"'.*taken' is not a folder; give a folder"):
+        export(run, file, format="twofiles")
+
+
+def test_a_failing_writer_leaves_nothing_behind(
+    paper_run: Path, tmp_path: Path, writers: dict[str, Writer]
+) -> None:
+    run = _copied(paper_run, tmp_path)
+    before = sorted(p.name for p in run.iterdir())
+    register_writer(_FolderWriter(fail=True))
+    new = tmp_path / "new" / "folder"
+    with pytest.raises(CaseError, match="cannot be driven"):
+        export(run, new, format="twofiles")
+    assert not (tmp_path / "new").exists()  # every folder it made is gone
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    (kept / "main.prog").write_text("the old program\n")
+    with pytest.raises(CaseError, match="cannot be driven"):
+        export(run, kept, format="twofiles")
+    assert [p.name for p in kept.iterdir()] == ["main.prog"]
+    assert (kept / "main.prog").read_text() == "the old program\n"
+    with pytest.raises(CaseError, match="cannot be driven"):
+        export(run, format="twofiles")
+    assert sorted(p.name for p in run.iterdir()) == before
+
+
+def test_a_writer_never_replaces_the_runs_files(
+    paper_run: Path, tmp_path: Path, writers: dict[str, Writer]
+) -> None:
+    run = _copied(paper_run, tmp_path)
+    before = {p.name: p.read_bytes() for p in run.iterdir()}
+    register_writer(_FolderWriter(names=("weld.prog", "result.json")))
+    with pytest.raises(CaseError, match=r"is the run's own result\.json"):
+        export(run, run, format="twofiles")
+    assert {p.name: p.read_bytes() for p in run.iterdir()} == before  # not even weld.prog
+    WRITERS.pop("twofiles")
+    register_writer(_FolderWriter(names=("../escape.prog", "a.dat")))
+    with pytest.raises(ValueError, match=r"names '\.\./escape\.prog', not a file it wrote"):
+        export(run, tmp_path / "out", format="twofiles")
+    assert not (tmp_path / "escape.prog").exists() and not (tmp_path / "out").exists()
+
+
+@dataclass(frozen=True)
+class _ProgramWriter:
+    """A program format of one file: the program the builder returns, and the options."""
+
+    name: str = "prog"
+    suffix: str = ".prog"
+    default_file: str = "main.prog"
+    folder: bool = False
+
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+        keys = ("motion", "name", "period", "force")
+        program = source.program(**{key: options[key] for key in keys if key in options})
+        again = source.program(**{key: options[key] for key in keys if key in options})
+        assert again is program  # built once per set of arguments
+        text = json.dumps({"program": program, "max_points": options.get("max_points")})
+        (folder / options["file_name"]).write_text(text)
+        return (options["file_name"],)
+
+
+@pytest.fixture
+def fake_builder(monkeypatch: pytest.MonkeyPatch) -> list[dict[str, Any]]:
+    """``trackplan.programs.build`` replaced by a builder that records its calls."""
+    import types
+
+    calls: list[dict[str, Any]] = []
+
+    def build_program(replayed: Any, **arguments: Any) -> dict[str, Any]:
+        calls.append({"replayed": replayed, **arguments})
+        return {"case": replayed.case.name, **arguments}
+
+    module = types.ModuleType("trackplan.programs.build")
+    module.build_program = build_program  # type: ignore[attr-defined]
+    monkeypatch.setitem(__import__("sys").modules, "trackplan.programs.build", module)
+    return calls
+
+
+def test_the_cli_options_reach_the_program_writer(
+    paper_run: Path,
+    tmp_path: Path,
+    writers: dict[str, Writer],
+    fake_builder: list[dict[str, Any]],
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    register_writer(_ProgramWriter())
+    out = tmp_path / "weld.prog"
+    arguments = ["--motion", "joint", "--name", "Weld 1", "--period", "0.008"]
+    argv = ["export", str(paper_run), "--format", "prog", "--output", str(out), *arguments]
+    assert main([*argv, "--max-points", "500", "--force"]) == 0
+    assert capsys.readouterr().out == f"wrote {out}\n"
+    written = json.loads(out.read_text())
+    assert written == {
+        "program": {
+            "case": "paper-line",
+            "motion": "joint",
+            "name": "Weld 1",
+            "period": 0.008,
+            "force": True,
+        },
+        "max_points": 500,
+    }
+    assert len(fake_builder) == 1
+    replayed = fake_builder[0]["replayed"]
+    assert replayed.folder == paper_run
+    np.testing.assert_allclose(replayed.plan.trajectory.q, replayed.table.q, rtol=0, atol=1e-9)
+    # defaults, and the case given with --case
+    assert main(["export", str(paper_run), "--format", "prog", "--output", str(out), "--case",
+                 str(CASES / "paper-line.yaml")]) == 0  # fmt: skip
+    assert json.loads(out.read_text())["program"] == {
+        "case": "paper-line", "motion": "cartesian", "name": None, "period": None, "force": False
+    }  # fmt: skip
+
+
+def test_bad_program_options_are_one_line(
+    paper_run: Path, tmp_path: Path, writers: dict[str, Writer], capsys: pytest.CaptureFixture[str]
+) -> None:
+    register_writer(_ProgramWriter())
+    out = str(tmp_path / "x.prog")
+    for extra, message in (
+        (["--motion", "circular"], "--motion: unknown motion 'circular': use cartesian or joint"),
+        (["--max-points", "1"], "--max-points: must be at least 2 points, got 1"),
+    ):
+        capsys.readouterr()
+        assert main(["export", str(paper_run), "--format", "prog", "--output", out, *extra]) == 2
+        err = capsys.readouterr().err
+        assert err == message + "\n"
+    # a number that does not parse is a usage error, as for every typed option
+    assert main(["export", str(paper_run), "--format", "prog", "--period", "soon"]) == 2
+    assert "Invalid value for '--period'" in capsys.readouterr().err
+    assert not Path(out).exists()
+
+
+def test_a_program_needs_a_run(
+    paper_run: Path, tmp_path: Path, writers: dict[str, Writer], fake_builder: list[dict[str, Any]]
+) -> None:
+    register_writer(_ProgramWriter())
+    table = read_trajectory_table(paper_run)
+    source = ExportSource(table=table)
+    with pytest.raises(CaseError, match=r"a program needs a run folder.*held in memory"):
+        export(source, tmp_path / "a.prog", format="prog")
+    bare = tmp_path / "motion.csv"
+    bare.write_bytes((paper_run / "trajectory.csv").read_bytes())
+    with pytest.raises(CaseError, match="a program needs a run folder"):
+        export(bare, format="prog")
+    assert not (tmp_path / "main.prog").exists() and fake_builder == []
+
+
+def test_the_format_help_lists_every_registered_writer(
+    writers: dict[str, Writer], capsys: pytest.CaptureFixture[str]
+) -> None:
+    register_writer(_FolderWriter())
+    assert main(["export", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "One of csv, json, ros, twofiles." in out

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
+from typer.core import TyperCommand
 
 from trackplan.cli import ExitCode
 from trackplan.cli.common import (
@@ -125,15 +126,60 @@ def check(
     return ExitCode.OK if report.success else ExitCode.INFEASIBLE
 
 
-@app.command()
+class _ExportCommand(TyperCommand):
+    """``export``: its ``--format`` help lists the registered writers when help is shown
+    (building it at import would import the writers before any command runs)."""
+
+    def format_help(self, ctx: Any, formatter: Any) -> None:
+        """Fill in the formats, then format the help as typer does."""
+        from trackplan.writers import WRITERS
+
+        for param in self.params:
+            if param.name == "format":
+                param.help = f"One of {', '.join(WRITERS)}."  # type: ignore[attr-defined]
+        super().format_help(ctx, formatter)
+
+
+@app.command(cls=_ExportCommand)
 def export(
     run: Annotated[Path, typer.Argument(help="Run folder (or its trajectory.csv).")],
-    format: Annotated[
-        str, typer.Option("--format", help="csv, json or ros (ROS 2 JointTrajectory YAML).")
-    ] = "ros",
+    format: Annotated[str, typer.Option("--format", help="A registered export format.")] = "ros",
+    motion: Annotated[
+        str,
+        typer.Option(
+            "--motion",
+            help="Programs: cartesian (the seams in path moves) or joint (the samples).",
+        ),
+    ] = "cartesian",
+    name: Annotated[
+        str | None, typer.Option("--name", help="Program name (default: the case's).")
+    ] = None,
     output: Annotated[
         Path | None,
-        typer.Option("--output", help="File to write (default: next to trajectory.csv)."),
+        typer.Option(
+            "--output",
+            help="File to write, or for a program of several files the folder "
+            "(default: next to trajectory.csv).",
+        ),
+    ] = None,
+    period: Annotated[
+        float | None,
+        typer.Option(
+            "--period", help="Programs, --motion joint: s between targets, a multiple of Ts."
+        ),
+    ] = None,
+    max_points: Annotated[
+        int | None,
+        typer.Option(
+            "--max-points", help="Programs: most points per part, >= 2 (default: the format's)."
+        ),
+    ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Programs: write an infeasible run too.")
+    ] = False,
+    case: Annotated[
+        Path | None,
+        typer.Option("--case", help="Programs: the case file of the run (default: result.json's)."),
     ] = None,
     joint_names: Annotated[
         str | None,
@@ -146,12 +192,36 @@ def export(
         str, typer.Option("--frame-id", help="header.frame_id of the ROS message.")
     ] = "",
 ) -> ExitCode:
-    """Export a run's trajectory as CSV, JSON or a ROS 2 trajectory_msgs/JointTrajectory."""
-    from trackplan.writers import export as export_run
+    """Export a run: its trajectory (CSV, JSON, ROS 2 JointTrajectory) or a robot program.
 
+    The program formats re-plan the run's case where the run was planned and check that
+    it reproduces trajectory.csv before they write (docs/results.md).
+    """
+    from trackplan.programs.model import MOTION_FORMS
+    from trackplan.writers import export_files
+
+    if motion not in MOTION_FORMS:
+        raise CaseError(
+            f"unknown motion {motion!r}: use {' or '.join(MOTION_FORMS)}", key="--motion"
+        )
+    if max_points is not None and max_points < 2:
+        raise CaseError(f"must be at least 2 points, got {max_points}", key="--max-points")
     if output is not None and not output.is_dir():
         output_folder(output.parent, "--output")
-    names = [name.strip() for name in joint_names.split(",")] if joint_names else None
-    written = export_run(run, output, format=format, joint_names=names, frame_id=frame_id)
-    typer.echo(f"wrote {written}")
+    names = [joint.strip() for joint in joint_names.split(",")] if joint_names else None
+    written = export_files(
+        run,
+        output,
+        format=format,
+        joint_names=names,
+        case=case,
+        frame_id=frame_id,
+        motion=motion,
+        name=name,
+        period=period,
+        max_points=max_points,
+        force=force,
+    )
+    for file in written:
+        typer.echo(f"wrote {file}")
     return ExitCode.OK

@@ -1,13 +1,16 @@
 """Writers: the export formats behind one protocol, and ``export``.
 
-Each format is a :class:`Writer` (``name``, ``suffix``, ``default_file``,
-``write(table, output, **options)``) registered by name in :data:`WRITERS`;
-:func:`export` picks one by name or by the output's suffix. The built-in writers are
-``csv``, ``json`` and ``ros`` (:mod:`trackplan.writers.trajectory_formats`); a new format
-registers with :func:`register_writer`. See ``docs/results.md`` and ``docs/api.md``.
+Each format is a :class:`Writer` (``name``, ``suffix``, ``default_file``, ``folder``,
+``write(source, folder, **options) -> names``) registered by name in :data:`WRITERS`;
+:func:`export` picks one by name or by the output's suffix, lets it write into a staging
+folder and moves its files into place. The trajectory writers are ``csv``, ``json`` and
+``ros`` (:mod:`trackplan.writers.trajectory_formats`); the program writers print a
+:class:`~trackplan.programs.Program` (:meth:`ExportSource.program`) in a controller's
+language. A new format registers with :func:`register_writer`. See ``docs/results.md`` and
+``docs/api.md``.
 """
 
-from trackplan.writers.exporter import export, export_trajectory
+from trackplan.writers.exporter import export, export_files, export_trajectory
 from trackplan.writers.protocol import (
     WRITERS,
     Writer,
@@ -15,18 +18,26 @@ from trackplan.writers.protocol import (
     writer_for_file,
     writer_named,
 )
+from trackplan.writers.source import ExportSource
 from trackplan.writers.trajectory_formats import CsvWriter, JsonWriter, RosWriter
 
+# The registry, in the order `--format` lists the formats: the trajectory formats, then
+# the controller program writers (trackplan/writers/{krl,rapid,fanuc,urscript}.py) each
+# registered here with one line, e.g. `register_writer(KrlWriter())`.
 for _writer in (CsvWriter(), JsonWriter(), RosWriter()):
     register_writer(_writer)
+
+# -- program writers: register here --
 
 __all__ = [
     "WRITERS",
     "CsvWriter",
+    "ExportSource",
     "JsonWriter",
     "RosWriter",
     "Writer",
     "export",
+    "export_files",
     "export_trajectory",
     "register_writer",
     "writer_for_file",

@@ -1,18 +1,24 @@
 """The writer protocol and the registry of writers by name.
 
-A writer turns a :class:`~trackplan.io.export.TrajectoryTable` into one file of its format.
-:func:`register_writer` adds one to :data:`WRITERS`; :func:`writer_named` and
+A writer writes one export format: a trajectory file (``csv``, ``json``, ``ros``) or a
+controller program (``krl``, ``rapid``, ``fanuc``, ``urscript``) of one or several files.
+It takes an :class:`~trackplan.writers.source.ExportSource` (the trajectory table, and on
+demand the replayed run and the program built from it) and writes its files into a fresh
+staging folder; :func:`trackplan.writers.export` moves them into place.
+:func:`register_writer` adds a writer to :data:`WRITERS`; :func:`writer_named` and
 :func:`writer_for_file` pick one by name or by the output file's suffix, so the code that
-exports (:func:`trackplan.writers.export`) has no branch per format. See ``docs/results.md``.
+exports has no branch per format. See ``docs/results.md``.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from trackplan.errors import CaseError
-from trackplan.io.export import TrajectoryTable
+
+if TYPE_CHECKING:
+    from trackplan.writers.source import ExportSource
 
 
 @runtime_checkable
@@ -24,10 +30,14 @@ class Writer(Protocol):
     name
         The format's name as ``--format`` takes it (lower case, unique).
     suffix
-        The file suffix that picks this writer when no format is given (``".csv"``), lower case.
+        The suffix of its (main) file (``".csv"``, ``".src"``, ``".script"``), lower case;
+        it picks a one-file writer when no format is given.
     default_file
-        The file name written next to ``trajectory.csv`` when no output is given; it ends
-        with ``suffix``.
+        The default output next to ``trajectory.csv``: a file name ending with ``suffix``,
+        or for a writer of several files the folder's name (``"krl"``).
+    folder
+        True for a writer of several files: its output is a folder, and it names its files
+        itself; False for a writer of one file (written as ``options["file_name"]``).
     """
 
     @property
@@ -37,25 +47,40 @@ class Writer(Protocol):
 
     @property
     def suffix(self) -> str:
-        """The file suffix that picks the writer (``.csv``)."""
+        """The suffix of the (main) file (``.csv``)."""
         ...
 
     @property
     def default_file(self) -> str:
-        """The file written next to ``trajectory.csv`` by default."""
+        """The file, or folder, written next to ``trajectory.csv`` by default."""
         ...
 
-    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
-        """Write ``table`` to the file ``output`` (a new file: the caller renames it into place).
+    @property
+    def folder(self) -> bool:
+        """True when the writer writes several files into a folder."""
+        ...
+
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+        """Write the format's files into ``folder`` and return their names, main file first.
 
         Parameters
         ----------
-        table
-            The trajectory: times (N,) in s, joint columns (N, n) in rad and their rates.
-        output
-            The file to write; its folder exists.
+        source
+            What to export: ``source.table`` (times (N,) s, joints (N, n) rad and their
+            rates), ``source.run`` (the replayed run) and ``source.program(...)`` (the
+            program in no language) for the program writers.
+        folder
+            A fresh, empty staging folder; the caller moves the files into place
+            atomically, each by a rename, and removes the folder.
         **options
-            Format options (``frame_id`` for ROS); a writer ignores those it does not take.
+            ``file_name`` (the file a one-file writer writes), and format options:
+            ``frame_id`` (ROS), ``motion``, ``name``, ``period``, ``max_points``, ``force``
+            (programs); a writer ignores those it does not take.
+
+        Returns
+        -------
+        tuple of str
+            The names of the files written, plain names in ``folder``, main file first.
         """
         ...
 
@@ -70,7 +95,7 @@ def register_writer(writer: Writer) -> Writer:
     Parameters
     ----------
     writer
-        Any object with ``name``, ``suffix``, ``default_file`` and ``write``.
+        Any object with ``name``, ``suffix``, ``default_file``, ``folder`` and ``write``.
 
     Returns
     -------
@@ -80,8 +105,8 @@ def register_writer(writer: Writer) -> Writer:
     Raises
     ------
     ValueError
-        When the name or the suffix is taken by another writer, or the default file does not
-        end with the suffix (a programming error, not bad input).
+        When the name or the suffix is taken by another writer, or a one-file writer's
+        default file does not end with the suffix (a programming error, not bad input).
     """
     name, suffix = writer.name.lower(), writer.suffix.lower()
     if name in WRITERS and WRITERS[name] is not writer:
@@ -89,7 +114,7 @@ def register_writer(writer: Writer) -> Writer:
     taken = [other.name for other in WRITERS.values() if other.suffix == suffix]
     if taken and taken != [name]:
         raise ValueError(f"the suffix {suffix!r} belongs to the {taken[0]!r} writer already")
-    if not writer.default_file.lower().endswith(suffix):
+    if not writer.folder and not writer.default_file.lower().endswith(suffix):
         raise ValueError(f"{writer.default_file!r} does not end with {suffix!r}")
     WRITERS[name] = writer
     return writer
@@ -113,7 +138,9 @@ def writer_named(name: str) -> Writer:
 
 
 def writer_for_file(output: Path) -> Writer:
-    """The writer whose suffix ends ``output``'s name (the longest suffix wins).
+    """The one-file writer whose suffix ends ``output``'s name (the longest suffix wins).
+
+    A writer of several files writes a folder: it is picked by name only.
 
     Raises
     ------
@@ -121,9 +148,10 @@ def writer_for_file(output: Path) -> Writer:
         When no writer's suffix matches, listing the suffixes (key ``format``).
     """
     file_name = output.name.lower()
-    matches = [writer for writer in WRITERS.values() if file_name.endswith(writer.suffix)]
+    single = [writer for writer in WRITERS.values() if not writer.folder]
+    matches = [writer for writer in single if file_name.endswith(writer.suffix)]
     if not matches:
-        suffixes = ", ".join(f"{writer.suffix} ({writer.name})" for writer in WRITERS.values())
+        suffixes = ", ".join(f"{writer.suffix} ({writer.name})" for writer in single)
         raise CaseError(
             f"no export format for {output.name!r}: give --format, or a file ending in "
             f"one of {suffixes}",

@@ -1,5 +1,8 @@
 """The plain trajectory writers: CSV, JSON and a ROS 2 JointTrajectory (YAML).
 
+Each writes one file, ``options["file_name"]`` in the folder it is given (default its
+``default_file``), from the source's table (:class:`~trackplan.writers.source.ExportSource`):
+
 - ``csv`` → ``trajectory.export.csv``: ``t,<joint names>``, one row per sample (s, rad);
   the header is quoted as the ``csv`` module quotes, and a name that a spreadsheet would
   take for a formula gets a leading ``'`` (:func:`~trackplan.io.csv_cells.neutralised`).
@@ -20,6 +23,7 @@ import yaml
 from trackplan.io.csv_cells import neutralised
 from trackplan.io.csv_table import write_csv_table
 from trackplan.io.export import TrajectoryTable
+from trackplan.writers.source import ExportSource
 
 UNITS = {
     "t": "s",
@@ -40,11 +44,14 @@ class CsvWriter:
     name: str = "csv"
     suffix: str = ".csv"
     default_file: str = "trajectory.export.csv"
+    folder: bool = False
 
-    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
-        """Write the CSV file (options are ignored)."""
-        header = ["t", *(neutralised(name) for name in table.joint_names)]
-        write_csv_table(output, np.column_stack([table.t, table.q]), header)
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+        """Write the CSV file (options other than ``file_name`` are ignored)."""
+        name, table = _file_name(self, options), source.table
+        header = ["t", *(neutralised(joint) for joint in table.joint_names)]
+        write_csv_table(folder / name, np.column_stack([table.t, table.q]), header)
+        return (name,)
 
 
 @dataclass(frozen=True)
@@ -54,9 +61,12 @@ class JsonWriter:
     name: str = "json"
     suffix: str = ".json"
     default_file: str = "trajectory.json"
+    folder: bool = False
 
-    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
-        """Write the JSON file, one key per line (options are ignored)."""
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+        """Write the JSON file, one key per line (options other than ``file_name`` are
+        ignored)."""
+        name, table = _file_name(self, options), source.table
         content = {
             "joint_names": list(table.joint_names),
             "units": UNITS,
@@ -72,7 +82,8 @@ class JsonWriter:
         body = ",\n".join(
             f"  {json.dumps(key)}: {json.dumps(value)}" for key, value in content.items()
         )
-        output.write_text("{\n" + body + "\n}\n", encoding="utf-8")
+        (folder / name).write_text("{\n" + body + "\n}\n", encoding="utf-8")
+        return (name,)
 
 
 @dataclass(frozen=True)
@@ -82,9 +93,11 @@ class RosWriter:
     name: str = "ros"
     suffix: str = ".yaml"
     default_file: str = "trajectory.ros.yaml"
+    folder: bool = False
 
-    def write(self, table: TrajectoryTable, output: Path, **options: Any) -> None:
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
         """Write the YAML message; ``frame_id`` (default empty) goes to ``header.frame_id``."""
+        name, table = _file_name(self, options), source.table
         dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
         text = yaml.dump(
             joint_trajectory_msg(table, str(options.get("frame_id", ""))),
@@ -93,7 +106,13 @@ class RosWriter:
             default_flow_style=None,
             width=120,
         )
-        output.write_text(text, encoding="utf-8")
+        (folder / name).write_text(text, encoding="utf-8")
+        return (name,)
+
+
+def _file_name(writer: CsvWriter | JsonWriter | RosWriter, options: dict[str, Any]) -> str:
+    """The file a one-file writer writes: ``options["file_name"]``, else its default."""
+    return str(options.get("file_name") or writer.default_file)
 
 
 def _duration_msg(t: float) -> dict[str, int]:
