@@ -82,6 +82,8 @@ from trackplan.io.robot_schema import (
     RobotFileModel,
     ToolModel,
     collision_problems,
+    controller_convention,
+    controller_problems,
     link_capsules,
 )
 from trackplan.io.robot_schema import PayloadModel as PayloadModel
@@ -97,6 +99,7 @@ from trackplan.io.yaml_input import (
     validate_model,
 )
 from trackplan.robots.builtin import DH_ROBOTS
+from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics_parameters import (
     RobotDynamics,
     inertia_matrix,
@@ -169,6 +172,7 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
     ]
     problems += _dynamics_problems(model)
     problems += collision_problems(model.collision, len(model.joints), {})
+    problems += controller_problems(model.controller, len(model.joints))
     raise_first(problems, data, file)
     tool = model.tool or ToolModel()
     columns = {
@@ -191,6 +195,7 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
         source=model.source,
         dynamics=_dynamics(model, columns),
         collision=link_capsules(model.collision, {}),
+        controller=controller_convention(model.controller, len(model.joints)),
     )
 
 
@@ -372,6 +377,16 @@ class _Dumper(yaml.SafeDumper):  # type: ignore[misc]  # PyYAML ships no type st
         super().increase_indent(flow, False)
 
 
+class _FlowList(list[Any]):
+    """A list written on one line (``[1.0, -1.0, 1.0]``)."""
+
+
+_Dumper.add_representer(
+    _FlowList,
+    lambda dumper, data: dumper.represent_sequence(
+        "tag:yaml.org,2002:seq", list(data), flow_style=True
+    ),
+)
 _Dumper.add_representer(
     _FlowMapping,
     lambda dumper, data: dumper.represent_mapping(
@@ -446,7 +461,32 @@ def robot_to_yaml(robot: Robot) -> str:
             )
             for k in range(len(robot.collision))
         ]
+    if robot.controller is not None:
+        data["controller"] = _controller_block(robot.controller)
     body: str = yaml.dump(
         data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=1_000_000
     )
     return _HEADER + body
+
+
+def _controller_block(controller: ControllerConvention) -> dict[str, Any]:
+    """The ``controller:`` block of a convention: the keys that differ from their defaults
+    (joint numbers 1-based)."""
+    block: dict[str, Any] = {"vendor": controller.vendor}
+    if np.any(controller.signs != 1.0):
+        block["signs"] = _FlowList(float(sign) for sign in controller.signs)
+    if np.any(controller.offsets):
+        block["offsets"] = _FlowList(float(offset) for offset in controller.offsets)
+    if controller.coupling is not None:
+        joint, driver, factor = controller.coupling
+        block["coupling"] = _FlowMapping(joint=joint + 1, driver=driver + 1, factor=float(factor))
+    if not np.array_equal(controller.world, np.eye(4)):
+        block["world"] = _FlowMapping(
+            xyz=[float(value) for value in controller.world[:3, 3]],
+            rpy=[float(value) for value in rpy_from_matrix(controller.world[:3, :3])],
+        )
+    if controller.cycle is not None:
+        block["cycle"] = float(controller.cycle)
+    if controller.source:
+        block["source"] = controller.source
+    return block

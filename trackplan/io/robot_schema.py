@@ -1,5 +1,5 @@
 """The robot file schema: the pydantic models of robot files (DH and URDF), their
-payload and collision blocks, and the checks and conversions of those blocks.
+payload, collision and controller blocks, and the checks and conversions of those blocks.
 
 :mod:`trackplan.io.robot_file` reads robot files with these models; the case file
 (:mod:`trackplan.io.case_file`) uses the payload block too. docs/files.md documents
@@ -8,12 +8,14 @@ the keys.
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+import math
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, PlainValidator
 from pydantic_core import PydanticCustomError
 
+from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_bounds import (
     MAX_ANGLE,
     MAX_LENGTH,
@@ -39,6 +41,7 @@ from trackplan.io.yaml_input import (
     list_default,
 )
 from trackplan.robots.collision import Capsules, frame_name, transform_capsule
+from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics_parameters import (
     STANDARD_GRAVITY,
     Payload,
@@ -154,6 +157,95 @@ class URDFDynamicsModel(StrictModel):
     motor_constant: list[MotorConstant] | None = None
 
 
+class CouplingModel(StrictModel):
+    """A joint coupling: the controller's ``joint`` adds ``factor`` · the model's ``driver``
+    (1-based joint numbers; rad per rad)."""
+
+    joint: int
+    driver: int
+    factor: float
+
+
+class ControllerWorldModel(StrictModel):
+    """The controller's world frame in the model's base frame: ``Trans(xyz) · RPY(rpy)``
+    (m, rad)."""
+
+    xyz: Vec3 = list_default(0.0, 0.0, 0.0)
+    rpy: Vec3 = list_default(0.0, 0.0, 0.0)
+
+
+class ControllerModel(StrictModel):
+    """The ``controller:`` block: how the robot's controller counts the joints
+    (:class:`~trackplan.robots.controller.ControllerConvention`)."""
+
+    vendor: Literal["kuka", "abb", "fanuc", "ur", "generic"]  # VENDORS (a test checks)
+    signs: list[float] | None = None
+    offsets: list[Angle] | None = None
+    coupling: CouplingModel | None = None
+    world: ControllerWorldModel | None = None
+    cycle: Annotated[float, Field(gt=0, le=1.0)] | None = None
+    source: str = ""
+
+
+def controller_problems(controller: ControllerModel | None, n_dof: int) -> list[Problem]:
+    """Per-joint lists of another length than the chain, signs other than ±1, coupled
+    joints out of range or the same, a factor that is not finite."""
+    if controller is None:
+        return []
+    problems: list[Problem] = []
+    loc = ("controller",)
+    for key in ("signs", "offsets"):
+        values = getattr(controller, key)
+        if values is not None and len(values) != n_dof:
+            problems.append(
+                ((*loc, key), f"expected {n_dof} entries, one per joint, got {len(values)}")
+            )
+    for i, sign in enumerate(controller.signs or []):
+        if sign not in (1.0, -1.0):
+            problems.append(((*loc, "signs", i), f"a sign is 1 or -1, got {sign:g}"))
+    coupling = controller.coupling
+    if coupling is not None:
+        for key in ("joint", "driver"):
+            number = getattr(coupling, key)
+            if not 1 <= number <= n_dof:
+                problems.append(
+                    ((*loc, "coupling", key), f"expected a joint number 1..{n_dof}, got {number}")
+                )
+        if coupling.joint == coupling.driver:
+            problems.append(
+                (
+                    (*loc, "coupling", "driver"),
+                    f"a joint is not coupled to itself: the driver must differ from joint "
+                    f"{coupling.joint}",
+                )
+            )
+        if not math.isfinite(coupling.factor):
+            problems.append(((*loc, "coupling", "factor"), "expected a finite number"))
+    return problems
+
+
+def controller_convention(
+    controller: ControllerModel | None, n_dof: int
+) -> ControllerConvention | None:
+    """The convention of a validated ``controller:`` block (None when not given); joint
+    numbers become 0-based."""
+    if controller is None:
+        return None
+    coupling = controller.coupling
+    world = controller.world or ControllerWorldModel()
+    return ControllerConvention(
+        vendor=controller.vendor,
+        signs=np.array(controller.signs if controller.signs is not None else [1.0] * n_dof),
+        offsets=np.array(controller.offsets if controller.offsets is not None else [0.0] * n_dof),
+        coupling=None
+        if coupling is None
+        else (coupling.joint - 1, coupling.driver - 1, float(coupling.factor)),
+        world=pose_matrix(np.array(world.xyz), rpy_matrix(np.array(world.rpy))),
+        source=controller.source,
+        cycle=controller.cycle,
+    )
+
+
 class URDFRobotFileModel(StrictModel):
     """Schema of a robot file that points at a URDF."""
 
@@ -170,6 +262,7 @@ class URDFRobotFileModel(StrictModel):
     payload: PayloadModel | None = None
     assumptions: list[str] = Field(default_factory=list)
     collision: Collision | None = None
+    controller: ControllerModel | None = None
 
 
 class RobotFileModel(StrictModel):
@@ -182,6 +275,7 @@ class RobotFileModel(StrictModel):
     gravity: Vec3 = list_default(*STANDARD_GRAVITY)
     payload: PayloadModel | None = None
     collision: Collision | None = None
+    controller: ControllerModel | None = None
 
 
 def payload_problems(payload: PayloadModel, loc: tuple[str | int, ...]) -> list[Problem]:

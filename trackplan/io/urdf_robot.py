@@ -25,6 +25,8 @@ from trackplan.io.robot_schema import (
     URDFRobotFileModel,
     as_payload,
     collision_problems,
+    controller_convention,
+    controller_problems,
     link_capsules,
     payload_problems,
 )
@@ -84,6 +86,7 @@ def load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Ro
         for key in ("acceleration", "jerk", "velocity")
         if (values := getattr(model.limits, key)) is not None and len(values) != n
     ]
+    problems += controller_problems(model.controller, n)
     raise_first(problems, data, file)
     tool = model.tool or ToolModel()
     T_tool = pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy)))
@@ -99,7 +102,8 @@ def load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Ro
     )
     dynamics = urdf_dynamics(base / model.urdf, chain, model, data, file)
     collision = _urdf_collision(model, base / model.urdf, chain, data, file)
-    return replace(robot, dynamics=dynamics, collision=collision)
+    controller = controller_convention(model.controller, n)
+    return replace(robot, dynamics=dynamics, collision=collision, controller=controller)
 
 
 def _urdf_collision(
