@@ -182,3 +182,28 @@ def test_a_bare_csv_or_a_summary_without_placement_is_refused(
     _edit_summary(run, placement=None)
     with pytest.raises(CaseError, match=r"lacks the run's placement.*plan the case again"):
         replay_run(run)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("reverse", [False, True])
+def test_a_varying_spin_of_a_reversed_seam_replays(reverse: bool, tmp_path: Path) -> None:
+    from tests.planning.test_cycle import X, spun_case
+    from trackplan.io.results import write_plan_files
+    from trackplan.planning.plan import plan
+    from trackplan.planning.sequence import Sequence, Visit
+
+    case = spun_case({}, {"spin": "free-varying", "spin_range": [-0.5, 0.5], "spin_rate": 5.0})
+    variables = np.r_[-0.3, np.linspace(1.0, -0.2, case.seams[1].task.tool.n_spin - 1)]
+    order = Sequence(visits=(Visit(0, False), Visit(1, reverse)), cost=0.0, exact=False)
+    cycle = plan(case, X, sequence=order, spins=(None, variables))
+    assert cycle.success, cycle.message
+    write_plan_files(cycle, case, tmp_path)
+    summary = json.loads((tmp_path / "result.json").read_text())
+    assert summary["case_file"] is None  # built in Python: the case must be given
+    with pytest.raises(CaseError, match="give --case CASE"):
+        replay_run(tmp_path)
+    replayed = replay_run(tmp_path, case)
+    np.testing.assert_allclose(replayed.plan.trajectory.q, replayed.table.q, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        replayed.plan.trajectory.spin, cycle.trajectory.spin, rtol=0, atol=1e-12
+    )
