@@ -207,3 +207,21 @@ def test_a_varying_spin_of_a_reversed_seam_replays(reverse: bool, tmp_path: Path
     np.testing.assert_allclose(
         replayed.plan.trajectory.spin, cycle.trajectory.spin, rtol=0, atol=1e-12
     )
+
+
+def test_the_run_records_its_robot_file(kuka_run: Path, tmp_path: Path) -> None:
+    from trackplan.io.robot_file import robot_to_yaml
+    from trackplan.robots.builtin import puma560
+
+    assert json.loads((kuka_run / "result.json").read_text())["robot_file"] is None  # built-in
+    (tmp_path / "robots").mkdir()
+    (tmp_path / "robots" / "arm.yaml").write_text(robot_to_yaml(puma560()))
+    text = (CASES / "paper-line.yaml").read_text()
+    case = tmp_path / "line.yaml"
+    case.write_text(text.replace("robot: puma560", "robot: robots/arm.yaml"))
+    run = tmp_path / "run"
+    assert main(["plan", str(case), "--out", str(run), "--no-report"]) == 0
+    summary = json.loads((run / "result.json").read_text())
+    assert summary["robot_file"] == str((tmp_path / "robots" / "arm.yaml").resolve())
+    assert summary["case_file"] == str(case.resolve())
+    assert replay_run(run).case.robot.name == "puma560"

@@ -334,6 +334,7 @@ def plan_summary(result: PlanResult, case: Case) -> dict:
     return {
         **result_summary(result, case.robot.joint_names),
         "case_file": case_file(case),
+        "robot_file": robot_file(case),
         **seams_summary(result, case),
     }
 
@@ -345,6 +346,27 @@ def case_file(case: Case) -> str | None:
     if case.source is None:
         return None
     return str(Path(case.source).resolve())
+
+
+def robot_file(case: Case) -> str | None:
+    """The absolute path of the robot file the case file names (``robot: my-arm.yaml``),
+    or None for a built-in robot, a case built in Python, or a case file that no longer
+    reads (``result.json``'s ``robot_file``)."""
+    if case.source is None:
+        return None
+    import yaml
+
+    from trackplan.io.robot_file import is_robot_file
+
+    file = Path(case.source)
+    try:
+        data = yaml.safe_load(file.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return None
+    name = data.get("robot") if isinstance(data, dict) else None
+    if not isinstance(name, str) or not is_robot_file(name):
+        return None
+    return str((file.parent / name).resolve())
 
 
 def write_plan_files(
