@@ -87,7 +87,6 @@ def test_a_single_seam_opw_run_replays(kuka_run: Path) -> None:
     assert "assumptions" in replayed.summary["robot"]  # loaded with the assumed limits
 
 
-@pytest.mark.slow
 def test_a_free_spin_run_replays_with_its_chosen_spin(tmp_path: Path) -> None:
     run = _plan_run(tmp_path, "seam-weld-free")
     _assert_replays(run, "seam-weld-free")
@@ -98,7 +97,6 @@ def test_a_free_spin_run_replays_with_its_chosen_spin(tmp_path: Path) -> None:
     assert replayed.plan.joint_path.tool.spin.as_dict() == {"value": pytest.approx(spin, abs=1e-12)}
 
 
-@pytest.mark.slow
 def test_a_run_of_several_seams_with_approaches_replays(tmp_path: Path) -> None:
     run = _plan_run(tmp_path, "bracket-4-fillets")
     summary = json.loads((run / "result.json").read_text())
@@ -107,7 +105,6 @@ def test_a_run_of_several_seams_with_approaches_replays(tmp_path: Path) -> None:
     _assert_replays(run, "bracket-4-fillets")
 
 
-@pytest.mark.slow
 def test_a_ur_run_replays(tmp_path: Path) -> None:
     _assert_replays(_plan_run(tmp_path, "ur5e-glue"), "ur5e-glue")
 
@@ -184,7 +181,6 @@ def test_a_bare_csv_or_a_summary_without_placement_is_refused(
         replay_run(run)
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("reverse", [False, True])
 def test_a_varying_spin_of_a_reversed_seam_replays(reverse: bool, tmp_path: Path) -> None:
     from tests.planning.test_cycle import X, spun_case
