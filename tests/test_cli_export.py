@@ -426,3 +426,45 @@ def test_the_format_help_lists_every_registered_writer(
     assert main(["export", "--help"]) == 0
     out = " ".join(capsys.readouterr().out.split())
     assert "One of csv, json, ros, twofiles." in out
+
+
+@dataclass(frozen=True)
+class _PartsWriter:
+    """A program split into parts: ``main.prog`` and ``part1.prog`` … ``partN.prog``."""
+
+    name: str = "parts"
+    suffix: str = ".part"
+    default_file: str = "parts"
+    folder: bool = True
+    parts: int = 5
+
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+        names = ("main.prog", *(f"part{k}.prog" for k in range(1, self.parts + 1)))
+        for name in names:
+            (folder / name).write_text(name)
+        return names
+
+
+@pytest.mark.parametrize("parts", [3, 5])
+def test_the_cli_sums_up_a_program_of_many_parts(
+    paper_run: Path,
+    tmp_path: Path,
+    writers: dict[str, Writer],
+    capsys: pytest.CaptureFixture[str],
+    parts: int,
+) -> None:
+    register_writer(_PartsWriter(parts=parts))
+    out = tmp_path / "prog"
+    capsys.readouterr()
+    assert main(["export", str(paper_run), "--format", "parts", "--output", str(out)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    files = ["main.prog", *(f"part{k}.prog" for k in range(1, parts + 1))]
+    assert sorted(p.name for p in out.iterdir()) == sorted(files)
+    if parts == 3:
+        assert printed == [f"wrote {out / name}" for name in files]
+    else:
+        assert printed == [
+            f"wrote {out / 'main.prog'}",
+            f"wrote {out / 'part1.prog'}",
+            f"wrote 4 more files in {out}{os.sep} (part2.prog … part5.prog)",
+        ]

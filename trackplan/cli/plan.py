@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import replace
 from pathlib import Path
 from typing import Annotated, Any
@@ -222,6 +223,24 @@ def export(
         max_points=max_points,
         force=force,
     )
-    for file in written:
-        typer.echo(f"wrote {file}")
+    for line in _written_lines(written):
+        typer.echo(line)
     return ExitCode.OK
+
+
+SHOWN_FILES = 4
+"""Files ``export`` names one per line; more are summed up in one line."""
+
+
+def _written_lines(written: tuple[Path, ...]) -> list[str]:
+    """``wrote <path>`` per file; of a program split into many parts, the first two files
+    (the main program and its data) and one line for the rest (their count, folder and
+    first and last names)."""
+    if len(written) <= SHOWN_FILES:
+        return [f"wrote {file}" for file in written]
+    rest = written[2:]
+    return [
+        *(f"wrote {file}" for file in written[:2]),
+        f"wrote {len(rest)} more files in {rest[0].parent}{os.sep} "
+        f"({rest[0].name} … {rest[-1].name})",
+    ]
