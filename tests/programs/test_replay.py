@@ -129,6 +129,14 @@ def test_a_run_without_case_file_needs_the_case(kuka_run: Path, tmp_path: Path) 
     )
     case_file = CASES / "kuka-weld.yaml"
     assert replay_run(run, case_file).case.name == "kuka-weld"  # a file
+    gone = tmp_path / "moved.yaml"
+    _edit_summary(run, case_file=str(gone))
+    with pytest.raises(CaseError) as error:
+        replay_run(run)
+    assert str(error.value) == (
+        f"--case: the run was planned from {str(gone)!r}, which is no longer there: "
+        "give --case CASE"
+    )
     loaded = load_case(case_file, assume_limits=True)
     assert replay_run(run, loaded).case is loaded  # a Case
 

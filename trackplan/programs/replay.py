@@ -172,6 +172,11 @@ def _the_case(case: Case | Path | str | None, summary: dict) -> Case:
     file = case if case is not None else summary.get("case_file")
     if not isinstance(file, str | Path) or not str(file):
         raise CaseError(NO_CASE, key="--case")
+    if case is None and not Path(file).exists():
+        raise CaseError(
+            f"the run was planned from {str(file)!r}, which is no longer there: give --case CASE",
+            key="--case",
+        )
     robot = summary.get("robot")
     assumed = isinstance(robot, dict) and bool(robot.get("assumptions"))
     return load_case(file, assume_limits=assumed)
