@@ -28,7 +28,8 @@ def frame_text(T: np.ndarray) -> str:
 
 
 def _numbers(values: np.ndarray, digits: int) -> str:
-    return ", ".join(f"{float(v):.{digits}f}" for v in values)
+    # rounded first, then + 0.0: no "-0.000" for a value that rounds to zero
+    return ", ".join(f"{round(float(v), digits) + 0.0:.{digits}f}" for v in values)
 
 
 def header_lines(
@@ -71,8 +72,8 @@ def header_lines(
     lines = [
         f"written by trackplan {trackplan_version()}",
         f"case: {case.name}" + (f" ({case.source})" if case.source else ""),
-        f"robot: {robot.name} ({robot.n_dof} joints); controller: {convention.vendor}, "
-        f"joints and world as {convention.source or 'the model'}",
+        f"robot: {robot.name} ({robot.n_dof} joints); controller {convention.vendor}: "
+        f"{convention.source or 'joints and world as the model'}",
         f"placement X: [{_numbers(X[:3], 6)}] m, [{_numbers(X[3:], 6)}] rad = "
         f"[{_numbers(1e3 * X[:3], 3)}] mm, [{_numbers(np.degrees(X[3:]), 4)}] deg",
         f"base (part frame in the controller world): {frame_text(base)}",
