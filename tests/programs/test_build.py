@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.conftest import CASES
 from tests.programs.roundtrip import (
     ANGLE_TOLERANCE,
     POSITION_TOLERANCE,
@@ -263,3 +265,25 @@ def test_a_run_that_is_not_feasible_needs_force() -> None:
 def test_an_unknown_form_is_refused() -> None:
     with pytest.raises(CaseError, match="--motion: must be one of cartesian, joint"):
         build_program(planned_run("paper-corner"), motion="spline")
+
+
+def test_a_reversal_inside_a_seam_is_a_stop_point(tmp_path: Path) -> None:
+    import trackplan
+
+    text = (CASES / "paper-line.yaml").read_text(encoding="utf-8")
+    there_and_back = "    - line: {to: [0.3, 0, 0.5]}\n    - line: {to: [0.15, 0, 0.25]}\n"
+    text = text.replace("    - line: {to: [0.3, 0, 0.5]}\n", there_and_back)
+    file = tmp_path / "reversal.yaml"
+    file.write_text(text, encoding="utf-8")
+    case = trackplan.load_case(file)
+    plan = trackplan.plan(case, case.bounds.example)
+    assert plan.success, plan.message
+    path = plan.seams[0].plan.joint_path.geometry.planned
+    assert len(path.stops) == 1
+    program = build_program(PlannedRun(case=case, plan=plan))
+    out, back = seam_moves(program)
+    assert isinstance(out, LinearMove) and isinstance(back, LinearMove)
+    np.testing.assert_allclose(out.target.pose[:3, 3], [0.3, 0.0, 0.5], atol=1e-12)
+    assert out.zone == 0.0 and back.zone == 0.0  # the plan stops at the turn and the end
+    budget = program.budget
+    assert budget is not None and budget.tracking_error < 1e-6  # lines: the whole budget

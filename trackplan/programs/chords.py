@@ -74,7 +74,7 @@ def spline_points(path: Path, s0: float, s1: float, chord: float) -> tuple[np.nd
     path
         The planned path.
     s0, s1
-        The stretch, m, ``s0 < s1``.
+        The stretch, m, ``s0 ≤ s1`` (an empty one is its end point).
     chord
         The largest distance of the polyline from the curve, m, > 0.
 
@@ -86,6 +86,8 @@ def spline_points(path: Path, s0: float, s1: float, chord: float) -> tuple[np.nd
     error
         The largest chord error reached, m.
     """
+    if not s1 > s0:
+        return np.array([s1]), 0.0
     n_dense = max(64, int(np.ceil((s1 - s0) / DENSE_STEP)))
     dense = np.linspace(s0, s1, n_dense + 1)
     kappa = np.linalg.norm(path.sample(dense).curvature, axis=1)
