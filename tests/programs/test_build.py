@@ -276,6 +276,7 @@ def test_a_reversal_inside_a_seam_is_a_stop_point(tmp_path: Path) -> None:
     file = tmp_path / "reversal.yaml"
     file.write_text(text, encoding="utf-8")
     case = trackplan.load_case(file)
+    assert case.bounds.example is not None
     plan = trackplan.plan(case, case.bounds.example)
     assert plan.success, plan.message
     path = plan.seams[0].plan.joint_path.geometry.planned
