@@ -4,10 +4,12 @@ error, and every target is the FK of its planned joints."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
-from tests.conftest import CASES
+from tests.conftest import CASES, REPO
 from tests.programs.roundtrip import (
     ANGLE_TOLERANCE,
     POSITION_TOLERANCE,
@@ -76,7 +78,39 @@ def test_random_placements_keep_the_budget() -> None:
             break
     assert len(slacks) == 20
     assert min(slacks) >= 0.0
+    docs = (REPO / "docs" / "export.md").read_text(encoding="utf-8")
+    stated = f"(seed 28) it is {np.median(slacks) * 1e3:.4f} mm"
+    assert stated in " ".join(docs.split()), f"docs/export.md should say: {stated}"
+    assert f"{np.median(slacks) * 1e3:.4f}" == f"{min(slacks) * 1e3:.4f}"
     print(
         f"slack over 20 placements: median {np.median(slacks) * 1e3:.4f} mm, "
         f"worst {min(slacks) * 1e3:.4f} mm"
     )
+
+
+@pytest.mark.slow
+def test_docs_state_the_shipped_cases_median_and_worst_slack() -> None:
+    slacks = []
+    for name in SHIPPED:
+        run = planned_run(name)
+        if run.plan.success:
+            program = build_program(run)
+            assert program.budget is not None
+            slacks.append(program.budget.slack)
+    assert len(slacks) == len(SHIPPED) - len(NOT_FEASIBLE_HERE)
+    docs = " ".join((REPO / "docs" / "export.md").read_text(encoding="utf-8").split())
+    for stated in (
+        f"({len(slacks)} cases,",
+        f"the slack is at least {min(slacks) * 1e3:.4f} mm",
+        f"median {np.median(slacks) * 1e3:.4f} mm",
+    ):
+        assert stated in docs, f"docs/export.md should say: {stated}"
+
+
+def test_the_docs_example_runs() -> None:
+    page = (REPO / "docs" / "export.md").read_text(encoding="utf-8")
+    (block,) = re.findall(r"^```python\n(.*?)^```", page, re.M | re.S)
+    namespace: dict[str, object] = {}
+    exec(compile(block, "docs/export.md", "exec"), namespace)
+    program = namespace["program"]
+    assert isinstance(program, Program) and program.budget is not None
