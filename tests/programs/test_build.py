@@ -288,3 +288,23 @@ def test_a_reversal_inside_a_seam_is_a_stop_point(tmp_path: Path) -> None:
     assert out.zone == 0.0 and back.zone == 0.0  # the plan stops at the turn and the end
     budget = program.budget
     assert budget is not None and budget.tracking_error < 1e-6  # lines: the whole budget
+
+
+def test_a_spline_that_ends_where_the_plan_stops_blends_through_its_points(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from trackplan.programs import cartesian
+
+    monkeypatch.setattr(cartesian, "MIN_MOVE", 10.0)  # m: every piece joins one spline
+    run = planned_run("paper-corner")
+    program = build_program(run)
+    through, last = seam_moves(program)
+    assert isinstance(through, SplineMove) and isinstance(last, SplineMove)
+    budget = program.budget
+    assert budget is not None and budget.slack >= 0.0
+    assert len(through.targets) > 2 and through.zone == budget.zone > 0.0
+    assert len(last.targets) == 1 and last.zone == 0.0
+    assert through.speed == last.speed
+    path = run.plan.seams[0].plan.joint_path.geometry.planned
+    _, end, _ = path.points(np.array([path.length]))
+    np.testing.assert_allclose(last.targets[0].pose[:3, 3], end[0], atol=1e-12)

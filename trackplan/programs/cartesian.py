@@ -184,6 +184,12 @@ def seam_moves(case: Case, seam: SeamPlan, check: CheckReport) -> tuple[tuple[Mo
             moves.append(LinearMove(target=own[0], speed=speed, zone=move_zone))
         elif spec.kind == "arc":
             moves.append(CircularMove(via=own[0], target=own[1], speed=speed, zone=move_zone))
+        elif stops_here and len(own) > 1:
+            # a spline written as blended linear moves blends between its points with its
+            # zone: one that ends where the plan stops runs through its points before the
+            # last with the seam's zone, then stops on the last
+            moves.append(SplineMove(targets=tuple(own[:-1]), speed=speed, zone=zone))
+            moves.append(SplineMove(targets=tuple(own[-1:]), speed=speed, zone=0.0))
         else:
             moves.append(SplineMove(targets=tuple(own), speed=speed, zone=move_zone))
     written_zone = max((_zone_of(move) for move in moves), default=0.0)
