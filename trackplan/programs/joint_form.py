@@ -18,12 +18,12 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.errors import CaseError
 from trackplan.planning.result import SEAM, PlanResult
-from trackplan.programs.model import Move, Section
+from trackplan.programs.model import JointMove, Move, Section
 from trackplan.programs.targets import (
+    MIN_SPEED_SHARE,
     START_SPEED,
     joint_move,
     seam_budget,
-    speed_share,
     zones_within,
 )
 
@@ -91,24 +91,29 @@ def joint_sections(case: Case, plan: PlanResult, step: int) -> tuple[Section, ..
     q, qd, t = trajectory.q, trajectory.qd, trajectory.t
     index = sample_indices(trajectory.n_samples, step)
     zones = _zones(case, plan, index)
+    q_written = q[index]  # a copy: the moves' rows are their own
+    theta = robot.convention.to_controller(q_written)
+    # each move's peak joint rate share over the samples after the one before it
+    rates = np.max(np.abs(qd) / robot.v_max, axis=1)
+    peaks = np.maximum.reduceat(rates, index[:-1] + 1) if len(index) > 1 else np.zeros(0)
+    shares = np.clip(np.concatenate([[0.0], peaks]), MIN_SPEED_SHARE, 1.0)
+    durations = np.concatenate([[0.0], np.diff(t[index])])
     start = joint_move(robot, q[0], START_SPEED)
     sections = [Section(kind="start", label="start", moves=(start,))]
     for span in plan.spans:
         inside = np.flatnonzero((index > span.first) & (index <= span.last))
-        moves: list[Move] = []
-        for m in inside:
-            before, here = int(index[m - 1]), int(index[m])
-            moves.append(
-                joint_move(
-                    robot,
-                    q[here],
-                    speed_share(robot, qd[before + 1 : here + 1]),
-                    zone=float(zones[m]),
-                    duration=float(t[here] - t[before]),
-                )
+        moves: tuple[Move, ...] = tuple(
+            JointMove(
+                joints=theta[m],
+                model_joints=q_written[m],
+                speed=float(shares[m]),
+                duration=float(durations[m]),
+                zone=float(zones[m]),
             )
+            for m in inside.tolist()
+        )
         if moves:
-            sections.append(Section(kind=span.kind, label=span.label, moves=tuple(moves)))
+            sections.append(Section(kind=span.kind, label=span.label, moves=moves))
     return tuple(sections)
 
 
