@@ -192,15 +192,11 @@ def seam_moves(case: Case, seam: SeamPlan, check: CheckReport) -> tuple[tuple[Mo
             moves.append(SplineMove(targets=tuple(own[-1:]), speed=speed, zone=0.0))
         else:
             moves.append(SplineMove(targets=tuple(own), speed=speed, zone=move_zone))
-    written_zone = max((_zone_of(move) for move in moves), default=0.0)
+    written_zone = max((float(move.zone) for move in moves), default=0.0)
     budget = Budget(
         tolerance=tolerance, tracking_error=tracking, chord_error=chord, zone=written_zone
     )
     return tuple(moves), budget
-
-
-def _zone_of(move: Move) -> float:
-    return float(move.zone)
 
 
 def _stretches(path: Path, chord_limit: float) -> list[_Stretch]:
