@@ -47,15 +47,12 @@ DURATION_TOLERANCE = 1e-6
 
 SHIPPED_PLACEMENTS: dict[str, tuple[float, ...]] = {
     "paper-corner-cell": (0.0902, 0.209, 0.202, 0.3263, 0.3016, -0.2522),
-    "kuka-weld": (0.3147, -0.0547, 0.0948, 0.0057, -0.1603, -0.0140),
-    "ur5e-glue": (-0.2961, -0.4990, 0.2686, -0.2244, 0.0992, 2.4809),
     "seam-weld-fixed": (0.5241, 0.2063, 0.0498, -0.2943, 0.2999, 2.4350),
     "seam-weld-free": (0.342, -0.238, 0.4, -0.132, -0.009, 3.019),
     "ur5-bead": (0.5961, -0.2199, -0.2935, -0.0136, -0.4994, -0.1238),
-    "bracket-4-fillets": (0.2149, -0.4997, -0.2996, 0.0463, -0.0083, -2.6086),
 }
 """Placements of the shipped cases without a ``placement.example`` (from optimize runs:
-tests/cell/test_robot_bodies.py, tests/planning/test_plan_golden.py, docs/seams.md)."""
+tests/cell/test_robot_bodies.py, tests/planning/test_plan_golden.py)."""
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,6 +20,7 @@ from tests.programs.roundtrip import (
 from trackplan.frames import placement_transform
 from trackplan.programs import Program, build_program
 from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.model import Robot
 
 SHIPPED = sorted(path.stem for path in CASES.glob("*.yaml"))
 
@@ -32,14 +33,21 @@ NOT_FEASIBLE_HERE = {
 """Shipped cases whose stored placement does not plan feasibly (exported with force)."""
 
 
-def assert_targets_are_fk(program: Program, run_placement: np.ndarray, robot: object) -> None:
+def assert_targets_are_fk(program: Program, run_placement: np.ndarray, robot: Robot) -> None:
+    """Every Cartesian target is the FK of its planned joints, in the model's base frame
+    (through the placement) and in the controller's world (through the program's base)."""
     T_X = placement_transform(run_placement)
     targets = [e for e in expected_targets(program) if e.pose is not None]
-    fk = forward_kinematics(robot, np.array([e.model_joints for e in targets]))  # type: ignore[arg-type]
-    for target, pose in zip(targets, fk, strict=True):
+    fk = forward_kinematics(robot, np.array([e.model_joints for e in targets]))
+    world_fk = robot.convention.world_from_base(fk)
+    for target, pose, world_pose in zip(targets, fk, world_fk, strict=True):
         assert target.pose is not None
-        distance, angle = frame_difference(T_X @ target.pose, pose)
-        assert distance <= POSITION_TOLERANCE and angle <= ANGLE_TOLERANCE
+        for got, want in ((T_X @ target.pose, pose), (program.base @ target.pose, world_pose)):
+            distance, angle = frame_difference(got, want)
+            assert distance <= POSITION_TOLERANCE and angle <= ANGLE_TOLERANCE
+        np.testing.assert_allclose(
+            target.joints, robot.convention.to_controller(target.model_joints), atol=1e-12
+        )
 
 
 @pytest.mark.slow
