@@ -5,6 +5,7 @@
 controller's language. See ``docs/export.md``.
 """
 
+from trackplan.programs.build import Run, build_program
 from trackplan.programs.model import (
     MOTION_FORMS,
     Budget,
@@ -33,9 +34,11 @@ __all__ = [
     "Move",
     "Part",
     "Program",
+    "Run",
     "Section",
     "SplineMove",
     "Target",
+    "build_program",
     "point_count",
     "program_identifier",
     "split_program",

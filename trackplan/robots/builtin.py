@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.robots.collision import puma560_capsules, ur5_capsules
+from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics.builtin import puma560_dynamics
 from trackplan.robots.model import Robot
 
@@ -79,6 +80,19 @@ def ur5() -> Robot:
             "(±360°, 180°/s); acceleration 15 rad/s² and jerk 150 rad/s³ are assumptions."
         ),
         collision=ur5_capsules(),
+        controller=ControllerConvention(
+            vendor="ur",
+            signs=np.ones(6),
+            offsets=np.zeros(6),
+            cycle=0.008,
+            source=(
+                "Universal Robots: the DH table is given in the controller's Base frame and "
+                "joint zero (UR CB3 user manual, appendix 'Robot DH parameters'; ur_description "
+                "docs 'Robot Frames': at all-zero joints the arm points along -x of Base); "
+                "CB3 controller step 8 ms (Universal_Robots_Client_Library rtde_client.h, "
+                "CB3_MAX_FREQUENCY = 125)"
+            ),
+        ),
     )
 
 

@@ -1,0 +1,223 @@
+"""Compare a program read back by a language's test parser with the plan it was built from.
+
+Every language's round-trip test calls :func:`assert_matches_plan` on the
+:class:`~tests.programs.parsed.ParsedProgram` its parser returns: the frames, every
+Cartesian target against the forward kinematics of the planned joints there, every joint
+target against the planned joints, and the number and kinds of targets.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import trackplan
+from tests.conftest import CASES
+from tests.programs.parsed import ParsedProgram, ParsedTarget
+from trackplan.case import Case
+from trackplan.planning.result import PlanResult
+from trackplan.programs.model import (
+    CircularMove,
+    JointMove,
+    LinearMove,
+    Program,
+    SplineMove,
+    Target,
+)
+from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.model import Robot
+
+POSITION_TOLERANCE = 1e-5
+"""Largest position difference of a frame or target, m (0.01 mm)."""
+
+ANGLE_TOLERANCE = np.radians(1e-3)
+"""Largest rotation between two frames or targets, rad (0.001°)."""
+
+JOINT_TOLERANCE = 1e-6
+"""Largest joint difference, rad (1e-4° is 1.7e-6 rad: the languages in degrees print
+to 1e-4° and better)."""
+
+DURATION_TOLERANCE = 1e-6
+"""Largest difference of a timed move's duration, s."""
+
+
+SHIPPED_PLACEMENTS: dict[str, tuple[float, ...]] = {
+    "paper-corner-cell": (0.0902, 0.209, 0.202, 0.3263, 0.3016, -0.2522),
+    "seam-weld-fixed": (0.5241, 0.2063, 0.0498, -0.2943, 0.2999, 2.4350),
+    "seam-weld-free": (0.342, -0.238, 0.4, -0.132, -0.009, 3.019),
+    "ur5-bead": (0.5961, -0.2199, -0.2935, -0.0136, -0.4994, -0.1238),
+}
+"""Placements of the shipped cases without a ``placement.example`` (from optimize runs:
+tests/cell/test_robot_bodies.py, tests/planning/test_plan_golden.py)."""
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedRun:
+    """A run made in code: what :func:`trackplan.programs.build_program` reads of a
+    replayed run folder."""
+
+    case: Case
+    plan: PlanResult
+    summary: dict[str, Any] = field(default_factory=dict)
+    folder: Path | None = None
+
+
+@functools.cache
+def planned_run(case_name: str, X: tuple[float, ...] | None = None) -> PlannedRun:
+    """The shipped case ``cases/<case_name>.yaml`` planned at ``X`` (default its example
+    placement, or :data:`SHIPPED_PLACEMENTS`), kept for the session."""
+    case = trackplan.load_case(CASES / f"{case_name}.yaml")
+    if X is None:
+        example = case.bounds.example
+        X = tuple(example) if example is not None else SHIPPED_PLACEMENTS[case_name]
+    return PlannedRun(case=case, plan=trackplan.plan(case, np.asarray(X, dtype=float)))
+
+
+@dataclass(frozen=True)
+class ExpectedTarget:
+    """One target of a program, in the order a parser returns them.
+
+    Attributes
+    ----------
+    kind
+        ``joint``, ``linear``, ``circular_via``, ``circular_end`` or ``spline``.
+    joints
+        The planned joints there in the controller's convention, shape (n,), rad.
+    model_joints
+        The same in the model's convention, shape (n,), rad.
+    pose
+        The TCP in the part frame, shape (4, 4), m; None for a joint target.
+    duration
+        A timed joint move's duration, s, else None.
+    """
+
+    kind: str
+    joints: np.ndarray
+    model_joints: np.ndarray
+    pose: np.ndarray | None = None
+    duration: float | None = None
+
+
+def expected_targets(program: Program) -> list[ExpectedTarget]:
+    """The program's targets in execution order (a circular move gives its via, then its
+    end; a spline each of its points)."""
+    out: list[ExpectedTarget] = []
+
+    def cartesian(kind: str, target: Target) -> ExpectedTarget:
+        return ExpectedTarget(
+            kind=kind, joints=target.joints, model_joints=target.model_joints, pose=target.pose
+        )
+
+    for move in program.moves():
+        if isinstance(move, JointMove):
+            out.append(
+                ExpectedTarget(
+                    kind="joint",
+                    joints=move.joints,
+                    model_joints=move.model_joints,
+                    duration=move.duration,
+                )
+            )
+        elif isinstance(move, LinearMove):
+            out.append(cartesian("linear", move.target))
+        elif isinstance(move, CircularMove):
+            out.append(cartesian("circular_via", move.via))
+            out.append(cartesian("circular_end", move.target))
+        elif isinstance(move, SplineMove):
+            out.extend(cartesian("spline", target) for target in move.targets)
+        else:  # pragma: no cover - a move kind this helper does not know
+            raise TypeError(f"unknown move {move!r}")
+    return out
+
+
+def frame_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """Distance (m) and rotation angle (rad) between two frames (4, 4).
+
+    The angle is ``2 asin(‖Ra − Rb‖_F / 2√2)``, exact near 0 (unlike an arccos of the
+    trace).
+    """
+    distance = float(np.linalg.norm(a[:3, 3] - b[:3, 3]))
+    chord = float(np.linalg.norm(a[:3, :3] - b[:3, :3])) / (2.0 * np.sqrt(2.0))
+    return distance, 2.0 * float(np.arcsin(min(chord, 1.0)))
+
+
+def _assert_frame(actual: np.ndarray, expected: np.ndarray, what: str) -> None:
+    distance, angle = frame_difference(actual, expected)
+    assert distance <= POSITION_TOLERANCE, (
+        f"{what}: {distance * 1e3:.6f} mm from the plan (at most {POSITION_TOLERANCE * 1e3} mm)"
+    )
+    assert angle <= ANGLE_TOLERANCE, (
+        f"{what}: {np.degrees(angle):.6f} deg from the plan (at most 0.001 deg)"
+    )
+
+
+def _kinds_agree(parsed: ParsedTarget, expected: ExpectedTarget) -> bool:
+    """A spline point may be written as a linear move (a language without a spline)."""
+    if expected.kind == "spline":
+        return parsed.kind in ("spline", "linear")
+    return parsed.kind == expected.kind
+
+
+def assert_matches_plan(parsed: ParsedProgram, program: Program, robot: Robot) -> None:
+    """Assert that a program read back is the plan's, target by target.
+
+    - The parsed base and tool equal the program's (0.01 mm, 0.001°).
+    - The parsed targets are as many as the program's, of the same kinds (a spline's
+      points may read back as linear moves), in the same order.
+    - Every Cartesian target, put through the parsed base, is the controller-world forward
+      kinematics of the planned joints there (model joints → ``forward_kinematics`` →
+      ``convention.world_from_base``) within 0.01 mm and 0.001°.
+    - Every joint target (and a Cartesian target that states joints) equals the planned
+      controller joints within 1e-6 rad; a timed move's duration equals the program's.
+
+    Parameters
+    ----------
+    parsed
+        The program as a language's parser read it.
+    program
+        The program the writer printed.
+    robot
+        The run's robot.
+    """
+    _assert_frame(parsed.base, program.base, "base frame")
+    _assert_frame(parsed.tool, program.tool, "tool frame")
+    expected = expected_targets(program)
+    assert len(parsed.targets) == len(expected), (
+        f"{len(parsed.targets)} targets read back, the program has {len(expected)}"
+    )
+    convention = robot.convention
+    world_poses = convention.world_from_base(
+        forward_kinematics(robot, np.array([e.model_joints for e in expected]))
+    )
+    for k, (got, want) in enumerate(zip(parsed.targets, expected, strict=True)):
+        where = f"target {k} ({want.kind}, {got.part or 'main'})"
+        assert _kinds_agree(got, want), f"{where}: read back as {got.kind}"
+        if want.pose is not None:
+            assert got.pose is not None, f"{where}: no pose read back"
+            _assert_frame(parsed.base @ got.pose, world_poses[k], where)
+        if want.kind == "joint" or got.joints is not None:
+            assert got.joints is not None, f"{where}: no joints read back"
+            error = float(np.max(np.abs(np.asarray(got.joints) - want.joints)))
+            assert error <= JOINT_TOLERANCE, f"{where}: joints {error:.3g} rad from the plan"
+        if want.duration is not None and got.duration is not None:
+            assert abs(got.duration - want.duration) <= DURATION_TOLERANCE, (
+                f"{where}: duration {got.duration} s, the plan's {want.duration} s"
+            )
+
+
+__all__ = [
+    "ANGLE_TOLERANCE",
+    "JOINT_TOLERANCE",
+    "POSITION_TOLERANCE",
+    "SHIPPED_PLACEMENTS",
+    "ExpectedTarget",
+    "PlannedRun",
+    "assert_matches_plan",
+    "expected_targets",
+    "frame_difference",
+    "planned_run",
+]
