@@ -468,3 +468,13 @@ def test_the_cli_sums_up_a_program_of_many_parts(
             f"wrote {out / 'part1.prog'}",
             f"wrote 4 more files in {out}{os.sep} (part2.prog … part5.prog)",
         ]
+
+
+def test_the_source_builds_the_runs_program_once(paper_run: Path) -> None:
+    source = ExportSource.of(paper_run)
+    program = source.program(motion="joint", name="line")
+    assert source.program(motion="joint", name="line") is program  # cached
+    assert program.motion == "joint" and program.n_dof == 6
+    assert source.program() is not program and source.program().motion == "cartesian"
+    assert source.run is source.run  # replayed once
+    assert source.run.folder == paper_run

@@ -9,7 +9,6 @@ program writers call :meth:`ExportSource.program`, which replays the run folder
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -31,9 +30,6 @@ from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 if TYPE_CHECKING:
     from trackplan.case import Case
     from trackplan.programs.model import MotionForm, Program
-
-BUILDER_MODULE = "trackplan.programs.build"
-"""The module of ``build_program(replayed, *, motion, name, period, force) -> Program``."""
 
 
 @dataclass(eq=False, kw_only=True)
@@ -172,8 +168,8 @@ class ExportSource:
         """
         key = (motion, name, period, force)
         if key not in self._programs:
-            # imported by name: the builder is a module of its own (trackplan.programs.build)
-            build_program = importlib.import_module(BUILDER_MODULE).build_program
+            from trackplan.programs.build import build_program
+
             self._programs[key] = build_program(
                 self.run, motion=motion, name=name, period=period, force=force
             )
@@ -187,4 +183,4 @@ def _run_folder_of(csv_file: Path) -> Path | None:
     return None
 
 
-__all__ = ["BUILDER_MODULE", "ExportSource"]
+__all__ = ["ExportSource"]
