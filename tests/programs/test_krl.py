@@ -347,3 +347,38 @@ def test_writer_writes_ascii_crlf_files(tmp_path: Path) -> None:
     assert "; case: Schweissnaht <= 0.5 mm" in main
     files = {p.name: p.read_text(encoding="ascii") for p in tmp_path.iterdir()}
     assert_reads_back(prog, parse_krl(files), robot)
+
+
+def flipped() -> Robot:
+    """The KR6 under a made-up convention: signs, offsets and a moved world."""
+    convention = ControllerConvention(
+        vendor="generic",
+        signs=np.array([-1.0, 1.0, -1.0, -1.0, 1.0, -1.0]),
+        offsets=np.array([0.0, -np.pi / 2, 0.3, 0.0, 0.0, np.pi]),
+        world=placement_transform(np.array([0.1, 0.0, 0.4, 0.0, 0.0, np.pi])),
+    )
+    return dataclasses.replace(kuka(), controller=convention)
+
+
+@pytest.mark.parametrize("name", ["kuka_kr6_r700_sixx", "kuka_kr10_r1420", "puma560", "flipped"])
+def test_status_turn_matches_the_reference(name: str) -> None:
+    """The writer's Status and Turn equal the oracle's on random joints within the limits."""
+    robots = {"puma560": puma560, "flipped": flipped}
+    robot = robots[name]() if name in robots else kuka(name)
+
+    @given(st.lists(st.floats(0.0, 1.0), min_size=6, max_size=6))
+    @settings(max_examples=150, deadline=None)
+    def check(fractions: list[float]) -> None:
+        q = robot.q_min + np.array(fractions) * (robot.q_max - robot.q_min)
+        theta = robot.convention.to_controller(q)
+        status, turn = status_turn(robot, theta[None, :])
+        assert (int(status[0]), int(turn[0])) == status_turn_reference(robot, theta)
+
+    check()
+
+
+def test_convention_and_world_round_trip() -> None:
+    """Joints in the controller's convention and frames in its world read back as planned."""
+    robot = flipped()
+    for prog in (cartesian_program(robot), joint_program(robot)):
+        assert_reads_back(prog, parse_krl(render_krl(prog, robot=robot)), robot)
