@@ -36,10 +36,12 @@ from trackplan.programs.names import program_identifier
 from trackplan.robots.model import Robot
 from trackplan.writers.krl_config import frame_values, real, status_turn
 
+# RoboDK's KUKA KRC4 post-processor (KUKA_KRC4.py, MAX_LINES_X_PROG) starts a new .src
+# after 1400 lines; KUKA publishes no limit (docs/export-krl.md).
 DEFAULT_MAX_POINTS = 1000
 """Targets per part: a part then writes about 1,100 lines of ``.src`` (motions, speed and
-zone changes), inside the 1,400 lines per ``.src`` page that RoboDK's KUKA KRC4
-post-processor keeps (``MAX_LINES_X_PROG``); KUKA publishes no limit."""
+zone changes), below the page length integrators' post-processors keep
+(``docs/export-krl.md``)."""
 
 MAX_NAME = 24
 """KRL's longest program (module) name."""

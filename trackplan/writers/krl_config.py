@@ -1,24 +1,23 @@
 """KUKA conventions for KRL programs: A, B, C angles, Status and Turn, KRL number literals.
 
 Angles: a KRL FRAME / E6POS orientation is ``R = Rz(A) · Ry(B) · Rx(C)`` in degrees (the
-matrix of RoboDK's ``KUKA_2_Pose``, RoboDK/RoboDK-API ``robomath.py``; the same matrix as
-trackplan's yaw, pitch, roll).
+same matrix as trackplan's yaw, pitch, roll). Status ``S`` and Turn ``T``
+(``docs/export-krl.md`` gives the definitions, their sources and what is verified):
 
-Status ``S`` and Turn ``T`` (``docs/export-krl.md`` lists the sources and what is verified):
-
-- ``T`` bit i (value 2^i) is set when axis A(i+1) < 0° (Beckhoff TF5200 / ISG kernel
-  manual "Status & Turn (IS, IT)"; RoboDK ``KUKA_KRC4_Config.py`` ``joints_2_turn_str``).
+- ``T`` bit i (value 2^i) is set when axis A(i+1) < 0°.
 - ``S`` bit 0 (1): the wrist root point (where the wrist axes meet) has a negative x in
-  the A1 coordinate system, i.e. ``$ROBROOT`` turned with axis 1 (the overhead area; KUKA's
-  expert programming manual as quoted in robot-forum.com thread 7173, SINUMERIK ONE
-  programming manual 12/2019 p. 710, ISG's first criterion).
-- ``S`` bit 1 (2): axis 3 is at or past the angle where the wrist root point lies on the
-  line through axes 2 and 3 (A3 ≥ 0° when axes 3 and 4 intersect, shifted by the A3–A4
-  offset otherwise; SINUMERIK p. 710, ISG's second criterion). Computed geometrically:
-  the forearm is turned positively about A3 from the stretched arm.
-- ``S`` bit 2 (4): A5 < 0° (A5 taken in [−180°, 180°); SINUMERIK p. 710 and the TF5200
-  pages; one ISG copy states the opposite sign and calls the bit legacy).
+  the A1 coordinate system, i.e. ``$ROBROOT`` turned with axis 1 (the overhead area).
+- ``S`` bit 1 (2): A3 ≥ φ, the angle at which the wrist root point lies on the line through
+  axes 2 and 3 (0° when axes 3 and 4 intersect); computed geometrically: the forearm is
+  turned positively about A3 from the stretched arm.
+- ``S`` bit 2 (4): A5 < 0° (A5 taken in [−180°, 180°)).
 """
+
+# Sources (docs/export-krl.md): A, B, C: RoboDK/RoboDK-API robomath.py KUKA_2_Pose.
+# T: Beckhoff TF5200 (ISG kernel) "Status & Turn (IS, IT)"; RoboDK KUKA_KRC4_Config.py.
+# S bit 0: KUKA's expert programming manual as quoted in robot-forum.com thread 7173;
+# SINUMERIK ONE programming manual 12/2019 p. 710. S bits 1 and 2: SINUMERIK p. 710 and
+# the TF5200 pages (an isg-stuttgart.de copy states the opposite sign of bit 2).
 
 from __future__ import annotations
 
