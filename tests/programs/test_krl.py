@@ -103,7 +103,7 @@ def cartesian_program(robot: Robot, name: str = "seam_demo") -> Program:
         moves=(
             LinearMove(target=t[1], speed=0.02, zone=0.0005),
             CircularMove(via=t[2], target=t[3], speed=0.02, zone=0.0005),
-            SplineMove(targets=(t[4], t[5]), speed=0.015, zone=0.0),
+            SplineMove(targets=(t[4], t[5]), speed=0.015, zone=0.0003),
         ),
     )
     air = Section(kind="air", label="air", moves=(joint_move(robot, poses[6], speed=0.3),))
@@ -182,7 +182,9 @@ def test_cartesian_program_reads_back(name: str) -> None:
         kinds.setdefault(parsed_target.kind, parsed_target)
     assert kinds["linear"].speed == pytest.approx(0.02)
     assert kinds["linear"].zone == pytest.approx(0.0005)
-    assert kinds["spline"].speed == pytest.approx(0.015)
+    assert kinds["spline"].speed == pytest.approx(0.015) and kinds["spline"].zone == 0.0
+    splines = [t for t in parsed.targets if t.kind == "spline"]
+    assert splines[-1].zone == pytest.approx(0.0003)  # ENDSPLINE C_SPL
     assert parsed.targets[0].speed == pytest.approx(0.2)  # the PTP start, $VEL_AXIS 20 %
     assert parsed.targets[-1].zone == 0.0 and parsed.targets[-1].speed == pytest.approx(0.01)
     assert "trackplan test" in parsed.header
@@ -208,13 +210,26 @@ def test_puma560_generic_reads_back() -> None:
     assert_reads_back(prog, parse_krl(files), robot)
 
 
-def test_split_program_reads_back_as_the_unsplit_one() -> None:
+def long_spline_program(robot: Robot) -> Program:
+    """The Cartesian program with a spline of seven points."""
+    base = cartesian_program(robot, name="a_rather_long_program_name_for_krl")
+    q = np.linspace([20, -70, 90, 8, 73, -12], [30, -60, 80, 10, 70, -20], 8)[1:]
+    spline = SplineMove(targets=tuple(target(robot, list(row)) for row in q), speed=0.01)
+    seam = Section(kind="seam", label="long", moves=(spline,))
+    return dataclasses.replace(base, sections=(*base.sections, seam))
+
+
+@pytest.mark.parametrize("max_points", [2, 3, 5])
+@pytest.mark.parametrize("form", ["cartesian", "joint"])
+def test_split_program_reads_back_as_the_unsplit_one(max_points: int, form: str) -> None:
     robot = kuka()
-    prog = cartesian_program(robot, name="a_rather_long_program_name_for_krl")
+    prog = long_spline_program(robot)
+    if form == "joint":
+        prog = dataclasses.replace(joint_program(robot), name=prog.name)
     whole = parse_krl(render_krl(prog, robot=robot))
-    files = render_krl(prog, robot=robot, max_points=3)
+    files = render_krl(prog, robot=robot, max_points=max_points)
     parts = sorted(name for name in files if "_P" in name and name.endswith(".src"))
-    assert len(parts) >= 3
+    assert len(parts) >= 2
     assert all(len(Path(name).stem) <= MAX_NAME for name in files)
     split = parse_krl(files)
     assert split.name == whole.name == "a_rather_long_program_na"
