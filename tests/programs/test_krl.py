@@ -339,6 +339,13 @@ def test_refuses_other_vendors_and_joint_counts() -> None:
         render_krl(dataclasses.replace(prog, n_dof=7), robot=robot)
 
 
+def test_refuses_fewer_than_two_points_per_part() -> None:
+    robot = kuka()
+    with pytest.raises(CaseError) as error:
+        render_krl(cartesian_program(robot), robot=robot, max_points=1)
+    assert error.value.key == "--max-points"
+
+
 def test_writer_writes_ascii_crlf_files(tmp_path: Path) -> None:
     robot = kuka()
     prog = cartesian_program(robot)

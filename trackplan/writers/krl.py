@@ -153,10 +153,16 @@ def render_krl(program: Program, *, robot: Robot, max_points: int | None = None)
     Raises
     ------
     CaseError
-        For a robot KRL cannot drive or a name that cannot be made valid.
+        For a robot KRL cannot drive, a name that cannot be made valid, or fewer than 2
+        points per part.
     """
     check_program(program)
     name = krl_name(program.name)
+    if max_points is not None and max_points < 2:
+        raise CaseError(
+            f"--max-points must be at least 2 (targets per part), got {max_points}",
+            key="--max-points",
+        )
     parts = split_program(program, max_points or DEFAULT_MAX_POINTS)
     configurations = _configurations(program, robot)
     main = _Module(name, configurations)
