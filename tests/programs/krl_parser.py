@@ -157,14 +157,14 @@ class _Values(Transformer[Token, Any]):
         return dict(item for item in items if isinstance(item, tuple))
 
 
-_PARSER = Lark(GRAMMAR, parser="lalr", propagate_positions=True, maybe_placeholders=True)
+_PARSER = Lark(GRAMMAR, parser="lalr", maybe_placeholders=True, transformer=_Values())
+"""LALR with the literals turned into values while parsing (one pass over the file)."""
 
 
 def parse_tree(text: str) -> Tree[Any]:
     """The parse tree of one KRL file, literals already turned into values."""
-    tree = _PARSER.parse(text if text.endswith("\n") else text + "\n")
-    values: Tree[Any] = _Values().transform(tree)
-    return values
+    tree: Tree[Any] = _PARSER.parse(text if text.endswith("\n") else text + "\n")
+    return tree
 
 
 def abc_rotation(a: float, b: float, c: float) -> np.ndarray:
