@@ -404,3 +404,34 @@ def test_convention_and_world_round_trip() -> None:
     robot = flipped()
     for prog in (cartesian_program(robot), joint_program(robot)):
         assert_reads_back(prog, parse_krl(render_krl(prog, robot=robot)), robot)
+
+
+def test_five_axis_robot_writes_no_status_turn() -> None:
+    """A five-joint robot: E6AXIS A1 … A5, E6POS without S and T (defined for six axes)."""
+    d, a = np.array([0.3, 0.0, 0.0, 0.0, 0.1]), np.array([0.05, 0.4, 0.35, 0.0, 0.0])
+    robot = Robot.from_dh(
+        name="five",
+        d=d,
+        a=a,
+        alpha=np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, 0.0]),
+        offset=np.zeros(5),
+        q_min=-np.full(5, np.pi),
+        q_max=np.full(5, np.pi),
+        v_max=np.ones(5),
+        a_max=np.ones(5),
+        j_max=np.ones(5),
+    )
+    start = Section(
+        kind="start", label="start", moves=(joint_move(robot, [0, 40, -60, 10, 5], speed=0.5),)
+    )
+    seam = Section(
+        kind="seam",
+        label="seam",
+        moves=(LinearMove(target=target(robot, [5, 42, -62, 12, 5]), speed=0.05),),
+    )
+    prog = program(robot, (start, seam))
+    files = render_krl(prog, robot=robot)
+    assert "A5 5.0}" in files["seam_demo.dat"] and ",S " not in files["seam_demo.dat"]
+    parsed = parse_krl(files)
+    assert_reads_back(prog, parsed, robot)
+    assert parsed.targets[1].config == {}
