@@ -208,6 +208,9 @@ def test_joint_form_split_keeps_every_sample_once() -> None:
         ("Naht ü-1 (rechts)", "Naht_u_1_rechts"),
         ("2nd seam", "nd_seam"),
         ("a" * 40, "a" * 32),
+        ("main", "main_prg"),
+        ("Module", "Module_prg"),
+        ("part2", "part2_prg"),
     ],
 )
 def test_program_name_is_a_rapid_identifier(asked: str, written: str) -> None:

@@ -11,6 +11,7 @@ ASCII (a subset of the ISO 8859-1 the controller reads). See ``docs/export-rapid
 
 from __future__ import annotations
 
+import re
 import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,6 +68,16 @@ DEG = 6
 QUAT = 9
 """Decimals of quaternion components (1e-9: < 1e-7°)."""
 
+RESERVED = frozenset(
+    """ALIAS AND BACKWARD CASE CONNECT CONST DEFAULT DIV DO ELSE ELSEIF ENDFOR ENDFUNC ENDIF
+    ENDMODULE ENDPROC ENDRECORD ENDTEST ENDTRAP ENDWHILE ERROR EXIT FALSE FOR FROM FUNC GOTO
+    IF INOUT LOCAL MOD MODULE NOSTEPIN NOT NOVIEW OR PERS PROC RAISE READONLY RECORD RETRY
+    RETURN STEP SYSMODULE TEST THEN TO TRAP TRUE TRYNEXT UNDO VAR VIEWONLY WHILE WITH XOR
+    MAIN""".split()
+)
+"""RAPID's reserved words (RAPID kernel reference) and ``main``: a module of such a name
+gets ``_prg`` appended; a name ``partK`` does too, to stay apart from the part routines."""
+
 _ASCII = {"°": " deg", "≤": "<=", "≥": ">=", "×": "x", "·": "*", "−": "-", "±": "+/-"}
 
 
@@ -105,7 +116,7 @@ def render_rapid(
         cannot be made an identifier (key ``--format`` / ``--name``).
     """
     _check_drivable(program)
-    name = program_identifier(program.name, max_length=MAX_IDENTIFIER, key="--name")
+    name = _module_name(program.name)
     names = _Names(
         module=name, tool=f"tool_{name}"[:MAX_IDENTIFIER], wobj=f"wobj_{name}"[:MAX_IDENTIFIER]
     )
@@ -127,6 +138,14 @@ def render_rapid(
         bodies.append(lines)
     text = _module_text(program, robot, names, data, bodies)
     return {f"{name}.mod": text}
+
+
+def _module_name(asked: str) -> str:
+    """The program name as a RAPID identifier that is no reserved word or routine name."""
+    name = program_identifier(asked, max_length=MAX_IDENTIFIER, key="--name")
+    if name.upper() in RESERVED or re.fullmatch(r"part\d+", name, flags=re.IGNORECASE):
+        name = f"{name[: MAX_IDENTIFIER - 4]}_prg"
+    return name
 
 
 def _check_drivable(program: Program) -> None:
