@@ -122,6 +122,7 @@ def render_rapid(
     )
     parts = split_program(program, max_points or DEFAULT_MAX_POINTS)
     data = _Data()
+    robtargets = _robtargets(program, robot)
     bodies: list[list[str]] = []
     previous: np.ndarray | None = None
     all_moves = list(program.moves())
@@ -132,7 +133,9 @@ def render_rapid(
             lines.append(f"! {_ascii(section.kind)}: {_ascii(section.label)}")
             for move in section.moves:
                 following = all_moves[index + 1] if index + 1 < len(all_moves) else None
-                lines.extend(_move_lines(move, following, previous, program, robot, names, data))
+                lines.extend(
+                    _move_lines(move, following, previous, program, robtargets, names, data)
+                )
                 previous = _end_joints(move)
                 index += 1
         bodies.append(lines)
@@ -198,7 +201,7 @@ def _move_lines(
     following: Move | None,
     previous: np.ndarray | None,
     program: Program,
-    robot: Robot,
+    robtargets: dict[int, str],
     names: _Names,
     data: _Data,
 ) -> list[str]:
@@ -217,26 +220,45 @@ def _move_lines(
             speed = "tpv_joint"
         return [f"MoveAbsJ {target},{speed},{data.zone(zone)},{tool};"]
     if isinstance(move, LinearMove):
-        return [_linear(move.target, data.speed(move.speed), data.zone(move.zone), tool, robot)]
+        speed_name, zone_name = data.speed(move.speed), data.zone(move.zone)
+        return [f"MoveL {robtargets[id(move.target)]},{speed_name},{zone_name},{tool};"]
     if isinstance(move, CircularMove):
-        via = _robtarget(move.via, robot)
-        end = _robtarget(move.target, robot)
+        via, end = robtargets[id(move.via)], robtargets[id(move.target)]
         return [f"MoveC {via},{end},{data.speed(move.speed)},{data.zone(move.zone)},{tool};"]
     # SplineMove: RAPID has no spline move; lines through its points, blended.
     speed_name, zone_name = data.speed(move.speed), data.zone(move.zone)
-    return [_linear(target, speed_name, zone_name, tool, robot) for target in move.targets]
+    return [
+        f"MoveL {robtargets[id(target)]},{speed_name},{zone_name},{tool};"
+        for target in move.targets
+    ]
 
 
-def _linear(target: Target, speed: str, zone: str, tool: str, robot: Robot) -> str:
-    return f"MoveL {_robtarget(target, robot)},{speed},{zone},{tool};"
-
-
-def _robtarget(target: Target, robot: Robot) -> str:
-    """``[[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[9E+09 × 6]]`` of a target (mm)."""
-    position = numbers(target.pose[:3, 3] * 1000.0, MM)
-    orient = numbers(quaternion(target.pose[:3, :3]), QUAT)
-    conf = ",".join(str(int(c)) for c in confdata(robot, target.joints, target.model_joints)[0])
-    return f"[[{position}],[{orient}],[{conf}],[{','.join([UNUSED] * 6)}]]"
+def _robtargets(program: Program, robot: Robot) -> dict[int, str]:
+    """``[[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[9E+09 × 6]]`` (mm) of every Cartesian target,
+    by ``id`` of the target, computed for all targets at once."""
+    targets: list[Target] = []
+    for move in program.moves():
+        if isinstance(move, LinearMove):
+            targets.append(move.target)
+        elif isinstance(move, CircularMove):
+            targets.extend((move.via, move.target))
+        elif isinstance(move, SplineMove):
+            targets.extend(move.targets)
+    if not targets:
+        return {}
+    poses = np.stack([target.pose for target in targets])
+    conf = confdata(
+        robot,
+        np.stack([target.joints for target in targets]),
+        np.stack([target.model_joints for target in targets]),
+    )
+    orients = quaternion(poses[:, :3, :3])
+    unused = ",".join([UNUSED] * 6)
+    return {
+        id(target): f"[[{numbers(pose[:3, 3] * 1000.0, MM)}],[{numbers(orient, QUAT)}],"
+        f"[{','.join(str(int(c)) for c in fields)}],[{unused}]]"
+        for target, pose, orient, fields in zip(targets, poses, orients, conf, strict=True)
+    }
 
 
 def _joint_time(move: JointMove, previous: np.ndarray, program: Program) -> float:
