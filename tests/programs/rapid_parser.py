@@ -150,7 +150,7 @@ class _Tree(Transformer[Token, Any]):
         return (str(items[0]), [item for item in items[1:] if item is not None])
 
 
-_PARSER = Lark(GRAMMAR, parser="lalr")
+_PARSER = Lark(GRAMMAR, parser="lalr", transformer=_Tree())
 
 
 def quaternion_matrix(q: list[float]) -> np.ndarray:
@@ -179,15 +179,17 @@ def parse_rapid(files: dict[str, str]) -> ParsedProgram:
     Returns
     -------
     ParsedProgram
-        Targets in SI units: poses in the work object (m), controller joints (rad),
-        speeds (m/s), zones (m), durations (s); config ``{"cf1", "cf4", "cf6", "cfx"}``.
+        ``name`` is the module that holds ``main`` (RAPID's entry routine is always
+        ``main``; the module carries the program's name). Targets in SI units: poses in
+        the work object (m), controller joints (rad), speeds (m/s), zones (m), durations
+        (s); config ``{"cf1", "cf4", "cf6", "cfx"}``.
     """
     data: dict[str, Any] = {}
     procs: dict[str, list[Call]] = {}
     header: list[str] = []
     main_module = ""
     for text in files.values():
-        tree = _Tree().transform(_PARSER.parse(text))
+        tree = _PARSER.parse(text)
         for module_name, items in tree.children:
             for item in items:
                 if item[0] == "data":
