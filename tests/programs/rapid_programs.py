@@ -6,9 +6,11 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import yaml
 from scipy.spatial.transform import Rotation
 
-from trackplan.io.robot_file import builtin_robot
+from trackplan.errors import CaseError
+from trackplan.io.robot_file import builtin_robot, library_robots, load_robot_text
 from trackplan.programs.model import (
     CircularMove,
     JointMove,
@@ -59,10 +61,24 @@ BASE = transform((1.1, 0.3, 0.2), (0.0, 0.0, 30.0))
 """The part frame in the controller's world."""
 
 
+def library_robot(name: str) -> Robot:
+    """A built-in robot; its ``controller:`` block is left out where the robot-file schema
+    does not know it yet (it lands with the export core), so these tests run either way."""
+    try:
+        return builtin_robot(name)
+    except CaseError as error:
+        if "controller" not in str(error):
+            raise
+    path = library_robots()[name]
+    data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    data.pop("controller")
+    return load_robot_text(yaml.safe_dump(data), str(path))
+
+
 def abb_robot(name: str, *, tool: np.ndarray = TOOL) -> Robot:
     """A built-in ABB robot with its controller convention built in Python."""
     convention = IRB2400_CONVENTION if name == "abb_irb2400" else IRB1600_CONVENTION
-    return replace(builtin_robot(name), controller=convention, T_flange_tool=tool)
+    return replace(library_robot(name), controller=convention, T_flange_tool=tool)
 
 
 def puma(*, tool: np.ndarray = TOOL) -> Robot:

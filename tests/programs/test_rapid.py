@@ -18,6 +18,7 @@ from tests.programs.parsed import ParsedProgram
 from tests.programs.rapid_parser import parse_rapid, quaternion_matrix
 from tests.programs.rapid_programs import (
     BASE,
+    IRB1600_CONVENTION,
     IRB2400_CONVENTION,
     abb_robot,
     cartesian_program,
@@ -29,7 +30,9 @@ from tests.programs.rapid_programs import (
 )
 from tests.programs.rapid_reference import reference_confdata
 from trackplan.errors import CaseError
+from trackplan.io.robot_file import builtin_robot
 from trackplan.programs.model import JointMove, LinearMove, Section, Target
+from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics_parameters import Payload
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
@@ -467,3 +470,24 @@ def test_parser_reads_an_optional_argument_after_a_comma() -> None:
     (target,) = parse_rapid({"Ros.mod": text}).targets
     assert target.duration == pytest.approx(0.25) and target.zone == pytest.approx(0.01)
     assert target.joints == pytest.approx(np.radians([1, 2, 3, 4, 5, 6]))
+
+
+@pytest.mark.parametrize(
+    ("name", "convention"),
+    [("abb_irb2400", IRB2400_CONVENTION), ("abb_irb1600", IRB1600_CONVENTION)],
+)
+def test_library_controller_block_is_the_sourced_convention(
+    name: str, convention: ControllerConvention
+) -> None:
+    try:
+        controller = builtin_robot(name).controller
+    except CaseError:
+        pytest.skip("the robot-file schema of controller: is not on this branch")
+    if controller is None:
+        pytest.skip("the robot file has no controller: block on this branch")
+    assert controller.vendor == "abb"
+    assert np.array_equal(controller.signs, convention.signs)
+    assert np.array_equal(controller.offsets, convention.offsets)
+    assert controller.coupling == convention.coupling
+    assert np.allclose(controller.world, np.eye(4))
+    assert controller.source
