@@ -23,6 +23,7 @@ from tests.programs.rapid_programs import (
     abb_robot,
     cartesian_program,
     expected_targets,
+    joint_move,
     joint_program,
     make_target,
     program,
@@ -31,7 +32,7 @@ from tests.programs.rapid_programs import (
 from tests.programs.rapid_reference import reference_confdata
 from trackplan.errors import CaseError
 from trackplan.io.robot_file import builtin_robot
-from trackplan.programs.model import JointMove, LinearMove, Section, Target
+from trackplan.programs.model import JointMove, LinearMove, Section, SplineMove, Target
 from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics_parameters import Payload
 from trackplan.robots.kinematics import forward_kinematics
@@ -254,6 +255,34 @@ def test_too_many_joints_are_refused() -> None:
     prog = replace(cartesian_program(robot, Q_IRB1600), n_dof=7)
     with pytest.raises(CaseError, match="six-axis arms: abb_irb1600 has 7 joints"):
         render_rapid(prog, robot=robot)
+
+
+def test_fewer_than_two_points_per_procedure_are_refused() -> None:
+    robot = abb_robot("abb_irb1600")
+    with pytest.raises(CaseError, match="at least 2 targets per procedure, got 1"):
+        render_rapid(cartesian_program(robot, Q_IRB1600), robot=robot, max_points=1)
+
+
+def test_a_spline_longer_than_a_part_is_split_without_loss() -> None:
+    robot = abb_robot("abb_irb2400")
+    prog = joint_program(robot, Q_IRB2400, n=4)
+    steps = np.linspace(0.0, 0.3, 9)[1:, None] * np.array([0.1, 0.05, -0.05, 0.2, 0.1, 0.1])
+    spline = SplineMove(
+        targets=tuple(make_target(robot, Q_IRB2400 + step) for step in steps), speed=0.02
+    )
+    prog = replace(
+        prog,
+        motion="cartesian",
+        sections=(
+            *prog.sections,
+            Section(kind="seam", label="curve", moves=(spline,)),
+            Section(kind="air", label="air", moves=(joint_move(robot, Q_IRB2400, speed=0.5),)),
+        ),
+    )
+    split = parse_rapid(render_rapid(prog, robot=robot, max_points=3))
+    assert_round_trip(split, prog, robot)
+    # The timed samples still blend; the air move after the split spline is timed.
+    assert split.targets[-1].duration is not None
 
 
 def test_unfeasible_run_written_with_force_says_so() -> None:

@@ -112,20 +112,26 @@ def render_rapid(
     Raises
     ------
     CaseError
-        For a robot RAPID cannot drive (not ABB or generic, not six axes) or a name that
-        cannot be made an identifier (key ``--format`` / ``--name``).
+        For a robot RAPID cannot drive (not ABB or generic, not six axes), a name that
+        cannot be made an identifier, or fewer than 2 points per procedure (keys
+        ``--format``, ``--name``, ``--max-points``).
     """
     _check_drivable(program)
     name = _module_name(program.name)
     names = _Names(
         module=name, tool=f"tool_{name}"[:MAX_IDENTIFIER], wobj=f"wobj_{name}"[:MAX_IDENTIFIER]
     )
+    if max_points is not None and max_points < 2:
+        raise CaseError(
+            f"--max-points must be at least 2 targets per procedure, got {max_points}",
+            key="--max-points",
+        )
     parts = split_program(program, max_points or DEFAULT_MAX_POINTS)
     data = _Data()
     robtargets = _robtargets(program, robot)
     bodies: list[list[str]] = []
     previous: np.ndarray | None = None
-    all_moves = list(program.moves())
+    all_moves = [move for part in parts for section in part.sections for move in section.moves]
     index = 0
     for part in parts:
         lines: list[str] = []
