@@ -173,6 +173,29 @@ def pose_matrix(pose: list[Any]) -> np.ndarray:
     return T
 
 
+@dataclass
+class Module:
+    """One module as declared: its data (name → value or None) and procedures."""
+
+    name: str
+    data: dict[str, Any]
+    procs: dict[str, list[Call]]
+
+
+def parse_modules(text: str) -> list[Module]:
+    """The modules of one file, names of data and procedures in lower case."""
+    modules = []
+    for module_name, items in _PARSER.parse(text).children:
+        module = Module(name=module_name, data={}, procs={})
+        for item in items:
+            if item[0] == "data":
+                module.data[item[2]] = item[3]
+            else:
+                module.procs[item[1]] = item[2]
+        modules.append(module)
+    return modules
+
+
 def parse_rapid(files: dict[str, str]) -> ParsedProgram:
     """Read RAPID modules (file name → text) from ``main`` on.
 
@@ -189,16 +212,12 @@ def parse_rapid(files: dict[str, str]) -> ParsedProgram:
     header: list[str] = []
     main_module = ""
     for text in files.values():
-        tree = _PARSER.parse(text)
-        for module_name, items in tree.children:
-            for item in items:
-                if item[0] == "data":
-                    data[item[2]] = item[3]
-                else:
-                    procs[item[1]] = item[2]
-                    if item[1] == "main":
-                        main_module = module_name
-                        header = _header(text)
+        for module in parse_modules(text):
+            data.update(module.data)
+            procs.update(module.procs)
+            if "main" in module.procs:
+                main_module = module.name
+                header = _header(text)
     if "main" not in procs:
         raise ValueError("no PROC main() in the modules")
     state = _Run(data=data, procs=procs)
@@ -323,4 +342,13 @@ class _Run:
             )
 
 
-__all__ = ["GRAMMAR", "parse_rapid", "pose_matrix", "quaternion_matrix"]
+__all__ = [
+    "GRAMMAR",
+    "Call",
+    "Module",
+    "Name",
+    "parse_modules",
+    "parse_rapid",
+    "pose_matrix",
+    "quaternion_matrix",
+]

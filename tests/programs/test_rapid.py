@@ -15,7 +15,13 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from tests.programs.parsed import ParsedProgram
-from tests.programs.rapid_parser import parse_rapid, quaternion_matrix
+from tests.programs.rapid_parser import (
+    Name,
+    parse_modules,
+    parse_rapid,
+    pose_matrix,
+    quaternion_matrix,
+)
 from tests.programs.rapid_programs import (
     BASE,
     IRB1600_CONVENTION,
@@ -520,3 +526,58 @@ def test_library_controller_block_is_the_sourced_convention(
     assert controller.coupling == convention.coupling
     assert np.allclose(controller.world, np.eye(4))
     assert controller.source
+
+
+# Lines quoted from robotics/open_abb, RAPID/SERVER.mod (MIT License, Copyright (c) 2015
+# robotics), in their order; the lines between them are left out and the Move lines
+# indented less.
+OPEN_ABB = r"""MODULE SERVER
+
+!////////////////
+!GLOBAL VARIABLES
+!////////////////
+
+!//Robot configuration
+PERS tooldata currentTool := [TRUE,[[0,0,0],[1,0,0,0]],[0.001,[0,0,0.001],[1,0,0,0],0,0,0]];
+PERS wobjdata currentWobj := [FALSE,TRUE,"",[[0,0,0],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];
+PERS speeddata currentSpeed;
+PERS zonedata currentZone;
+PERS bool startLog:=TRUE;
+PERS string ipController:= "127.0.0.1"; !local IP for testing in simulation
+PERS num serverPort:= 5000;
+VAR robtarget cartesianTarget;
+VAR jointtarget jointsTarget;
+VAR robtarget circPoint;
+CONST num SERVER_OK := 1;
+PROC main()
+    ConfL \Off;
+    SingArea \Wrist;
+    MoveL cartesianTarget, currentSpeed, currentZone, currentTool \WObj:=currentWobj ;
+    MoveAbsJ jointsTarget, currentSpeed, currentZone, currentTool \Wobj:=currentWobj;
+    MoveC circPoint, cartesianTarget, currentSpeed, currentZone, currentTool \WObj:=currentWobj ;
+ENDPROC
+ENDMODULE
+"""
+
+
+def test_parser_reads_public_declarations_and_instructions() -> None:
+    (module,) = parse_modules(OPEN_ABB)
+    assert module.name == "SERVER"
+    tool, wobj = module.data["currenttool"], module.data["currentwobj"]
+    assert tool[0] is True and np.allclose(pose_matrix(tool[1]), np.eye(4))
+    assert tool[2][0] == pytest.approx(0.001)
+    assert wobj[:3] == [False, True, ""] and np.allclose(pose_matrix(wobj[3]), np.eye(4))
+    assert module.data["currentspeed"] is None and module.data["serverport"] == 5000.0
+    assert module.data["iPController".lower()] == "127.0.0.1"
+    calls = module.procs["main"]
+    assert [call.name for call in calls] == ["ConfL", "SingArea", "MoveL", "MoveAbsJ", "MoveC"]
+    assert calls[0].options == {"off": True} and calls[1].options == {"wrist": True}
+    move_c = calls[4]
+    assert [arg.text for arg in move_c.args] == [
+        "circPoint",
+        "cartesianTarget",
+        "currentSpeed",
+        "currentZone",
+        "currentTool",
+    ]
+    assert all(isinstance(call.options["wobj"], Name) for call in calls[2:])
