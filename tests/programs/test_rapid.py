@@ -417,8 +417,8 @@ def test_half_turn_quaternion_has_a_unique_sign() -> None:
 
 # Written for these tests in the syntax of ABB's RAPID reference manual (MoveL, MoveC,
 # MoveAbsJ with \T, predefined v/z data, tool0, named CONST targets, a PERS wobjdata, a
-# procedure call). The code corpora searched hold RAPID modules only in repositories
-# without a licence, so none is quoted here.
+# procedure call). Public code (open_abb, MIT) is read further below; the complete
+# RAPID programs found in the code corpora carry no licence, so none is quoted.
 MANUAL_STYLE = """
 MODULE Demo
   ! cell demo
