@@ -252,7 +252,7 @@ class _State:
     tool: np.ndarray | None = None
 
 
-def parse_fanuc(files: dict[str, str]) -> ParsedProgram:
+def parse_fanuc(files: dict[str, str], *, strict: bool = True) -> ParsedProgram:
     """Read a TP program and the programs it calls.
 
     Parameters
@@ -260,6 +260,8 @@ def parse_fanuc(files: dict[str, str]) -> ParsedProgram:
     files
         File name → text; the main program is the one no other file calls (else the
         first).
+    strict
+        Raise ``KeyError`` on a ``CALL`` of a program not in ``files``; else skip it.
 
     Returns
     -------
@@ -278,7 +280,7 @@ def parse_fanuc(files: dict[str, str]) -> ParsedProgram:
     main = listings[roots[0] if roots else next(iter(listings))]
     state = _State()
     targets: list[ParsedTarget] = []
-    _run(main, listings, state, targets)
+    _run(main, listings, state, targets, strict)
     return ParsedProgram(
         name=main.name,
         base=np.eye(4) if state.base is None else state.base,
@@ -304,7 +306,11 @@ def _header(listing: Listing) -> list[str]:
 
 
 def _run(
-    listing: Listing, listings: dict[str, Listing], state: _State, targets: list[ParsedTarget]
+    listing: Listing,
+    listings: dict[str, Listing],
+    state: _State,
+    targets: list[ParsedTarget],
+    strict: bool,
 ) -> None:
     for kind, value in listing.statements:
         if kind == "element":
@@ -322,8 +328,8 @@ def _run(
                 state.uframe = number
             else:
                 state.utool = number
-        elif kind == "call":
-            _run(listings[str(value)], listings, state, targets)
+        elif kind == "call" and (strict or str(value) in listings):
+            _run(listings[str(value)], listings, state, targets, strict)
         elif kind == "motion":
             _motion(listing, value, state, targets)  # type: ignore[arg-type]
 

@@ -360,10 +360,9 @@ def _part_moves(
                 end = listing.cartesian_position(move.target, configs, options)
                 listing.circular(via, end, f"{speed} {term}")
             else:
-                for k, target in enumerate(move.targets):
+                for target in move.targets:
                     index = listing.cartesian_position(target, configs, options)
-                    inner = k < len(move.targets) - 1
-                    listing.motion("L", f"P[{index}] {speed} {blended if inner else term}")
+                    listing.motion("L", f"P[{index}] {speed} {term}")
 
 
 def _last_move(program: Program) -> Move | None:
