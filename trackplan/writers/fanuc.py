@@ -287,8 +287,7 @@ def _header_lines(program: Program, options: FanucOptions) -> list[str]:
         *program.header,
         f"frames: UFRAME[{options.uframe}] = base, UTOOL[{options.utool}] = tool, "
         f"assembled in PR[{options.register}] (all three overwritten)",
-        f"stops FINE, blended points CNT{options.cnt}: a share of speed kept, not a "
-        "distance, so the corner deviation is not bounded by the program",
+        f"stops FINE, blends CNT{options.cnt}: a speed share, not mm (deviation not bounded)",
     ]
 
 
