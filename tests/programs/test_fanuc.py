@@ -251,9 +251,12 @@ def test_m20ia_joints_follow_the_j2_j3_coupling_and_the_world_at_j2_height() -> 
     assert program.base[2, 3] == pytest.approx(PART_M20IA[2, 3] - 0.525)
 
 
-def test_joint_form_reads_back_as_timed_joint_moves() -> None:
-    robot = m20ia()
-    program = joint_program(robot, Q0_M20IA)
+@pytest.mark.parametrize(
+    ("make_robot", "q0"), [(m20ia, Q0_M20IA), (puma, Q0_PUMA)], ids=["fanuc_m20ia", "puma560"]
+)
+def test_joint_form_reads_back_as_timed_joint_moves(make_robot, q0) -> None:  # type: ignore[no-untyped-def]
+    robot = make_robot()
+    program = joint_program(robot, q0)
     files = render_fanuc(program, robot=robot)
     text = files["REPLAY.ls"]
     assert re.search(r":J P\[2\] 0\.024sec CNT100 ;$", text, re.M)
@@ -330,6 +333,21 @@ def test_more_joints_than_a_tp_group_is_refused() -> None:
     program = replace(joint_program(robot, Q0_M20IA, n=3), n_dof=7)
     with pytest.raises(CaseError, match=r"--format: .*J1\.\.J6.*7 joints"):
         render_fanuc(program, robot=robot)
+
+
+def test_cartesian_moves_of_a_robot_without_six_axes_are_refused() -> None:
+    robot = m20ia()
+    program = replace(cartesian_program(robot, PART_M20IA, Q0_M20IA), n_dof=5)
+    with pytest.raises(CaseError, match=r"--format: .*5 joints: use --motion joint"):
+        render_fanuc(program, robot=robot)
+
+
+@pytest.mark.parametrize(
+    ("key", "value"), [("uframe", 0), ("utool", 1000), ("register", -1), ("cnt", 101)]
+)
+def test_frame_register_and_cnt_numbers_out_of_range_are_refused(key: str, value: int) -> None:
+    with pytest.raises(CaseError, match=f"^{key}: "):
+        FanucOptions(**{key: value})  # type: ignore[arg-type]
 
 
 def test_header_and_comments_stay_within_the_comment_width() -> None:
