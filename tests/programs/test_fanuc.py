@@ -342,6 +342,13 @@ def test_cartesian_moves_of_a_robot_without_six_axes_are_refused() -> None:
         render_fanuc(program, robot=robot)
 
 
+def test_fewer_than_two_positions_per_file_is_refused() -> None:
+    robot = m20ia()
+    program = cartesian_program(robot, PART_M20IA, Q0_M20IA)
+    with pytest.raises(CaseError, match=r"^--max-points: .*at least 2, got 1"):
+        render_fanuc(program, robot=robot, max_points=1)
+
+
 @pytest.mark.parametrize(
     ("key", "value"), [("uframe", 0), ("utool", 1000), ("register", -1), ("cnt", 101)]
 )

@@ -146,10 +146,16 @@ def render_fanuc(
     ------
     CaseError
         For a robot TP cannot drive (a KUKA, ABB or UR robot, more than 6 axes, Cartesian
-        moves of a robot without 6 axes) or a name that cannot be made a TP name.
+        moves of a robot without 6 axes), a name that cannot be made a TP name, or fewer
+        than 2 positions per file.
     """
     options = options or FanucOptions()
     _check_drivable(program, robot)
+    if max_points is not None and max_points < 2:
+        raise CaseError(
+            f"must be at least 2, got {max_points}: a file holds at least one circular move",
+            key="--max-points",
+        )
     name = program_identifier(program.name, max_length=NAME_LENGTH, upper=True, key="--name")
     parts = split_program(program, max_points or DEFAULT_MAX_POINTS)
     configs = _configurations(program, robot)
