@@ -544,7 +544,7 @@ end
 """  # noqa: E501
 
 
-def test_the_writer_writes_utf8_files_into_the_folder(tmp_path: Path) -> None:
+def test_the_writer_writes_ascii_files_into_the_folder(tmp_path: Path) -> None:
     robot = ur_robot()
     asked: dict[str, object] = {}
 
@@ -563,6 +563,26 @@ def test_the_writer_writes_utf8_files_into_the_folder(tmp_path: Path) -> None:
     names = writer.write(source, tmp_path, motion="cartesian", max_points=5)
     assert names == ("Naht_u.script",)
     assert asked == {"motion": "cartesian", "name": None, "period": None, "force": False}
-    text = (tmp_path / "Naht_u.script").read_text(encoding="utf-8")
-    assert text.startswith("# Naht_u:") and "def Naht_u():" in text and text.endswith("end\n")
+    text = (tmp_path / "Naht_u.script").read_text(encoding="ascii")
+    assert text.startswith("def Naht_u():\n  # Naht_u:") and text.endswith("\nend\n")
     assert parse_urscript({"Naht_u.script": text}).targets
+
+
+@pytest.mark.parametrize("motion", ["cartesian", "joint"])
+def test_the_text_is_what_urcontrol_takes_from_a_socket(motion: str) -> None:
+    """URScript manual, "Connecting to URControl": extended ASCII only; the script starts
+    with ``def`` in the first column, every other line is indented, the last line is
+    ``end`` in the first column."""
+    robot = ur_robot()
+    prog = cartesian_program(robot) if motion == "cartesian" else joint_program(robot)
+    header = (*prog.header, "tolerance ≤ 0.5 mm · 1°, case Naht_ü → π")
+    sections = tuple(replace(s, label=s.label + "_ü") for s in prog.sections)
+    files = render_urscript(
+        replace(prog, header=header, sections=sections), robot=robot, max_points=5
+    )
+    lines = files["weld_cell.script"].splitlines()
+    assert lines[0] == "def weld_cell():" and lines[-1] == "end"
+    assert all(line.startswith(" ") for line in lines[1:-1])
+    assert all(line.isascii() for line in lines)
+    read = parse_urscript(files)
+    assert "tolerance <= 0.5 mm * 1 deg, case Naht_u -> pi" in read.header

@@ -269,7 +269,8 @@ def parse_urscript(files: dict[str, str]) -> ParsedProgram:
     -------
     ParsedProgram
         Targets in execution order (SI units, Cartesian poses in the ``part`` frame,
-        controller joints in rad), the tool set by ``set_tcp``, the header comment lines.
+        controller joints in rad), the tool set by ``set_tcp``, the comment lines that
+        open the program's body (its header).
     """
     file_name = next(name for name in files if name.endswith(".script"))
     text = files[file_name]
@@ -286,11 +287,11 @@ def parse_urscript(files: dict[str, str]) -> ParsedProgram:
     targets: list[ParsedTarget] = []
     for function, values, routine in reader.moves:
         targets.extend(_targets(function, values, routine, base, v_joint))
-    header = []
-    for line in text.splitlines():
-        if not line.startswith("#"):
+    header = []  # the comment lines that open the program's body
+    for line in text.splitlines()[1:]:
+        if not line.strip().startswith("#"):
             break
-        header.append(line[1:].removeprefix(" "))
+        header.append(line.strip()[1:].removeprefix(" "))
     return ParsedProgram(
         name=name, base=base, tool=reader.tool, targets=targets, header=header, files=[file_name]
     )

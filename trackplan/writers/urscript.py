@@ -20,6 +20,7 @@ See ``docs/export-urscript.md`` for the conventions and their sources.
 
 from __future__ import annotations
 
+import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -82,6 +83,21 @@ RESERVED = frozenset(
     "set_tcp pose_trans sleep sync stopj stopl".split()
 )
 """Names a program may not take (URScript keywords, the functions and variables it uses)."""
+
+
+_ASCII = {
+    "≤": "<=", "≥": ">=", "·": "*", "°": " deg", "±": "+/-", "−": "-", "×": "x",
+    "→": "->", "≈": "~", "µ": "u", "π": "pi", "–": "-", "—": "-", "’": "'", "“": '"', "”": '"',
+}  # fmt: skip
+"""Symbols a header may hold and their ASCII spelling."""
+
+
+def ascii_text(text: str) -> str:
+    """``text`` in ASCII: URControl takes "extended ASCII characters" only (URScript
+    manual, "Connecting to URControl"); symbols spelled out, accents dropped."""
+    for symbol, spelled in _ASCII.items():
+        text = text.replace(symbol, spelled)
+    return unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
 
 
 @dataclass(frozen=True, eq=False)
@@ -198,10 +214,13 @@ def render_urscript(
         _statement(step, float(r), mode, lookahead_time, gain)
         for step, r, mode in zip(steps, radii, modes, strict=True)
     )
-    lines = [f"# {line}" if line else "#" for line in _header(program, name, cycle, cycle_note)]
+    header = [
+        *_header(program, name, cycle, cycle_note),
+        f"largest blend radius written: {number(float(np.max(radii, initial=0.0)), 6)} m",
+    ]
+    lines = [f"def {name}():"]
+    lines += [f"  # {ascii_text(line)}" if line else "  #" for line in header]
     lines += [
-        f"# largest blend radius written: {number(float(np.max(radii, initial=0.0)), 6)} m",
-        f"def {name}():",
         f"  set_tcp({pose_literal(program.tool)})",
         f"  global part = {pose_literal(program.base)}",
         f"  global v_joint = {number(_slowest(program.v_max, robot, 'v'), 6)}",
@@ -258,7 +277,7 @@ def _part_items(part: Part, program: Program, robot: Robot | None) -> list[str |
     """A part's comment lines and moves, in order."""
     items: list[str | _Step] = []
     for section in part.sections:
-        items.append(f"# {section.kind}: {section.label}")
+        items.append(ascii_text(f"# {section.kind}: {section.label}"))
         if section.kind == "start":
             items.append(
                 "# the joint move to the planned start: URScript poses carry no "
@@ -339,7 +358,7 @@ def _statement(step: _Step, r: float, mode: int, lookahead_time: float, gain: fl
 
 @dataclass(frozen=True)
 class UrscriptWriter:
-    """``--format urscript``: ``NAME.script`` (UTF-8, ``\\n`` line ends) in the folder
+    """``--format urscript``: ``NAME.script`` (ASCII, ``\\n`` line ends) in the folder
     ``urscript``."""
 
     name: str = "urscript"
@@ -376,7 +395,7 @@ class UrscriptWriter:
             program, max_points=options.get("max_points"), robot=source.run.case.robot
         )
         for file_name, text in files.items():
-            (folder / file_name).write_text(text, encoding="utf-8", newline="\n")
+            (folder / file_name).write_text(text, encoding="ascii", newline="\n")
         return tuple(files)
 
 
