@@ -586,3 +586,39 @@ def test_the_text_is_what_urcontrol_takes_from_a_socket(motion: str) -> None:
     assert all(line.isascii() for line in lines)
     read = parse_urscript(files)
     assert "tolerance <= 0.5 mm * 1 deg, case Naht_u -> pi" in read.header
+
+
+def test_the_reference_pose_trans_is_the_manuals_example() -> None:
+    """URScript manual, ``pose_trans``: ``pose_trans(p[.2,.5,.1,1.57,0,0],
+    p[.2,.5,.6,1.57,0,0])`` returns ``p[0.4,-0.0996,0.60048,3.14,0.0,0.0]``."""
+    from tests.programs.urscript_reference import pose_trans
+
+    result = pose_trans(
+        pose_matrix(np.array([0.2, 0.5, 0.1, 1.57, 0, 0])),
+        pose_matrix(np.array([0.2, 0.5, 0.6, 1.57, 0, 0])),
+    )
+    np.testing.assert_allclose(result[:3, 3], [0.4, -0.0996, 0.60048], atol=1e-4)
+    np.testing.assert_allclose(vector_from_rotation(result[:3, :3]), [3.14, 0, 0], atol=1e-3)
+
+
+def test_without_a_robot_joint_moves_do_not_blend_and_the_cycle_is_assumed() -> None:
+    robot = ur_robot()
+    prog = cartesian_program(robot)
+    sections = tuple(
+        replace(
+            s,
+            moves=tuple(replace(m, zone=0.01) if isinstance(m, JointMove) else m for m in s.moves),
+        )
+        for s in prog.sections
+    )
+    prog = replace(prog, sections=sections)
+    with_robot = parse_urscript(render_urscript(prog, robot=robot))
+    without = parse_urscript(render_urscript(prog))
+    assert_reads_back(prog, without)
+    kinds = [t.kind for t in without.targets]
+    air = kinds.index("joint", 1)
+    assert without.targets[air].zone == 0.0 and without.targets[air - 1].zone == 0.0
+    assert (with_robot.targets[air].zone or 0.0) > 0.0  # with the robot's kinematics it blends
+    text = render_urscript(joint_program(robot, n=2))["weld_cell.script"]
+    assert "cycle (assumed: the robot states no cycle)" in text
+    assert "global a_joint = 1.4" in text
