@@ -48,6 +48,7 @@ from trackplan.writers.urscript_geometry import (
     joints_literal,
     number,
     pose_literal,
+    pose_literals,
 )
 
 DEFAULT_MAX_POINTS = 5000
@@ -210,8 +211,11 @@ def render_urscript(
         else 0
         for k, step in enumerate(steps)
     ]
+    cartesian = [t for step in steps for t in (step.via, step.target) if t is not None]
+    literals = pose_literals(np.array([t.pose for t in cartesian])) if cartesian else []
+    literal_of = {id(t): text for t, text in zip(cartesian, literals, strict=True)}
     statements = iter(
-        _statement(step, float(r), mode, lookahead_time, gain)
+        _statement(step, float(r), mode, lookahead_time, gain, literal_of)
         for step, r, mode in zip(steps, radii, modes, strict=True)
     )
     header = [
@@ -331,8 +335,15 @@ def _tcp_pose(model_joints: np.ndarray, program: Program, robot: Robot | None) -
     return pose
 
 
-def _statement(step: _Step, r: float, mode: int, lookahead_time: float, gain: float) -> str:
-    """One move as URScript."""
+def _statement(
+    step: _Step,
+    r: float,
+    mode: int,
+    lookahead_time: float,
+    gain: float,
+    literal_of: dict[int, str],
+) -> str:
+    """One move as URScript; ``literal_of`` holds each target's ``p[…]`` by ``id``."""
     if step.kind == "servoj":
         assert step.joints is not None and step.duration is not None
         return (
@@ -347,11 +358,11 @@ def _statement(step: _Step, r: float, mode: int, lookahead_time: float, gain: fl
             f"r={number(r, 6)})"
         )
     assert step.target is not None
-    to = f"pose_trans(part, {pose_literal(step.target.pose)})"
+    to = f"pose_trans(part, {literal_of[id(step.target)]})"
     speeds = f"a={number(LINEAR_ACCELERATION, 6)}, v={number(step.speed, 6)}, r={number(r, 6)}"
     if step.kind == "movec":
         assert step.via is not None
-        via = f"pose_trans(part, {pose_literal(step.via.pose)})"
+        via = f"pose_trans(part, {literal_of[id(step.via)]})"
         return f"movec({via}, {to}, {speeds}, mode={mode})"
     return f"movel({to}, {speeds})"
 

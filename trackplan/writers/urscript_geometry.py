@@ -37,30 +37,44 @@ def number(value: float, digits: int = 9) -> str:
     return "0.0" if text == "-0.0" else text
 
 
-def rotation_vector(rotation: np.ndarray) -> np.ndarray:
-    """The rotation vector (unit axis · angle, rad) of a rotation matrix, angle in [0, π].
+def rotation_vectors(rotations: np.ndarray) -> np.ndarray:
+    """The rotation vectors (unit axis · angle, rad) of rotation matrices, angle in [0, π].
 
     Parameters
     ----------
-    rotation
-        Shape (3, 3), orthonormal.
+    rotations
+        Shape (..., 3, 3), orthonormal.
 
     Returns
     -------
     numpy.ndarray
-        Shape (3,), rad: URScript's ``rx, ry, rz``.
+        Shape (..., 3), rad: URScript's ``rx, ry, rz``.
     """
     from scipy.spatial.transform import Rotation  # startup time: only programs need scipy
 
-    vector: np.ndarray = Rotation.from_matrix(rotation).as_rotvec()
-    return vector
+    rotations = np.asarray(rotations, dtype=float)
+    flat = rotations.reshape(-1, 3, 3)
+    vectors: np.ndarray = Rotation.from_matrix(flat).as_rotvec().reshape(*rotations.shape[:-2], 3)
+    return vectors
+
+
+def rotation_vector(rotation: np.ndarray) -> np.ndarray:
+    """The rotation vector of one rotation matrix (3, 3): shape (3,), rad."""
+    return rotation_vectors(rotation)
+
+
+def pose_literals(poses: np.ndarray) -> list[str]:
+    """``p[x, y, z, rx, ry, rz]`` of each (4, 4) pose of ``poses`` (N, 4, 4): m and a
+    rotation vector in rad, 9 decimals (1 nm, 1 nrad: a pose read back is within 0.01 mm
+    and 0.001° of the pose)."""
+    poses = np.asarray(poses, dtype=float).reshape(-1, 4, 4)
+    values = np.concatenate([poses[:, :3, 3], rotation_vectors(poses[:, :3, :3])], axis=1)
+    return ["p[" + ", ".join(number(v) for v in row) + "]" for row in values]
 
 
 def pose_literal(pose: np.ndarray) -> str:
-    """``p[x, y, z, rx, ry, rz]`` of a (4, 4) pose: m and a rotation vector in rad, 9
-    decimals (1 nm, 1 nrad: a pose read back is within 0.01 mm and 0.001° of ``pose``)."""
-    values = [*pose[:3, 3], *rotation_vector(pose[:3, :3])]
-    return "p[" + ", ".join(number(v) for v in values) + "]"
+    """``p[x, y, z, rx, ry, rz]`` of one (4, 4) pose (:func:`pose_literals`)."""
+    return pose_literals(pose)[0]
 
 
 def joints_literal(joints: np.ndarray) -> str:
@@ -86,20 +100,17 @@ def blend_radii(points: list[np.ndarray | None], zones: list[float]) -> np.ndarr
     numpy.ndarray
         Shape (len(points),), m.
     """
-    n = len(points)
     radii = np.maximum(np.asarray(zones, dtype=float), 0.0)
-    for i in range(n):
-        if i == n - 1 or points[i] is None:
-            radii[i] = 0.0
-            continue
-        for j in (i - 1, i + 1):
-            if 0 <= j < n:
-                other = points[j]
-                if other is None:
-                    radii[i] = 0.0
-                else:
-                    distance = float(np.linalg.norm(np.asarray(points[i]) - other))
-                    radii[i] = min(radii[i], BLEND_SHARE * distance)
+    if radii.size == 0:
+        return radii
+    unknown = np.full(3, np.nan)
+    positions = np.array([unknown if p is None else p for p in points], dtype=float)
+    share = BLEND_SHARE * np.linalg.norm(np.diff(positions, axis=0), axis=1)  # (n - 1,)
+    share = np.where(np.isnan(share), 0.0, share)  # a neighbour of unknown place: no blend
+    radii[1:] = np.minimum(radii[1:], share)
+    radii[:-1] = np.minimum(radii[:-1], share)
+    radii[np.isnan(positions[:, 0])] = 0.0
+    radii[-1] = 0.0
     return radii
 
 
@@ -209,5 +220,7 @@ __all__ = [
     "least_common_multiple",
     "number",
     "pose_literal",
+    "pose_literals",
     "rotation_vector",
+    "rotation_vectors",
 ]
