@@ -622,3 +622,11 @@ def test_without_a_robot_joint_moves_do_not_blend_and_the_cycle_is_assumed() -> 
     text = render_urscript(joint_program(robot, n=2))["weld_cell.script"]
     assert "cycle (assumed: the robot states no cycle)" in text
     assert "global a_joint = 1.4" in text
+
+
+@pytest.mark.parametrize("max_points", [1, 0, -3])
+def test_too_few_points_per_part_is_refused_in_one_line(max_points: int) -> None:
+    robot = ur_robot()
+    with pytest.raises(CaseError) as error:
+        render_urscript(cartesian_program(robot), robot=robot, max_points=max_points)
+    assert error.value.key == "--max-points" and "at least 2" in str(error.value)

@@ -188,14 +188,21 @@ def render_urscript(
     CaseError
         A robot that is not a UR or has not 6 joints (key ``--format``), a name that
         cannot be made valid (``--name``), a ``servoj`` period that is not a multiple of
-        the controller's cycle (``--period``).
+        the controller's cycle (``--period``), fewer than 2 points per part
+        (``--max-points``).
     """
     check_drivable(program)
     name = urscript_name(program.name)
     cycle = robot.convention.cycle if robot is not None else None
     cycle_note = "" if cycle is not None else " (assumed: the robot states no cycle)"
     cycle = cycle if cycle is not None else DEFAULT_CYCLE
-    parts = split_program(program, max_points or DEFAULT_MAX_POINTS)
+    if max_points is not None and max_points < 2:
+        raise CaseError(
+            f"--max-points must be at least 2 (a circular move writes two targets), got "
+            f"{max_points}",
+            key="--max-points",
+        )
+    parts = split_program(program, DEFAULT_MAX_POINTS if max_points is None else max_points)
     items = [_part_items(part, program, robot) for part in parts]
     steps = [item for part_items in items for item in part_items if isinstance(item, _Step)]
     for step in steps:
