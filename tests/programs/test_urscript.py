@@ -419,7 +419,9 @@ def prog_joints(prog: Program, index: int) -> np.ndarray:
     return wanted.model_joints
 
 
-def test_movec_mode_follows_the_planned_orientation() -> None:
+@pytest.mark.parametrize("sweep", [1.2, -1.2, 5.2, -5.2])
+def test_movec_mode_follows_the_planned_orientation(sweep: float) -> None:
+    """Arcs of ±69° and ±298° (either way round, less and more than half a turn)."""
     robot = ur_robot()
     start_q = START
     start = target(robot, start_q)
@@ -433,7 +435,7 @@ def test_movec_mode_follows_the_planned_orientation() -> None:
         return Target(pose=pose, joints=start.joints, model_joints=start.model_joints)
 
     for turn, mode in ((True, 1), (False, 0)):
-        arc = CircularMove(via=on_arc(0.6, turn), target=on_arc(1.2, turn), speed=0.01)
+        arc = CircularMove(via=on_arc(sweep / 2, turn), target=on_arc(sweep, turn), speed=0.01)
         line = LinearMove(target=start, speed=0.01)
         sections = (
             Section(kind="start", label="start", moves=(joint_move(robot, start_q),)),
@@ -630,3 +632,15 @@ def test_too_few_points_per_part_is_refused_in_one_line(max_points: int) -> None
     with pytest.raises(CaseError) as error:
         render_urscript(cartesian_program(robot), robot=robot, max_points=max_points)
     assert error.value.key == "--max-points" and "at least 2" in str(error.value)
+
+
+def test_a_header_or_label_with_a_line_break_stays_a_comment() -> None:
+    robot = ur_robot()
+    prog = cartesian_program(robot)
+    sections = tuple(
+        replace(s, label=s.label + "\nmovej([9, 9, 9, 9, 9, 9])") for s in prog.sections
+    )
+    prog = replace(prog, header=("case: two\nlines", *prog.header), sections=sections)
+    parsed = parse_urscript(render_urscript(prog, robot=robot))
+    assert_reads_back(prog, parsed)
+    assert "case: two lines" in parsed.header

@@ -95,7 +95,9 @@ _ASCII = {
 
 def ascii_text(text: str) -> str:
     """``text`` in ASCII: URControl takes "extended ASCII characters" only (URScript
-    manual, "Connecting to URControl"); symbols spelled out, accents dropped."""
+    manual, "Connecting to URControl"); symbols spelled out, accents dropped, and line
+    breaks made spaces so that a comment stays one line."""
+    text = " ".join(text.splitlines())
     for symbol, spelled in _ASCII.items():
         text = text.replace(symbol, spelled)
     return unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
