@@ -352,11 +352,35 @@ def test_the_header_comes_first_and_states_units_and_frames() -> None:
         assert words in header
 
 
-def test_the_builtin_urs_root_is_the_controller_base() -> None:
-    """ur_description's chain (config/ur5e/default_kinematics.yaml, from base_link via the π
-    turn of base_link_inertia, to tool0 via flange) expressed in its ``base`` frame (the
-    controller's Base) equals the built-in ur5e's forward kinematics: the built-in's root
-    is UR's Base, so its controller world is the identity."""
+UR_DESCRIPTION_CHAINS = {  # x y z, roll pitch yaw: shoulder, upper_arm, forearm, wrist_1..3
+    "ur5e": [
+        ([0, 0, 0.1625], [0, 0, 0]),
+        ([0, 0, 0], [1.570796327, 0, 0]),
+        ([-0.425, 0, 0], [0, 0, 0]),
+        ([-0.3922, 0, 0.1333], [0, 0, 0]),
+        ([0, -0.0997, 0], [1.570796327, 0, 0]),
+        ([0, 0.0996, 0], [1.570796326589793, np.pi, np.pi]),
+    ],
+    "ur10e": [
+        ([0, 0, 0.1807], [0, 0, 0]),
+        ([0, 0, 0], [1.570796327, 0, 0]),
+        ([-0.6127, 0, 0], [0, 0, 0]),
+        ([-0.57155, 0, 0.17415], [0, 0, 0]),
+        ([0, -0.11985, 0], [1.570796327, 0, 0]),
+        ([0, 0.11655, 0], [1.570796326589793, np.pi, np.pi]),
+    ],
+}
+"""UniversalRobots/Universal_Robots_ROS2_Description, config/<robot>/default_kinematics.yaml
+(the z of wrist_2 and wrist_3, about -2e-11 m, left out)."""
+
+
+@pytest.mark.parametrize("name", ["ur5e", "ur10e"])
+def test_the_builtin_urs_root_is_the_controller_base(name: str) -> None:
+    """ur_description's chain (urdf/ur_macro.xacro: from base_link through the π turn of
+    base_link_inertia, the six joints, then flange and tool0) expressed in its ``base``
+    frame (the controller's Base) equals the built-in robot's forward kinematics: the
+    built-in's root is UR's Base and its joints are UR's, so its controller convention is
+    the identity."""
     from scipy.spatial.transform import Rotation
 
     def frame(xyz: list[float], rpy: list[float]) -> np.ndarray:
@@ -365,15 +389,8 @@ def test_the_builtin_urs_root_is_the_controller_base() -> None:
         out[:3, 3] = xyz
         return out
 
-    chain = [  # ur5e: x y z roll pitch yaw of shoulder, upper_arm, forearm, wrist_1..3
-        ([0, 0, 0.1625], [0, 0, 0]),
-        ([0, 0, 0], [1.570796327, 0, 0]),
-        ([-0.425, 0, 0], [0, 0, 0]),
-        ([-0.3922, 0, 0.1333], [0, 0, 0]),
-        ([0, -0.0997, 0], [1.570796327, 0, 0]),
-        ([0, 0.0996, 0], [1.570796326589793, np.pi, np.pi]),
-    ]
-    robot = builtin_robot("ur5e")
+    chain = UR_DESCRIPTION_CHAINS[name]
+    robot = builtin_robot(name)
     rng = np.random.default_rng(3)
     for q in rng.uniform(-np.pi, np.pi, (20, 6)):
         pose = frame([0, 0, 0], [0, 0, np.pi])
