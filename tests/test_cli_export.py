@@ -334,18 +334,14 @@ class _ProgramWriter:
 
 @pytest.fixture
 def fake_builder(monkeypatch: pytest.MonkeyPatch) -> list[dict[str, Any]]:
-    """``trackplan.programs.build`` replaced by a builder that records its calls."""
-    import types
-
+    """The export source's builder replaced by one that records its calls."""
     calls: list[dict[str, Any]] = []
 
     def build_program(replayed: Any, **arguments: Any) -> dict[str, Any]:
         calls.append({"replayed": replayed, **arguments})
         return {"case": replayed.case.name, **arguments}
 
-    module = types.ModuleType("trackplan.programs.build")
-    module.build_program = build_program  # type: ignore[attr-defined]
-    monkeypatch.setitem(__import__("sys").modules, "trackplan.programs.build", module)
+    monkeypatch.setattr("trackplan.writers.source.build_program", build_program)
     return calls
 
 
@@ -424,8 +420,8 @@ def test_the_format_help_lists_every_registered_writer(
 ) -> None:
     register_writer(_FolderWriter())
     assert main(["export", "--help"]) == 0
-    out = " ".join(capsys.readouterr().out.split())
-    assert "One of csv, json, ros, twofiles." in out
+    out = " ".join(capsys.readouterr().out.replace("│", " ").split())  # the help's box wraps
+    assert "One of csv, json, ros, krl, rapid, fanuc, urscript, twofiles." in out
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,6 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -21,6 +20,7 @@ import trackplan.robots
 from tests.programs.fanuc_parser import parse_fanuc, read_listing, wpr_pose
 from tests.programs.fanuc_reference import fanuc_config, turn
 from tests.programs.parsed import ParsedProgram
+from tests.programs.stand_in import stand_in
 from trackplan.errors import CaseError
 from trackplan.io.robot_file import builtin_robot, load_robot_text
 from trackplan.programs.model import (
@@ -100,7 +100,7 @@ def target(robot: Robot, part: np.ndarray, q: np.ndarray) -> Target:
 
 def joint_move(robot: Robot, q: np.ndarray, **kwargs: object) -> JointMove:
     q = np.asarray(q, dtype=float)
-    return JointMove(joints=robot.convention.to_controller(q), model_joints=q, **kwargs)  # type: ignore[arg-type]
+    return JointMove(joints=robot.convention.to_controller(q), model_joints=q, **kwargs)
 
 
 def cartesian_program(
@@ -324,14 +324,14 @@ def test_a_name_that_cannot_be_a_tp_name_is_refused() -> None:
 def test_a_robot_of_another_vendor_is_refused() -> None:
     robot = m20ia()
     program = cartesian_program(robot, PART_M20IA, Q0_M20IA, vendor="kuka")
-    with pytest.raises(CaseError, match=r"--format: .*kuka robot"):
+    with pytest.raises(CaseError, match=r"TP drives FANUC .* KUKA controller: use --format krl$"):
         render_fanuc(program, robot=robot)
 
 
 def test_more_joints_than_a_tp_group_is_refused() -> None:
     robot = m20ia()
     program = replace(joint_program(robot, Q0_M20IA, n=3), n_dof=7)
-    with pytest.raises(CaseError, match=r"--format: .*J1\.\.J6.*7 joints"):
+    with pytest.raises(CaseError, match=r"--format: TP drives 1 to 6 robot axes, .* has 7 joints"):
         render_fanuc(program, robot=robot)
 
 
@@ -354,7 +354,7 @@ def test_fewer_than_two_positions_per_file_is_refused() -> None:
 )
 def test_frame_register_and_cnt_numbers_out_of_range_are_refused(key: str, value: int) -> None:
     with pytest.raises(CaseError, match=f"^{key}: "):
-        FanucOptions(**{key: value})  # type: ignore[arg-type]
+        FanucOptions(**{key: value})
 
 
 def test_header_and_comments_stay_within_the_comment_width() -> None:
@@ -381,9 +381,9 @@ def test_the_writer_writes_ascii_files_of_the_sources_program(tmp_path: Path) ->
         asked.update(kwargs)
         return program
 
-    source = SimpleNamespace(run=SimpleNamespace(case=SimpleNamespace(robot=robot)), program=build)
+    source = stand_in(build, robot)
     writer = FanucWriter()
-    names = writer.write(source, tmp_path, max_points=4, uframe=2)  # type: ignore[arg-type]
+    names = writer.write(source, tmp_path, max_points=4, uframe=2)
     assert asked == {"motion": "cartesian", "name": None, "period": None, "force": False}
     assert names[0] == "WELD_SEA.ls" and len(names) > 2
     files = {name: (tmp_path / name).read_text(encoding="ascii") for name in names}

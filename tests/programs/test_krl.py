@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -14,6 +13,7 @@ from hypothesis import strategies as st
 from tests.programs.krl_parser import abc_rotation, parse_krl
 from tests.programs.krl_reference import status_turn_reference
 from tests.programs.parsed import ParsedProgram, ParsedTarget
+from tests.programs.stand_in import stand_in
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.io.robot_file import builtin_robot
@@ -65,7 +65,7 @@ def target(robot: Robot, q_model_deg: list[float]) -> Target:
 
 def joint_move(robot: Robot, q_deg: list[float], **kwargs: float) -> JointMove:
     q = np.deg2rad(q_deg)
-    return JointMove(joints=robot.convention.to_controller(q), model_joints=q, **kwargs)  # type: ignore[arg-type]
+    return JointMove(joints=robot.convention.to_controller(q), model_joints=q, **kwargs)
 
 
 def program(robot: Robot, sections: tuple[Section, ...], **kwargs: object) -> Program:
@@ -82,7 +82,7 @@ def program(robot: Robot, sections: tuple[Section, ...], **kwargs: object) -> Pr
         "sample_time": 0.004,
         **kwargs,
     }
-    return Program(**fields)  # type: ignore[arg-type]
+    return Program(**fields)
 
 
 def cartesian_program(robot: Robot, name: str = "seam_demo") -> Program:
@@ -334,7 +334,8 @@ def test_refuses_other_vendors_and_joint_counts() -> None:
     prog = cartesian_program(robot)
     with pytest.raises(CaseError) as error:
         render_krl(dataclasses.replace(prog, vendor="abb"), robot=robot)
-    assert error.value.key == "--format" and "abb" in error.value.message
+    assert error.value.key == "--format"
+    assert "has an ABB controller: use --format rapid" in error.value.message
     with pytest.raises(CaseError, match="7 joints"):
         render_krl(dataclasses.replace(prog, n_dof=7), robot=robot)
 
@@ -355,7 +356,7 @@ def test_writer_writes_ascii_crlf_files(tmp_path: Path) -> None:
         asked.update(options)
         return dataclasses.replace(prog, header=("case: Schweißnaht ≤ 0.5 mm",))
 
-    source = SimpleNamespace(program=build, run=SimpleNamespace(case=SimpleNamespace(robot=robot)))
+    source = stand_in(build, robot)
     writer = KrlWriter()
     names = writer.write(source, tmp_path, motion="cartesian", name="demo", max_points=4)
     assert asked == {"motion": "cartesian", "name": "demo", "period": None, "force": False}

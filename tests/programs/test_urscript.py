@@ -9,7 +9,6 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -17,6 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.programs.parsed import ParsedProgram
+from tests.programs.stand_in import stand_in
 from tests.programs.urscript_parser import parse_urscript
 from tests.programs.urscript_programs import (
     START,
@@ -296,7 +296,7 @@ def test_a_robot_that_is_not_a_ur_is_refused() -> None:
         render_urscript(prog, robot=puma)
     message = str(error.value)
     assert error.value.key == "--format" and "\n" not in message
-    assert "puma560" in message.lower() and "csv" in message
+    assert "puma560" in message and "controller: vendor is ur" in message
     with pytest.raises(CaseError, match="--format krl"):
         render_urscript(replace(prog, vendor="kuka", robot="kr6"))
 
@@ -571,7 +571,7 @@ def test_the_writer_writes_ascii_files_into_the_folder(tmp_path: Path) -> None:
         asked.update(options)
         return cartesian_program(robot, name="Naht ü")
 
-    source = SimpleNamespace(program=build, run=SimpleNamespace(case=SimpleNamespace(robot=robot)))
+    source = stand_in(build, robot)
     writer = UrscriptWriter()
     assert (writer.name, writer.suffix, writer.default_file, writer.folder) == (
         "urscript",

@@ -195,8 +195,8 @@ def export(
 ) -> ExitCode:
     """Export a run: its trajectory (CSV, JSON, ROS 2 JointTrajectory) or a robot program.
 
-    The program formats re-plan the run's case where the run was planned and check that
-    it reproduces trajectory.csv before they write (docs/results.md).
+    The program formats plan the run's case again at the run's placement and check that
+    the plan reproduces trajectory.csv before they write (docs/export.md).
     """
     from trackplan.programs.model import MOTION_FORMS
     from trackplan.writers import export_files

@@ -59,4 +59,41 @@ def program_identifier(
     return cleaned.upper() if upper else cleaned
 
 
-__all__ = ["program_identifier"]
+SPELLED = {
+    "ß": "ss",
+    "·": "*",
+    "×": "x",
+    "≤": "<=",
+    "≥": ">=",
+    "±": "+/-",
+    "°": " deg",
+    "−": "-",
+    "–": "-",
+    "—": "-",
+    "→": "->",
+    "≈": "~",
+    "µ": "u",
+    "π": "pi",
+    "’": "'",
+    "“": '"',
+    "”": '"',
+}
+"""Symbols the headers use, spelled in ASCII."""
+
+
+def ascii_comment(text: str) -> str:
+    """``text`` as one line of ASCII for a program comment.
+
+    Controllers read program files as ASCII or a single-byte code page (KRL Windows-1252,
+    RAPID ISO 8859-1, URControl "extended ASCII"), so symbols are spelled out
+    (:data:`SPELLED`), accents dropped, any other character becomes ``?`` and line breaks
+    become spaces (a comment stays on its line).
+    """
+    text = " ".join(text.splitlines())
+    for symbol, spelled in SPELLED.items():
+        text = text.replace(symbol, spelled)
+    decomposed = unicodedata.normalize("NFKD", text)
+    return "".join(c if ord(c) < 128 else "?" for c in decomposed if not unicodedata.combining(c))
+
+
+__all__ = ["SPELLED", "ascii_comment", "program_identifier"]

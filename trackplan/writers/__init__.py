@@ -11,35 +11,50 @@ language. A new format registers with :func:`register_writer`. See ``docs/result
 """
 
 from trackplan.writers.exporter import export, export_files, export_trajectory
+from trackplan.writers.fanuc import FanucWriter
+from trackplan.writers.krl import KrlWriter
 from trackplan.writers.protocol import (
     WRITERS,
     Writer,
     register_writer,
+    write_text_files,
     writer_for_file,
     writer_named,
 )
+from trackplan.writers.rapid import RapidWriter
 from trackplan.writers.source import ExportSource
 from trackplan.writers.trajectory_formats import CsvWriter, JsonWriter, RosWriter
+from trackplan.writers.urscript import UrscriptWriter
 
 # The registry, in the order `--format` lists the formats: the trajectory formats, then
-# the controller program writers (trackplan/writers/{krl,rapid,fanuc,urscript}.py) each
-# registered here with one line, e.g. `register_writer(KrlWriter())`.
-for _writer in (CsvWriter(), JsonWriter(), RosWriter()):
+# the controller program writers.
+for _writer in (
+    CsvWriter(),
+    JsonWriter(),
+    RosWriter(),
+    KrlWriter(),
+    RapidWriter(),
+    FanucWriter(),
+    UrscriptWriter(),
+):
     register_writer(_writer)
-
-# -- program writers: register here --
 
 __all__ = [
     "WRITERS",
     "CsvWriter",
     "ExportSource",
+    "FanucWriter",
     "JsonWriter",
+    "KrlWriter",
+    "RapidWriter",
     "RosWriter",
+    "UrscriptWriter",
     "Writer",
     "export",
     "export_files",
     "export_trajectory",
     "register_writer",
+    "write_text_files",
     "writer_for_file",
     "writer_named",
 ]

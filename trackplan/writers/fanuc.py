@@ -12,11 +12,10 @@ what the controller does differently from the plan: ``docs/export-fanuc.md``.
 from __future__ import annotations
 
 import textwrap
-import unicodedata
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
@@ -32,8 +31,10 @@ from trackplan.programs.model import (
     Target,
     split_program,
 )
-from trackplan.programs.names import program_identifier
+from trackplan.programs.names import ascii_comment, program_identifier
 from trackplan.robots.model import Robot
+from trackplan.run_files import RESULT_FILE
+from trackplan.writers.drivable import Drives, check_drivable
 from trackplan.writers.fanuc_config import (
     cartesian_record,
     config_strings,
@@ -41,6 +42,8 @@ from trackplan.writers.fanuc_config import (
     number,
     xyzwpr,
 )
+from trackplan.writers.protocol import write_text_files
+from trackplan.writers.source import ExportSource
 
 DEFAULT_MAX_POINTS = 5000
 """Positions per ``.ls`` file by default. RoboDK's FANUC post (``Fanuc_R30iA.py``) splits
@@ -58,27 +61,11 @@ COMMENT_WIDTH = 20
 ATTR_COMMENT_LENGTH = 16
 """Characters of the ``/ATTR`` COMMENT (the program comment on the SELECT screen)."""
 
-FANUC_VENDORS = ("fanuc", "generic")
-"""Robot vendors a TP program drives."""
+TP = Drives(format="fanuc", language="TP", vendors=("fanuc", "generic"), min_axes=1)
+"""TP drives FANUC and generic robots, J1 … J6 of motion group 1."""
 
 MAX_AXES = 6
 """Robot axes of motion group 1 written (J1…J6); external axes are not written."""
-
-
-class _ProgramSource(Protocol):
-    """What :class:`FanucWriter` needs of an export source (the run and its program)."""
-
-    @property
-    def run(self) -> Any: ...
-
-    def program(
-        self,
-        *,
-        motion: str,
-        name: str | None,
-        period: float | None,
-        force: bool,
-    ) -> Program: ...
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -199,7 +186,7 @@ class FanucWriter:
     default_file = "fanuc"
     folder = True
 
-    def write(self, source: _ProgramSource, folder: Path, **options: Any) -> tuple[str, ...]:
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
         """Write the program's ``.ls`` files (ASCII) into ``folder``.
 
         Returns
@@ -207,45 +194,35 @@ class FanucWriter:
         tuple[str, ...]
             The names of the files written, the main program first.
         """
-        program = source.program(
-            motion=options.get("motion", "cartesian"),
-            name=options.get("name"),
-            period=options.get("period"),
-            force=bool(options.get("force", False)),
-        )
         fanuc_options = FanucOptions(
             **{
                 key: options[key]
                 for key in ("uframe", "utool", "register", "cnt")
                 if options.get(key) is not None
             },
-            created=datetime.now(),
+            created=_run_time(source),
         )
-        files = render_fanuc(
-            program,
-            robot=source.run.case.robot,
+        texts = render_fanuc(
+            source.program_of(options),
+            robot=source.robot,
             max_points=options.get("max_points"),
             options=fanuc_options,
         )
-        for file_name, text in files.items():
-            (Path(folder) / file_name).write_text(text, encoding="ascii", newline="\n")
-        return tuple(files)
+        return write_text_files(folder, texts)
+
+
+def _run_time(source: ExportSource) -> datetime | None:
+    """When the run was written (its ``result.json``'s modification time), for /ATTR's
+    CREATE and MODIFIED; None for a run in memory. The run's time, not the export's,
+    keeps the files of one run the same from export to export."""
+    if source.folder is None:
+        return None
+    return datetime.fromtimestamp((source.folder / RESULT_FILE).stat().st_mtime)
 
 
 def _check_drivable(program: Program, robot: Robot | None) -> None:
     """Refuse a robot TP does not drive (one line, key ``--format``)."""
-    if program.vendor not in FANUC_VENDORS:
-        raise CaseError(
-            f"--format fanuc writes programs for FANUC robots (vendor fanuc) or generic ones; "
-            f"robot {program.robot!r} is a {program.vendor} robot: choose its own format",
-            key="--format",
-        )
-    if program.n_dof > MAX_AXES:
-        raise CaseError(
-            f"--format fanuc writes J1..J{MAX_AXES} of motion group 1; robot "
-            f"{program.robot!r} has {program.n_dof} joints",
-            key="--format",
-        )
+    check_drivable(program, TP)
     cartesian = any(not isinstance(move, JointMove) for move in program.moves())
     if cartesian and program.n_dof != MAX_AXES:
         raise CaseError(
@@ -283,8 +260,7 @@ def _configurations(program: Program, robot: Robot | None) -> dict[int, str]:
 
 def _ascii(text: str) -> str:
     """``text`` as TP comment characters: ASCII, no ``;`` (it ends an instruction)."""
-    plain = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
-    return plain.replace(";", ",").replace("\t", " ")
+    return ascii_comment(text).replace(";", ",").replace("\t", " ")
 
 
 def _header_lines(program: Program, options: FanucOptions) -> list[str]:

@@ -13,10 +13,9 @@ in order from ``NAME.src``. Units: mm, degrees, m/s (``$VEL.CP``), % (``$VEL_AXI
 
 from __future__ import annotations
 
-import unicodedata
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
@@ -32,9 +31,12 @@ from trackplan.programs.model import (
     Target,
     split_program,
 )
-from trackplan.programs.names import program_identifier
+from trackplan.programs.names import ascii_comment, program_identifier
 from trackplan.robots.model import Robot
+from trackplan.writers.drivable import Drives, check_drivable
 from trackplan.writers.krl_config import frame_values, real, status_turn
+from trackplan.writers.protocol import write_text_files
+from trackplan.writers.source import ExportSource
 
 # RoboDK's KUKA KRC4 post-processor (KUKA_KRC4.py, MAX_LINES_X_PROG) starts a new .src
 # after 1400 lines; KUKA publishes no limit (docs/export-krl.md).
@@ -46,8 +48,8 @@ zone changes), below the page length integrators' post-processors keep
 MAX_NAME = 24
 """KRL's longest program (module) name."""
 
-DRIVEN_VENDORS = ("kuka", "generic")
-"""Controller families a KRL program drives."""
+KRL = Drives(format="krl", language="KRL", vendors=("kuka", "generic"), min_axes=1)
+"""KRL drives KUKA and generic robots of up to six axes (A1 … A6)."""
 
 MAX_AXES = 6
 """Robot axes A1 … A6 of an E6AXIS (external axes E1 … E6 are not written)."""
@@ -67,28 +69,6 @@ DIGITS_MM = 4
 """Decimals of X, Y, Z (mm): 1e-4 mm, below KRL's REAL (32-bit) resolution at 1 m."""
 DIGITS_DEG = 6
 """Decimals of A, B, C and of axis angles (deg): 1e-6° (1.7e-8 rad)."""
-
-_ASCII = {
-    "ß": "ss",
-    "·": "*",
-    "×": "x",
-    "≤": "<=",
-    "≥": ">=",
-    "°": " deg",
-    "−": "-",
-    "–": "-",
-    "—": "-",
-}
-
-
-class _ExportSource(Protocol):
-    """What the writer needs of an export source: its program and its run's robot."""
-
-    run: Any
-
-    def program(
-        self, *, motion: str, name: str | None, period: float | None, force: bool
-    ) -> Program: ...
 
 
 def krl_name(name: str) -> str:
@@ -116,22 +96,6 @@ def part_names(name: str, n_parts: int) -> tuple[str, ...]:
     return tuple(f"{stem}_P{index}" for index in range(1, n_parts + 1))
 
 
-def check_program(program: Program) -> None:
-    """Refuse a program a KUKA controller cannot drive (key ``--format``)."""
-    if program.vendor not in DRIVEN_VENDORS:
-        raise CaseError(
-            f"robot {program.robot!r} has a {program.vendor} controller: KRL drives KUKA "
-            "robots (or a generic robot file); choose its vendor's format",
-            key="--format",
-        )
-    if not 1 <= program.n_dof <= MAX_AXES:
-        raise CaseError(
-            f"robot {program.robot!r} has {program.n_dof} joints: KRL drives robot axes "
-            f"A1 … A{MAX_AXES} only",
-            key="--format",
-        )
-
-
 def render_krl(program: Program, *, robot: Robot, max_points: int | None = None) -> dict[str, str]:
     """The KRL files of a program.
 
@@ -156,7 +120,7 @@ def render_krl(program: Program, *, robot: Robot, max_points: int | None = None)
         For a robot KRL cannot drive, a name that cannot be made valid, or fewer than 2
         points per part.
     """
-    check_program(program)
+    check_drivable(program, KRL)
     name = krl_name(program.name)
     if max_points is not None and max_points < 2:
         raise CaseError(
@@ -214,7 +178,7 @@ class _Module:
     def add_sections(self, sections: tuple[Section, ...], n_dof: int) -> None:
         """Every move of ``sections``, each section under a comment line."""
         for section in sections:
-            self.code.append(f"; {_ascii(section.kind)}: {_ascii(section.label)}")
+            self.code.append(f"; {ascii_comment(section.kind)}: {ascii_comment(section.label)}")
             moves = section.moves
             start = 0
             while start < len(moves):
@@ -334,7 +298,7 @@ def _timed(move: Move) -> bool:
 
 def _header(program: Program, n_parts: int) -> list[str]:
     """The header comment lines (ASCII, without the ``;``)."""
-    lines = [_ascii(line) for line in program.header]
+    lines = [ascii_comment(line) for line in program.header]
     lines.append(
         "KRL: $BASE = the part frame in $WORLD (with $ROBROOT = $WORLD), $TOOL = the TCP in "
         "$FLANGE; X Y Z mm, A B C deg with R = Rz(A) Ry(B) Rx(C)"
@@ -368,14 +332,6 @@ def _percent(share: float) -> str:
     return str(int(min(100, max(1, round(100.0 * share)))))
 
 
-def _ascii(text: str) -> str:
-    """Text as ASCII for a KRL comment (the KRC's editor reads Windows-1252)."""
-    for symbol, replacement in _ASCII.items():
-        text = text.replace(symbol, replacement)
-    decomposed = unicodedata.normalize("NFKD", text)
-    return "".join(c if ord(c) < 128 else "?" for c in decomposed if not unicodedata.combining(c))
-
-
 @dataclass(frozen=True)
 class KrlWriter:
     """The ``krl`` export: a folder of ``.src``/``.dat`` files (ASCII, CRLF line ends)."""
@@ -385,24 +341,16 @@ class KrlWriter:
     default_file: str = "krl"
     folder: bool = True
 
-    def write(self, source: _ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
         """Write the program's files into ``folder``; their names.
 
         Options: ``motion`` (``cartesian``/``joint``), ``name``, ``period`` (s), ``force``,
         ``max_points``.
         """
-        program = source.program(
-            motion=options.get("motion", "cartesian"),
-            name=options.get("name"),
-            period=options.get("period"),
-            force=bool(options.get("force", False)),
-        )
         texts = render_krl(
-            program, robot=source.run.case.robot, max_points=options.get("max_points")
+            source.program_of(options), robot=source.robot, max_points=options.get("max_points")
         )
-        for file_name, text in texts.items():
-            (folder / file_name).write_bytes(text.replace("\n", "\r\n").encode("ascii"))
-        return tuple(texts)
+        return write_text_files(folder, texts, line_end="\r\n")
 
 
 __all__ = [
@@ -410,7 +358,6 @@ __all__ = [
     "KEYWORDS",
     "MAX_NAME",
     "KrlWriter",
-    "check_program",
     "krl_name",
     "part_names",
     "render_krl",

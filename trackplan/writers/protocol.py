@@ -158,3 +158,30 @@ def writer_for_file(output: Path) -> Writer:
             key="format",
         )
     return max(matches, key=lambda writer: len(writer.suffix))
+
+
+def write_text_files(
+    folder: Path, texts: dict[str, str], *, line_end: str = "\n"
+) -> tuple[str, ...]:
+    """Write program texts into ``folder`` as ASCII files, lines ended by ``line_end``.
+
+    Controllers read program files as ASCII (KRL, RAPID, TP, URScript); the writers
+    print ASCII only, so a character outside it is a programming error here.
+
+    Parameters
+    ----------
+    folder
+        The staging folder the exporter gave the writer.
+    texts
+        File name → text with ``\\n`` line ends, the main file first.
+    line_end
+        ``"\\n"``, or ``"\\r\\n"`` for a controller that expects it (KUKA).
+
+    Returns
+    -------
+    tuple[str, ...]
+        The names written, in the order of ``texts``.
+    """
+    for file_name, text in texts.items():
+        (folder / file_name).write_bytes(text.replace("\n", line_end).encode("ascii"))
+    return tuple(texts)

@@ -12,7 +12,6 @@ ASCII (a subset of the ISO 8859-1 the controller reads). See ``docs/export-rapid
 from __future__ import annotations
 
 import re
-import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,9 +29,12 @@ from trackplan.programs.model import (
     Target,
     split_program,
 )
-from trackplan.programs.names import program_identifier
+from trackplan.programs.names import ascii_comment, program_identifier
 from trackplan.robots.model import Robot
+from trackplan.writers.drivable import Drives, check_drivable
+from trackplan.writers.protocol import write_text_files
 from trackplan.writers.rapid_config import confdata, number, numbers, quaternion
+from trackplan.writers.source import ExportSource
 
 DEFAULT_MAX_POINTS = 5000
 """Targets per procedure. ABB publishes no limit on a routine's length; the controller's
@@ -43,8 +45,8 @@ FlexPendant."""
 MAX_IDENTIFIER = 32
 """Longest RAPID identifier (RAPID overview, *Basic elements: identifiers*)."""
 
-VENDORS = ("abb", "generic")
-"""Controller families a RAPID program can drive (a generic robot as an ABB arm would)."""
+RAPID = Drives(format="rapid", language="RAPID", vendors=("abb", "generic"))
+"""RAPID drives ABB and generic six-axis arms (a generic robot as an ABB arm would)."""
 
 N_AXES = 6
 """Robot axes of a ``robjoint``; the confdata here is defined for six-axis arms."""
@@ -77,8 +79,6 @@ RESERVED = frozenset(
 )
 """RAPID's reserved words (RAPID kernel reference) and ``main``: a module of such a name
 gets ``_prg`` appended; a name ``partK`` does too, to stay apart from the part routines."""
-
-_ASCII = {"°": " deg", "≤": "<=", "≥": ">=", "×": "x", "·": "*", "−": "-", "±": "+/-"}
 
 
 @dataclass(frozen=True)
@@ -116,7 +116,7 @@ def render_rapid(
         cannot be made an identifier, or fewer than 2 points per procedure (keys
         ``--format``, ``--name``, ``--max-points``).
     """
-    _check_drivable(program)
+    check_drivable(program, RAPID)
     name = _module_name(program.name)
     names = _Names(
         module=name, tool=f"tool_{name}"[:MAX_IDENTIFIER], wobj=f"wobj_{name}"[:MAX_IDENTIFIER]
@@ -136,7 +136,7 @@ def render_rapid(
     for part in parts:
         lines: list[str] = []
         for section in part.sections:
-            lines.append(f"! {_ascii(section.kind)}: {_ascii(section.label)}")
+            lines.append(f"! {ascii_comment(section.kind)}: {ascii_comment(section.label)}")
             for move in section.moves:
                 following = all_moves[index + 1] if index + 1 < len(all_moves) else None
                 lines.extend(
@@ -155,21 +155,6 @@ def _module_name(asked: str) -> str:
     if name.upper() in RESERVED or re.fullmatch(r"part\d+", name, flags=re.IGNORECASE):
         name = f"{name[: MAX_IDENTIFIER - 4]}_prg"
     return name
-
-
-def _check_drivable(program: Program) -> None:
-    """Refuse a robot that a RAPID program cannot drive."""
-    if program.vendor not in VENDORS:
-        raise CaseError(
-            f"RAPID drives ABB robots: {program.robot} has a {program.vendor} controller; "
-            "export it in that controller's format",
-            key="--format",
-        )
-    if program.n_dof != N_AXES:
-        raise CaseError(
-            f"RAPID here drives six-axis arms: {program.robot} has {program.n_dof} joints",
-            key="--format",
-        )
 
 
 class _Data:
@@ -308,14 +293,6 @@ def _tload(program: Program, robot: Robot) -> tuple[str, str]:
     )
 
 
-def _ascii(text: str) -> str:
-    """Text as ASCII (the controller reads ISO 8859-1; ASCII is safe in both)."""
-    for symbol, replacement in _ASCII.items():
-        text = text.replace(symbol, replacement)
-    folded = unicodedata.normalize("NFKD", text).encode("ascii", "replace").decode("ascii")
-    return folded.replace("\n", " ")
-
-
 def _module_text(
     program: Program, robot: Robot, names: _Names, data: _Data, bodies: list[list[str]]
 ) -> str:
@@ -332,8 +309,8 @@ def _module_text(
     ]
     if not program.feasible:
         header.append("WARNING: the run is NOT feasible (written with --force)")
-    lines.extend(f"  ! {_ascii(line)}".rstrip() for line in header)
-    lines.append(f"  ! {_ascii(tload_note)}")
+    lines.extend(f"  ! {ascii_comment(line)}".rstrip() for line in header)
+    lines.append(f"  ! {ascii_comment(tload_note)}")
     lines.append(
         f"  PERS tooldata {names.tool}:=[TRUE,{_pose(program.tool)},{tload}];",
     )
@@ -372,7 +349,7 @@ class RapidWriter:
     default_file = "rapid"
     folder = True
 
-    def write(self, source: Any, folder: Path, **options: Any) -> tuple[str, ...]:
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
         """Build the program from the run, render it and write ``NAME.mod`` (ASCII).
 
         Parameters
@@ -390,18 +367,10 @@ class RapidWriter:
         tuple[str, ...]
             The names of the files written.
         """
-        program = source.program(
-            motion=options.get("motion", "cartesian"),
-            name=options.get("name"),
-            period=options.get("period"),
-            force=bool(options.get("force", False)),
+        texts = render_rapid(
+            source.program_of(options), robot=source.robot, max_points=options.get("max_points")
         )
-        files = render_rapid(
-            program, robot=source.run.case.robot, max_points=options.get("max_points")
-        )
-        for file_name, text in files.items():
-            (folder / file_name).write_text(text, encoding="ascii")
-        return tuple(files)
+        return write_text_files(folder, texts)
 
 
 __all__ = ["DEFAULT_MAX_POINTS", "RapidWriter", "render_rapid"]

@@ -9,7 +9,7 @@ program writers call :meth:`ExportSource.program`, which replays the run folder
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
@@ -24,12 +24,14 @@ from trackplan.io.export import (
 )
 from trackplan.io.run_folder import verified_trajectory
 from trackplan.planning.result import Trajectory
+from trackplan.programs.build import build_program
 from trackplan.programs.replay import ReplayedRun, replay_run
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 
 if TYPE_CHECKING:
     from trackplan.case import Case
     from trackplan.programs.model import MotionForm, Program
+    from trackplan.robots.model import Robot
 
 
 @dataclass(eq=False, kw_only=True)
@@ -168,12 +170,25 @@ class ExportSource:
         """
         key = (motion, name, period, force)
         if key not in self._programs:
-            from trackplan.programs.build import build_program
-
             self._programs[key] = build_program(
                 self.run, motion=motion, name=name, period=period, force=force
             )
         return self._programs[key]
+
+    def program_of(self, options: Mapping[str, Any]) -> Program:
+        """:meth:`program` with the export options a writer is given (``motion``,
+        ``name``, ``period``, ``force``; the others are ignored)."""
+        return self.program(
+            motion=options.get("motion") or "cartesian",
+            name=options.get("name"),
+            period=options.get("period"),
+            force=bool(options.get("force", False)),
+        )
+
+    @property
+    def robot(self) -> Robot:
+        """The robot of the run (:attr:`run`'s case)."""
+        return self.run.case.robot
 
 
 def _run_folder_of(csv_file: Path) -> Path | None:

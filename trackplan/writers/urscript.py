@@ -20,7 +20,6 @@ See ``docs/export-urscript.md`` for the conventions and their sources.
 
 from __future__ import annotations
 
-import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -38,9 +37,12 @@ from trackplan.programs.model import (
     Target,
     split_program,
 )
-from trackplan.programs.names import program_identifier
+from trackplan.programs.names import ascii_comment, program_identifier
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
+from trackplan.writers.drivable import Drives, check_drivable
+from trackplan.writers.protocol import write_text_files
+from trackplan.writers.source import ExportSource
 from trackplan.writers.urscript_geometry import (
     arc_mode,
     blend_radii,
@@ -72,11 +74,8 @@ SERVO_LOOKAHEAD_TIME = 0.1
 SERVO_GAIN = 300.0
 """``servoj`` ``gain`` (range [100, 2000]; the URScript manual's default)."""
 
-JOINT_COUNT = 6
-"""Joints of a UR arm: ``movej`` and ``servoj`` take 6 values."""
-
-NATIVE_FORMATS = {"kuka": "krl", "abb": "rapid", "fanuc": "fanuc"}
-"""The program format of each controller family that is not Universal Robots'."""
+URSCRIPT = Drives(format="urscript", language="URScript", vendors=("ur",))
+"""URScript drives Universal Robots arms: ``movej`` and ``servoj`` take 6 values."""
 
 RESERVED = frozenset(
     "def end if elif else while for return global local thread run kill halt pass break "
@@ -84,23 +83,6 @@ RESERVED = frozenset(
     "set_tcp pose_trans sleep sync stopj stopl".split()
 )
 """Names a program may not take (URScript keywords, the functions and variables it uses)."""
-
-
-_ASCII = {
-    "≤": "<=", "≥": ">=", "·": "*", "°": " deg", "±": "+/-", "−": "-", "×": "x",
-    "→": "->", "≈": "~", "µ": "u", "π": "pi", "–": "-", "—": "-", "’": "'", "“": '"', "”": '"',
-}  # fmt: skip
-"""Symbols a header may hold and their ASCII spelling."""
-
-
-def ascii_text(text: str) -> str:
-    """``text`` in ASCII: URControl takes "extended ASCII characters" only (URScript
-    manual, "Connecting to URControl"); symbols spelled out, accents dropped, and line
-    breaks made spaces so that a comment stays one line."""
-    text = " ".join(text.splitlines())
-    for symbol, spelled in _ASCII.items():
-        text = text.replace(symbol, spelled)
-    return unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,31 +111,6 @@ def urscript_name(name: str) -> str:
     """
     identifier = program_identifier(name, key="--name")
     return f"{identifier}_program" if identifier in RESERVED else identifier
-
-
-def check_drivable(program: Program) -> None:
-    """Refuse a program URScript cannot drive: a robot whose controller is not a UR, or
-    not 6 joints.
-
-    Raises
-    ------
-    CaseError
-        One line naming the robot and the formats that can drive it (key ``--format``).
-    """
-    if program.vendor != "ur":
-        native = NATIVE_FORMATS.get(program.vendor)
-        use = f"--format {native}" if native else "a robot file whose controller: vendor is ur"
-        raise CaseError(
-            f"robot {program.robot!r} has a {program.vendor!r} controller and URScript drives "
-            f"Universal Robots only: use {use} (csv, json and ros export any robot's joints)",
-            key="--format",
-        )
-    if program.n_dof != JOINT_COUNT:
-        raise CaseError(
-            f"robot {program.robot!r} has {program.n_dof} joints and URScript drives "
-            f"{JOINT_COUNT}: use --format csv, json or ros for its joint trajectory",
-            key="--format",
-        )
 
 
 def render_urscript(
@@ -193,7 +150,7 @@ def render_urscript(
         the controller's cycle (``--period``), fewer than 2 points per part
         (``--max-points``).
     """
-    check_drivable(program)
+    check_drivable(program, URSCRIPT)
     name = urscript_name(program.name)
     cycle = robot.convention.cycle if robot is not None else None
     cycle_note = "" if cycle is not None else " (assumed: the robot states no cycle)"
@@ -232,7 +189,7 @@ def render_urscript(
         f"largest blend radius written: {number(float(np.max(radii, initial=0.0)), 6)} m",
     ]
     lines = [f"def {name}():"]
-    lines += [f"  # {ascii_text(line)}" if line else "  #" for line in header]
+    lines += [f"  # {ascii_comment(line)}" if line else "  #" for line in header]
     lines += [
         f"  set_tcp({pose_literal(program.tool)})",
         f"  global part = {pose_literal(program.base)}",
@@ -290,7 +247,7 @@ def _part_items(part: Part, program: Program, robot: Robot | None) -> list[str |
     """A part's comment lines and moves, in order."""
     items: list[str | _Step] = []
     for section in part.sections:
-        items.append(ascii_text(f"# {section.kind}: {section.label}"))
+        items.append(ascii_comment(f"# {section.kind}: {section.label}"))
         if section.kind == "start":
             items.append(
                 "# the joint move to the planned start: URScript poses carry no "
@@ -386,7 +343,7 @@ class UrscriptWriter:
     default_file: str = "urscript"
     folder: bool = True
 
-    def write(self, source: Any, folder: Path, **options: Any) -> tuple[str, ...]:
+    def write(self, source: ExportSource, folder: Path, **options: Any) -> tuple[str, ...]:
         """Build the run's program and write its ``.script`` file into ``folder``.
 
         Parameters
@@ -405,25 +362,16 @@ class UrscriptWriter:
         tuple[str, ...]
             The names of the files written.
         """
-        program = source.program(
-            motion=options.get("motion", "cartesian"),
-            name=options.get("name"),
-            period=options.get("period"),
-            force=bool(options.get("force", False)),
+        texts = render_urscript(
+            source.program_of(options), robot=source.robot, max_points=options.get("max_points")
         )
-        files = render_urscript(
-            program, max_points=options.get("max_points"), robot=source.run.case.robot
-        )
-        for file_name, text in files.items():
-            (folder / file_name).write_text(text, encoding="ascii", newline="\n")
-        return tuple(files)
+        return write_text_files(folder, texts)
 
 
 __all__ = [
     "DEFAULT_CYCLE",
     "DEFAULT_MAX_POINTS",
     "UrscriptWriter",
-    "check_drivable",
     "render_urscript",
     "urscript_name",
 ]
