@@ -374,10 +374,9 @@ class _Listing:
         """``! …`` comment lines, each wrapped to :data:`COMMENT_WIDTH` characters;
         a wrapped line's continuations start with ``..``."""
         for line in lines:
-            chunks = textwrap.wrap(_ascii(line), COMMENT_WIDTH) or [""]
-            self.instruction(f"! {chunks[0]}")
-            for chunk in textwrap.wrap(" ".join(chunks[1:]), COMMENT_WIDTH - 2):
-                self.instruction(f"! ..{chunk}")
+            chunks = textwrap.wrap(_ascii(line), COMMENT_WIDTH, subsequent_indent="..")
+            for chunk in chunks or [""]:
+                self.instruction(f"! {chunk}")
 
     def motion(self, letter: str, text: str) -> None:
         """A motion instruction ``J``/``L`` with its position, speed and termination."""
