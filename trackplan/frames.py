@@ -55,6 +55,10 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     return R
 
 
+GIMBAL_LOCK = 1e-9
+"""|cos pitch| below which :func:`rpy_from_matrix` is at the gimbal lock (pitch = ±π/2)."""
+
+
 def rpy_from_matrix(R: np.ndarray) -> np.ndarray:
     """Roll, pitch, yaw of rotation matrices (inverse of :func:`rpy_matrix`).
 
@@ -66,12 +70,21 @@ def rpy_from_matrix(R: np.ndarray) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Shape (..., 3), rad, pitch in [-π/2, π/2].
+        Shape (..., 3), rad, pitch in [-π/2, π/2]. At the gimbal lock (|cos pitch| below
+        :data:`GIMBAL_LOCK`) roll is 0 and yaw carries the rotation about the common axis,
+        so that the angles compose back to the matrix. The same angles are KUKA's C, B, A
+        and FANUC's W, P, R (``docs/export.md``).
     """
     R = np.asarray(R, dtype=float)
-    pitch = np.arcsin(np.clip(-R[..., 2, 0], -1.0, 1.0))
-    roll = np.arctan2(R[..., 2, 1], R[..., 2, 2])
-    yaw = np.arctan2(R[..., 1, 0], R[..., 0, 0])
+    cos_pitch = np.hypot(R[..., 0, 0], R[..., 1, 0])
+    pitch = np.arctan2(-R[..., 2, 0], cos_pitch)  # arcsin loses digits near ±π/2
+    locked = cos_pitch < GIMBAL_LOCK
+    roll = np.where(locked, 0.0, np.arctan2(R[..., 2, 1], R[..., 2, 2]))
+    yaw = np.where(
+        locked,
+        np.arctan2(-R[..., 0, 1], R[..., 1, 1]),
+        np.arctan2(R[..., 1, 0], R[..., 0, 0]),
+    )
     return np.stack([roll, pitch, yaw], axis=-1)
 
 

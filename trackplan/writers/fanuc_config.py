@@ -27,21 +27,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from trackplan.frames import rpy_from_matrix
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
+from trackplan.robots.wrist import wrist_centres
 
 MM = 1000.0
 """mm per m."""
 
-_LOCK = 1e-9
-"""|cos P| below which W, P, R are at the gimbal lock (P = ±90°) and W is set to 0."""
-
 
 def wpr_from_matrix(R: np.ndarray) -> np.ndarray:
-    """FANUC W, P, R of rotation matrices.
-
-    ``R = Rz(R)·Ry(P)·Rx(W)``; at the gimbal lock (P = ±90°) W is 0 and R carries the
-    rotation about the common axis, so that the angles compose back to the matrix.
+    """FANUC W, P, R of rotation matrices (``R = Rz(R)·Ry(P)·Rx(W)``): the
+    :func:`~trackplan.frames.rpy_from_matrix` angles in degrees (at the gimbal lock,
+    P = ±90°, W is 0 and R carries the rotation about the common axis).
 
     Parameters
     ----------
@@ -53,17 +51,7 @@ def wpr_from_matrix(R: np.ndarray) -> np.ndarray:
     numpy.ndarray
         (W, P, R), shape (..., 3), degrees; P in [−90, 90].
     """
-    R = np.asarray(R, dtype=float)
-    cos_p = np.hypot(R[..., 0, 0], R[..., 1, 0])
-    pitch = np.arctan2(-R[..., 2, 0], cos_p)
-    locked = cos_p < _LOCK
-    roll = np.where(locked, 0.0, np.arctan2(R[..., 2, 1], R[..., 2, 2]))
-    yaw = np.where(
-        locked,
-        np.arctan2(-R[..., 0, 1], R[..., 1, 1]),
-        np.arctan2(R[..., 1, 0], R[..., 0, 0]),
-    )
-    return np.degrees(np.stack([roll, pitch, yaw], axis=-1))
+    return np.degrees(rpy_from_matrix(R))
 
 
 def xyzwpr(pose: np.ndarray) -> np.ndarray:
@@ -100,47 +88,10 @@ def turn_numbers(angles_deg: np.ndarray) -> np.ndarray:
     return (np.sign(a) * np.floor((np.abs(a) + 180.0) / 360.0)).astype(int)
 
 
-def _closest_points(
-    p: np.ndarray, u: np.ndarray, q: np.ndarray, v: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Nearest points of the lines p + s·u and q + t·v, each shape (N, 3).
-
-    Where the lines are parallel, ``q`` itself and its projection on the first line.
-    """
-    w = p - q
-    a = np.einsum("ni,ni->n", u, u)
-    b = np.einsum("ni,ni->n", u, v)
-    c = np.einsum("ni,ni->n", v, v)
-    d = np.einsum("ni,ni->n", u, w)
-    e = np.einsum("ni,ni->n", v, w)
-    den = a * c - b * b
-    parallel = den < 1e-12 * a * c
-    safe = np.where(parallel, 1.0, den)
-    s = np.where(parallel, -d / a, (b * e - c * d) / safe)
-    t = np.where(parallel, 0.0, (a * e - b * d) / safe)
-    return p + s[:, None] * u, q + t[:, None] * v
-
-
 def wrist_centre(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """The wrist centre: where the J4 and J5 axes meet (nearest point), in the base frame.
-
-    Parameters
-    ----------
-    robot
-        A six-axis robot.
-    q
-        Model joints, shape (N, n), rad.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (N, 3), m.
-    """
-    frames = axis_frames(robot, q)
-    _, on_j5 = _closest_points(
-        frames[:, 4, :3, 3], frames[:, 4, :3, 2], frames[:, 5, :3, 3], frames[:, 5, :3, 2]
-    )
-    return on_j5
+    """Wrist centres (:func:`~trackplan.robots.wrist.wrist_centres`) of model joints
+    ``q``, shape (N, n), rad; shape (N, 3), m, in the base frame."""
+    return wrist_centres(axis_frames(robot, q))
 
 
 def arm_configuration(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

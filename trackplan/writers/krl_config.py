@@ -23,15 +23,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from trackplan.frames import rpy_from_matrix
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
-
-GIMBAL_TOLERANCE = 1e-9
-"""cos B below which A and C are coupled (B = ±90°): C is set to 0 there."""
+from trackplan.robots.wrist import wrist_centres
 
 
 def abc_from_matrix(R: np.ndarray) -> np.ndarray:
-    """KUKA A, B, C of rotation matrices (``R = Rz(A) · Ry(B) · Rx(C)``).
+    """KUKA A, B, C of rotation matrices (``R = Rz(A) · Ry(B) · Rx(C)``): the reversed
+    :func:`~trackplan.frames.rpy_from_matrix`.
 
     Parameters
     ----------
@@ -43,15 +43,7 @@ def abc_from_matrix(R: np.ndarray) -> np.ndarray:
     numpy.ndarray
         (A, B, C), shape (..., 3), rad; B in [−π/2, π/2]; at B = ±π/2, C = 0.
     """
-    R = np.asarray(R, dtype=float)
-    cos_b = np.hypot(R[..., 0, 0], R[..., 1, 0])
-    b = np.arctan2(-R[..., 2, 0], cos_b)
-    regular = cos_b > GIMBAL_TOLERANCE
-    a = np.where(
-        regular, np.arctan2(R[..., 1, 0], R[..., 0, 0]), np.arctan2(-R[..., 0, 1], R[..., 1, 1])
-    )
-    c = np.where(regular, np.arctan2(R[..., 2, 1], R[..., 2, 2]), 0.0)
-    return np.stack([a, b, c], axis=-1)
+    return rpy_from_matrix(R)[..., ::-1]
 
 
 def frame_values(T: np.ndarray) -> np.ndarray:
@@ -74,34 +66,9 @@ def frame_values(T: np.ndarray) -> np.ndarray:
 
 
 def wrist_points(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Wrist root points: where the axes of joints 4 and 5 meet (the midpoint of their common
-    perpendicular), or joint 5's axis origin when the two are parallel.
-
-    Parameters
-    ----------
-    robot
-        A robot of 6 joints.
-    q
-        Model joints, shape (k, 6), rad.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (k, 3), m, in the model's base frame.
-    """
-    frames = axis_frames(robot, q)
-    p4, d4 = frames[:, 4, :3, 3], frames[:, 4, :3, 2]
-    p5, d5 = frames[:, 5, :3, 3], frames[:, 5, :3, 2]
-    w = p5 - p4
-    cos = np.einsum("ki,ki->k", d4, d5)
-    denominator = 1.0 - cos**2
-    parallel = denominator < 1e-12
-    safe = np.where(parallel, 1.0, denominator)
-    s = (np.einsum("ki,ki->k", w, d4) - cos * np.einsum("ki,ki->k", w, d5)) / safe
-    t = (cos * np.einsum("ki,ki->k", w, d4) - np.einsum("ki,ki->k", w, d5)) / safe
-    middle = 0.5 * ((p4 + s[:, None] * d4) + (p5 + t[:, None] * d5))
-    points: np.ndarray = np.where(parallel[:, None], p5, middle)
-    return points
+    """Wrist root points (:func:`~trackplan.robots.wrist.wrist_centres`) of model joints
+    ``q``, shape (k, 6), rad; shape (k, 3), m, in the model's base frame."""
+    return wrist_centres(axis_frames(robot, q))
 
 
 def status_turn(robot: Robot, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -166,7 +133,6 @@ def real(value: float, digits: int) -> str:
 
 
 __all__ = [
-    "GIMBAL_TOLERANCE",
     "abc_from_matrix",
     "frame_values",
     "real",

@@ -20,6 +20,7 @@ from scipy.spatial.transform import Rotation
 
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
+from trackplan.robots.wrist import wrist_centres
 
 _SIDE_TOLERANCE = 1e-12
 """m: a reference side closer than this to its plane counts as in front."""
@@ -43,11 +44,10 @@ def quadrants(theta: np.ndarray) -> np.ndarray:
     return np.floor(np.round(degrees, 9) / 90.0).astype(int)
 
 
-def wrist_centres(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def wrist_centres_and_frames(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The wrist centre and the axis frames of model joints ``q``.
 
-    The wrist centre is the point of axis 4 nearest to axis 5 (their intersection on a
-    spherical wrist).
+    The wrist centre is where axes 4 and 5 meet (:func:`~trackplan.robots.wrist.wrist_centres`).
 
     Parameters
     ----------
@@ -62,16 +62,7 @@ def wrist_centres(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Wrist centres in the base frame, shape (N, 3), m; axis frames, shape (N, 8, 4, 4).
     """
     frames = axis_frames(robot, q)
-    o4, z4 = frames[:, 4, :3, 3], frames[:, 4, :3, 2]
-    o5, z5 = frames[:, 5, :3, 3], frames[:, 5, :3, 2]
-    w0 = o4 - o5
-    b = np.einsum("ij,ij->i", z4, z5)
-    d = np.einsum("ij,ij->i", z4, w0)
-    e = np.einsum("ij,ij->i", z5, w0)
-    denominator = 1.0 - b * b
-    parallel = denominator < 1e-12
-    t = np.where(parallel, 0.0, (b * e - d) / np.where(parallel, 1.0, denominator))
-    return o4 + t[:, None] * z4, frames
+    return wrist_centres(frames), frames
 
 
 def _sides(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -83,7 +74,7 @@ def _sides(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Shape (N,) each, m; positive on the side of ``cross(z2, z1)`` and
         ``cross(z2, lower arm)``.
     """
-    wrist, frames = wrist_centres(robot, q)
+    wrist, frames = wrist_centres_and_frames(robot, q)
     o1, z1 = frames[:, 1, :3, 3], frames[:, 1, :3, 2]
     o2, z2 = frames[:, 2, :3, 3], frames[:, 2, :3, 2]
     o3 = frames[:, 3, :3, 3]
