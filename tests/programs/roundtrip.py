@@ -2,8 +2,12 @@
 
 Every language's round-trip test calls :func:`assert_matches_plan` on the
 :class:`~tests.programs.parsed.ParsedProgram` its parser returns: the frames, every
-Cartesian target against the forward kinematics of the planned joints there, every joint
-target against the planned joints, and the number and kinds of targets.
+Cartesian target against the program's and against the forward kinematics of the planned
+joints there, every joint target against the planned joints, and the number and kinds of
+targets (:func:`assert_matches_program` leaves the forward kinematics out, for a program
+whose targets are not the FK of their joints). What one language adds (configuration
+fields, speeds, zones, times) it checks on top, over :func:`target_pairs` and with
+:func:`assert_joint_timing`; the tolerances are this module's.
 """
 
 from __future__ import annotations
@@ -93,6 +97,9 @@ class ExpectedTarget:
         The TCP in the part frame, shape (4, 4), m; None for a joint target.
     duration
         A timed joint move's duration, s, else None.
+    speed
+        The move's speed: m/s for a Cartesian move, share of the joint rates for a joint
+        move.
     """
 
     kind: str
@@ -100,6 +107,7 @@ class ExpectedTarget:
     model_joints: np.ndarray
     pose: np.ndarray | None = None
     duration: float | None = None
+    speed: float | None = None
 
 
 def expected_targets(program: Program) -> list[ExpectedTarget]:
@@ -107,9 +115,13 @@ def expected_targets(program: Program) -> list[ExpectedTarget]:
     end; a spline each of its points)."""
     out: list[ExpectedTarget] = []
 
-    def cartesian(kind: str, target: Target) -> ExpectedTarget:
+    def cartesian(kind: str, target: Target, speed: float) -> ExpectedTarget:
         return ExpectedTarget(
-            kind=kind, joints=target.joints, model_joints=target.model_joints, pose=target.pose
+            kind=kind,
+            joints=target.joints,
+            model_joints=target.model_joints,
+            pose=target.pose,
+            speed=speed,
         )
 
     for move in program.moves():
@@ -120,85 +132,87 @@ def expected_targets(program: Program) -> list[ExpectedTarget]:
                     joints=move.joints,
                     model_joints=move.model_joints,
                     duration=move.duration,
+                    speed=move.speed,
                 )
             )
         elif isinstance(move, LinearMove):
-            out.append(cartesian("linear", move.target))
+            out.append(cartesian("linear", move.target, move.speed))
         elif isinstance(move, CircularMove):
-            out.append(cartesian("circular_via", move.via))
-            out.append(cartesian("circular_end", move.target))
+            out.append(cartesian("circular_via", move.via, move.speed))
+            out.append(cartesian("circular_end", move.target, move.speed))
         elif isinstance(move, SplineMove):
-            out.extend(cartesian("spline", target) for target in move.targets)
+            out.extend(cartesian("spline", target, move.speed) for target in move.targets)
         else:  # pragma: no cover - a move kind this helper does not know
             raise TypeError(f"unknown move {move!r}")
     return out
 
 
-def frame_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    """Distance (m) and rotation angle (rad) between two frames (4, 4).
+def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
+    """The angle of the rotation between two rotations, rad.
 
-    The angle is ``2 asin(‖Ra − Rb‖_F / 2√2)``, exact near 0 (unlike an arccos of the
-    trace).
+    ``a`` and ``b`` are rotation matrices (3, 3) or frames (4, 4) (their rotation part is
+    used). The angle is ``2 asin(‖Ra − Rb‖_F / 2√2)``, exact near 0 (unlike an arccos of
+    the trace).
     """
-    distance = float(np.linalg.norm(a[:3, 3] - b[:3, 3]))
     chord = float(np.linalg.norm(a[:3, :3] - b[:3, :3])) / (2.0 * np.sqrt(2.0))
-    return distance, 2.0 * float(np.arcsin(min(chord, 1.0)))
+    return 2.0 * float(np.arcsin(min(chord, 1.0)))
 
 
-def _assert_frame(actual: np.ndarray, expected: np.ndarray, what: str) -> None:
+def frame_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """Distance (m) and rotation angle (rad, :func:`rotation_angle`) between two frames
+    (4, 4)."""
+    return float(np.linalg.norm(a[:3, 3] - b[:3, 3])), rotation_angle(a, b)
+
+
+def _assert_frame(actual: np.ndarray, expected: np.ndarray, what: str, whose: str) -> None:
     distance, angle = frame_difference(actual, expected)
     assert distance <= POSITION_TOLERANCE, (
-        f"{what}: {distance * 1e3:.6f} mm from the plan (at most {POSITION_TOLERANCE * 1e3} mm)"
+        f"{what}: {distance * 1e3:.6f} mm from the {whose} (at most {POSITION_TOLERANCE * 1e3} mm)"
     )
     assert angle <= ANGLE_TOLERANCE, (
-        f"{what}: {np.degrees(angle):.6f} deg from the plan (at most 0.001 deg)"
+        f"{what}: {np.degrees(angle):.6f} deg from the {whose} (at most 0.001 deg)"
     )
 
 
-def _kinds_agree(parsed: ParsedTarget, expected: ExpectedTarget) -> bool:
-    """A spline point may be written as a linear move (a language without a spline)."""
+def _kinds_agree(parsed: ParsedTarget, expected: ExpectedTarget, spline_as: str | None) -> bool:
+    """A spline point reads back as ``spline_as``; as a spline or a linear move when it is
+    None (a language without a spline writes lines)."""
     if expected.kind == "spline":
-        return parsed.kind in ("spline", "linear")
+        return parsed.kind == spline_as if spline_as else parsed.kind in ("spline", "linear")
     return parsed.kind == expected.kind
 
 
-def assert_matches_plan(parsed: ParsedProgram, program: Program, robot: Robot) -> None:
-    """Assert that a program read back is the plan's, target by target.
-
-    - The parsed base and tool equal the program's (0.01 mm, 0.001°).
-    - The parsed targets are as many as the program's, of the same kinds (a spline's
-      points may read back as linear moves), in the same order.
-    - Every Cartesian target, put through the parsed base, is the controller-world forward
-      kinematics of the planned joints there (model joints → ``forward_kinematics`` →
-      ``convention.world_from_base``) within 0.01 mm and 0.001°.
-    - Every joint target (and a Cartesian target that states joints) equals the planned
-      controller joints within 1e-6 rad; a timed move's duration equals the program's.
-
-    Parameters
-    ----------
-    parsed
-        The program as a language's parser read it.
-    program
-        The program the writer printed.
-    robot
-        The run's robot.
-    """
-    _assert_frame(parsed.base, program.base, "base frame")
-    _assert_frame(parsed.tool, program.tool, "tool frame")
+def target_pairs(
+    parsed: ParsedProgram, program: Program
+) -> list[tuple[ParsedTarget, ExpectedTarget]]:
+    """Every target read back with the program's target it stands for, in order; asserts
+    that they are as many."""
     expected = expected_targets(program)
     assert len(parsed.targets) == len(expected), (
         f"{len(parsed.targets)} targets read back, the program has {len(expected)}"
     )
-    convention = robot.convention
-    world_poses = convention.world_from_base(
-        forward_kinematics(robot, np.array([e.model_joints for e in expected]))
-    )
-    for k, (got, want) in enumerate(zip(parsed.targets, expected, strict=True)):
+    return list(zip(parsed.targets, expected, strict=True))
+
+
+def _assert_targets(
+    parsed: ParsedProgram, program: Program, robot: Robot | None, spline_as: str | None
+) -> None:
+    _assert_frame(parsed.base, program.base, "base frame", "plan")
+    _assert_frame(parsed.tool, program.tool, "tool frame", "plan")
+    pairs = target_pairs(parsed, program)
+    world_poses = None
+    if robot is not None and pairs:
+        world_poses = robot.convention.world_from_base(
+            forward_kinematics(robot, np.array([want.model_joints for _, want in pairs]))
+        )
+    for k, (got, want) in enumerate(pairs):
         where = f"target {k} ({want.kind}, {got.part or 'main'})"
-        assert _kinds_agree(got, want), f"{where}: read back as {got.kind}"
+        assert _kinds_agree(got, want, spline_as), f"{where}: read back as {got.kind}"
         if want.pose is not None:
             assert got.pose is not None, f"{where}: no pose read back"
-            _assert_frame(parsed.base @ got.pose, world_poses[k], where)
+            if world_poses is not None:
+                _assert_frame(parsed.base @ got.pose, world_poses[k], where, "plan")
+            _assert_frame(got.pose, want.pose, where, "program")
         if want.kind == "joint" or got.joints is not None:
             assert got.joints is not None, f"{where}: no joints read back"
             error = float(np.max(np.abs(np.asarray(got.joints) - want.joints)))
@@ -209,6 +223,78 @@ def assert_matches_plan(parsed: ParsedProgram, program: Program, robot: Robot) -
             )
 
 
+def assert_matches_program(
+    parsed: ParsedProgram, program: Program, *, spline_as: str | None = None
+) -> None:
+    """Assert that a program read back is the program the writer printed, target by target.
+
+    - The parsed base and tool equal the program's (0.01 mm, 0.001°).
+    - The parsed targets are as many as the program's, of the same kinds, in the same
+      order; a spline's points read back as ``spline_as`` (``spline`` or ``linear``; either
+      when None).
+    - Every Cartesian target equals the program's (TCP in the part frame) within 0.01 mm
+      and 0.001°.
+    - Every joint target (and a Cartesian target that states joints) equals the program's
+      controller joints within 1e-6 rad; a timed move's duration, where read back, equals
+      the program's within 1e-6 s.
+
+    Parameters
+    ----------
+    parsed
+        The program as a language's parser read it.
+    program
+        The program the writer printed.
+    spline_as
+        The kind the language writes a spline point as, or None.
+    """
+    _assert_targets(parsed, program, None, spline_as)
+
+
+def assert_matches_plan(
+    parsed: ParsedProgram, program: Program, robot: Robot, *, spline_as: str | None = None
+) -> None:
+    """Assert that a program read back is the plan's, target by target.
+
+    Everything :func:`assert_matches_program` asserts, and: every Cartesian target, put
+    through the parsed base, is the controller-world forward kinematics of the planned
+    joints there (model joints → ``forward_kinematics`` → ``convention.world_from_base``)
+    within 0.01 mm and 0.001°.
+
+    Parameters
+    ----------
+    parsed
+        The program as a language's parser read it.
+    program
+        The program the writer printed.
+    robot
+        The run's robot.
+    spline_as
+        The kind the language writes a spline point as, or None.
+    """
+    _assert_targets(parsed, program, robot, spline_as)
+
+
+def assert_joint_timing(
+    parsed: ParsedProgram, program: Program, *, speed: float | None, duration: float
+) -> None:
+    """Assert the timing of every joint move read back: a timed move's duration within
+    ``duration`` s of the program's (it must be read back), an untimed one's speed (share
+    of the joint rates) within ``speed`` (not checked when None)."""
+    for k, (got, want) in enumerate(target_pairs(parsed, program)):
+        if want.kind != "joint":
+            continue
+        if want.duration is not None:
+            assert got.duration is not None, f"target {k}: no duration read back"
+            assert abs(got.duration - want.duration) <= duration, (
+                f"target {k}: duration {got.duration} s, the program's {want.duration} s"
+            )
+        elif speed is not None:
+            assert got.speed is not None and want.speed is not None
+            assert abs(got.speed - want.speed) <= speed, (
+                f"target {k}: speed {got.speed}, the program's {want.speed}"
+            )
+
+
 __all__ = [
     "ANGLE_TOLERANCE",
     "JOINT_TOLERANCE",
@@ -216,8 +302,12 @@ __all__ = [
     "SHIPPED_PLACEMENTS",
     "ExpectedTarget",
     "PlannedRun",
+    "assert_joint_timing",
     "assert_matches_plan",
+    "assert_matches_program",
     "expected_targets",
     "frame_difference",
     "planned_run",
+    "rotation_angle",
+    "target_pairs",
 ]

@@ -20,6 +20,15 @@ import trackplan.robots
 from tests.programs.fanuc_parser import parse_fanuc, read_listing, wpr_pose
 from tests.programs.fanuc_reference import fanuc_config, turn
 from tests.programs.parsed import ParsedProgram
+from tests.programs.roundtrip import (
+    ANGLE_TOLERANCE,
+    JOINT_TOLERANCE,
+    POSITION_TOLERANCE,
+    assert_joint_timing,
+    assert_matches_plan,
+    frame_difference,
+    target_pairs,
+)
 from tests.programs.stand_in import stand_in
 from trackplan.errors import CaseError
 from trackplan.io.robot_file import builtin_robot, load_robot_text
@@ -44,10 +53,6 @@ from trackplan.writers.fanuc import (
 )
 from trackplan.writers.fanuc_config import turn_numbers, wpr_from_matrix, xyzwpr
 
-POSITION_TOL = 1e-5  # m: 0.01 mm
-ANGLE_TOL = np.radians(0.001)  # rad
-JOINT_TOL = 1e-6  # rad
-
 LIBRARY = Path(trackplan.robots.__file__).parent / "library" / "fanuc_m20ia.yaml"
 
 M20IA_WORLD = np.eye(4)
@@ -67,20 +72,6 @@ M20IA_CONVENTION = ControllerConvention(
 """The M-20iA's controller convention, as its robot file's ``controller:`` block states it."""
 
 
-def m20ia() -> Robot:
-    """The built-in M-20iA with its controller convention (read without the ``controller``
-    block, which the robot file loader takes once its schema is merged)."""
-    data = yaml.safe_load(LIBRARY.read_text())
-    data.pop("controller", None)
-    robot = load_robot_text(yaml.safe_dump(data), file=str(LIBRARY))
-    return replace(robot, controller=M20IA_CONVENTION)
-
-
-def puma() -> Robot:
-    """The PUMA560: generic vendor, identity convention."""
-    return builtin_robot("puma560")
-
-
 def frame(xyz: tuple[float, float, float], rpy_deg: tuple[float, float, float]) -> np.ndarray:
     """A pose from a position (m) and W, P, R (deg)."""
     return wpr_pose([*(1000.0 * np.asarray(xyz)), *rpy_deg])
@@ -91,10 +82,24 @@ PART_PUMA = frame((0.45, 0.1, -0.2), (0.0, 0.0, -10.0))
 TOOL = frame((0.01, 0.0, 0.18), (0.0, 30.0, 0.0))
 
 
+def m20ia(tool: np.ndarray = TOOL) -> Robot:
+    """The built-in M-20iA with its controller convention (read without the ``controller``
+    block, which the robot file loader takes once its schema is merged) and ``tool``."""
+    data = yaml.safe_load(LIBRARY.read_text())
+    data.pop("controller", None)
+    robot = load_robot_text(yaml.safe_dump(data), file=str(LIBRARY))
+    return replace(robot, controller=M20IA_CONVENTION, T_flange_tool=tool)
+
+
+def puma() -> Robot:
+    """The PUMA560 with :data:`TOOL`: generic vendor, identity convention."""
+    return replace(builtin_robot("puma560"), T_flange_tool=TOOL)
+
+
 def target(robot: Robot, part: np.ndarray, q: np.ndarray) -> Target:
     """A Target whose pose and joints agree: the TCP of ``q`` in the part frame."""
     q = np.asarray(q, dtype=float)
-    pose = np.linalg.inv(part) @ forward_kinematics(robot, q) @ TOOL
+    pose = np.linalg.inv(part) @ forward_kinematics(robot, q)
     return Target(pose=pose, joints=robot.convention.to_controller(q), model_joints=q)
 
 
@@ -138,7 +143,7 @@ def cartesian_program(
         vendor=vendor or convention.vendor,
         n_dof=robot.n_dof,
         base=convention.world_from_base(part),
-        tool=TOOL,
+        tool=robot.T_flange_tool,
         sections=(start, seam_1, air, seam_2),
         header=("trackplan test", "case: weld_seam", "verdict: feasible; duration 4.2 s"),
         sample_time=0.004,
@@ -157,7 +162,7 @@ def joint_program(robot: Robot, q0: np.ndarray, n: int = 25, period: float = 0.0
         vendor=robot.convention.vendor,
         n_dof=robot.n_dof,
         base=np.eye(4),
-        tool=TOOL,
+        tool=robot.T_flange_tool,
         sections=(start, Section(kind="seam", label="seam 1", moves=moves)),
         header=("trackplan test", "form: joint"),
         sample_time=0.008,
@@ -169,54 +174,19 @@ Q0_M20IA = np.array([0.15, 0.35, 0.1, 0.4, -0.9, 0.2])
 Q0_PUMA = np.array([0.2, -0.6, 0.4, 0.3, 0.8, -0.2])
 
 
-def expected_targets(program: Program) -> list[tuple[str, object]]:
-    """(kind, Target or JointMove) of every position the program writes, in order."""
-    expected: list[tuple[str, object]] = []
-    for move in program.moves():
-        if isinstance(move, JointMove):
-            expected.append(("joint", move))
-        elif isinstance(move, LinearMove):
-            expected.append(("linear", move.target))
-        elif isinstance(move, CircularMove):
-            expected += [("circular_via", move.via), ("circular_end", move.target)]
-        elif isinstance(move, SplineMove):
-            expected += [("linear", t) for t in move.targets]
-    return expected
-
-
-def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
-    """The angle between two rotations (rad), accurate for small angles."""
-    return float(2.0 * np.arcsin(min(1.0, np.linalg.norm(a[:3, :3] - b[:3, :3]) / np.sqrt(8.0))))
-
-
 def assert_pose_close(actual: np.ndarray, wanted: np.ndarray) -> None:
-    assert np.linalg.norm(actual[:3, 3] - wanted[:3, 3]) < POSITION_TOL
-    assert rotation_angle(actual, wanted) < ANGLE_TOL
+    distance, angle = frame_difference(actual, wanted)
+    assert distance < POSITION_TOLERANCE and angle < ANGLE_TOLERANCE
 
 
 def assert_reads_back(program: Program, parsed: ParsedProgram, robot: Robot) -> None:
-    """Every position, speed, frame and CONFIG field read back equals the program's."""
-    assert_pose_close(parsed.base, program.base)
-    assert_pose_close(parsed.tool, program.tool)
-    expected = expected_targets(program)
-    assert [t.kind for t in parsed.targets] == [kind for kind, _ in expected]
-    for read, (kind, wanted) in zip(parsed.targets, expected, strict=True):
-        if kind == "joint":
-            assert isinstance(wanted, JointMove)
-            assert read.joints is not None
-            assert np.max(np.abs(read.joints - wanted.joints)) < JOINT_TOL
-            if wanted.duration is None:
-                assert read.speed == pytest.approx(wanted.speed, abs=0.005)
-            else:
-                assert read.duration == pytest.approx(wanted.duration, abs=5e-4)
-            continue
-        assert isinstance(wanted, Target)
-        assert read.pose is not None
-        assert_pose_close(read.pose, wanted.pose)
-        # through the program's frames: the planned TCP in the controller's world
-        planned = robot.convention.world_from_base(forward_kinematics(robot, wanted.model_joints))
-        assert_pose_close(parsed.base @ read.pose @ np.linalg.inv(parsed.tool), planned)
-        assert read.config == fanuc_config(robot, wanted.model_joints, wanted.joints)
+    """The shared round trip (spline points as lines), joint moves' speeds and times as TP
+    prints them (0.5 %, 0.5 ms), every CONFIG as the reference's and every TCP speed."""
+    assert_matches_plan(parsed, program, robot, spline_as="linear")
+    assert_joint_timing(parsed, program, speed=0.005, duration=5e-4)
+    for read, wanted in target_pairs(parsed, program):
+        if wanted.pose is not None:
+            assert read.config == fanuc_config(robot, wanted.model_joints, wanted.joints)
     speeds = [move.speed for move in program.moves() if not isinstance(move, JointMove)]
     read_speeds = [t.speed for t in parsed.targets if t.kind != "joint" and t.speed is not None]
     assert len(read_speeds) >= len(speeds)
@@ -245,8 +215,8 @@ def test_m20ia_joints_follow_the_j2_j3_coupling_and_the_world_at_j2_height() -> 
     start = parse_fanuc(render_fanuc(program, robot=robot)).targets[0]
     assert start.joints is not None
     # FANUC J3 counts from the horizontal: θ3 = q3 − q2 (fanuc_driver, J23_factor 1)
-    assert start.joints[2] == pytest.approx(Q0_M20IA[2] - Q0_M20IA[1], abs=JOINT_TOL)
-    assert np.delete(start.joints, 2) == pytest.approx(np.delete(Q0_M20IA, 2), abs=JOINT_TOL)
+    assert start.joints[2] == pytest.approx(Q0_M20IA[2] - Q0_M20IA[1], abs=JOINT_TOLERANCE)
+    assert np.delete(start.joints, 2) == pytest.approx(np.delete(Q0_M20IA, 2), abs=JOINT_TOLERANCE)
     # the user frame is the part in the FANUC world, 0.525 m above the model's base
     assert program.base[2, 3] == pytest.approx(PART_M20IA[2, 3] - 0.525)
 
@@ -448,7 +418,7 @@ def test_turn_numbers_at_the_half_turns() -> None:
 def test_xyzwpr_of_the_m20ia_zero_pose_is_fanucs() -> None:
     # at all joints zero the M-20iA's faceplate is at X 1085, Z 1040 mm in the FANUC world,
     # W 180, P -90, R 0 (tool0 of ros-industrial fanuc_m20ia_support)
-    robot = m20ia()
+    robot = m20ia(tool=np.eye(4))
     flange = robot.convention.world_from_base(forward_kinematics(robot, np.zeros(6)))
     values = xyzwpr(flange)
     assert values[:3] == pytest.approx([1085.0, 0.0, 1040.0], abs=1e-6)

@@ -13,6 +13,14 @@ from hypothesis import strategies as st
 from tests.programs.krl_parser import abc_rotation, parse_krl
 from tests.programs.krl_reference import status_turn_reference
 from tests.programs.parsed import ParsedProgram, ParsedTarget
+from tests.programs.roundtrip import (
+    ANGLE_TOLERANCE,
+    POSITION_TOLERANCE,
+    assert_matches_plan,
+    frame_difference,
+    rotation_angle,
+    target_pairs,
+)
 from tests.programs.stand_in import stand_in
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
@@ -34,9 +42,6 @@ from trackplan.writers.krl import MAX_NAME, KrlWriter, krl_name, render_krl
 from trackplan.writers.krl_config import abc_from_matrix, frame_values, status_turn
 
 KUKA_SOURCE = "ros-industrial kuka_experimental: q = A * pi/180, base_link = $ROBROOT"
-POSITION_TOL = 1e-5  # m (0.01 mm)
-ANGLE_TOL = np.deg2rad(1e-3)  # rad (0.001 deg)
-JOINT_TOL = 1e-6  # rad
 
 
 def kuka(name: str = "kuka_kr6_r700_sixx") -> Robot:
@@ -130,42 +135,17 @@ def joint_program(robot: Robot) -> Program:
     return program(robot, sections, motion="joint", period=0.004)
 
 
-def expected_targets(prog: Program) -> list[tuple[str, object]]:
-    """(kind, Target or JointMove) of every target of a program, in order."""
-    found: list[tuple[str, object]] = []
-    for move in prog.moves():
-        if isinstance(move, JointMove):
-            found.append(("joint", move))
-        elif isinstance(move, LinearMove):
-            found.append(("linear", move.target))
-        elif isinstance(move, CircularMove):
-            found += [("circular_via", move.via), ("circular_end", move.target)]
-        else:
-            found += [("spline", t) for t in move.targets]
-    return found
-
-
-def rotation_angle(R: np.ndarray) -> float:
-    return float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1)))
-
-
 def assert_reads_back(prog: Program, parsed: ParsedProgram, robot: Robot) -> None:
-    """Every target within 0.01 mm / 0.001 deg / 1e-6 rad, S and T as the oracle's."""
-    expected = expected_targets(prog)
-    assert [t.kind for t in parsed.targets] == [kind for kind, _ in expected]
+    """The shared round trip (spline points as SPLINE), the frames as KRL prints them
+    (1e-7) and S and T of every Cartesian target as the oracle's."""
+    assert_matches_plan(parsed, prog, robot, spline_as="spline")
     np.testing.assert_allclose(parsed.base, prog.base, atol=1e-7)
     np.testing.assert_allclose(parsed.tool, prog.tool, atol=1e-7)
-    for got, (_, want) in zip(parsed.targets, expected, strict=True):
-        if isinstance(want, JointMove):
-            assert got.joints is not None
-            np.testing.assert_allclose(got.joints, want.joints, atol=JOINT_TOL)
-            continue
-        assert isinstance(want, Target) and got.pose is not None
-        assert np.linalg.norm(got.pose[:3, 3] - want.pose[:3, 3]) < POSITION_TOL
-        assert rotation_angle(got.pose[:3, :3].T @ want.pose[:3, :3]) < ANGLE_TOL
-        if robot.n_dof == 6:
-            s, t = status_turn_reference(robot, want.joints)
-            assert got.config == {"S": s, "T": t}
+    if robot.n_dof == 6:
+        for got, want in target_pairs(parsed, prog):
+            if want.pose is not None:
+                s, t = status_turn_reference(robot, want.joints)
+                assert got.config == {"S": s, "T": t}
 
 
 @pytest.mark.parametrize("name", ["kuka_kr6_r700_sixx", "kuka_kr10_r1420"])
@@ -284,7 +264,7 @@ def test_abc_round_trip(angles: list[float], gimbal: float | None) -> None:
     abc = abc_from_matrix(R)
     assert -np.pi / 2 <= abc[1] <= np.pi / 2
     printed = np.round(np.rad2deg(abc), 6)  # the digits the writer prints
-    assert rotation_angle(abc_rotation(*printed).T @ R) < ANGLE_TOL / 10
+    assert rotation_angle(abc_rotation(*printed), R) < ANGLE_TOLERANCE / 10
 
 
 def test_printed_digits_survive_krl_real() -> None:
@@ -292,16 +272,16 @@ def test_printed_digits_survive_krl_real() -> None:
     robot = kuka()
     prog = cartesian_program(robot)
     parsed = parse_krl(render_krl(prog, robot=robot))
-    for got, (_, want) in zip(parsed.targets, expected_targets(prog), strict=True):
+    for got, want in target_pairs(parsed, prog):
         if got.pose is None:
             continue
         values = frame_values(got.pose).astype(np.float32).astype(float)
         pose = np.eye(4)
         pose[:3, :3] = abc_rotation(*values[3:])
         pose[:3, 3] = values[:3] / 1000
-        assert isinstance(want, Target)
-        assert np.linalg.norm(pose[:3, 3] - want.pose[:3, 3]) < POSITION_TOL
-        assert rotation_angle(pose[:3, :3].T @ want.pose[:3, :3]) < ANGLE_TOL
+        assert want.pose is not None
+        distance, angle = frame_difference(pose, want.pose)
+        assert distance < POSITION_TOLERANCE and angle < ANGLE_TOLERANCE
 
 
 @pytest.mark.parametrize(

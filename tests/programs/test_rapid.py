@@ -27,7 +27,6 @@ from tests.programs.rapid_programs import (
     IRB2400_CONVENTION,
     abb_robot,
     cartesian_program,
-    expected_targets,
     joint_move,
     joint_program,
     make_target,
@@ -35,10 +34,19 @@ from tests.programs.rapid_programs import (
     puma,
 )
 from tests.programs.rapid_reference import reference_confdata
+from tests.programs.roundtrip import (
+    ANGLE_TOLERANCE,
+    JOINT_TOLERANCE,
+    POSITION_TOLERANCE,
+    assert_joint_timing,
+    assert_matches_plan,
+    rotation_angle,
+    target_pairs,
+)
 from tests.programs.stand_in import stand_in
 from trackplan.errors import CaseError
 from trackplan.io.robot_file import builtin_robot
-from trackplan.programs.model import JointMove, LinearMove, Section, SplineMove, Target
+from trackplan.programs.model import JointMove, LinearMove, Program, Section, SplineMove
 from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics_parameters import Payload
 from trackplan.robots.kinematics import forward_kinematics
@@ -50,42 +58,16 @@ Q_IRB2400 = np.array([0.2, 0.3, -0.2, 0.5, 0.8, -0.4])
 Q_IRB1600 = np.array([-0.4, 0.2, -0.3, -1.2, -0.7, 2.0])
 Q_PUMA = np.array([0.3, -0.6, 0.4, 0.2, 0.9, -0.5])
 
-POSITION_TOL = 1e-5  # m: 0.01 mm
-ANGLE_TOL = math.radians(0.001)
-JOINT_TOL = 1e-6  # rad
 
-
-def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
-    """Angle of the rotation between two rotation matrices, rad."""
-    cos = (np.trace(a.T @ b) - 1.0) / 2.0
-    return float(np.arccos(np.clip(cos, -1.0, 1.0)))
-
-
-def assert_round_trip(parsed: ParsedProgram, prog, robot: Robot) -> None:
-    """Every target as the program states it, configuration fields as the oracle's."""
-    expected = expected_targets(prog)
-    assert [t.kind for t in parsed.targets] == [kind for kind, _ in expected]
-    assert np.allclose(parsed.base[:3, 3], prog.base[:3, 3], atol=POSITION_TOL)
-    assert rotation_angle(parsed.base[:3, :3], prog.base[:3, :3]) < ANGLE_TOL
-    assert np.allclose(parsed.tool[:3, 3], prog.tool[:3, 3], atol=POSITION_TOL)
-    assert rotation_angle(parsed.tool[:3, :3], prog.tool[:3, :3]) < ANGLE_TOL
-    for read, (kind, item) in zip(parsed.targets, expected, strict=True):
-        if kind == "joint":
-            assert isinstance(item, JointMove)
-            assert np.max(np.abs(read.joints - item.joints)) < JOINT_TOL
-            if item.duration is not None:
-                assert read.duration == pytest.approx(item.duration, abs=1e-9)
-            continue
-        assert isinstance(item, Target)
-        assert np.max(np.abs(read.pose[:3, 3] - item.pose[:3, 3])) < POSITION_TOL
-        assert rotation_angle(read.pose[:3, :3], item.pose[:3, :3]) < ANGLE_TOL
-        cf1, cf4, cf6, cfx = reference_confdata(robot, item.model_joints)
-        assert read.config == {"cf1": cf1, "cf4": cf4, "cf6": cf6, "cfx": cfx}
-        # Through the program's frames, the target is the planned TCP in the world.
-        world = robot.convention.world_from_base(forward_kinematics(robot, item.model_joints))
-        through = parsed.base @ read.pose
-        assert np.max(np.abs(through[:3, 3] - world[:3, 3])) < POSITION_TOL
-        assert rotation_angle(through[:3, :3], world[:3, :3]) < ANGLE_TOL
+def assert_round_trip(parsed: ParsedProgram, prog: Program, robot: Robot) -> None:
+    """The shared round trip (spline points as lines), every timed MoveAbsJ's \\T as
+    planned (1e-9 s) and the confdata of every target as the oracle's."""
+    assert_matches_plan(parsed, prog, robot, spline_as="linear")
+    assert_joint_timing(parsed, prog, speed=None, duration=1e-9)
+    for read, item in target_pairs(parsed, prog):
+        if item.pose is not None:
+            cf1, cf4, cf6, cfx = reference_confdata(robot, item.model_joints)
+            assert read.config == {"cf1": cf1, "cf4": cf4, "cf6": cf6, "cfx": cfx}
 
 
 def text_of(files: dict[str, str]) -> str:
@@ -144,9 +126,9 @@ def test_parallel_arm_axis_3_counts_q2_plus_q3() -> None:
     prog = cartesian_program(robot, Q_IRB2400)
     parsed = parse_rapid(render_rapid(prog, robot=robot))
     start = parsed.targets[0].joints
-    assert start[2] == pytest.approx(Q_IRB2400[2] + Q_IRB2400[1], abs=JOINT_TOL)
-    assert start[1] == pytest.approx(Q_IRB2400[1], abs=JOINT_TOL)
-    assert IRB2400_CONVENTION.to_model(start) == pytest.approx(Q_IRB2400, abs=JOINT_TOL)
+    assert start[2] == pytest.approx(Q_IRB2400[2] + Q_IRB2400[1], abs=JOINT_TOLERANCE)
+    assert start[1] == pytest.approx(Q_IRB2400[1], abs=JOINT_TOLERANCE)
+    assert IRB2400_CONVENTION.to_model(start) == pytest.approx(Q_IRB2400, abs=JOINT_TOLERANCE)
 
 
 @pytest.mark.parametrize(
@@ -396,7 +378,7 @@ def test_quaternion_round_trip(seed: int) -> None:
     assert q[0] >= 0.0
     assert np.linalg.norm(q) == pytest.approx(1.0, abs=1e-12)
     printed = [float(number(float(v), 9)) for v in q]
-    assert rotation_angle(quaternion_matrix(printed), matrix) < ANGLE_TOL / 100
+    assert rotation_angle(quaternion_matrix(printed), matrix) < ANGLE_TOLERANCE / 100
 
 
 @settings(max_examples=100, deadline=None)
@@ -487,10 +469,10 @@ def test_targets_are_the_planned_tcp_for_a_moved_base() -> None:
         base=moved,
     )
     parsed = parse_rapid(render_rapid(prog, robot=robot))
-    assert parsed.base[:3, 3] == pytest.approx(moved[:3, 3], abs=POSITION_TOL)
+    assert parsed.base[:3, 3] == pytest.approx(moved[:3, 3], abs=POSITION_TOLERANCE)
     world = forward_kinematics(robot, Q_IRB2400)
     assert (parsed.base @ parsed.targets[0].pose)[:3, 3] == pytest.approx(
-        world[:3, 3], abs=POSITION_TOL
+        world[:3, 3], abs=POSITION_TOLERANCE
     )
 
 

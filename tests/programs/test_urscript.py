@@ -16,6 +16,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.programs.parsed import ParsedProgram
+from tests.programs.roundtrip import (
+    ANGLE_TOLERANCE,
+    JOINT_TOLERANCE,
+    POSITION_TOLERANCE,
+    assert_joint_timing,
+    assert_matches_plan,
+    assert_matches_program,
+    expected_targets,
+    rotation_angle,
+)
 from tests.programs.stand_in import stand_in
 from tests.programs.urscript_parser import parse_urscript
 from tests.programs.urscript_programs import (
@@ -33,7 +43,6 @@ from tests.programs.urscript_reference import (
     E_SERIES_CYCLE,
     base_from_rep103,
     pose_matrix,
-    rotation_angle,
     vector_from_rotation,
 )
 from trackplan.errors import CaseError
@@ -49,6 +58,7 @@ from trackplan.programs.model import (
 )
 from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.model import Robot
 from trackplan.writers.urscript import (
     DEFAULT_MAX_POINTS,
     UrscriptWriter,
@@ -62,49 +72,17 @@ from trackplan.writers.urscript_geometry import (
     rotation_vector,
 )
 
-POSITION_TOL = 1e-5  # m: 0.01 mm
-ANGLE_TOL = np.radians(0.001)  # rad: 0.001°
-JOINT_TOL = 1e-6  # rad
 
-
-def expected_targets(prog: Program) -> list[tuple[str, Target | JointMove]]:
-    """(kind, target or joint move) of every target the program writes, in order."""
-    expected: list[tuple[str, Target | JointMove]] = []
-    for move in prog.moves():
-        if isinstance(move, JointMove):
-            expected.append(("joint", move))
-        elif isinstance(move, LinearMove):
-            expected.append(("linear", move.target))
-        elif isinstance(move, CircularMove):
-            expected += [("circular_via", move.via), ("circular_end", move.target)]
-        elif isinstance(move, SplineMove):
-            expected += [("linear", t) for t in move.targets]
-    return expected
-
-
-def assert_reads_back(prog: Program, parsed: ParsedProgram) -> None:
-    """Every target, the frames, speeds and times as the program states them."""
-    expected = expected_targets(prog)
-    assert [t.kind for t in parsed.targets] == [kind for kind, _ in expected]
-    for read, (kind, wanted) in zip(parsed.targets, expected, strict=True):
-        assert read.config == {}  # URScript poses carry no configuration fields
-        if kind == "joint":
-            assert isinstance(wanted, JointMove)
-            assert read.joints is not None
-            np.testing.assert_allclose(read.joints, wanted.joints, atol=JOINT_TOL, rtol=0)
-            if wanted.duration is None:
-                assert read.speed == pytest.approx(wanted.speed, abs=1e-6)
-            else:
-                assert read.duration == pytest.approx(wanted.duration, abs=1e-9)
-        else:
-            assert isinstance(wanted, Target)
-            assert read.pose is not None
-            np.testing.assert_allclose(read.pose[:3, 3], wanted.pose[:3, 3], atol=POSITION_TOL)
-            assert rotation_angle(read.pose, wanted.pose) <= ANGLE_TOL
-    np.testing.assert_allclose(parsed.base[:3, 3], prog.base[:3, 3], atol=POSITION_TOL)
-    assert rotation_angle(parsed.base, prog.base) <= ANGLE_TOL
-    np.testing.assert_allclose(parsed.tool[:3, 3], prog.tool[:3, 3], atol=POSITION_TOL)
-    assert rotation_angle(parsed.tool, prog.tool) <= ANGLE_TOL
+def assert_reads_back(prog: Program, parsed: ParsedProgram, robot: Robot | None) -> None:
+    """The shared round trip (spline points as lines; against the plan's forward
+    kinematics unless ``robot`` is None), no configuration fields, every joint move's
+    speed (1e-6) and time (1e-9 s) as the program's."""
+    if robot is None:
+        assert_matches_program(parsed, prog, spline_as="linear")
+    else:
+        assert_matches_plan(parsed, prog, robot, spline_as="linear")
+    assert_joint_timing(parsed, prog, speed=1e-6, duration=1e-9)
+    assert all(read.config == {} for read in parsed.targets)  # URScript poses carry none
 
 
 @pytest.mark.parametrize("name", ["ur5e", "ur10e"])
@@ -115,15 +93,8 @@ def test_cartesian_program_reads_back(name: str) -> None:
     assert list(files) == ["weld_cell.script"]
     parsed = parse_urscript(files)
     assert parsed.name == "weld_cell"
-    assert_reads_back(prog, parsed)
     # the world TCP of each target is the planned TCP: base · pose = FK(q) in the Base
-    for read, (kind, wanted) in zip(parsed.targets, expected_targets(prog), strict=True):
-        if kind != "joint":
-            assert isinstance(wanted, Target) and read.pose is not None
-            world = parsed.base @ read.pose
-            planned = forward_kinematics(robot, wanted.model_joints)
-            np.testing.assert_allclose(world[:3, 3], planned[:3, 3], atol=POSITION_TOL)
-            assert rotation_angle(world, planned) <= ANGLE_TOL
+    assert_reads_back(prog, parsed, robot)
 
 
 def test_start_is_a_joint_move_on_the_planned_joints_and_says_the_branch_is_kept() -> None:
@@ -136,7 +107,7 @@ def test_start_is_a_joint_move_on_the_planned_joints_and_says_the_branch_is_kept
     np.testing.assert_allclose(first.joints, robot.convention.to_controller(START + 0), atol=0.05)
     start_move = prog.sections[0].moves[0]
     assert isinstance(start_move, JointMove)
-    np.testing.assert_allclose(first.joints, start_move.joints, atol=JOINT_TOL)
+    np.testing.assert_allclose(first.joints, start_move.joints, atol=JOINT_TOLERANCE)
     assert "keeps the arm's branch" in text
     assert text.index("keeps the arm's branch") < text.index("movej(")
 
@@ -206,7 +177,7 @@ def test_joint_form_reads_back() -> None:
     prog = joint_program(robot, n=30, period=0.008)
     text = render_urscript(prog, robot=robot)["weld_cell.script"]
     parsed = parse_urscript({"weld_cell.script": text})
-    assert_reads_back(prog, parsed)
+    assert_reads_back(prog, parsed, robot)
     assert [t.duration for t in parsed.targets[1:]] == pytest.approx([0.008] * 30)
     assert text.count("servoj(") == 30 and "lookahead_time=0.1, gain=300" in text
     assert "a=0, v=0, t=0.008" in text
@@ -236,7 +207,7 @@ def test_a_split_program_reads_back_as_the_unsplit_one(motion: str) -> None:
         if a.joints is not None and b.joints is not None:
             np.testing.assert_array_equal(a.joints, b.joints)
     assert {t.part for t in split.targets} == {f"weld_cell_part{k}" for k in range(1, n_parts + 1)}
-    assert_reads_back(prog, split)
+    assert_reads_back(prog, split, robot)
 
 
 def test_default_max_points_keeps_a_short_program_in_one_function() -> None:
@@ -421,19 +392,18 @@ def test_a_world_turned_by_pi_reads_back_in_the_controller_base() -> None:
     )
     prog = cartesian_program(turned)
     parsed = parse_urscript(render_urscript(prog, robot=turned))
-    np.testing.assert_allclose(parsed.base, base_from_rep103(placement()), atol=POSITION_TOL)
+    np.testing.assert_allclose(parsed.base, base_from_rep103(placement()), atol=POSITION_TOLERANCE)
     read = parsed.targets[1]
     assert read.pose is not None
     planned = base_from_rep103(forward_kinematics(turned, prog_joints(prog, 1)))
     world = parsed.base @ read.pose
-    np.testing.assert_allclose(world[:3, 3], planned[:3, 3], atol=POSITION_TOL)
-    assert rotation_angle(world, planned) <= ANGLE_TOL
+    np.testing.assert_allclose(world[:3, 3], planned[:3, 3], atol=POSITION_TOLERANCE)
+    assert rotation_angle(world, planned) <= ANGLE_TOLERANCE
 
 
 def prog_joints(prog: Program, index: int) -> np.ndarray:
     """Model joints of the ``index``-th expected target."""
-    wanted = expected_targets(prog)[index][1]
-    return wanted.model_joints
+    return expected_targets(prog)[index].model_joints
 
 
 @pytest.mark.parametrize("sweep", [1.2, -1.2, 5.2, -5.2])
@@ -460,7 +430,7 @@ def test_movec_mode_follows_the_planned_orientation(sweep: float) -> None:
         )
         text = render_urscript(program(robot, sections), robot=robot)["weld_cell.script"]
         assert f"mode={mode})" in text
-        assert_reads_back(program(robot, sections), parse_urscript({"w.script": text}))
+        assert_reads_back(program(robot, sections), parse_urscript({"w.script": text}), None)
 
 
 def rotation_z(angle: float) -> np.ndarray:
@@ -633,7 +603,7 @@ def test_without_a_robot_joint_moves_do_not_blend_and_the_cycle_is_assumed() -> 
     prog = replace(prog, sections=sections)
     with_robot = parse_urscript(render_urscript(prog, robot=robot))
     without = parse_urscript(render_urscript(prog))
-    assert_reads_back(prog, without)
+    assert_reads_back(prog, without, robot)
     kinds = [t.kind for t in without.targets]
     air = kinds.index("joint", 1)
     assert without.targets[air].zone == 0.0 and without.targets[air - 1].zone == 0.0
@@ -659,5 +629,5 @@ def test_a_header_or_label_with_a_line_break_stays_a_comment() -> None:
     )
     prog = replace(prog, header=("case: two\nlines", *prog.header), sections=sections)
     parsed = parse_urscript(render_urscript(prog, robot=robot))
-    assert_reads_back(prog, parsed)
+    assert_reads_back(prog, parsed, robot)
     assert "case: two lines" in parsed.header
