@@ -20,6 +20,7 @@ import trackplan.robots
 from tests.programs.fanuc_parser import parse_fanuc, read_listing, wpr_pose
 from tests.programs.fanuc_reference import fanuc_config, turn
 from tests.programs.parsed import ParsedProgram
+from tests.programs.programs import joint_form, joint_move, make_target, program, vendor_robot
 from tests.programs.roundtrip import (
     ANGLE_TOLERANCE,
     JOINT_TOLERANCE,
@@ -31,7 +32,6 @@ from tests.programs.roundtrip import (
 )
 from tests.programs.stand_in import stand_in
 from trackplan.errors import CaseError
-from trackplan.io.robot_file import builtin_robot, load_robot_text
 from trackplan.programs.model import (
     CircularMove,
     JointMove,
@@ -83,29 +83,19 @@ TOOL = frame((0.01, 0.0, 0.18), (0.0, 30.0, 0.0))
 
 
 def m20ia(tool: np.ndarray = TOOL) -> Robot:
-    """The built-in M-20iA with its controller convention (read without the ``controller``
-    block, which the robot file loader takes once its schema is merged) and ``tool``."""
-    data = yaml.safe_load(LIBRARY.read_text())
-    data.pop("controller", None)
-    robot = load_robot_text(yaml.safe_dump(data), file=str(LIBRARY))
-    return replace(robot, controller=M20IA_CONVENTION, T_flange_tool=tool)
+    """The built-in M-20iA with the tests' controller convention and ``tool``."""
+    return vendor_robot("fanuc_m20ia", M20IA_CONVENTION, tool)
 
 
 def puma() -> Robot:
     """The PUMA560 with :data:`TOOL`: generic vendor, identity convention."""
-    return replace(builtin_robot("puma560"), T_flange_tool=TOOL)
+    return vendor_robot("puma560", None, TOOL)
 
 
 def target(robot: Robot, part: np.ndarray, q: np.ndarray) -> Target:
-    """A Target whose pose and joints agree: the TCP of ``q`` in the part frame."""
-    q = np.asarray(q, dtype=float)
-    pose = np.linalg.inv(part) @ forward_kinematics(robot, q)
-    return Target(pose=pose, joints=robot.convention.to_controller(q), model_joints=q)
-
-
-def joint_move(robot: Robot, q: np.ndarray, **kwargs: object) -> JointMove:
-    q = np.asarray(q, dtype=float)
-    return JointMove(joints=robot.convention.to_controller(q), model_joints=q, **kwargs)
+    """The target of model joints ``q``: the TCP in the part frame ``part`` (given in the
+    model's base)."""
+    return make_target(robot, q, robot.convention.world_from_base(part))
 
 
 def cartesian_program(
@@ -135,38 +125,28 @@ def cartesian_program(
         ),
     )
     start = Section(kind="start", label="start", moves=(joint_move(robot, qs[0], speed=0.25),))
-    convention = robot.convention
-    return Program(
+    return program(
+        robot,
+        (start, seam_1, air, seam_2),
+        base=robot.convention.world_from_base(part),
         name=name,
-        motion="cartesian",
-        robot=robot.name,
-        vendor=vendor or convention.vendor,
-        n_dof=robot.n_dof,
-        base=convention.world_from_base(part),
-        tool=robot.T_flange_tool,
-        sections=(start, seam_1, air, seam_2),
         header=("trackplan test", "case: weld_seam", "verdict: feasible; duration 4.2 s"),
-        sample_time=0.004,
+        vendor=vendor or robot.convention.vendor,
     )
 
 
 def joint_program(robot: Robot, q0: np.ndarray, n: int = 25, period: float = 0.024) -> Program:
     """The joint form: a start move and ``n`` timed samples."""
     samples = q0 + np.outer(np.linspace(0.0, 1.0, n), [0.3, -0.2, 0.25, 1.0, 0.4, -3.5])
-    moves = tuple(joint_move(robot, q, speed=1.0, duration=period) for q in samples[1:])
-    start = Section(kind="start", label="start", moves=(joint_move(robot, samples[0], speed=0.2),))
-    return Program(
-        name="replay",
-        motion="joint",
-        robot=robot.name,
-        vendor=robot.convention.vendor,
-        n_dof=robot.n_dof,
+    return joint_form(
+        robot,
+        samples,
+        period=period,
+        start_speed=0.2,
         base=np.eye(4),
-        tool=robot.T_flange_tool,
-        sections=(start, Section(kind="seam", label="seam 1", moves=moves)),
+        name="replay",
         header=("trackplan test", "form: joint"),
         sample_time=0.008,
-        period=period,
     )
 
 

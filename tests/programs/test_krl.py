@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from tests.programs.krl_parser import abc_rotation, parse_krl
 from tests.programs.krl_reference import status_turn_reference
 from tests.programs.parsed import ParsedProgram, ParsedTarget
+from tests.programs.programs import joint_form, joint_move, make_target, program, vendor_robot
 from tests.programs.roundtrip import (
     ANGLE_TOLERANCE,
     POSITION_TOLERANCE,
@@ -27,7 +28,6 @@ from trackplan.frames import placement_transform
 from trackplan.io.robot_file import builtin_robot
 from trackplan.programs.model import (
     CircularMove,
-    JointMove,
     LinearMove,
     Program,
     Section,
@@ -46,48 +46,20 @@ KUKA_SOURCE = "ros-industrial kuka_experimental: q = A * pi/180, base_link = $RO
 
 def kuka(name: str = "kuka_kr6_r700_sixx") -> Robot:
     """A KUKA robot of the library with its controller convention (identity, kuka)."""
-    robot = builtin_robot(name)
-    tool = placement_transform(np.array([0.01, -0.02, 0.15, 0.1, -0.2, 0.3]))
     convention = ControllerConvention(
         vendor="kuka", signs=np.ones(6), offsets=np.zeros(6), source=KUKA_SOURCE
     )
-    return dataclasses.replace(robot, controller=convention, T_flange_tool=tool)
+    tool = placement_transform(np.array([0.01, -0.02, 0.15, 0.1, -0.2, 0.3]))
+    return vendor_robot(name, convention, tool)
 
 
 BASE = placement_transform(np.array([0.45, -0.1, 0.2, 0.0, 0.0, 0.7]))
+HEADER = ("trackplan test", "case: by hand", "form: cartesian")
 
 
-def target(robot: Robot, q_model_deg: list[float]) -> Target:
-    """A target whose pose (TCP in the part frame :data:`BASE`) is the FK of its joints."""
-    q = np.deg2rad(q_model_deg)
-    world_tcp = robot.convention.world_from_base(forward_kinematics(robot, q))
-    return Target(
-        pose=np.linalg.inv(BASE) @ world_tcp,
-        joints=robot.convention.to_controller(q),
-        model_joints=q,
-    )
-
-
-def joint_move(robot: Robot, q_deg: list[float], **kwargs: float) -> JointMove:
-    q = np.deg2rad(q_deg)
-    return JointMove(joints=robot.convention.to_controller(q), model_joints=q, **kwargs)
-
-
-def program(robot: Robot, sections: tuple[Section, ...], **kwargs: object) -> Program:
-    fields = {
-        "name": "seam_demo",
-        "motion": "cartesian",
-        "robot": robot.name,
-        "vendor": robot.convention.vendor,
-        "n_dof": robot.n_dof,
-        "base": BASE,
-        "tool": robot.T_flange_tool,
-        "sections": sections,
-        "header": ("trackplan test", "case: by hand", "form: cartesian"),
-        "sample_time": 0.004,
-        **kwargs,
-    }
-    return Program(**fields)
+def target(robot: Robot, q_deg: list[float]) -> Target:
+    """The target of model joints ``q_deg`` (degrees) in the part frame :data:`BASE`."""
+    return make_target(robot, np.deg2rad(q_deg), BASE)
 
 
 def cartesian_program(robot: Robot, name: str = "seam_demo") -> Program:
@@ -111,28 +83,33 @@ def cartesian_program(robot: Robot, name: str = "seam_demo") -> Program:
             SplineMove(targets=(t[4], t[5]), speed=0.015, zone=0.0003),
         ),
     )
-    air = Section(kind="air", label="air", moves=(joint_move(robot, poses[6], speed=0.3),))
+    air_move = joint_move(robot, np.deg2rad(poses[6]), speed=0.3)
+    air = Section(kind="air", label="air", moves=(air_move,))
     second = Section(
         kind="seam",
         label="seam 2",
         moves=(LinearMove(target=target(robot, [-28, -98, 62, -18, -42, 28]), speed=0.01),),
     )
-    start = Section(kind="start", label="start", moves=(joint_move(robot, poses[0], speed=0.2),))
-    return program(robot, (start, seam, air, second), name=name)
+    start_move = joint_move(robot, np.deg2rad(poses[0]), speed=0.2)
+    start = Section(kind="start", label="start", moves=(start_move,))
+    sections = (start, seam, air, second)
+    return program(robot, sections, base=BASE, name=name, header=HEADER)
 
 
 def joint_program(robot: Robot) -> Program:
     """The joint form: a PTP to the start, then timed joint samples."""
     q = np.linspace([0, -80, 100, 0, 70, 0], [20, -70, 90, 8, 73, -12], 6)
-    timed = tuple(
-        joint_move(robot, list(row), speed=0.5 if k < 3 else 0.8, duration=0.004)
-        for k, row in enumerate(q[1:])
+    speeds = [0.5, 0.5, 0.5, 0.8, 0.8]
+    return joint_form(
+        robot,
+        np.deg2rad(q),
+        period=0.004,
+        start_speed=0.2,
+        speed=speeds,
+        base=BASE,
+        name="seam_demo",
+        header=HEADER,
     )
-    sections = (
-        Section(kind="start", label="start", moves=(joint_move(robot, list(q[0]), speed=0.2),)),
-        Section(kind="seam", label="seam 1", moves=timed),
-    )
-    return program(robot, sections, motion="joint", period=0.004)
 
 
 def assert_reads_back(prog: Program, parsed: ParsedProgram, robot: Robot) -> None:
@@ -403,14 +380,16 @@ def test_five_axis_robot_writes_no_status_turn() -> None:
         j_max=np.ones(5),
     )
     start = Section(
-        kind="start", label="start", moves=(joint_move(robot, [0, 40, -60, 10, 5], speed=0.5),)
+        kind="start",
+        label="start",
+        moves=(joint_move(robot, np.deg2rad([0, 40, -60, 10, 5]), speed=0.5),),
     )
     seam = Section(
         kind="seam",
         label="seam",
         moves=(LinearMove(target=target(robot, [5, 42, -62, 12, 5]), speed=0.05),),
     )
-    prog = program(robot, (start, seam))
+    prog = program(robot, (start, seam), base=BASE, name="seam_demo", header=HEADER)
     files = render_krl(prog, robot=robot)
     assert "A5 5.0}" in files["seam_demo.dat"] and ",S " not in files["seam_demo.dat"]
     parsed = parse_krl(files)

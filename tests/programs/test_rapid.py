@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from tests.programs.parsed import ParsedProgram
+from tests.programs.programs import joint_move, make_target, program
 from tests.programs.rapid_parser import (
     Name,
     parse_modules,
@@ -27,10 +28,7 @@ from tests.programs.rapid_programs import (
     IRB2400_CONVENTION,
     abb_robot,
     cartesian_program,
-    joint_move,
     joint_program,
-    make_target,
-    program,
     puma,
 )
 from tests.programs.rapid_reference import reference_confdata
@@ -256,7 +254,7 @@ def test_a_spline_longer_than_a_part_is_split_without_loss() -> None:
     prog = joint_program(robot, Q_IRB2400, n=4)
     steps = np.linspace(0.0, 0.3, 9)[1:, None] * np.array([0.1, 0.05, -0.05, 0.2, 0.1, 0.1])
     spline = SplineMove(
-        targets=tuple(make_target(robot, Q_IRB2400 + step) for step in steps), speed=0.02
+        targets=tuple(make_target(robot, Q_IRB2400 + step, BASE) for step in steps), speed=0.02
     )
     prog = replace(
         prog,
@@ -457,14 +455,12 @@ def test_targets_are_the_planned_tcp_for_a_moved_base() -> None:
     robot = abb_robot("abb_irb2400")
     moved = BASE.copy()
     moved[:3, 3] += [0.05, -0.02, 0.01]
-    target = make_target(robot, Q_IRB2400, base=moved)
-    prog = replace(
-        program(
-            robot,
-            (
-                Section(kind="start", label="start", moves=()),
-                Section(kind="seam", label="s", moves=(LinearMove(target=target, speed=0.01),)),
-            ),
+    target = make_target(robot, Q_IRB2400, moved)
+    prog = program(
+        robot,
+        (
+            Section(kind="start", label="start", moves=()),
+            Section(kind="seam", label="s", moves=(LinearMove(target=target, speed=0.01),)),
         ),
         base=moved,
     )

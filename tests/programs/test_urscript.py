@@ -16,6 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.programs.parsed import ParsedProgram
+from tests.programs.programs import joint_move, make_target
 from tests.programs.roundtrip import (
     ANGLE_TOLERANCE,
     JOINT_TOLERANCE,
@@ -31,11 +32,10 @@ from tests.programs.urscript_parser import parse_urscript
 from tests.programs.urscript_programs import (
     START,
     cartesian_program,
-    joint_move,
     joint_program,
+    part_base,
     placement,
-    program,
-    target,
+    ur_program,
     ur_robot,
 )
 from tests.programs.urscript_reference import (
@@ -411,7 +411,7 @@ def test_movec_mode_follows_the_planned_orientation(sweep: float) -> None:
     """Arcs of ±69° and ±298° (either way round, less and more than half a turn)."""
     robot = ur_robot()
     start_q = START
-    start = target(robot, start_q)
+    start = make_target(robot, start_q, part_base(robot))
     centre = start.pose[:3, 3] + np.array([0.0, 0.05, 0.0])
 
     def on_arc(angle: float, turn: bool) -> Target:
@@ -425,12 +425,12 @@ def test_movec_mode_follows_the_planned_orientation(sweep: float) -> None:
         arc = CircularMove(via=on_arc(sweep / 2, turn), target=on_arc(sweep, turn), speed=0.01)
         line = LinearMove(target=start, speed=0.01)
         sections = (
-            Section(kind="start", label="start", moves=(joint_move(robot, start_q),)),
+            Section(kind="start", label="start", moves=(joint_move(robot, start_q, speed=0.25),)),
             Section(kind="seam", label="arc", moves=(line, arc)),
         )
-        text = render_urscript(program(robot, sections), robot=robot)["weld_cell.script"]
+        text = render_urscript(ur_program(robot, sections), robot=robot)["weld_cell.script"]
         assert f"mode={mode})" in text
-        assert_reads_back(program(robot, sections), parse_urscript({"w.script": text}), None)
+        assert_reads_back(ur_program(robot, sections), parse_urscript({"w.script": text}), None)
 
 
 def rotation_z(angle: float) -> np.ndarray:
