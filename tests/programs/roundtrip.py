@@ -223,42 +223,22 @@ def _assert_targets(
             )
 
 
-def assert_matches_program(
-    parsed: ParsedProgram, program: Program, *, spline_as: str | None = None
-) -> None:
-    """Assert that a program read back is the program the writer printed, target by target.
-
-    - The parsed base and tool equal the program's (0.01 mm, 0.001°).
-    - The parsed targets are as many as the program's, of the same kinds, in the same
-      order; a spline's points read back as ``spline_as`` (``spline`` or ``linear``; either
-      when None).
-    - Every Cartesian target equals the program's (TCP in the part frame) within 0.01 mm
-      and 0.001°.
-    - Every joint target (and a Cartesian target that states joints) equals the program's
-      controller joints within 1e-6 rad; a timed move's duration, where read back, equals
-      the program's within 1e-6 s.
-
-    Parameters
-    ----------
-    parsed
-        The program as a language's parser read it.
-    program
-        The program the writer printed.
-    spline_as
-        The kind the language writes a spline point as, or None.
-    """
-    _assert_targets(parsed, program, None, spline_as)
-
-
 def assert_matches_plan(
     parsed: ParsedProgram, program: Program, robot: Robot, *, spline_as: str | None = None
 ) -> None:
     """Assert that a program read back is the plan's, target by target.
 
-    Everything :func:`assert_matches_program` asserts, and: every Cartesian target, put
-    through the parsed base, is the controller-world forward kinematics of the planned
-    joints there (model joints → ``forward_kinematics`` → ``convention.world_from_base``)
-    within 0.01 mm and 0.001°.
+    - The parsed base and tool equal the program's (0.01 mm, 0.001°).
+    - The parsed targets are as many as the program's, of the same kinds, in the same
+      order; a spline's points read back as ``spline_as`` (``spline`` or ``linear``; either
+      when None).
+    - Every Cartesian target equals the program's (TCP in the part frame) and, put through
+      the parsed base, is the controller-world forward kinematics of the planned joints
+      there (model joints → ``forward_kinematics`` → ``convention.world_from_base``), both
+      within 0.01 mm and 0.001°.
+    - Every joint target (and a Cartesian target that states joints) equals the program's
+      controller joints within 1e-6 rad; a timed move's duration, where read back, equals
+      the program's within 1e-6 s.
 
     Parameters
     ----------
@@ -272,6 +252,14 @@ def assert_matches_plan(
         The kind the language writes a spline point as, or None.
     """
     _assert_targets(parsed, program, robot, spline_as)
+
+
+def assert_matches_program(
+    parsed: ParsedProgram, program: Program, *, spline_as: str | None = None
+) -> None:
+    """:func:`assert_matches_plan` without the forward kinematics, for a program whose
+    targets are not the FK of their joints."""
+    _assert_targets(parsed, program, None, spline_as)
 
 
 def assert_joint_timing(
@@ -295,16 +283,43 @@ def assert_joint_timing(
             )
 
 
+SAME_FIELDS = ("kind", "config", "speed", "zone", "duration")
+"""The fields of a target that a split program keeps as the whole one states them."""
+
+
+def assert_same_targets(
+    split: ParsedProgram, whole: ParsedProgram, *, fields: tuple[str, ...] = SAME_FIELDS
+) -> None:
+    """Assert that a program split into parts reads back as the whole one: as many
+    targets, each with the same ``fields`` (of :data:`SAME_FIELDS`), the same pose and the
+    same joints (the same numbers: both are printed from one program)."""
+    assert len(split.targets) == len(whole.targets), (
+        f"{len(split.targets)} targets in the parts, {len(whole.targets)} in the whole"
+    )
+    for k, (a, b) in enumerate(zip(split.targets, whole.targets, strict=True)):
+        where = f"target {k} ({a.part})"
+        for name in fields:
+            assert getattr(a, name) == getattr(b, name), (
+                f"{where}: {name} {getattr(a, name)!r}, the whole's {getattr(b, name)!r}"
+            )
+        for name in ("pose", "joints"):
+            x, y = getattr(a, name), getattr(b, name)
+            assert (x is None) == (y is None), f"{where}: {name} read back in one only"
+            assert x is None or np.array_equal(x, y), f"{where}: {name} differs"
+
+
 __all__ = [
     "ANGLE_TOLERANCE",
     "JOINT_TOLERANCE",
     "POSITION_TOLERANCE",
+    "SAME_FIELDS",
     "SHIPPED_PLACEMENTS",
     "ExpectedTarget",
     "PlannedRun",
     "assert_joint_timing",
     "assert_matches_plan",
     "assert_matches_program",
+    "assert_same_targets",
     "expected_targets",
     "frame_difference",
     "planned_run",

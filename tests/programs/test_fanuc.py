@@ -27,6 +27,7 @@ from tests.programs.roundtrip import (
     POSITION_TOLERANCE,
     assert_joint_timing,
     assert_matches_plan,
+    assert_same_targets,
     frame_difference,
     target_pairs,
 )
@@ -246,12 +247,7 @@ def test_a_split_program_reads_back_as_the_unsplit_one(max_points: int) -> None:
         assert len(read_listing(files[part]).positions) <= max_points
     split = parse_fanuc(files)
     assert_reads_back(program, split, robot)
-    assert [t.kind for t in split.targets] == [t.kind for t in whole.targets]
-    for a, b in zip(split.targets, whole.targets, strict=True):
-        assert a.config == b.config
-        assert a.speed == b.speed and a.zone == b.zone
-        if a.pose is not None and b.pose is not None:
-            assert_pose_close(a.pose, b.pose)
+    assert_same_targets(split, whole)
     assert [t.part for t in split.targets] == sorted(t.part for t in split.targets)
 
 

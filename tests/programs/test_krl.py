@@ -18,6 +18,7 @@ from tests.programs.roundtrip import (
     ANGLE_TOLERANCE,
     POSITION_TOLERANCE,
     assert_matches_plan,
+    assert_same_targets,
     frame_difference,
     rotation_angle,
     target_pairs,
@@ -190,13 +191,7 @@ def test_split_program_reads_back_as_the_unsplit_one(max_points: int, form: str)
     assert all(len(Path(name).stem) <= MAX_NAME for name in files)
     split = parse_krl(files)
     assert split.name == whole.name == "a_rather_long_program_na"
-    assert len(split.targets) == len(whole.targets)
-    for a, b in zip(split.targets, whole.targets, strict=True):
-        assert a.kind == b.kind and a.config == b.config
-        for x, y in ((a.pose, b.pose), (a.joints, b.joints)):
-            assert (x is None) == (y is None)
-            if x is not None:
-                np.testing.assert_allclose(x, y, atol=1e-12)
+    assert_same_targets(split, whole)
     assert {t.part for t in split.targets} == {Path(p).stem for p in parts}
     assert_reads_back(prog, split, robot)
 

@@ -38,6 +38,7 @@ from tests.programs.roundtrip import (
     POSITION_TOLERANCE,
     assert_joint_timing,
     assert_matches_plan,
+    assert_same_targets,
     rotation_angle,
     target_pairs,
 )
@@ -171,12 +172,8 @@ def test_split_program_reads_back_as_the_unsplit_one() -> None:
     split = parse_rapid(files)
     parts = {t.part for t in split.targets}
     assert len(parts) == math.ceil(prog.n_points / 3) and "main" not in parts
-    assert len(split.targets) == len(whole.targets) == prog.n_points
-    for a, b in zip(whole.targets, split.targets, strict=True):
-        assert a.kind == b.kind and a.config == b.config
-        assert a.speed == b.speed and a.zone == b.zone and a.duration == b.duration
-        for x, y in ((a.pose, b.pose), (a.joints, b.joints)):
-            assert (x is None and y is None) or np.array_equal(x, y)
+    assert len(whole.targets) == prog.n_points
+    assert_same_targets(split, whole)
     assert_round_trip(split, prog, robot)
     text = text_of(files)
     assert text.count("LOCAL PROC part") == len(parts)

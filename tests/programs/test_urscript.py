@@ -24,6 +24,7 @@ from tests.programs.roundtrip import (
     assert_joint_timing,
     assert_matches_plan,
     assert_matches_program,
+    assert_same_targets,
     expected_targets,
     rotation_angle,
 )
@@ -199,13 +200,7 @@ def test_a_split_program_reads_back_as_the_unsplit_one(motion: str) -> None:
         if re.fullmatch(r"weld_cell_part\d+\(\)", line.strip())
     ]
     assert calls == [f"weld_cell_part{k}()" for k in range(1, n_parts + 1)]
-    assert len(split.targets) == len(whole.targets)
-    for a, b in zip(split.targets, whole.targets, strict=True):
-        assert a.kind == b.kind and a.zone == b.zone and a.speed == b.speed
-        if a.pose is not None and b.pose is not None:
-            np.testing.assert_array_equal(a.pose, b.pose)
-        if a.joints is not None and b.joints is not None:
-            np.testing.assert_array_equal(a.joints, b.joints)
+    assert_same_targets(split, whole)
     assert {t.part for t in split.targets} == {f"weld_cell_part{k}" for k in range(1, n_parts + 1)}
     assert_reads_back(prog, split, robot)
 
