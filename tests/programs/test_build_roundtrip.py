@@ -13,7 +13,10 @@ import trackplan
 from tests.programs.parsed import ParsedProgram, ParsedTarget
 from tests.programs.roundtrip import (
     PlannedRun,
+    assert_joint_timing,
     assert_matches_plan,
+    assert_matches_program,
+    assert_same_targets,
     expected_targets,
     planned_run,
 )
@@ -190,3 +193,60 @@ def test_the_read_back_is_compared_with_the_fk_not_with_the_program() -> None:
     bad = replace(program, sections=tuple(sections))
     with pytest.raises(AssertionError, match="mm from the plan"):
         assert_matches_plan(read_back(bad), bad, robot)
+
+
+def test_a_pose_the_program_and_fk_disagree_on_passes_only_against_the_program() -> None:
+    """assert_matches_program compares with the program's targets, not with the FK; a
+    target 0.02 mm off the program's fails it."""
+    program, _ = program_and_robot("cartesian")
+    line = next(m for m in program.moves() if isinstance(m, LinearMove))
+    wrong = replace(line, target=replace(line.target, pose=shifted(line.target.pose, 2e-5)))
+    sections = tuple(
+        replace(s, moves=tuple(wrong if m is line else m for m in s.moves))
+        for s in program.sections
+    )
+    bad = replace(program, sections=sections)
+    assert_matches_program(read_back(bad), bad)
+    with pytest.raises(AssertionError, match="mm from the program"):
+        assert_matches_program(read_back(bad), program)
+
+
+def test_a_spline_read_back_as_another_kind_than_the_languages_fails() -> None:
+    program, robot = program_and_robot("cartesian")
+    assert_matches_plan(read_back(program, spline_as="linear"), program, robot, spline_as="linear")
+    with pytest.raises(AssertionError, match="read back as linear"):
+        assert_matches_plan(
+            read_back(program, spline_as="linear"), program, robot, spline_as="spline"
+        )
+
+
+def test_joint_timing_fails_on_a_lost_or_wrong_duration_or_speed() -> None:
+    program, _ = program_and_robot("joint")
+    parsed = read_back(program)
+    for target, expected in zip(parsed.targets, expected_targets(program), strict=True):
+        target.speed = expected.speed
+    assert_joint_timing(parsed, program, speed=1e-6, duration=1e-9)
+    parsed.targets[0].speed = (parsed.targets[0].speed or 0.0) + 1e-3  # the untimed start
+    with pytest.raises(AssertionError, match="speed"):
+        assert_joint_timing(parsed, program, speed=1e-6, duration=1e-9)
+    assert_joint_timing(parsed, program, speed=None, duration=1e-9)
+    parsed.targets[3].duration = None
+    with pytest.raises(AssertionError, match="no duration"):
+        assert_joint_timing(parsed, program, speed=None, duration=1e-9)
+
+
+def test_a_split_program_that_differs_from_the_whole_fails() -> None:
+    program, _ = program_and_robot("cartesian")
+    whole = read_back(program)
+    assert_same_targets(read_back(program), whole)
+    split = read_back(program)
+    split.targets[4].zone = 1e-5
+    with pytest.raises(AssertionError, match="zone"):
+        assert_same_targets(split, whole)
+    assert_same_targets(split, whole, fields=("kind", "config", "speed", "duration"))
+    split = read_back(program)
+    pose = split.targets[4].pose
+    assert pose is not None
+    pose[0, 3] += 1e-9
+    with pytest.raises(AssertionError, match="pose differs"):
+        assert_same_targets(split, whole)
