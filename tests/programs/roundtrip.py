@@ -197,8 +197,8 @@ def target_pairs(
 def _assert_targets(
     parsed: ParsedProgram, program: Program, robot: Robot | None, spline_as: str | None
 ) -> None:
-    _assert_frame(parsed.base, program.base, "base frame", "plan")
-    _assert_frame(parsed.tool, program.tool, "tool frame", "plan")
+    _assert_frame(parsed.base, program.base, "base frame", "program")
+    _assert_frame(parsed.tool, program.tool, "tool frame", "program")
     pairs = target_pairs(parsed, program)
     world_poses = None
     if robot is not None and pairs:
