@@ -18,11 +18,14 @@ from tests.io.test_case_file import validate_fails, write_case
 from tests.oracles import oracle
 from tests.programs.krl_parser import parse_krl
 from tests.robots.test_families import assert_round_trip
+from trackplan.case import Case
 from trackplan.cli import main
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_robot, robot_to_yaml
 from trackplan.jointpath import JointPath
+from trackplan.planning.result import PlanResult
+from trackplan.report.html_case import case_section
 from trackplan.outputs import write_run
 from trackplan.robots.families import ik_family
 from trackplan.writers import ExportSource
@@ -160,15 +163,32 @@ def test_planned_joints_put_the_tcp_on_the_planned_poses(tmp_path: Path) -> None
 
 
 @pytest.fixture(scope="module")
-def torch_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """cases/kuka-torch.yaml planned at its example placement, as a run folder."""
+def torch_plan() -> tuple[Case, PlanResult]:
+    """cases/kuka-torch.yaml planned at its example placement."""
     case = load_case(CASES / "kuka-torch.yaml")
     assert case.bounds.example is not None
     result = trackplan.plan(case, np.asarray(case.bounds.example))
     assert result.feasible, result.message
+    return case, result
+
+
+@pytest.fixture(scope="module")
+def torch_run(
+    tmp_path_factory: pytest.TempPathFactory, torch_plan: tuple[Case, PlanResult]
+) -> Path:
+    """The kuka-torch plan as a run folder."""
+    case, result = torch_plan
     folder = tmp_path_factory.mktemp("torch") / "run"
     write_run(folder, result, case, report=False)
     return folder
+
+
+def test_the_report_states_the_tcp_and_its_source(torch_plan: tuple[Case, PlanResult]) -> None:
+    case, result = torch_plan
+    html = case_section(result, case)
+    assert "xyz (0.045, 0, 0.35) m, rpy (0, 0.384, 0) rad (the case&#x27;s tcp)" in html
+    plain = load_case(CASES / "kuka-weld.yaml")
+    assert "none (tool = flange)" in case_section(result, plain)
 
 
 def test_kuka_torch_is_feasible_and_records_its_tcp(torch_run: Path) -> None:

@@ -30,7 +30,8 @@ _TCP_SOURCES = {"case": "the case's tcp", "robot": "the robot's tool"}
 
 
 def _tcp_text(case: Case) -> str:
-    """The TCP used, ``Trans(xyz) · RPY(rpy)`` in the flange, and where it comes from."""
+    """The TCP used, ``Trans(xyz) · RPY(rpy)`` in the flange, and where it comes from
+    (escaped HTML)."""
     if case.tcp_source == "none":
         return "none (tool = flange)"
     T = case.robot.T_flange_tool
@@ -39,7 +40,7 @@ def _tcp_text(case: Case) -> str:
         f"({_TCP_SOURCES[case.tcp_source]}"
     )
     replaced = case.robot_tool is not None and not np.allclose(case.robot_tool, np.eye(4))
-    return text + (", in place of the robot's own tool)" if replaced else ")")
+    return esc(text + (", in place of the robot's own tool)" if replaced else ")"))
 
 
 def case_section(result: PlanResult, case: Case) -> str:
@@ -63,7 +64,7 @@ def case_section(result: PlanResult, case: Case) -> str:
             ("name", esc(robot.name)),
             ("joints", str(robot.n_dof)),
             ("IK family", esc(ik_family(robot).name)),
-            ("TCP in the flange", _tcp_text(case)),
+            ("tool offset", _tcp_text(case)),
             *(("assumption", esc(note)) for note in robot.assumptions),
             ("source", esc(robot.source or "–")),
         ]
