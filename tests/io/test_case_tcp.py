@@ -24,9 +24,9 @@ from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.case_file import load_case
 from trackplan.io.robot_file import builtin_robot, robot_to_yaml
 from trackplan.jointpath import JointPath
+from trackplan.outputs import write_run
 from trackplan.planning.result import PlanResult
 from trackplan.report.html_case import case_section
-from trackplan.outputs import write_run
 from trackplan.robots.families import ik_family
 from trackplan.writers import ExportSource
 
