@@ -117,6 +117,14 @@ def test_a_bad_tcp_is_one_located_line(
     assert str(file) in line
 
 
+def test_validate_prints_the_cases_tcp(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["validate", str(CASES / "kuka-torch.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert "tcp       xyz [0.045, 0, 0.35] m, rpy [0, 0.383972, 0] rad" in out
+    assert main(["validate", str(CASES / "kuka-weld.yaml")]) == 0
+    assert "  tcp  " not in capsys.readouterr().out
+
+
 def test_a_top_level_tool_points_to_tcp(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     file = write_case(tmp_path, {"tool": TCP})
     line = validate_fails(capsys, str(file))
