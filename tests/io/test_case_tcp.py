@@ -5,6 +5,7 @@ result.json and a KRL export's tool frame."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +28,7 @@ from trackplan.jointpath import JointPath
 from trackplan.outputs import write_run
 from trackplan.planning.result import PlanResult
 from trackplan.report.html_case import case_section
+from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.families import ik_family
 from trackplan.writers import ExportSource
 
@@ -165,6 +167,51 @@ def test_planned_joints_put_the_tcp_on_the_planned_poses(tmp_path: Path) -> None
     # the trajectory's tool point is the TCP too
     fk_samples = np.array([with_tcp.fkine(q).A[:3, 3] for q in result.trajectory.q[::50]])
     np.testing.assert_allclose(fk_samples, result.trajectory.tool_position[::50], atol=1e-9)
+
+
+def entries(inertia: np.ndarray) -> list[float]:
+    """An inertia matrix as a payload's ``[Ixx, Iyy, Izz, Ixy, Iyz, Ixz]``."""
+    pairs = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
+    return [float(inertia[i, j]) for i, j in pairs]
+
+
+def test_the_payload_sits_at_the_cases_tcp(tmp_path: Path, rng: np.random.Generator) -> None:
+    """A payload given in the case's TCP frame has the torques of the same body given in the
+    flange frame (centre of mass moved by the TCP, inertia turned by its rotation)."""
+    tcp = {"xyz": [0.02, -0.01, 0.3], "rpy": [0.2, 0.4, -0.1]}
+    T = tcp_matrix(tcp)
+    com = np.array([0.01, 0.0, 0.05])
+    inertia = np.array([[0.03, 0.001, 0.002], [0.001, 0.035, 0.003], [0.002, 0.003, 0.02]])
+    at_tcp = load_case(
+        write_case(
+            tmp_path,
+            {
+                "tcp": tcp,
+                "payload": {"mass": 4.0, "com": com.tolist(), "inertia": entries(inertia)},
+            },
+            "tcp.yaml",
+        )
+    )
+    R = T[:3, :3]
+    in_flange = load_case(
+        write_case(
+            tmp_path,
+            {
+                "payload": {
+                    "mass": 4.0,
+                    "com": (T[:3, :3] @ com + T[:3, 3]).tolist(),
+                    "inertia": entries(R @ inertia @ R.T),
+                }
+            },
+            "flange.yaml",
+        )
+    )
+    q, qd, qdd = (rng.uniform(-2, 2, (200, 6)) for _ in range(3))
+    tau_tcp = inverse_dynamics(at_tcp.robot, q, qd, qdd)
+    tau_flange = inverse_dynamics(in_flange.robot, q, qd, qdd)
+    np.testing.assert_allclose(tau_tcp, tau_flange, rtol=0, atol=1e-9)
+    moved = replace(at_tcp.robot, T_flange_tool=np.eye(4))  # the same payload at the flange
+    assert np.abs(inverse_dynamics(moved, q, qd, qdd) - tau_tcp).max() > 0.1
 
 
 # --------------------------------------------------------------------------- outputs
