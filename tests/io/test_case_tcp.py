@@ -30,6 +30,7 @@ from trackplan.planning.result import PlanResult
 from trackplan.report.html_case import case_section
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.families import ik_family
+from trackplan.robots.kinematics import joint_frames
 from trackplan.writers import ExportSource
 
 TCP = {"xyz": [0.02, -0.01, 0.12], "rpy": [0.1, 0.3839724354387525, -0.2]}
@@ -162,6 +163,8 @@ def test_planned_joints_put_the_tcp_on_the_planned_poses(tmp_path: Path) -> None
     without = rtb.DHRobot(links)
     fk = np.array([with_tcp.fkine(q).A for q in path.q])
     assert np.abs(fk - planned).max() < 1e-8
+    # the frame the cell's tool capsules ride (docs/cell.md) is the TCP too
+    np.testing.assert_allclose(joint_frames(case.robot, path.q)[:, -1], fk, rtol=0, atol=1e-9)
     bare = np.array([without.fkine(q).A for q in path.q])
     assert np.abs(bare[:, :3, 3] - planned[:, :3, 3]).max() > 0.1
     # the trajectory's tool point is the TCP too
