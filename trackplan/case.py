@@ -206,6 +206,11 @@ class Case:
         ``segments`` and ``task``; read them as :attr:`seams`.
     sequencing
         The sequence mode, approach distance and home configuration of the cycle.
+    robot_tool
+        When the case file gives the TCP (``tcp:``, ``docs/files.md``): the robot's own
+        ``T_flange_tool`` that it replaced, shape (4, 4) (the identity for a robot without
+        a tool); None when the TCP is the robot's own. ``robot.T_flange_tool`` is the TCP
+        used either way.
     """
 
     name: str
@@ -220,6 +225,15 @@ class Case:
     cell: Cell | None = None
     paths: tuple[Seam, ...] = ()
     sequencing: Sequencing = field(default_factory=Sequencing)
+    robot_tool: np.ndarray | None = None
+
+    @property
+    def tcp_source(self) -> str:
+        """Where the TCP used (``robot.T_flange_tool``) comes from: ``case`` (the case
+        file's ``tcp``), ``robot`` (the robot's own tool) or ``none`` (the flange)."""
+        if self.robot_tool is not None:
+            return "case"
+        return "robot" if self.robot.has_tool else "none"
 
     @property
     def seams(self) -> tuple[Seam, ...]:

@@ -9,6 +9,7 @@ import numpy as np
 from rich.markup import escape
 
 from trackplan.case import Case
+from trackplan.frames import rpy_from_matrix
 from trackplan.paths import NominalPath
 from trackplan.planning.result import CheckReport, PlanResult
 from trackplan.robots.model import Robot
@@ -47,7 +48,18 @@ def describe_case(case: Case, file: Path | str) -> list[str]:
         f"sample time {task.sample_time * 1e3:g} ms, timing {task.timing}",
         f"  sequence  {sequencing.sequence}, approach {sequencing.approach:g} m, "
         f"home {'none' if sequencing.home is None else 'given'}",
+        *_tcp_line(case),
     ]
+
+
+def _tcp_line(case: Case) -> list[str]:
+    """The case's ``tcp`` (xyz in m, rpy in rad), when it gives one."""
+    if case.tcp_source != "case":
+        return []
+    T = case.robot.T_flange_tool
+    xyz = ", ".join(f"{v:.6g}" for v in T[:3, 3])
+    rpy = ", ".join(f"{v:.6g}" for v in rpy_from_matrix(T[:3, :3]))
+    return [f"  tcp       xyz [{xyz}] m, rpy [{rpy}] rad in the flange (the case's)"]
 
 
 def segment_corners(path: NominalPath) -> list[tuple[int, float]]:

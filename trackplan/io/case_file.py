@@ -37,6 +37,7 @@ from trackplan.io.case_schema import (
     SegmentModel,
     SinglePathCaseModel,
 )
+from trackplan.io.case_tcp import misplaced_tool, tcp_problems, with_tcp
 from trackplan.io.cell_file import build_cell, cell_problems
 from trackplan.io.points_file import load_points_csv
 from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
@@ -154,9 +155,11 @@ def load_case_data(
     """
     base = Path(base_dir)
     several = isinstance(data, dict) and "paths" in data
+    raise_first(misplaced_tool(data), data, file)
     model = validate_model(CaseModel if several else SinglePathCaseModel, data, file)
     raise_first(_seam_key_problems(model), data, file)
     robot = load_robot_spec(model.robot, base, case_file=file, assume_limits=assume_limits)
+    robot, robot_tool = with_tcp(robot, model.tcp)
     seams = _seam_models(model)
     paths = [
         (
@@ -183,6 +186,7 @@ def load_case_data(
         *(cell_problems(model.cell, robot.n_dof) if model.cell is not None else []),
         *_objective_kind_problems(model.objective, robot),
         *_payload_problems(model.payload, robot),
+        *tcp_problems(model.tcp),
     ]
     # the sizes before any costly path work: a path too long for the memory budget is
     # refused before it is built (and its tool frames sampled)
@@ -203,7 +207,7 @@ def load_case_data(
     if model.payload is not None and robot.dynamics is not None:
         dynamics = dataclasses.replace(robot.dynamics, payload=as_payload(model.payload))
         robot = dataclasses.replace(robot, dynamics=dynamics)
-    case = _case(model, robot, start, segments, file)
+    case = dataclasses.replace(_case(model, robot, start, segments, file), robot_tool=robot_tool)
     if model.paths is not None:
         case = _with_seams(case, model, paths)
     if model.cell is None:
@@ -245,12 +249,8 @@ def _case(
     segments: tuple[SegmentSpec, ...],
     file: str | None,
 ) -> Case:
-    task, placement, objective, optimizer = (
-        model.task,
-        model.placement,
-        model.objective,
-        model.optimizer,
-    )
+    task, placement = model.task, model.placement
+    objective, optimizer = model.objective, model.optimizer
     weights = objective.weights
     if weights is None:
         weights = list(PAPER_WEIGHTS) if robot.n_dof == len(PAPER_WEIGHTS) else [1.0] * robot.n_dof

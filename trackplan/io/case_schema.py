@@ -11,6 +11,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 from pydantic_core import PydanticCustomError
 
+from trackplan.io.case_tcp import TcpModel
 from trackplan.io.cell_file import CellModel
 from trackplan.io.points_file import MIN_POINTS
 from trackplan.io.robot_file import PayloadModel
@@ -185,6 +186,7 @@ class CaseModel(StrictModel):
     name: NonEmptyStr
     robot: NonEmptyStr = "puma560"
     payload: PayloadModel | None = None
+    tcp: TcpModel | None = None
     path: PathModel | None = None
     paths: Annotated[list[SeamModel], Field(min_length=1)] | None = None
     sequence: Literal["optimize", "given"] | None = None

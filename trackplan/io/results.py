@@ -14,6 +14,7 @@ import numpy as np
 
 from trackplan.case import PLACEMENT_KEYS, Case
 from trackplan.errors import CaseError
+from trackplan.frames import rpy_from_matrix
 from trackplan.io.csv_table import format_table, write_csv_table
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.io.sizes import MAX_TRAJECTORY_BYTES, max_samples
@@ -335,7 +336,29 @@ def plan_summary(result: PlanResult, case: Case) -> dict:
         **result_summary(result, case.robot.joint_names),
         "case_file": case_file(case),
         "robot_file": robot_file(case),
+        "tcp": tcp_summary(case),
         **seams_summary(result, case),
+    }
+
+
+def tcp_summary(case: Case) -> dict:
+    """``result.json``'s ``tcp``: the TCP used in the flange (``xyz``, m; ``rpy``, rad, as a
+    robot file's ``tool``), where it comes from (``source``: ``case``, ``robot`` or
+    ``none``) and, when the case's ``tcp`` replaced a robot's own tool, that tool
+    (``replaced``, else None)."""
+
+    def pose(T: np.ndarray) -> dict:
+        return {
+            "xyz": [float(v) for v in T[:3, 3]],
+            "rpy": [float(v) for v in rpy_from_matrix(T[:3, :3])],
+        }
+
+    own = case.robot_tool
+    replaced = own is not None and not np.allclose(own, np.eye(4))
+    return {
+        **pose(case.robot.T_flange_tool),
+        "source": case.tcp_source,
+        "replaced": pose(own) if replaced and own is not None else None,
     }
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.frames import rpy_from_matrix
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 from trackplan.planning.result import PlanResult
 from trackplan.report.html_markup import Cell, esc, grid, key_values, num, vector
@@ -23,6 +24,23 @@ def _describe_segment(segment: SegmentSpec) -> tuple[str, str]:
     if isinstance(segment, PointsSpec):
         return "points", f"{len(segment.points)} sampled points"
     return type(segment).__name__, ""
+
+
+_TCP_SOURCES = {"case": "the case's tcp", "robot": "the robot's tool"}
+
+
+def _tcp_text(case: Case) -> str:
+    """The TCP used, ``Trans(xyz) · RPY(rpy)`` in the flange, and where it comes from
+    (escaped HTML)."""
+    if case.tcp_source == "none":
+        return "none (tool = flange)"
+    T = case.robot.T_flange_tool
+    text = (
+        f"xyz {vector(T[:3, 3])} m, rpy {vector(rpy_from_matrix(T[:3, :3]))} rad "
+        f"({_TCP_SOURCES[case.tcp_source]}"
+    )
+    replaced = case.robot_tool is not None and not np.allclose(case.robot_tool, np.eye(4))
+    return esc(text + (", in place of the robot's own tool)" if replaced else ")"))
 
 
 def case_section(result: PlanResult, case: Case) -> str:
@@ -46,7 +64,7 @@ def case_section(result: PlanResult, case: Case) -> str:
             ("name", esc(robot.name)),
             ("joints", str(robot.n_dof)),
             ("IK family", esc(ik_family(robot).name)),
-            ("tool offset", "yes" if robot.has_tool else "none (tool = flange)"),
+            ("tool offset", _tcp_text(case)),
             *(("assumption", esc(note)) for note in robot.assumptions),
             ("source", esc(robot.source or "–")),
         ]
