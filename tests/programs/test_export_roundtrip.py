@@ -56,6 +56,7 @@ RUNS = [
     # language drives it; lines, arcs, sampled curves, sharp corners, several seams with
     # approach and air moves and a reversal, couplings and moved world frames
     ("krl", "kuka-weld"),
+    ("krl", "kuka-torch"),  # a torch TCP from the case file
     ("krl", "bracket-4-fillets"),
     ("rapid", "abb-weld"),
     ("rapid", "bracket-weld"),
