@@ -125,7 +125,7 @@ def _normal_problems(tool: ToolModel, nominal: NominalPath | None) -> list[Probl
                 "frame: seam needs task.tool.normal [x, y, z] or task.tool.normals "
                 "[[x, y, z], ...] (one per path segment)"
                 + (
-                    f", or a weld normal on path.segments[{uncovered[0]}] and every other segment"
+                    f", or a weld normal on every segment (path.segments[{uncovered[0]}] has none)"
                     if nominal is not None and len(uncovered) < len(nominal.segments)
                     else ""
                 ),
