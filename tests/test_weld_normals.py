@@ -281,3 +281,15 @@ def test_points_file_with_a_constant_normal_plans_like_the_constant_normal(tmp_p
     assert a.success == b.success
     assert a.trajectory.q.shape == b.trajectory.q.shape
     np.testing.assert_allclose(a.trajectory.q, b.trajectory.q, rtol=0, atol=1e-9)
+
+
+def test_the_report_describes_weld_normals_without_a_tool_normal():
+    """The case section names the segments' own normals (a tool without ``normal`` and
+    ``normals`` used to raise a TypeError in the report)."""
+    from trackplan.report.html_case import _describe_segment, _tool_text
+
+    case = load_case(PIPE)
+    assert case.task.tool.normal is None and case.task.tool.normals is None
+    assert "the path segments' own weld normals" in _tool_text(case.task.tool)
+    kind, text = _describe_segment(case.segments[0])
+    assert kind == "arc" and "weld normal (1, 0, 1) at its start, turning" in text
