@@ -37,8 +37,8 @@ class PointsSpec:
     """A sampled curve from the current point through ``points``, shape (K, 3).
 
     ``normals`` (K, 3): the weld's surface normal at each point, interpolated along the
-    curve (None: the tool's normal holds); the current point takes ``start_normal`` (3,),
-    by default the first point's."""
+    curve (None: the tool's normal holds); ``start_normal`` (3,) is the current point's
+    (None: continued from the first points' normals)."""
 
     points: np.ndarray
     normals: np.ndarray | None = None

@@ -33,6 +33,7 @@ from trackplan.robots.path_ik import solve_path_ik
 from trackplan.status import Status
 from trackplan.timing import time_law
 from trackplan.tool import SpinMode, SpinProfile
+from trackplan.tool.weld_normal import PointsNormal
 
 APPROACH_POSES = 21
 """Poses along the approach line on which its IK is solved (continuity on the seam's branch)."""
@@ -78,7 +79,9 @@ def reversed_segments(
                 backwards.append(PointsSpec(points=through))
                 continue
             normals = np.asarray(segment.normals, dtype=float)
-            first = normals[0] if segment.start_normal is None else segment.start_normal
+            first = segment.start_normal
+            if first is None:  # the normal the forward segment has at its start
+                first = PointsNormal.from_points(begin, segment)(begin[None], np.zeros(1))[0]
             along = np.vstack([normals[-2::-1], np.asarray(first, dtype=float)[None]])
             backwards.append(PointsSpec(through, along, normals[-1].copy()))
     return points[-1].copy(), tuple(backwards)

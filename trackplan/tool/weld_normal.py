@@ -90,11 +90,12 @@ def _radial_frame(
 class PointsNormal:
     """Per-point normals interpolated by a cubic spline in the segment's arc length.
 
-    The knots are the arc lengths of the polyline's vertices (the segment's start, which
-    takes the first point's normal, then each point); the spline (not-a-knot ends, a line
-    or parabola for two or three knots) interpolates each component, so the field is C2 in
-    the arc length and exact at the points; it is normalised where it is used. Beyond the
-    ends it continues as the end polynomials (blends at the ends stay smooth).
+    The knots are the arc lengths of the points along the polyline from the segment's start
+    (the current point, whose normal the spline continues from the first points, unless
+    ``start_normal`` gives it, as a reversed segment does); the spline (not-a-knot ends, a
+    line or parabola for two or three knots) interpolates each component, so the field is
+    C2 in the arc length and exact at the points; it is normalised where it is used. Beyond
+    the knots it continues as the end polynomials (blends at the ends stay smooth).
     """
 
     knots: np.ndarray
@@ -107,11 +108,12 @@ class PointsNormal:
         vertices = np.vstack([np.asarray(start, dtype=float)[None], points.points])
         normals = np.asarray(points.normals, dtype=float)
         normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
-        first = normals[:1] if points.start_normal is None else points.start_normal[None]
-        first = first / np.linalg.norm(first)
-        normals = np.vstack([first, normals])
         steps = np.linalg.norm(np.diff(vertices, axis=0), axis=1)
-        knots = np.concatenate([[0.0], np.cumsum(steps)])
+        knots = np.cumsum(steps)
+        if points.start_normal is not None:  # a reversed segment: its start's normal is known
+            first = np.asarray(points.start_normal, dtype=float)
+            normals = np.vstack([first / np.linalg.norm(first), normals])
+            knots = np.concatenate([[0.0], knots])
         return cls(knots, CubicSpline(knots, normals, axis=0))
 
     def __call__(self, position: np.ndarray, sigma: np.ndarray) -> np.ndarray:
