@@ -235,8 +235,17 @@ def _tool_axes_in_part(case, X, q):
     return T[:, :3, 2], T[:, :3, 3]
 
 
-def test_pipe_fillet_plans_feasibly_and_holds_the_work_angle_to_the_turning_normal():
+@pytest.mark.parametrize("work_angle", [None, 0.25])
+def test_pipe_fillet_plans_feasibly_and_holds_the_work_angle_to_the_turning_normal(
+    tmp_path, work_angle
+):
+    """The shipped case (work angle 0) and the same with a work angle of 0.25 rad."""
     case = load_case(PIPE)
+    if work_angle is not None:
+        data = yaml.safe_load(PIPE.read_text())
+        data["task"]["tool"]["work_angle"] = work_angle
+        (tmp_path / "pipe.yaml").write_text(yaml.safe_dump(data))
+        case = load_case(tmp_path / "pipe.yaml")
     X = case.bounds.example
     result = plan(case, X)
     assert result.success, result.message
@@ -250,10 +259,12 @@ def test_pipe_fillet_plans_feasibly_and_holds_the_work_angle_to_the_turning_norm
     phi = np.arctan2(position[on_seam, 1], position[on_seam, 0])
     normal = _rotate_z(_unit(np.array([1.0, 0.0, 1.0])), phi)
     tangent = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)], 1)
-    # the tool axis points along -n turned by the travel angle about the seam's y axis;
-    # its work angle is the angle between the axis and -n in the plane across the seam
-    across = axis[on_seam] - np.einsum("mk,mk->m", axis[on_seam], tangent)[:, None] * tangent
-    work = np.arccos(np.clip(np.einsum("mk,mk->m", _unit(across), -normal), -1.0, 1.0))
+    # the seam frame: x = t, z = -n, y = z × x; the tool axis is
+    # (sin β, −sin w cos β, cos w cos β) in it (docs/tool.md): the work angle w is the
+    # signed angle from -n to the axis's part across the seam, about the tangent
+    y_seam = np.cross(-normal, tangent)
+    a = axis[on_seam]
+    work = np.arctan2(-np.einsum("mk,mk->m", a, y_seam), np.einsum("mk,mk->m", a, -normal))
     travel = np.arcsin(np.clip(np.einsum("mk,mk->m", axis[on_seam], tangent), -1.0, 1.0))
     spec = case.task.tool
     np.testing.assert_allclose(work, spec.work_angle, atol=WORK_ANGLE_TOL)
