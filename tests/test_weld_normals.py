@@ -174,8 +174,11 @@ def test_refusals_name_the_segment(tmp_path):
     assert "path.segments[0].arc.weld_normal" in line and "frame: seam" in line
     line = _refusal(tmp_path, [{"points": [[0.1, 0, 0, 0, 0, 1], [0.2, 0, 0]]}])
     assert "path.segments[0].points" in line and "not a mix" in line
-    line = _refusal(tmp_path, [{"points": [[0.1, 0, 0, 1, 0, 0], [0.2, 0, 0, 0, 0, 1]]}])
+    line = _refusal(
+        tmp_path, [{"points": [[0.1, 0, 0, 0, 0, 1], [0.2, 0, 0, 0, 1, 1], [0.3, 0, 0, 1, 0, 0]]}]
+    )
     assert "path.segments[0].points" in line and "parallel" in line
+    assert "near its point 2" in line
     line = _refusal(tmp_path, [{"points": [[0.1, 0, 0, 0, 0, 1], [0.2, 0, 0, 0, 0, -1]]}])
     assert "path.segments[0].points" in line and "half a turn" in line
     # a segment without its own normal needs the tool's

@@ -15,6 +15,7 @@ import numpy as np
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.paths.pieces import Piece
+from trackplan.paths.specs import PointsSpec
 from trackplan.tool.spec import MIN_NORMAL_LENGTH, ToolFrame, ToolSpec
 from trackplan.tool.weld_normal import (
     ConstantNormal,
@@ -337,6 +338,11 @@ def seam_problems(spec: ToolSpec, nominal: NominalPath) -> list[tuple[int | None
         g = int(segment[at])
         index = None if spec.normals is None and not own else g
         whose = "" if index is None else f" of path.segments[{index}]"
+        segment_spec = nominal.segments[g]
+        if isinstance(segment_spec, PointsSpec) and segment_spec.normals is not None:
+            steps = np.linalg.norm(np.diff(nominal.vertices(g), axis=0), axis=1)
+            sigma = s[at] - table.s_start[np.flatnonzero(nominal.segment_index == g)[0]]
+            whose += f" (near its point {int(np.argmin(np.abs(np.cumsum(steps) - sigma)))})"
         if length[at] < 0.1:
             return [
                 (
