@@ -26,7 +26,6 @@ from trackplan.case import (
     Task,
 )
 from trackplan.choices import OBJECTIVE_KINDS, Method, Penalty, Timing
-from trackplan.errors import CaseError
 from trackplan.io.case_schema import (
     CaseModel,
     ObjectiveModel,
@@ -42,7 +41,7 @@ from trackplan.io.cell_file import build_cell, cell_problems
 from trackplan.io.points_file import load_points_csv
 from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
 from trackplan.io.sizes import size_problems
-from trackplan.io.tool_file import ToolModel, as_spec, segment_normal_problems, tool_problems
+from trackplan.io.tool_file import as_spec, path_tool_problems
 from trackplan.io.yaml_input import (
     Loc,
     Problem,
@@ -192,22 +191,9 @@ def load_case_data(
         built = not problems and not sizes
         nominal = NominalPath.from_specs(seam_start, seam_segments) if built else None
         own = seam.task if isinstance(seam, SeamModel) else None
-        if own is not None and (own.tool is not None or own.tool_rpy is not None):
-            tool_key, frame = key_path((*loc, "task", "tool")), _frame(own.tool, own.tool_rpy)
-            problems += [
-                ((*loc, *where[1:]) if where[:1] == ("path",) else (*loc, *where), message)
-                for where, message in tool_problems(own.tool, own.tool_rpy, nominal)
-            ]
-        else:
-            tool_key, frame = "task.tool", _frame(model.task.tool, model.task.tool_rpy)
-            problems += [
-                ((*loc, *where[1:]) if where[:1] == ("path",) else where, message)
-                for where, message in tool_problems(model.task.tool, model.task.tool_rpy, nominal)
-            ]
-        problems += [
-            ((*loc, *where), message)
-            for where, message in segment_normal_problems(seam_segments, frame, tool_key)
-        ]
+        task = own if own is not None and (own.tool, own.tool_rpy) != (None, None) else model.task
+        at = loc if task is own else ()
+        problems += path_tool_problems(task.tool, task.tool_rpy, nominal, seam_segments, loc, at)
     raise_first(problems, data, file)
     raise_first(sizes, data, file)
     if model.payload is not None and robot.dynamics is not None:
@@ -219,11 +205,6 @@ def load_case_data(
     if model.cell is None:
         return case
     return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
-
-
-def _frame(tool: ToolModel | None, tool_rpy: list[float] | None) -> str:
-    """The tool frame of a ``tool``/``tool_rpy`` pair: ``seam`` or ``part``."""
-    return tool.frame if tool is not None else "part"
 
 
 def _size_problems(
@@ -450,16 +431,7 @@ def _segment(
     if isinstance(segment.points, PointsFileModel):
         key = key_path((*loc, "points", "file"))
         rows = load_points_csv(base / segment.points.file, file, key)
-    else:
-        assert segment.points is not None  # exactly one kind, checked by the schema
-        widths = {len(row) for row in segment.points}
-        if len(widths) > 1:
-            raise CaseError(
-                "expected every point as [x, y, z] or every point as [x, y, z, nx, ny, nz] "
-                "(with the weld's normal), not a mix",
-                file=file,
-                key=key_path((*loc, "points")),
-            )
+    else:  # one width, checked by the schema
         rows = np.array(segment.points, dtype=float)
     if rows.shape[1] == 6:
         return PointsSpec(points=_array(rows[:, :3]), normals=_array(rows[:, 3:]))

@@ -63,6 +63,16 @@ PointRow = Annotated[list[Coordinate], AfterValidator(_point_row)]
 """An inline point: ``[x, y, z]`` or ``[x, y, z, nx, ny, nz]`` (with the weld's normal)."""
 
 
+def _one_width(rows: list[list[float]]) -> list[list[float]]:
+    if len({len(row) for row in rows}) > 1:
+        raise PydanticCustomError(
+            "points_width",
+            "expected every point as [x, y, z] or every point as [x, y, z, nx, ny, nz] "
+            "(with the weld's normal), not a mix",
+        )
+    return rows
+
+
 class PointsFileModel(StrictModel):
     """``points: {file: seam.csv}``: x, y, z rows (or x, y, z, nx, ny, nz), relative to the
     case file."""
@@ -79,7 +89,9 @@ def _points_kind(value: Any) -> str | None:
 
 
 PointsModel = Annotated[
-    Annotated[list[PointRow], Field(min_length=MIN_POINTS), Tag("<list>")]
+    Annotated[
+        list[PointRow], Field(min_length=MIN_POINTS), AfterValidator(_one_width), Tag("<list>")
+    ]
     | Annotated[PointsFileModel, Tag("<file>")],
     Discriminator(
         _points_kind,

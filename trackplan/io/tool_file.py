@@ -23,6 +23,7 @@ from trackplan.io.yaml_input import (
     Range,
     StrictModel,
     Vec3,
+    key_path,
     list_default,
     parse_yaml,
     show,
@@ -166,6 +167,29 @@ def _seam_problem_key(tool: ToolModel, nominal: NominalPath, index: int | None) 
     if tool.normals is not None:
         return (*at, "normals", index)
     return (*at, "normal")
+
+
+def path_tool_problems(
+    tool: ToolModel | None,
+    tool_rpy: list[float] | None,
+    nominal: NominalPath | None,
+    segments: Sequence[SegmentSpec],
+    loc: Loc,
+    prefix: Loc,
+) -> list[Problem]:
+    """The problems of one path's tool (:func:`tool_problems`) and of the weld normals on
+    its segments (:func:`segment_normal_problems`), located in the file: ``loc`` is the
+    path's location, ``prefix`` that of the ``task`` holding the tool (() for the case's)."""
+    problems: list[Problem] = [
+        ((*loc, *where[1:]) if where[:1] == ("path",) else (*prefix, *where), message)
+        for where, message in tool_problems(tool, tool_rpy, nominal)
+    ]
+    frame = None if tool is None else tool.frame
+    tool_key = key_path((*prefix, "task", "tool"))
+    return problems + [
+        ((*loc, *where), message)
+        for where, message in segment_normal_problems(segments, frame, tool_key)
+    ]
 
 
 def _segments_without_normal(nominal: NominalPath | None) -> list[int | str]:
