@@ -122,6 +122,19 @@ def test_points_file_with_normals_reads_six_columns(tmp_path):
     np.testing.assert_array_equal(load_points_csv(csv), [[0.1, 0, 0], [0.2, 0, 0]])
 
 
+def test_both_readers_take_a_file_with_normals(tmp_path):
+    """A line of spaces sends the file to the line-by-line reader: same rows."""
+    csv = tmp_path / "seam.csv"
+    csv.write_text("# seam\nX, Y, Z, NX, NY, NZ\n0.1,0,0,0,0,1\n   \n0.2, 0, 0, 0, 1, 1\n")
+    np.testing.assert_array_equal(
+        load_points_csv(csv), [[0.1, 0, 0, 0, 0, 1], [0.2, 0, 0, 0, 1, 1]]
+    )
+    csv.write_text("x,y,z,nx,ny,nz\n0.1,0,0,0,0,1\n   \n0.2,0,0,0,1\n")
+    with pytest.raises(CaseError, match="got 5 values") as err:
+        load_points_csv(csv)
+    assert "line 4" in err.value.one_line()
+
+
 def test_six_numbers_without_the_header_are_refused_with_a_hint(tmp_path):
     csv = tmp_path / "seam.csv"
     csv.write_text("0.1,0,0,0,0,1\n0.2,0,0,0,1,1\n")
