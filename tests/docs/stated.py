@@ -31,6 +31,10 @@ TWO_FACES_PLAN = (
     "trackplan plan cases/bracket-two-faces.yaml --out runs/two-faces-example --no-report"
 )
 TWO_FACES_CHECK = "trackplan check cases/bracket-two-faces.yaml runs/two-faces-example"
+PIPE_FILLET = "trackplan optimize cases/pipe-fillet.yaml --out runs/pipe-fillet --no-report"
+PIPE_FILLET_PLAN = (
+    "trackplan plan cases/pipe-fillet.yaml --out runs/pipe-fillet-example --no-report"
+)
 CIRCLE_FREE_PLAN = (
     "trackplan plan cases/paper-circle-seam-free.yaml --out runs/circle-seam-free --no-report"
 )
@@ -382,6 +386,13 @@ STATED: tuple[Stated, ...] = (
             *j_duration(plan),
             f"{_json(plan)['max_orientation_error']:.3f}",
         ),
+    ),
+    Stated(
+        "docs/tool.md",
+        "evaluations) finds a feasible placement with J = {}, {} s; `trackplan plan` at the "
+        "case's example placement (that one, rounded) plans feasibly with J = {}, {} s,",
+        (PIPE_FILLET, PIPE_FILLET_PLAN),
+        lambda search, plan: (*j_duration(search), *j_duration(plan)),
     ),
     Stated(
         "docs/tool.md",

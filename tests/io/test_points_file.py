@@ -39,7 +39,7 @@ def test_both_readers_give_the_same_points(tmp_path, monkeypatch, text):
     csv = tmp_path / "seam.csv"
     csv.write_text(text)
     fast = load_points_csv(csv)
-    monkeypatch.setattr(points_file, "_parse_fast", lambda _: None)
+    monkeypatch.setattr(points_file, "_parse_fast", lambda *_: None)
     np.testing.assert_array_equal(fast, EXPECTED)
     np.testing.assert_array_equal(load_points_csv(csv), EXPECTED)
 
@@ -237,7 +237,7 @@ def test_the_screened_search_finds_the_row_the_line_by_line_reader_names(
         outcomes = []
         for screened in (True, False):
             if not screened:
-                monkeypatch.setattr(points_file, "_first_bad_row", lambda _: None)
+                monkeypatch.setattr(points_file, "_first_bad_row", lambda *_: None)
             try:
                 outcomes.append(load_points_csv(csv).tolist())
             except CaseError as exc:

@@ -42,7 +42,7 @@ from trackplan.io.cell_file import build_cell, cell_problems
 from trackplan.io.points_file import load_points_csv
 from trackplan.io.robot_file import PayloadModel, as_payload, load_robot_spec, payload_problems
 from trackplan.io.sizes import size_problems
-from trackplan.io.tool_file import as_spec, tool_problems
+from trackplan.io.tool_file import as_spec, path_tool_problems
 from trackplan.io.yaml_input import (
     Loc,
     Problem,
@@ -195,13 +195,9 @@ def load_case_data(
         built = not problems and not sizes
         nominal = NominalPath.from_specs(seam_start, seam_segments) if built else None
         own = seam.task if isinstance(seam, SeamModel) else None
-        if own is not None and (own.tool is not None or own.tool_rpy is not None):
-            problems += [
-                ((*loc, *where), message)
-                for where, message in tool_problems(own.tool, own.tool_rpy, nominal)
-            ]
-        else:
-            problems += tool_problems(model.task.tool, model.task.tool_rpy, nominal)
+        task = own if own is not None and (own.tool, own.tool_rpy) != (None, None) else model.task
+        at = loc if task is own else ()
+        problems += path_tool_problems(task.tool, task.tool_rpy, nominal, seam_segments, loc, at)
     raise_first(problems, data, file)
     raise_first(sizes, data, file)
     if model.payload is not None and robot.dynamics is not None:
@@ -430,11 +426,16 @@ def _segment(
         return LineSpec(to=_array(segment.line.to))
     if segment.arc is not None:
         arc = segment.arc
-        return ArcSpec(center=_array(arc.center), normal=_array(arc.normal), angle=arc.angle)
+        weld = None if arc.weld_normal is None else _array(arc.weld_normal)
+        return ArcSpec(_array(arc.center), _array(arc.normal), arc.angle, weld)
     if isinstance(segment.points, PointsFileModel):
         key = key_path((*loc, "points", "file"))
-        return PointsSpec(points=_array(load_points_csv(base / segment.points.file, file, key)))
-    return PointsSpec(points=_array(segment.points))
+        rows = load_points_csv(base / segment.points.file, file, key)
+    else:  # one width, checked by the schema
+        rows = np.array(segment.points, dtype=float)
+    if rows.shape[1] == 6:
+        return PointsSpec(points=_array(rows[:, :3]), normals=_array(rows[:, 3:]))
+    return PointsSpec(points=_array(rows))
 
 
 # --------------------------------------------------------------------------- value checks

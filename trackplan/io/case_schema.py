@@ -40,15 +40,43 @@ class LineModel(StrictModel):
 
 
 class ArcModel(StrictModel):
-    """``arc: {center, normal, angle}``: rotation of the current point by ``angle`` (rad)."""
+    """``arc: {center, normal, angle}``: rotation of the current point by ``angle`` (rad).
+
+    ``weld_normal``: the weld's surface normal at the arc's start, turned with the arc."""
 
     center: Vec3
     normal: Vec3
     angle: float
+    weld_normal: Vec3 | None = None
+
+
+def _point_row(value: list[float]) -> list[float]:
+    if len(value) not in (3, 6):
+        raise PydanticCustomError(
+            "vector_length",
+            "expected 3 numbers [x, y, z] or 6 [x, y, z, nx, ny, nz], got {actual}",
+            {"actual": len(value)},
+        )
+    return value
+
+
+PointRow = Annotated[list[Coordinate], AfterValidator(_point_row)]
+"""An inline point: ``[x, y, z]`` or ``[x, y, z, nx, ny, nz]`` (with the weld's normal)."""
+
+
+def _one_width(rows: list[list[float]]) -> list[list[float]]:
+    if len({len(row) for row in rows}) > 1:
+        raise PydanticCustomError(
+            "points_width",
+            "expected every point as [x, y, z] or every point as [x, y, z, nx, ny, nz] "
+            "(with the weld's normal), not a mix",
+        )
+    return rows
 
 
 class PointsFileModel(StrictModel):
-    """``points: {file: seam.csv}``: x, y, z rows, relative to the case file."""
+    """``points: {file: seam.csv}``: x, y, z rows (or x, y, z, nx, ny, nz), relative to the
+    case file."""
 
     file: NonEmptyStr
 
@@ -62,12 +90,16 @@ def _points_kind(value: Any) -> str | None:
 
 
 PointsModel = Annotated[
-    Annotated[list[Vec3], Field(min_length=MIN_POINTS), Tag("<list>")]
+    Annotated[
+        list[PointRow], Field(min_length=MIN_POINTS), AfterValidator(_one_width), Tag("<list>")
+    ]
     | Annotated[PointsFileModel, Tag("<file>")],
     Discriminator(
         _points_kind,
         custom_error_type="points_type",
-        custom_error_message="expected a list of [x, y, z] points or {file: name.csv}",
+        custom_error_message=(
+            "expected a list of [x, y, z] (or [x, y, z, nx, ny, nz]) points or {file: name.csv}"
+        ),
     ),
 ]
 

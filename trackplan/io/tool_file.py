@@ -7,6 +7,7 @@ giving both is an error. The keys and conventions are in ``docs/tool.md``.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -22,11 +23,13 @@ from trackplan.io.yaml_input import (
     Range,
     StrictModel,
     Vec3,
+    key_path,
     list_default,
     parse_yaml,
     show,
 )
 from trackplan.paths.nominal import NominalPath
+from trackplan.paths.specs import ArcSpec, PointsSpec, SegmentSpec
 from trackplan.tool import (
     DEFAULT_SPIN_RATE,
     MIN_NORMAL_LENGTH,
@@ -36,6 +39,7 @@ from trackplan.tool import (
     ToolSpec,
     seam_problems,
 )
+from trackplan.tool.weld_normal import declares_normals
 
 MAX_SPIN_RATE = 1.0e6
 """Largest ``spin_rate``, rad/m (one ≤ 0 is reported with its unit by :func:`tool_problems`)."""
@@ -114,12 +118,18 @@ def _normal_problems(tool: ToolModel, nominal: NominalPath | None) -> list[Probl
                 "path segment); remove one of the two",
             )
         ]
-    if tool.normal is None and tool.normals is None:
+    uncovered = _segments_without_normal(nominal)
+    if tool.normal is None and tool.normals is None and uncovered:
         return [
             (
                 (*at, "frame"),
                 "frame: seam needs task.tool.normal [x, y, z] or task.tool.normals "
-                "[[x, y, z], ...] (one per path segment)",
+                "[[x, y, z], ...] (one per path segment)"
+                + (
+                    f", or a weld normal on every segment (path.segments[{uncovered[0]}] has none)"
+                    if nominal is not None and len(uncovered) < len(nominal.segments)
+                    else ""
+                ),
             )
         ]
     short = f"expected a surface normal of length ≥ {MIN_NORMAL_LENGTH:g}, got"
@@ -141,9 +151,98 @@ def _normal_problems(tool: ToolModel, nominal: NominalPath | None) -> list[Probl
     if nominal is None:
         return []
     return [
-        ((*at, "normal") if index is None else (*at, "normals", index), text)
+        (_seam_problem_key(tool, nominal, index), text)
         for index, text in seam_problems(as_spec(tool), nominal)
     ]
+
+
+def _seam_problem_key(tool: ToolModel, nominal: NominalPath, index: int | None) -> Loc:
+    """Where a problem of :func:`seam_problems` about normal ``index`` is in the file."""
+    at: Loc = ("task", "tool")
+    if index is None:
+        return (*at, "normal")
+    if declares_normals([nominal.segments[index]]):
+        kind = "arc" if isinstance(nominal.segments[index], ArcSpec) else "points"
+        return ("path", "segments", index, kind)
+    if tool.normals is not None:
+        return (*at, "normals", index)
+    return (*at, "normal")
+
+
+def path_tool_problems(
+    tool: ToolModel | None,
+    tool_rpy: list[float] | None,
+    nominal: NominalPath | None,
+    segments: Sequence[SegmentSpec],
+    loc: Loc,
+    prefix: Loc,
+) -> list[Problem]:
+    """The problems of one path's tool (:func:`tool_problems`) and of the weld normals on
+    its segments (:func:`segment_normal_problems`), located in the file: ``loc`` is the
+    path's location, ``prefix`` that of the ``task`` holding the tool (() for the case's)."""
+    problems: list[Problem] = [
+        ((*loc, *where[1:]) if where[:1] == ("path",) else (*prefix, *where), message)
+        for where, message in tool_problems(tool, tool_rpy, nominal)
+    ]
+    frame = None if tool is None else tool.frame
+    tool_key = key_path((*prefix, "task", "tool"))
+    return problems + [
+        ((*loc, *where), message)
+        for where, message in segment_normal_problems(segments, frame, tool_key)
+    ]
+
+
+def _segments_without_normal(nominal: NominalPath | None) -> list[int | str]:
+    """The segments that declare no weld normal of their own (["?"] without a path)."""
+    if nominal is None:
+        return ["?"]
+    return [i for i, segment in enumerate(nominal.segments) if not declares_normals([segment])]
+
+
+def segment_normal_problems(
+    segments: Sequence[SegmentSpec], frame: str | None, tool_key: str = "task.tool"
+) -> list[Problem]:
+    """Bad weld normals declared on path segments (locations relative to the path).
+
+    A declared normal needs ``frame: seam`` and a length of at least
+    :data:`~trackplan.tool.MIN_NORMAL_LENGTH` (each row of a points segment).
+    """
+    problems: list[Problem] = []
+    for i, segment in enumerate(segments):
+        if not declares_normals([segment]):
+            continue
+        key: Loc = ("segments", i, "arc", "weld_normal")
+        if isinstance(segment, PointsSpec):
+            key = ("segments", i, "points")
+        if frame != "seam":
+            problems.append(
+                (
+                    key,
+                    f"a weld normal applies to {tool_key}.frame: seam (the tool held relative "
+                    "to the seam); set that frame or remove the normal",
+                )
+            )
+            continue
+        given = (
+            segment.weld_normal
+            if isinstance(segment, ArcSpec)
+            else segment.normals
+            if isinstance(segment, PointsSpec)
+            else None
+        )
+        length = np.linalg.norm(np.atleast_2d(np.asarray(given, dtype=float)), axis=1)
+        short = np.flatnonzero(~(length >= MIN_NORMAL_LENGTH))
+        if len(short):
+            where = "" if isinstance(segment, ArcSpec) else f" at point {int(short[0])}"
+            shown = show(np.atleast_2d(np.asarray(given))[short[0]].tolist())
+            problems.append(
+                (
+                    key,
+                    f"expected a surface normal of length ≥ {MIN_NORMAL_LENGTH:g}{where}, got "
+                    f"{shown}",
+                )
+            )
+    return problems
 
 
 def as_spec(tool: ToolModel | None, tool_rpy: list[float] | None = None) -> ToolSpec:

@@ -33,6 +33,7 @@ from trackplan.robots.path_ik import solve_path_ik
 from trackplan.status import Status
 from trackplan.timing import time_law
 from trackplan.tool import SpinMode, SpinProfile
+from trackplan.tool.weld_normal import PointsNormal
 
 APPROACH_POSES = 21
 """Poses along the approach line on which its IK is solved (continuity on the seam's branch)."""
@@ -68,10 +69,21 @@ def reversed_segments(
         if isinstance(segment, LineSpec):
             backwards.append(LineSpec(to=begin.copy()))
         elif isinstance(segment, ArcSpec):
-            backwards.append(ArcSpec(segment.center, segment.normal, -segment.angle))
+            weld = segment.weld_normal
+            if weld is not None:  # the normal at the arc's end
+                weld = _rotated(np.asarray(weld, dtype=float), segment.normal, segment.angle)
+            backwards.append(ArcSpec(segment.center, segment.normal, -segment.angle, weld))
         else:
             through = np.vstack([segment.points[-2::-1], begin[None]])
-            backwards.append(PointsSpec(points=through))
+            if segment.normals is None:
+                backwards.append(PointsSpec(points=through))
+                continue
+            normals = np.asarray(segment.normals, dtype=float)
+            first = segment.start_normal
+            if first is None:  # the normal the forward segment has at its start
+                first = PointsNormal.from_points(begin, segment)(begin[None], np.zeros(1))[0]
+            along = np.vstack([normals[-2::-1], np.asarray(first, dtype=float)[None]])
+            backwards.append(PointsSpec(through, along, normals[-1].copy()))
     return points[-1].copy(), tuple(backwards)
 
 
@@ -81,12 +93,19 @@ def _segment_end(begin: np.ndarray, segment: SegmentSpec) -> np.ndarray:
         return np.asarray(segment.to, dtype=float)
     if isinstance(segment, PointsSpec):
         return np.asarray(segment.points[-1], dtype=float)
-    axis = np.asarray(segment.normal, dtype=float)
+    return np.asarray(
+        segment.center + _rotated(begin - segment.center, segment.normal, segment.angle),
+        dtype=float,
+    )
+
+
+def _rotated(vector: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
+    """``vector`` (3,) turned by ``angle`` (rad) about ``axis`` (3,, any length), (3,)."""
+    axis = np.asarray(axis, dtype=float)
     axis = axis / np.linalg.norm(axis)
-    radius = begin - segment.center
-    c, s = np.cos(segment.angle), np.sin(segment.angle)
-    rotated = radius * c + np.cross(axis, radius) * s + axis * (axis @ radius) * (1.0 - c)
-    return np.asarray(segment.center + rotated, dtype=float)
+    c, s = np.cos(angle), np.sin(angle)
+    turned = vector * c + np.cross(axis, vector) * s + axis * (axis @ vector) * (1.0 - c)
+    return np.asarray(turned, dtype=float)
 
 
 def seam_direction_case(case: Case, index: int, reverse: bool) -> Case:

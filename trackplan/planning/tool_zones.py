@@ -14,6 +14,7 @@ from trackplan.paths import NominalPath
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.tracking import locate_on_nominal
 from trackplan.tool import ToolFrame, ToolOrientation, ToolSpec
+from trackplan.tool.weld_normal import declares_normals, nominal_normals
 
 ZONE_STEP = 1e-3
 """Four grid steps of the deviation measurement, m."""
@@ -38,13 +39,15 @@ def nominal_rotations(
     """The spec's ``R_part_tool`` at zero spin on the nominal path, shape (N, 3, 3).
 
     At arc lengths ``s`` (N,) on pieces ``piece`` (N,): the nominal tangent there and the
-    normal of the segment the piece belongs to (per-segment ``normals``), so the spec's
-    normal jumps exactly at the segment junctions. A part-frame spec does not depend on
-    the tangent.
+    normal of the segment the piece belongs to (per-segment ``normals``, or the segment's
+    own weld normal there), so the spec's normal jumps exactly at the segment junctions.
+    A part-frame spec does not depend on the tangent.
     """
     if spec.frame is ToolFrame.PART:
         return spec.base_rotations(np.zeros((len(s), 3)))
     tangent = nominal_tangents(nominal, s, piece)
+    if declares_normals(nominal.segments):
+        return spec.base_rotations(tangent, nominal_normals(spec, nominal, s, piece))
     if spec.normals is None:
         return spec.base_rotations(tangent)
     return spec.base_rotations(tangent, spec.segment_normals(nominal.segment_index[piece]))

@@ -17,12 +17,15 @@ def _describe_segment(segment: SegmentSpec) -> tuple[str, str]:
     if isinstance(segment, LineSpec):
         return "line", f"to {vector(segment.to)} m"
     if isinstance(segment, ArcSpec):
+        weld = segment.weld_normal
         return "arc", (
             f"centre {vector(segment.center)} m, normal {vector(segment.normal)}, "
             f"angle {num(segment.angle)} rad ({num(np.degrees(segment.angle))}°)"
+            + ("" if weld is None else f", weld normal {vector(weld)} at its start, turning")
         )
     if isinstance(segment, PointsSpec):
-        return "points", f"{len(segment.points)} sampled points"
+        normals = "" if segment.normals is None else " with weld normals"
+        return "points", f"{len(segment.points)} sampled points{normals}"
     return type(segment).__name__, ""
 
 
@@ -135,7 +138,9 @@ def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]
         where = f"part frame, roll/pitch/yaw {vector(tool.rpy)} rad"
     else:
         normal = (
-            f"normal {vector(tool.normal)}"
+            "the path segments' own weld normals"
+            if tool.normal is None and tool.normals is None
+            else f"normal {vector(tool.normal)}"
             if tool.normals is None
             else "normals " + " ".join(vector(n) for n in tool.normals)
         )

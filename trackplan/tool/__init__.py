@@ -8,6 +8,7 @@ free profile (:mod:`trackplan.profiles`, :meth:`ToolSpec.spin_profile`).
 
 Modules: :mod:`~trackplan.tool.spec` (the spec), :mod:`~trackplan.tool.spin` (the spin's
 free profile), :mod:`~trackplan.tool.seam` (the seam frame's tangent and normal),
+:mod:`~trackplan.tool.weld_normal` (normals declared on segments),
 :mod:`~trackplan.tool.orientation` (the orientation with a chosen spin) and
 :mod:`~trackplan.tool.rotations` (rotation helpers).
 
@@ -18,7 +19,9 @@ Conventions (``docs/tool.md``):
 - ``frame: seam``: ``R = [x_s y_s z_s] · Rx(work_angle) · Ry(travel_angle) · Rz(spin)``;
 - ``frame: part``: ``R = RPY(rpy) · Rz(spin)``;
 - the tool axis is the tool's z axis;
-- one ``normal`` for the whole path, or ``normals``: one per path segment.
+- one ``normal`` for the whole path, or ``normals``: one per path segment; a segment's own
+  weld normal (an arc's ``weld_normal`` turned with it, or points with normals) wins on
+  that segment (:mod:`~trackplan.tool.weld_normal`).
 
 The tangent is the planned path's, so through a blend the orientation turns with the
 blend's tangent, which is continuous with its curvature (G2 blends). Per-segment normals

@@ -12,6 +12,7 @@ from trackplan.tool.rotations import spun
 from trackplan.tool.seam import SeamNormal, SeamTangent
 from trackplan.tool.spec import ToolFrame, ToolSpec
 from trackplan.tool.spin import SPIN_DEGREE, SpinMode, SpinProfile
+from trackplan.tool.weld_normal import declares_normals
 
 
 @dataclass(frozen=True, eq=False)
@@ -27,7 +28,8 @@ class ToolOrientation:
     seam
         The rounded seam tangent (``frame: seam``).
     normals
-        The surface normal along the planned path (per-segment ``normals``).
+        The surface normal along the planned path (per-segment ``normals``, or segments
+        with their own weld normal).
     """
 
     spec: ToolSpec
@@ -63,7 +65,8 @@ class ToolOrientation:
         length = geometry.planned.length
         seam = SeamTangent.from_geometry(geometry) if spec.frame is ToolFrame.SEAM else None
         normals = None
-        if spec.frame is ToolFrame.SEAM and spec.normals is not None:
+        own = declares_normals(geometry.nominal.segments)
+        if spec.frame is ToolFrame.SEAM and (spec.normals is not None or own):
             normals = SeamNormal.from_geometry(spec, geometry)
         if not isinstance(spin, SpinProfile):
             return cls(spec, spec.profile(spin, length), seam, normals)
