@@ -17,14 +17,16 @@ evaluated at a position and at the arc length along their segment; both the nomi
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.specs import ArcSpec, PointsSpec, SegmentSpec
 from trackplan.tool.spec import ToolSpec
+
+if TYPE_CHECKING:
+    from scipy.interpolate import CubicSpline
 
 
 class NormalField(Protocol):
@@ -114,6 +116,10 @@ class PointsNormal:
             first = np.asarray(points.start_normal, dtype=float)
             normals = np.vstack([first / np.linalg.norm(first), normals])
             knots = np.concatenate([[0.0], knots])
+        # imported here: scipy.interpolate loads scipy's solvers, which a plan without
+        # normals on points never needs (tests/test_startup.py)
+        from scipy.interpolate import CubicSpline
+
         return cls(knots, CubicSpline(knots, normals, axis=0))
 
     def __call__(self, position: np.ndarray, sigma: np.ndarray) -> np.ndarray:
