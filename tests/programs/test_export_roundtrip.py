@@ -65,6 +65,19 @@ RUNS = [
     ("urscript", "ur5e-glue"),
 ]
 
+
+def _fast_first(runs: list[tuple[str, str]]) -> list[object]:
+    """``runs`` with the first run of each format in the fast tier, the others marked slow
+    (the fast tier keeps every format; the slow tier every run)."""
+    seen: set[str] = set()
+    params: list[object] = []
+    for format, case_name in runs:
+        marks = [pytest.mark.slow] if format in seen else []
+        seen.add(format)
+        params.append(pytest.param(format, case_name, marks=marks))
+    return params
+
+
 JOINT_PERIOD_SAMPLES = 25
 """The joint form is exported every 25th sample (the parsers read thousands of lines a
 second; every sample is exported in the slow tier)."""
@@ -138,7 +151,7 @@ def test_a_cartesian_program_reads_back_as_the_plan(
     assert "joint" in kinds and kinds & {"linear", "spline"}, kinds
 
 
-@pytest.mark.parametrize(("format", "case_name"), RUNS)
+@pytest.mark.parametrize(("format", "case_name"), _fast_first(RUNS))
 def test_a_joint_program_is_the_trajectory_sampled(
     format: str, case_name: str, runs: Callable[[str], Path], tmp_path: Path
 ) -> None:
@@ -166,7 +179,7 @@ def test_a_joint_program_is_the_trajectory_sampled(
     assert np.max(np.abs(got[0] - expected[0])) <= JOINT_TOLERANCE
 
 
-@pytest.mark.parametrize(("format", "case_name"), RUNS[::2])
+@pytest.mark.parametrize(("format", "case_name"), _fast_first(RUNS))
 def test_a_split_program_reads_back_as_the_whole(
     format: str, case_name: str, runs: Callable[[str], Path], tmp_path: Path
 ) -> None:
