@@ -55,8 +55,14 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     return R
 
 
-GIMBAL_LOCK = 1e-9
-"""|cos pitch| below which :func:`rpy_from_matrix` is at the gimbal lock (pitch = ±π/2)."""
+GIMBAL_LOCK = 1e-8
+"""|cos pitch| below which :func:`rpy_from_matrix` is at the gimbal lock (pitch = ±π/2).
+
+Near the lock the angles are ill-conditioned: the locked branch errs by about twice this
+threshold, the regular branch by the matrix's rounding over |cos pitch| (≈ 1e-16 / 1e-8).
+1e-8, about √ε, balances the two: the angles compose back to within 3e-8 of any rotation
+matrix rounded to double precision (measured on 100,000 near-lock rotations built from
+quaternions)."""
 
 
 def rpy_from_matrix(R: np.ndarray) -> np.ndarray:
