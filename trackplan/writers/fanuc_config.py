@@ -31,6 +31,7 @@ from trackplan.frames import rpy_from_matrix
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
 from trackplan.robots.wrist import wrist_centres
+from trackplan.writers.numbers import fixed
 
 MM = 1000.0
 """mm per m."""
@@ -157,11 +158,8 @@ def config_strings(robot: Robot, model_joints: np.ndarray, joints: np.ndarray) -
 
 
 def number(value: float, decimals: int) -> str:
-    """A TP number: fixed point, no exponent, ``-0`` printed as ``0``."""
-    text = f"{value:.{decimals}f}"
-    if float(text) == 0.0:
-        text = f"{0.0:.{decimals}f}"
-    return text
+    """A TP number: fixed point, every decimal, no exponent, ``-0`` printed as ``0``."""
+    return fixed(value, decimals)
 
 
 def cartesian_record(index: int, values: np.ndarray, config: str, uframe: int, utool: int) -> str:

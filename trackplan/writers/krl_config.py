@@ -27,6 +27,7 @@ from trackplan.frames import rpy_from_matrix
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
 from trackplan.robots.wrist import wrist_centres
+from trackplan.writers.numbers import fixed
 
 
 def abc_from_matrix(R: np.ndarray) -> np.ndarray:
@@ -112,24 +113,9 @@ def status_turn(robot: Robot, joints: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 def real(value: float, digits: int) -> str:
-    """A KRL REAL literal with at most ``digits`` decimals and at least one (``-0`` → ``0``).
-
-    Parameters
-    ----------
-    value
-        The number.
-    digits
-        Decimals kept (≥ 1).
-
-    Returns
-    -------
-    str
-        E.g. ``"12.5"``, ``"-0.000123"``, ``"100.0"``.
-    """
-    text = f"{value:.{digits}f}".rstrip("0")
-    if text.endswith("."):
-        text += "0"
-    return "0.0" if text in ("-0.0", "0.0") else text
+    """A KRL REAL literal with at most ``digits`` decimals and at least one (``-0`` → ``0``):
+    ``"12.5"``, ``"-0.000123"``, ``"100.0"``."""
+    return fixed(value, digits, keep=1)
 
 
 __all__ = [

@@ -21,6 +21,7 @@ from scipy.spatial.transform import Rotation
 from trackplan.robots.kinematics import axis_frames
 from trackplan.robots.model import Robot
 from trackplan.robots.wrist import wrist_centres
+from trackplan.writers.numbers import fixed
 
 _SIDE_TOLERANCE = 1e-12
 """m: a reference side closer than this to its plane counts as in front."""
@@ -150,12 +151,7 @@ def quaternion(rotation: np.ndarray) -> np.ndarray:
 
 def number(value: float, decimals: int) -> str:
     """A RAPID ``num`` literal: fixed point, trailing zeros dropped, never ``-0``."""
-    text = f"{value:.{decimals}f}"
-    if "." in text:
-        text = text.rstrip("0").rstrip(".")
-    if text in ("-0", ""):
-        text = "0"
-    return text
+    return fixed(value, decimals, keep=0)
 
 
 def numbers(values: np.ndarray, decimals: int) -> str:

@@ -14,6 +14,7 @@ from fractions import Fraction
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.writers.numbers import fixed
 
 BLEND_SHARE = 0.4
 """A blend radius is at most this share of the distance to the waypoint before and to the
@@ -31,10 +32,7 @@ relative to the tangent)."""
 def number(value: float, digits: int = 9) -> str:
     """A URScript float literal, ``digits`` decimals, trailing zeros dropped (``0.425``,
     ``-1.5``, ``0.0``)."""
-    text = f"{float(value):.{digits}f}".rstrip("0")
-    if text.endswith("."):
-        text += "0"
-    return "0.0" if text == "-0.0" else text
+    return fixed(value, digits, keep=1)
 
 
 def rotation_vectors(rotations: np.ndarray) -> np.ndarray:
