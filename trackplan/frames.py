@@ -60,9 +60,9 @@ GIMBAL_LOCK = 1e-8
 
 Near the lock the angles are ill-conditioned: the locked branch errs by about twice this
 threshold, the regular branch by the matrix's rounding over |cos pitch| (≈ 1e-16 / 1e-8).
-1e-8, about √ε, balances the two: the angles compose back to within 3e-8 of any rotation
-matrix rounded to double precision (measured on 100,000 near-lock rotations built from
-quaternions)."""
+1e-8, about √ε, balances the two: 20,000 near-lock rotations built from quaternions
+(``tests/test_frames.py``, seed 0) compose back within 2.0e-8, where a threshold of 1e-9
+leaves errors of 1e-7."""
 
 
 def rpy_from_matrix(R: np.ndarray) -> np.ndarray:
