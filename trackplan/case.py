@@ -10,9 +10,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from trackplan.axes.rules import Downhand
 from trackplan.cell.model import Cell
 from trackplan.choices import Method, Penalty, choose
+from trackplan.derived import derived
 from trackplan.paths.specs import SegmentSpec
+from trackplan.robots.machine import Machine, Positioner, Track
 from trackplan.robots.model import Robot
 from trackplan.task import Task
 
@@ -211,6 +214,13 @@ class Case:
         ``T_flange_tool`` that it replaced, shape (4, 4) (the identity for a robot without
         a tool); None when the TCP is the robot's own. ``robot.T_flange_tool`` is the TCP
         used either way.
+    track
+        The linear axis that carries the arm (``track:``), or None.
+    positioner
+        The positioner that turns the part (``positioner:``), or None; with one, the
+        placement X places the part on its flange.
+    downhand
+        The downhand rule (``downhand:``), or None.
     """
 
     name: str
@@ -226,6 +236,18 @@ class Case:
     paths: tuple[Seam, ...] = ()
     sequencing: Sequencing = field(default_factory=Sequencing)
     robot_tool: np.ndarray | None = None
+    track: Track | None = None
+    positioner: Positioner | None = None
+    downhand: Downhand | None = None
+
+    @property
+    def machine(self) -> Robot | Machine:
+        """What the planner moves: the robot, or with a track or a positioner the
+        :class:`~trackplan.robots.machine.Machine` of the robot and its external axes
+        (one joint vector: the robot's joints, the track, the positioner's axes)."""
+        if self.track is None and self.positioner is None:
+            return self.robot
+        return derived(self, "machine", lambda: Machine(self.robot, self.track, self.positioner))
 
     @property
     def tcp_source(self) -> str:

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 from trackplan.choices import Timing, choose
 from trackplan.tool import ToolSpec
+from trackplan.tool.weave import Weave
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,6 +32,8 @@ class Task:
     timing
         The time law: ``smooth`` (jerk-limited, G2 blends) or ``paper`` (Section 3.1 as
         written).
+    weave
+        The torch's weave across the seam (:class:`~trackplan.tool.weave.Weave`), or None.
     """
 
     rated_speed: float
@@ -39,6 +42,7 @@ class Task:
     sample_time: float
     tool: ToolSpec = field(default_factory=ToolSpec)
     timing: Timing = Timing.SMOOTH
+    weave: Weave | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "timing", choose(Timing, self.timing, "task.timing"))

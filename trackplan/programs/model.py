@@ -29,6 +29,29 @@ trajectory replayed sample by sample."""
 MOTION_FORMS: tuple[MotionForm, ...] = ("cartesian", "joint")
 
 
+@dataclass(frozen=True, kw_only=True)
+class ExternalAxis:
+    """An external axis of a program: a track or a positioner axis.
+
+    Attributes
+    ----------
+    name
+        Its name in the trajectory (``track``, the positioner's joint names).
+    kind
+        ``track`` or ``positioner``.
+    unit
+        ``m`` (track) or ``rad`` (positioner); targets carry SI values, each writer
+        converts to its language's unit (mm, degrees).
+    v_max
+        Rated velocity, m/s or rad/s.
+    """
+
+    name: str
+    kind: str
+    unit: str
+    v_max: float
+
+
 @dataclass(frozen=True, eq=False, kw_only=True)
 class Target:
     """A Cartesian target and the planned joints there.
@@ -44,11 +67,15 @@ class Target:
     model_joints
         The same planned joints in the robot model's convention, shape (n,), rad (for
         geometric configuration tests: wrist centre behind axis 1, elbow, flip).
+    external
+        The external axes there (:attr:`Program.external_axes`: track in m, positioner
+        axes in rad), shape (e,); empty without external axes.
     """
 
     pose: np.ndarray
     joints: np.ndarray
     model_joints: np.ndarray
+    external: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -70,6 +97,8 @@ class JointMove:
         The move's time, s, when the program times it (``--motion joint``), else None.
     zone
         Blend radius at the end, m; 0 stops there.
+    external
+        The external axes at the end (:attr:`Program.external_axes`), shape (e,).
     """
 
     joints: np.ndarray
@@ -77,6 +106,7 @@ class JointMove:
     speed: float
     duration: float | None = None
     zone: float = 0.0
+    external: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -233,6 +263,9 @@ class Program:
         The run's verdict.
     v_max
         Each joint's rated velocity, shape (n,), rad/s (for joint speeds as a share).
+    external_axes
+        The external axes every target carries, in order (track, then the positioner's);
+        empty for an arm alone.
     """
 
     name: str
@@ -249,6 +282,7 @@ class Program:
     budget: Budget | None = None
     feasible: bool = True
     v_max: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    external_axes: tuple[ExternalAxis, ...] = ()
 
     def moves(self) -> Iterator[Move]:
         """Every move in order."""
