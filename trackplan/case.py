@@ -67,6 +67,9 @@ class Objective:
         ``time`` or ``weighted`` (see :mod:`trackplan.planning.objectives`).
     mix
         For ``weighted``: coefficient of each objective by name.
+    external_weights
+        Weights of the external axes' travel (track per m, positioner axes per rad), in the
+        machine's order; empty: 0 for each (only the arm's travel counts).
     """
 
     weights: np.ndarray
@@ -75,6 +78,7 @@ class Objective:
     flat_penalty: float = 1.0e6
     kind: str = "travel"
     mix: dict[str, float] = field(default_factory=dict)
+    external_weights: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "penalty", choose(Penalty, self.penalty, "objective.penalty"))
@@ -239,6 +243,17 @@ class Case:
     track: Track | None = None
     positioner: Positioner | None = None
     downhand: Downhand | None = None
+
+    @property
+    def travel_weights(self) -> np.ndarray:
+        """The weight of every joint of :attr:`machine` in the travel (Eq. 8), shape (n,):
+        ``objective.weights`` for the arm, ``objective.external_weights`` (or 0) for the
+        external axes."""
+        n_external = self.machine.n_dof - self.robot.n_dof
+        external = np.asarray(self.objective.external_weights, dtype=float)
+        if external.size == 0:
+            external = np.zeros(n_external)
+        return np.concatenate([np.asarray(self.objective.weights, dtype=float), external])
 
     @property
     def machine(self) -> Robot | Machine:

@@ -15,9 +15,11 @@ from functools import cached_property
 
 import numpy as np
 
+from trackplan.axes.profile import AxesProfile
 from trackplan.derived import derived
 from trackplan.frames import placement_transform, tool_pose_parts, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
+from trackplan.robots.machine import Machine, arm_of
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import PathIK, branch_joints_along, solve_path_ik
 from trackplan.status import Status
@@ -33,10 +35,14 @@ derivatives change, large against the IK's round-off."""
 class JointPath:
     """IK of a placed path on its planning grid, one branch, continuous.
 
+    With a :class:`~trackplan.robots.machine.Machine` (a track, a positioner) the joints are
+    the machine's joint vector: the arm's by IK, the external axes' from :attr:`axes`, and
+    the placement X places the part in the machine's carrier frame.
+
     Attributes
     ----------
     robot
-        The robot.
+        The robot, or the machine of the robot and its external axes.
     geometry
         The case's paths and zones.
     placement
@@ -54,9 +60,11 @@ class JointPath:
         dq/ds, d²q/ds², d³q/ds³ at the grid, shape (G, n), rad/m, rad/m², rad/m³.
     ik
         The path IK over the grid and its stencils (branch, status, message, margin).
+    axes
+        The external axes along the path (a machine's), or None for a robot.
     """
 
-    robot: Robot
+    robot: Robot | Machine
     geometry: PathGeometry
     placement: np.ndarray
     tool: ToolOrientation
@@ -67,22 +75,24 @@ class JointPath:
     ddq: np.ndarray
     dddq: np.ndarray
     ik: PathIK
+    axes: AxesProfile | None = None
 
     @classmethod
     def solve(
         cls,
-        robot: Robot,
+        robot: Robot | Machine,
         geometry: PathGeometry,
         placement: np.ndarray,
         tool: ToolOrientation,
         branch: int | None = None,
+        axes: AxesProfile | None = None,
     ) -> JointPath:
         """Poses and path IK of the planning grid, in one pose pass and one IK pass.
 
         Parameters
         ----------
         robot
-            The robot.
+            The robot, or a machine (then ``axes`` is required).
         geometry
             The case's paths (:meth:`PathGeometry.zone_grids` gives the grid).
         placement
@@ -91,6 +101,8 @@ class JointPath:
             Tool orientation along the path (:class:`trackplan.tool.ToolOrientation`).
         branch
             Force an IK branch; default: the usable one with the largest margin.
+        axes
+            A machine's external axes along the path (track, positioner), m and rad.
 
         Returns
         -------
@@ -100,13 +112,24 @@ class JointPath:
         """
         placement = np.asarray(placement, dtype=float)
         grid = _planning_grid(geometry)
+        arm = arm_of(robot)
         rotations = _rotations(tool, grid.points.ravel(), grid.tangents)
         poses = tool_poses(placement, grid.positions, rotations)
-        ik = solve_path_ik(robot, poses[None], branch=branch)
-        q_points = ik.q[0].reshape(*grid.points.shape, robot.n_dof)
+        external = _external(robot, axes, grid.points.ravel())
+        if external is not None:
+            poses = _carried(robot, external) @ poses
+        ik = solve_path_ik(arm, poses[None], branch=branch)
+        q_points = ik.q[0].reshape(*grid.points.shape, arm.n_dof)
+        if external is not None:
+            q_points = np.concatenate([q_points, external.reshape(*grid.points.shape, -1)], axis=-1)
         dq, ddq, dddq = stencil_derivatives(q_points, grid.offset, grid.h)
         q = q_points[np.arange(len(grid.s)), grid.offset]
-        return cls(robot, geometry, placement, tool, grid.s, grid.zone, q, dq, ddq, dddq, ik)
+        return cls(robot, geometry, placement, tool, grid.s, grid.zone, q, dq, ddq, dddq, ik, axes)
+
+    @property
+    def arm(self) -> Robot:
+        """The robot arm (the robot itself, or a machine's arm)."""
+        return arm_of(self.robot)
 
     @property
     def success(self) -> bool:
@@ -144,9 +167,14 @@ class JointPath:
         return self.tool.rotations(s_path, tangent)
 
     def poses(self, s: np.ndarray) -> np.ndarray:
-        """Tool poses in the base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
+        """Tool poses in the arm's base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
         s_path, position, tangent = self.geometry.planned.points(np.asarray(s, dtype=float))
-        return tool_poses(self.placement, position, _rotations(self.tool, s_path, tangent))
+        poses = tool_poses(self.placement, position, _rotations(self.tool, s_path, tangent))
+        external = _external(self.robot, self.axes, np.asarray(s, dtype=float))
+        if external is None:
+            return poses
+        carried: np.ndarray = _carried(self.robot, external) @ poses
+        return carried
 
     def joints(self, s: np.ndarray) -> np.ndarray:
         """Joint positions at arc lengths ``s`` by IK on this path's branch.
@@ -171,16 +199,32 @@ class JointPath:
         rotations = _rotations(self.tool, s_path, tangent)
         R_base_tool, p_base_tool = tool_pose_parts(self.placement, position, rotations)
         grid, q_grid = self._distinct_grid
-        return branch_joints_along(
-            self.robot, R_base_tool, p_base_tool, self.branch, s, grid, q_grid
+        external = _external(self.robot, self.axes, s)
+        if external is None:
+            return branch_joints_along(
+                self.arm, R_base_tool, p_base_tool, self.branch, s, grid, q_grid
+            )
+        carrier = _carried(self.robot, external)
+        R_base_tool = carrier[:, :3, :3] @ R_base_tool
+        p_base_tool = np.einsum("mij,mj->mi", carrier[:, :3, :3], p_base_tool) + carrier[:, :3, 3]
+        n_arm = self.arm.n_dof
+        q_arm = branch_joints_along(
+            self.arm,
+            np.ascontiguousarray(R_base_tool),
+            np.ascontiguousarray(p_base_tool),
+            self.branch,
+            s,
+            grid,
+            np.ascontiguousarray(q_grid[:, :n_arm]),
         )
+        return np.concatenate([q_arm, external], axis=1)
 
     def interpolate(self, s: np.ndarray) -> np.ndarray:
         """q at ``s`` (M,) by linear interpolation of the grid, shape (M, n), rad."""
         grid, q_grid = self._distinct_grid
         s = np.asarray(s, dtype=float)
-        out = np.empty((len(s), self.robot.n_dof))
-        for j in range(self.robot.n_dof):
+        out = np.empty((len(s), q_grid.shape[1]))
+        for j in range(q_grid.shape[1]):
             out[:, j] = np.interp(s, grid, q_grid[:, j])
         return out
 
@@ -214,6 +258,33 @@ class JointPath:
         points, offset = stencil_points(np.asarray(s, dtype=float), lo, hi, spacing)
         q = self.joints(points.ravel()).reshape(*points.shape, self.robot.n_dof)
         return stencil_derivatives(q, offset, spacing)
+
+
+def _external(robot: Robot | Machine, axes: AxesProfile | None, s: np.ndarray) -> np.ndarray | None:
+    """A machine's external axes at arc lengths ``s`` (M,), shape (M, n_external), or None
+    for a robot.
+
+    Raises
+    ------
+    ValueError
+        When a machine comes without its axes' profile, or with one of another size.
+    """
+    if not isinstance(robot, Machine):
+        return None
+    if axes is None or axes.n_axes != robot.n_external:
+        found = None if axes is None else axes.n_axes
+        raise ValueError(
+            f"a machine with {robot.n_external} external axes needs their profile, got {found}"
+        )
+    return axes.values(s)
+
+
+def _carried(machine: Robot | Machine, external: np.ndarray) -> np.ndarray:
+    """``T_base_carrier`` at the external axes' positions (M, e), shape (M, 4, 4)."""
+    assert isinstance(machine, Machine)
+    q = np.zeros((len(external), machine.n_dof))
+    q[:, machine.n_arm :] = external
+    return machine.T_base_carrier(q)
 
 
 def _rotations(tool: ToolOrientation, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:

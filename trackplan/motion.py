@@ -21,6 +21,7 @@ import numpy as np
 from trackplan.derivatives import REST_PADDING, backward_derivatives
 from trackplan.robots.dynamics.rne import inverse_dynamics
 from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 
 
@@ -35,7 +36,8 @@ class JointSamples:
     Attributes
     ----------
     robot
-        The robot.
+        The robot, or a machine (the arm with a track or a positioner: ``q`` is its whole
+        joint vector).
     q
         Joint positions, shape (N, n), rad, one row per controller period; not to be
         changed once the motion exists (the derived arrays are those of these values).
@@ -43,7 +45,7 @@ class JointSamples:
         Ts, s.
     """
 
-    robot: Robot
+    robot: Robot | Machine
     q: np.ndarray
     sample_time: float
 
@@ -90,7 +92,7 @@ class JointSamples:
     def torque(self) -> np.ndarray | None:
         """Joint torques by inverse dynamics of ``q_held``, ``qd``, ``qdd``, shape (N + 3, n),
         N·m (``docs/dynamics.md``); None for a robot without dynamics."""
-        if self.robot.dynamics is None:
+        if isinstance(self.robot, Machine) or self.robot.dynamics is None:
             return None
         tau = inverse_dynamics(self.robot, self.q_held, self.qd, self.qdd)
         tau.flags.writeable = False
@@ -98,8 +100,13 @@ class JointSamples:
 
     @cached_property
     def T_base_tool(self) -> np.ndarray:
-        """Tool poses by FK in the base frame, shape (N, 4, 4)."""
-        poses = forward_kinematics(self.robot, self.q)
+        """Tool poses by FK in the base frame, shape (N, 4, 4); for a machine, in its
+        carrier frame (the frame the placement X refers to: the positioner's flange, or the
+        cell), :meth:`~trackplan.robots.machine.Machine.T_carrier_tool`."""
+        if isinstance(self.robot, Machine):
+            poses = self.robot.T_carrier_tool(self.q)
+        else:
+            poses = forward_kinematics(self.robot, self.q)
         poses.flags.writeable = False
         return poses
 

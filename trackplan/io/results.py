@@ -19,6 +19,7 @@ from trackplan.io.csv_table import format_table, write_csv_table
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.io.sizes import MAX_TRAJECTORY_BYTES, max_samples
 from trackplan.planning.result import SEAM, CheckReport, PlanResult, Trajectory
+from trackplan.robots.machine import machine_of
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 from trackplan.timing.protocol import SlowDown
 
@@ -333,12 +334,24 @@ def plan_summary(result: PlanResult, case: Case) -> dict:
     plan's figures (:func:`result_summary`), then its seams, moves and sequence
     (:func:`seams_summary`)."""
     return {
-        **result_summary(result, case.robot.joint_names),
+        **result_summary(result, case.machine.joint_names),
+        "axes": axes_summary(case),
         "case_file": case_file(case),
         "robot_file": robot_file(case),
         "tcp": tcp_summary(case),
         **seams_summary(result, case),
     }
+
+
+def axes_summary(case: Case) -> list[dict]:
+    """``result.json``'s ``axes``: every joint of the trajectory in order (the robot's, the
+    track, the positioner's), each with its ``name``, ``kind`` (``robot``, ``track`` or
+    ``positioner``) and ``unit`` (``rad`` or ``m``)."""
+    machine = machine_of(case.machine)
+    return [
+        {"name": name, "kind": kind, "unit": unit}
+        for name, kind, unit in zip(machine.joint_names, machine.kinds, machine.units, strict=True)
+    ]
 
 
 def tcp_summary(case: Case) -> dict:
@@ -442,7 +455,7 @@ def write_plan_csv(result: PlanResult, file: Path, *, labels: bool = True) -> No
 def seams_summary(result: PlanResult, case: Case) -> dict:
     """The ``result.json`` keys of the seams, the moves and the sequence of a plan (plain
     JSON types; ``docs/files.md``)."""
-    joint_names = case.robot.joint_names
+    joint_names = case.machine.joint_names
     sample_time = result.trajectory.sample_time
     seams = []
     for seam, own in zip(result.seams, result.seam_checks, strict=True):

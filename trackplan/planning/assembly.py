@@ -68,7 +68,7 @@ def join_seams(case: Case, X: np.ndarray, stage: SeamStage, sequence: Sequence) 
     plans, ends = stage.plans, stage.ends
     approach, home = case.sequencing.approach, case.sequencing.home
     geometries = {key: plans[key].joint_path.geometry for key in plans}
-    robot = case.robot
+    robot = case.machine
     seams = case.seams
     sample_time = case.task.sample_time
     parts: list[_Part] = []
@@ -178,7 +178,7 @@ def join_seams(case: Case, X: np.ndarray, stage: SeamStage, sequence: Sequence) 
         branch=first_plan.branch,
         trajectory=trajectory,
         check=check,
-        objective=float(joint_travel(q_cycle, case.objective.weights)),
+        objective=float(joint_travel(q_cycle, case.travel_weights)),
         duration=trajectory.duration,
         path_length=float(lengths.sum()),
         rated_speed_fraction=float(fractions @ lengths / lengths.sum()),
@@ -285,7 +285,7 @@ def unplanned(case: Case, X: np.ndarray, failed: dict[str, PlanResult]) -> PlanR
     name, plan = next(iter(failed.items()))
     if not has_moves(case, given_sequence(len(case.seams))):
         return replace(plan, case_name=case.name, unplanned=dict(failed))
-    n = case.robot.n_dof
+    n = case.machine.n_dof
     trajectory = Trajectory.empty(n, case.task.sample_time)
     status = plan.status if plan.status is not Status.FEASIBLE else Status.UNREACHABLE
     check = CheckReport.of_nothing(status)

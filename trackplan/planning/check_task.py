@@ -30,6 +30,7 @@ from trackplan.planning.tracking import (
     jump_allowance,
     locate_on_nominal,
 )
+from trackplan.robots.machine import Machine
 from trackplan.robots.path_ik import _NEWTON_TOL as NEWTON_TOLERANCE
 
 IK_POSITION_TOLERANCE = NEWTON_TOLERANCE
@@ -88,18 +89,24 @@ def check_task(
     # read), in the definition frame; and its points between the samples, along the
     # joint-space interpolation a controller follows (each period in parts of at most
     # BETWEEN_STEP ρ of chord, at least two): one compiled pass over the poses and joints
-    chain, tail = robot.kernel_chain
-    # read-only inputs: one compiled version whoever made them (read_only)
-    p_part, velocity, speed, x_part, z_part, p_between, t_between = _kernels.task_frames(
-        read_only(np.ascontiguousarray(motion.T_base_tool)),
-        read_only(T_base_part),
-        sample_time,
-        read_only(chain),
-        read_only(tail),
-        read_only(np.ascontiguousarray(q)),
-        BETWEEN_STEP * ref.tolerance,
-        MAX_BETWEEN_PER_PERIOD,
-    )
+    if isinstance(robot, Machine):
+        frames = machine_task_frames(
+            robot, motion.T_base_tool, T_base_part, sample_time, q, BETWEEN_STEP * ref.tolerance
+        )
+    else:
+        chain, tail = robot.kernel_chain
+        # read-only inputs: one compiled version whoever made them (read_only)
+        frames = _kernels.task_frames(
+            read_only(np.ascontiguousarray(motion.T_base_tool)),
+            read_only(T_base_part),
+            sample_time,
+            read_only(chain),
+            read_only(tail),
+            read_only(np.ascontiguousarray(q)),
+            BETWEEN_STEP * ref.tolerance,
+            MAX_BETWEEN_PER_PERIOD,
+        )
+    p_part, velocity, speed, x_part, z_part, p_between, t_between = frames
     t = np.arange(len(q)) * sample_time
     violations: list[Violation] = []
     margins: dict[str, float] = {}
@@ -149,6 +156,63 @@ def check_task(
     margins["coverage"] = 1.0 if not coverage else -1.0
     violations.extend(coverage)
     return (margins, violations), worst, orientation_error
+
+
+def machine_task_frames(
+    machine: Machine,
+    T_carrier_tool: np.ndarray,
+    T_carrier_part: np.ndarray,
+    sample_time: float,
+    q: np.ndarray,
+    chord_step: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`trackplan.planning._kernels.task_frames` of a machine, whose part moves with
+    its carrier: the tool relative to the part at the samples and between them (every
+    joint, the external axes too, interpolated linearly within a period).
+
+    Parameters
+    ----------
+    machine
+        The arm and its external axes.
+    T_carrier_tool
+        The tool in the carrier frame at the samples, shape (N, 4, 4).
+    T_carrier_part
+        The placement X in the carrier frame, shape (4, 4).
+    sample_time
+        Ts, s.
+    q
+        The joint vector at the samples, shape (N, n).
+    chord_step
+        Largest chord between checked points, m (> 0).
+
+    Returns
+    -------
+    tuple
+        As the kernel: points, velocity (N, 3), speed (N,), x and z axes (N, 3), the points
+        between the samples (K, 3) and their times in periods (K,).
+    """
+    R = T_carrier_part[:3, :3]
+    origin = T_carrier_part[:3, 3]
+    points = (T_carrier_tool[:, :3, 3] - origin) @ R
+    x_axis = T_carrier_tool[:, :3, 0] @ R
+    z_axis = T_carrier_tool[:, :3, 2] @ R
+    velocity = np.zeros_like(points)
+    velocity[1:] = (points[1:] - points[:-1]) / sample_time
+    speed = np.linalg.norm(velocity, axis=1)
+    if len(q) < 2:
+        return points, velocity, speed, x_axis, z_axis, np.zeros((0, 3)), np.zeros(0)
+    chord = np.linalg.norm(points[1:] - points[:-1], axis=1)
+    with np.errstate(invalid="ignore"):
+        parts = np.ceil(chord / chord_step)
+    parts = np.where(np.isfinite(parts), parts, 2.0)
+    parts = np.clip(parts, 2, MAX_BETWEEN_PER_PERIOD).astype(np.int64)
+    period = np.repeat(np.arange(len(parts)), parts - 1)
+    first = np.cumsum(parts - 1) - (parts - 1)
+    j = np.arange(len(period)) - first[period] + 1
+    fraction = j / parts[period]
+    q_between = q[period] + fraction[:, None] * (q[period + 1] - q[period])
+    between = (machine.T_carrier_tool(q_between)[:, :3, 3] - origin) @ R
+    return points, velocity, speed, x_axis, z_axis, between, period + fraction
 
 
 def speed_verdict(

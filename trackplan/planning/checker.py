@@ -20,6 +20,7 @@ from trackplan.planning.check_joints import check_joint_limits
 from trackplan.planning.check_reference import ORIENTATION_TOLERANCE, TrackingReference
 from trackplan.planning.check_task import IK_POSITION_TOLERANCE, check_task, speed_slack
 from trackplan.planning.check_violations import RELATIVE_SLACK, UNITS
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 
 if TYPE_CHECKING:
@@ -27,7 +28,7 @@ if TYPE_CHECKING:
 
 
 def check_trajectory(
-    robot: Robot,
+    robot: Robot | Machine,
     q: np.ndarray,
     sample_time: float,
     reference: TrackingReference | None = None,
@@ -43,7 +44,7 @@ def check_trajectory(
     Parameters
     ----------
     robot
-        The robot (limits and kinematics).
+        The robot (limits and kinematics), or a machine (``q`` its whole joint vector).
     q
         Joint positions, shape (N, n), rad, one row per controller period.
     sample_time

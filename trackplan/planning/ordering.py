@@ -30,14 +30,14 @@ def order_seams(case: Case, stage: SeamStage) -> Sequence:
 
 def _move_cost(case: Case, q_from: np.ndarray, q_to: np.ndarray) -> np.ndarray:
     """Estimated cost of air moves, shape of the leading axes: seconds, or J + w·T."""
-    robot = case.robot
+    robot = case.machine
     from trackplan.timing.airmove import air_time_estimate  # ruckig: only with moves
 
     time = air_time_estimate(q_from, q_to, robot.v_max, robot.a_max, robot.j_max)
     weight = case.objective.time_weight
     if weight == 0.0:
         return np.asarray(time)
-    travel = np.sum(case.objective.weights * np.abs(np.asarray(q_to) - q_from), axis=-1)
+    travel = np.sum(case.travel_weights * np.abs(np.asarray(q_to) - q_from), axis=-1)
     return np.asarray(travel + weight * time)
 
 
@@ -61,7 +61,7 @@ def sequence_costs(
         ``end_cost`` (m, 2) and ``reversible`` (m,).
     """
     m = len(case.seams)
-    n = case.robot.n_dof
+    n = case.machine.n_dof
     weight = case.objective.time_weight
     seam_cost = np.full((m, 2), np.inf)
     q_in = np.zeros((m, 2, n))

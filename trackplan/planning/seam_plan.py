@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from trackplan.axes.choose import choose_axes
 from trackplan.case import Case
 from trackplan.derived import derived
 from trackplan.errors import CaseError
@@ -24,6 +25,7 @@ from trackplan.planning.energy import motion_energy
 from trackplan.planning.objectives import joint_travel
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.planning.tool_zones import transition_zones
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.task import Task
@@ -80,7 +82,11 @@ def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> Tra
 
 
 def make_trajectory(
-    robot: Robot, q: np.ndarray, s: np.ndarray, sample_time: float, spin: np.ndarray | None = None
+    robot: Robot | Machine,
+    q: np.ndarray,
+    s: np.ndarray,
+    sample_time: float,
+    spin: np.ndarray | None = None,
 ) -> Trajectory:
     """Sampled trajectory with derivatives exactly as the checker computes them.
 
@@ -116,11 +122,13 @@ def motion_trajectory(
         Spin about the tool axis per sample, shape (N,), rad; default 0.
     """
     q, sample_time, n = motion.q, motion.sample_time, motion.n_samples
-    position = motion.T_base_tool[:, :3, 3]
+    position = motion.T_base_tool[:, :3, 3]  # relative to the part's carrier
     step = np.empty(position.shape)  # np.diff(position, axis=0, prepend=position[:1])
     np.subtract(position[:1], position[:1], out=step[:1])
     np.subtract(position[1:], position[:-1], out=step[1:])
     speed = vector_norms(step) / sample_time
+    if isinstance(motion.robot, Machine):  # the tool point in the cell frame
+        position = motion.robot.T_cell_tool(q)[:, :3, 3]
     return Trajectory(
         sample_time=sample_time,
         t=np.arange(n) * sample_time,
@@ -181,7 +189,11 @@ def plan_seam(
     if geometry is None or geometry.mode != law.path_mode:
         geometry = case_geometry(case, law.path_mode)
     tool = ToolOrientation.choose(case.task.tool, geometry, spin)
-    joint_path = JointPath.solve(case.robot, geometry, X, tool, branch)
+    machine = case.machine
+    axes = None
+    if isinstance(machine, Machine):
+        axes = choose_axes(machine, geometry, case.task.tool, X, case.downhand)
+    joint_path = JointPath.solve(machine, geometry, X, tool, branch, axes)
     if not joint_path.success:
         message = joint_path.message + _twist_note(joint_path)
         return _unplanned(case, joint_path, law.timing, joint_path.status, message)
@@ -236,7 +248,7 @@ def _unplanned(
     case: Case, joint_path: JointPath, timing: str, status: Status, message: str
 ) -> PlanResult:
     """The result of a placement that has no trajectory."""
-    n_dof = case.robot.n_dof
+    n_dof = case.machine.n_dof
     trajectory = Trajectory.empty(n_dof, case.task.sample_time)
     check = CheckReport.of_nothing(status)
     return PlanResult(
@@ -265,8 +277,8 @@ def _checked(case: Case, joint_path: JointPath, timed: TimedPath) -> PlanResult:
     geometry = joint_path.geometry
     spin = joint_path.tool.spin.value(timed.s)
     motion = timed.motion
-    if motion is None or motion.q is not timed.q or motion.robot is not case.robot:
-        motion = JointSamples(case.robot, timed.q, timed.sample_time)
+    if motion is None or motion.q is not timed.q or motion.robot is not case.machine:
+        motion = JointSamples(case.machine, timed.q, timed.sample_time)
     trajectory = motion_trajectory(motion, timed.s, spin)
     check = check_motion(
         motion, tracking_reference(case, geometry, joint_path.placement), cell_geometry(case)
@@ -291,7 +303,7 @@ def _checked(case: Case, joint_path: JointPath, timed: TimedPath) -> PlanResult:
         branch=joint_path.branch,
         trajectory=trajectory,
         check=check,
-        objective=float(joint_travel(timed.q, case.objective.weights)),
+        objective=float(joint_travel(timed.q, case.travel_weights)),
         duration=trajectory.duration,
         path_length=geometry.nominal.length,
         rated_speed_fraction=fraction,
@@ -299,7 +311,7 @@ def _checked(case: Case, joint_path: JointPath, timed: TimedPath) -> PlanResult:
         slowdowns=timed.slowdowns,
         references={},
         joint_path=joint_path,
-        energy=None if case.robot.dynamics is None else motion_energy(motion),
+        energy=None if motion.torque is None else motion_energy(motion),
     )
 
 
@@ -330,4 +342,4 @@ def cell_geometry(case: Case) -> CellGeometry | None:
         return None
     from trackplan.cell.screening import CellGeometry
 
-    return CellGeometry.from_cell(case.cell, case.robot)
+    return CellGeometry.from_cell(case.cell, case.machine)

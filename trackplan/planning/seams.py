@@ -28,6 +28,7 @@ from trackplan.planning.result import PlanResult
 from trackplan.planning.seam_plan import plan_seam
 from trackplan.planning.sequence import Sequence
 from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import solve_path_ik
 from trackplan.status import Status
@@ -192,7 +193,7 @@ def seam_spin(
 
 
 def approach_configuration(
-    robot: Robot, q_end: np.ndarray, distance: float, branch: int
+    robot: Robot | Machine, q_end: np.ndarray, distance: float, branch: int
 ) -> tuple[np.ndarray | None, str]:
     """The configuration ``distance`` metres back along the tool axis from a seam end.
 
@@ -204,7 +205,7 @@ def approach_configuration(
     Parameters
     ----------
     robot
-        The robot.
+        The robot, or a machine (its external axes held where they are at the seam end).
     q_end
         The seam's first or last configuration, shape (n,), rad.
     distance
@@ -221,6 +222,12 @@ def approach_configuration(
     q_end = np.asarray(q_end, dtype=float)
     if distance == 0.0:
         return q_end.copy(), ""
+    if isinstance(robot, Machine):
+        arm = robot.arm
+        q_arm, why = approach_configuration(arm, q_end[: arm.n_dof], distance, branch)
+        if q_arm is None:
+            return None, why
+        return np.concatenate([q_arm, q_end[arm.n_dof :]]), ""
     T_end = forward_kinematics(robot, q_end)
     back = np.linspace(0.0, distance, APPROACH_POSES)
     T_line = np.repeat(T_end[None], APPROACH_POSES, axis=0)
@@ -353,8 +360,8 @@ def plan_seams(
                 problems.append(plan)
                 continue
             q = plan.trajectory.q
-            q_in, why_in = approach_configuration(case.robot, q[0], approach, plan.branch)
-            q_out, why_out = approach_configuration(case.robot, q[-1], approach, plan.branch)
+            q_in, why_in = approach_configuration(case.machine, q[0], approach, plan.branch)
+            q_out, why_out = approach_configuration(case.machine, q[-1], approach, plan.branch)
             if q_in is None or q_out is None:
                 problems.append(_without_trajectory(plan, why_in or why_out))
                 continue

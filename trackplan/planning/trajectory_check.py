@@ -22,7 +22,7 @@ from trackplan.planning.checker import check_trajectory
 from trackplan.planning.result import MOVE_KINDS, SEAM, CheckReport, Span, Violation
 from trackplan.planning.seam_plan import case_geometry, cell_geometry, tracking_reference
 from trackplan.planning.seams import SeamGeometries, reversed_segments, seam_direction_case
-from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.machine import carrier_tool
 from trackplan.timing import time_law
 
 if TYPE_CHECKING:  # the cell's compiled screening only for cases with a cell
@@ -77,7 +77,7 @@ def check_spans(
             cell = cell_geometry(case)
             known = _seam_report(case, X, q, sample_time, spans[0], geometries, timing, cell)
         return known, (known,)
-    whole = check_trajectory(case.robot, q, sample_time)
+    whole = check_trajectory(case.machine, q, sample_time)
     cell = cell_geometry(case)
     cell_report = None
     violations = list(whole.violations)
@@ -85,7 +85,7 @@ def check_spans(
     if cell is not None:  # the cell's exact check (coal) only for a case with a cell
         from trackplan.cell.check import check_cell
 
-        cell_report = check_cell(cell, case.robot, q, sample_time, placement_transform(X))
+        cell_report = check_cell(cell, case.machine, q, sample_time, placement_transform(X))
         violations += list(cell_report.violations)
         task_margins["clearance"] = cell_report.margin
     seam_checks: list[CheckReport] = []
@@ -173,7 +173,7 @@ def spans_from_segments(
             )
         i = names.index(label)
         seam = case.seams[i]
-        tool = forward_kinematics(case.robot, q[first])[:3, 3]
+        tool = carrier_tool(case.machine, q[first])[:3, 3]
         forward = T_base_part[:3, :3] @ seam.start + T_base_part[:3, 3]
         backward_start, _ = reversed_segments(seam.start, seam.segments)
         backward = T_base_part[:3, :3] @ backward_start + T_base_part[:3, 3]
@@ -192,7 +192,7 @@ def _runs_backwards(case: Case, index: int, q: np.ndarray, T_base_part: np.ndarr
     projections on the seam as written at a quarter and at half of the run go backwards."""
     seam = case.seams[index]
     quarter, half = len(q) // 4, len(q) // 2
-    frames = forward_kinematics(case.robot, q[[quarter, half]])
+    frames = carrier_tool(case.machine, q[[quarter, half]])
     points = (frames[:, :3, 3] - T_base_part[:3, 3]) @ T_base_part[:3, :3]  # part frame
     s, _ = NominalPath.from_specs(seam.start, seam.segments).project(points)
     return bool(s[1] < s[0])
@@ -235,7 +235,7 @@ def _seam_report(
         geometry = case_geometry(seam_case, mode)
     reference = tracking_reference(seam_case, geometry, X)
     samples = q[span.first : span.last + 1]
-    return check_trajectory(case.robot, samples, sample_time, reference, cell)
+    return check_trajectory(case.machine, samples, sample_time, reference, cell)
 
 
 __all__ = ["check_spans", "spans_from_segments", "uncovered_seams"]

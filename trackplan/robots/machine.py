@@ -358,6 +358,14 @@ class Machine:
         return T
 
 
+def carrier_tool(robot: Robot | Machine, q: np.ndarray) -> np.ndarray:
+    """The tool in the frame the placement X refers to: the base frame of a robot
+    (its FK), a machine's carrier frame (:meth:`Machine.T_carrier_tool`); shape (..., 4, 4)."""
+    if isinstance(robot, Machine):
+        return robot.T_carrier_tool(q)
+    return forward_kinematics(robot, q)
+
+
 def arm_of(robot: Robot | Machine) -> Robot:
     """The arm of a robot or a machine."""
     return robot.arm if isinstance(robot, Machine) else robot

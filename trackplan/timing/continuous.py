@@ -66,6 +66,7 @@ import numpy as np
 
 from trackplan.jointpath import JointPath
 from trackplan.motion import JointSamples
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.task import Task
 from trackplan.timing.curve_nodes import CAP_SHARE, Stretch, node_steps, split_stretches
@@ -329,7 +330,9 @@ def _lower(
     hits += touched
 
 
-def _joint_caps(stretch: Stretch, robot: Robot, share: float) -> tuple[np.ndarray, np.ndarray]:
+def _joint_caps(
+    stretch: Stretch, robot: Robot | Machine, share: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Highest constant speed the joints allow at each node, shape (G,), m/s, and what sets
     it (e.g. ``"joint 4 jerk"``), shape (G,)."""
     q1, q2, q3 = (np.abs(d).max(axis=0) for d in (stretch.d1, stretch.d2, stretch.d3))

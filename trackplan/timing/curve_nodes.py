@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.jointpath import STENCIL_FRACTION, JointPath
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.task import Task
 from trackplan.timing.sample_checks import LIMIT_MARGIN
@@ -98,7 +99,7 @@ def _demand(
     grid: np.ndarray,
     values: list[np.ndarray],
     exact: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
-    robot: Robot,
+    robot: Robot | Machine,
 ) -> tuple[list[np.ndarray], np.ndarray]:
     """q', q'', q''' at the nodes ``s`` (G,) just before and just after each, shape
     (2, G, n) each, and the gaps of the planning grid where the joint demand rises between
@@ -164,7 +165,7 @@ def _features(
     s: np.ndarray,
     missed: np.ndarray,
     exact: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
-    robot: Robot,
+    robot: Robot | Machine,
     rated: float,
 ) -> np.ndarray:
     """Points (F,), m, where the joint demand steps between two nodes.
@@ -204,7 +205,7 @@ def _features(
 
 
 def _steady_demand(
-    derivatives: tuple[np.ndarray, np.ndarray, np.ndarray], robot: Robot
+    derivatives: tuple[np.ndarray, np.ndarray, np.ndarray], robot: Robot | Machine
 ) -> np.ndarray:
     """One over the cube of the constant speed the joints' acceleration and jerk limits
     allow at each point, shape (M,), s³/m³: the largest ``(|q''| / a_max)^1.5`` and

@@ -21,6 +21,7 @@ from dataclasses import InitVar, dataclass, field
 
 import numpy as np
 
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.timing import _kernels, _kernels_samples
 from trackplan.timing._kernels import MAX_PATH_ACCELERATION, MAX_PATH_JERK
@@ -181,7 +182,7 @@ class ZoneDemand:
         stop = min(int(np.searchsorted(self.s, s_to, side="left")) + 2, len(self.s))
         return slice(first, max(stop, first + 1))
 
-    def local_caps(self, robot: Robot, share: float) -> np.ndarray:
+    def local_caps(self, robot: Robot | Machine, share: float) -> np.ndarray:
         """Highest constant speed the joint limits allow at each grid point, shape (G,), m/s.
 
         Per point the least of ``share · v_max / |q'|``, ``√(share · a_max / |q''|)`` and
@@ -194,7 +195,7 @@ class ZoneDemand:
 
 
 def cruise_cap(
-    robot: Robot, peaks: tuple[np.ndarray, np.ndarray, np.ndarray], share: float
+    robot: Robot | Machine, peaks: tuple[np.ndarray, np.ndarray, np.ndarray], share: float
 ) -> tuple[float, str]:
     """Highest constant path speed the joint limits allow given peak demands, and what binds.
 
@@ -234,7 +235,10 @@ def cruise_cap(
 
 
 def uniform_change_bounds(
-    robot: Robot, peaks: tuple[np.ndarray, np.ndarray, np.ndarray], top_speed: float, share: float
+    robot: Robot | Machine,
+    peaks: tuple[np.ndarray, np.ndarray, np.ndarray],
+    top_speed: float,
+    share: float,
 ) -> tuple[float, float]:
     """Path acceleration and jerk bounds valid wherever the demand stays below ``peaks``.
 
@@ -254,7 +258,7 @@ def uniform_change_bounds(
 
 
 def uniform_change_bounds_many(
-    robot: Robot,
+    robot: Robot | Machine,
     peaks: tuple[np.ndarray, np.ndarray, np.ndarray] | np.ndarray,
     top_speed: np.ndarray,
     share: float,
@@ -321,7 +325,7 @@ class SpeedChange:
 
 
 def speed_change(
-    robot: Robot,
+    robot: Robot | Machine,
     demand: ZoneDemand,
     s_start: float,
     s_end: float,
@@ -411,7 +415,7 @@ _PHASE_SHARES = np.linspace(0.0, 1.0, PHASE_POINTS)
 
 
 def _changes_within_limits(
-    robot: Robot,
+    robot: Robot | Machine,
     demand: ZoneDemand,
     s_start: float,
     s_end: float,

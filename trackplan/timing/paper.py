@@ -48,10 +48,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.choices import Timing
+from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.jointpath import JointPath
 from trackplan.paths.curves import unwrap_closed_arc
 from trackplan.robots.kinematics import forward_kinematics, jacobian
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import solve_path_ik
 from trackplan.robots.resolved_rate import solve_path_resolved_rate
@@ -117,6 +119,12 @@ def plan_paper_trajectory(joint_path: JointPath, task: Task) -> TimedPath:
         off the branch).
     """
     robot = joint_path.robot
+    if isinstance(robot, Machine):
+        raise CaseError(
+            "the paper's time law drives the arm alone: a case with a track or a positioner "
+            "needs timing: smooth",
+            key="task.timing",
+        )
     planner = _PaperPlanner(robot, task, joint_path)
     try:
         q, s = planner.run(joint_path.q[0])

@@ -33,6 +33,7 @@ from scipy.interpolate import BSpline, make_interp_spline
 
 from trackplan.errors import CaseError
 from trackplan.jointpath import JointPath
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.task import Task
 
@@ -126,7 +127,7 @@ def _sample_times(duration: float, sample_time: float) -> np.ndarray:
 
 
 def toppra_reference(
-    robot: Robot,
+    robot: Robot | Machine,
     s_grid: np.ndarray,
     q_grid: GridJoints,
     speed_cap_grid: np.ndarray,
@@ -213,7 +214,7 @@ def toppra_reference(
 
 
 def topp3_reference(
-    robot: Robot,
+    robot: Robot | Machine,
     s_grid: np.ndarray,
     q_grid: GridJoints,
     speed_cap_grid: np.ndarray,

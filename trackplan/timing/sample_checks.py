@@ -27,6 +27,7 @@ import numpy as np
 
 from trackplan.motion import JointSamples
 from trackplan.robots.dynamics.rne import inverse_dynamics
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.timing import _kernels_samples
 
@@ -70,7 +71,7 @@ class RateLimits:
         Relative margin kept under each limit.
     """
 
-    robot: Robot
+    robot: Robot | Machine
     margin: float = LIMIT_MARGIN
 
     def __call__(self, q: np.ndarray, sample_time: float) -> Found:
@@ -182,10 +183,10 @@ class TorqueLimits:
         return np.minimum(rows[bad], len(q) - 1), np.full(int(bad.sum()), 2), ratio[bad]
 
 
-def robot_checks(robot: Robot) -> tuple[SampleCheck, ...]:
+def robot_checks(robot: Robot | Machine) -> tuple[SampleCheck, ...]:
     """The sample checks of a robot: its rate limits, and its torque limits when it has
     dynamics."""
-    if robot.dynamics is None:
+    if isinstance(robot, Machine) or robot.dynamics is None:
         return (RateLimits(robot),)
     return (RateLimits(robot), TorqueLimits(robot))
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.jointpath import JointPath
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 from trackplan.timing import _kernels, _kernels_samples
 from trackplan.timing.demand import SpeedChange, ZoneDemand, cruise_cap, speed_change
@@ -93,7 +94,7 @@ WINDOW_MIN_LENGTH: a blend a few millimetres long gets several windows)."""
 
 
 def slow_down_windows(
-    robot: Robot,
+    robot: Robot | Machine,
     zones: list[tuple[float, float, str]],
     demands: list[ZoneDemand],
     rated_speed: float,
@@ -147,7 +148,7 @@ class ZonePlanner:
 
     def __init__(
         self,
-        robot: Robot,
+        robot: Robot | Machine,
         zones: list[tuple[float, float, str]],
         demands: list[ZoneDemand],
         rated_speed: float,
