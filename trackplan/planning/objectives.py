@@ -30,6 +30,7 @@ from trackplan.choices import OBJECTIVE_KINDS
 from trackplan.errors import CaseError
 from trackplan.planning.result import PlanResult
 from trackplan.robots.dynamics.rne import inverse_dynamics
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 
 
@@ -69,7 +70,7 @@ class ScreenInput:
         C_i of Eq. 8, shape (n,).
     """
 
-    robot: Robot
+    robot: Robot | Machine
     q: np.ndarray
     dt: np.ndarray
     weights: np.ndarray
@@ -105,6 +106,7 @@ def _quasi_static_torque(data: ScreenInput) -> tuple[np.ndarray, np.ndarray]:
     q = np.nan_to_num(data.q)
     qd = np.diff(q, axis=-2) / np.maximum(data.dt, 1e-12)[..., None]
     mid = 0.5 * (q[..., 1:, :] + q[..., :-1, :])
+    assert not isinstance(data.robot, Machine)  # refused when the objective is chosen
     return inverse_dynamics(data.robot, mid, qd, np.zeros_like(qd)), qd
 
 
@@ -219,6 +221,12 @@ def with_objective(case: Case, kind: str, key: str = "--objective") -> Case:
     """
     if kind not in OBJECTIVES:
         raise CaseError(f"unknown objective {kind!r}: use {', '.join(OBJECTIVES)}", key=key)
+    if OBJECTIVES[kind].needs_dynamics and case.machine is not case.robot:
+        raise CaseError(
+            f"{kind} needs joint torques, which trackplan does not compute for an arm on a "
+            "track or with a positioner: use travel or time",
+            key=key,
+        )
     if OBJECTIVES[kind].needs_dynamics and case.robot.dynamics is None:
         raise CaseError(
             f"{kind} needs joint torques, but robot {case.robot.name} has no dynamic parameters",

@@ -358,6 +358,32 @@ class Machine:
         return T
 
 
+def carried_poses(machine: Robot | Machine, external: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Tool poses given in the carrier frame, in the arm's base frame:
+    ``T_base_carrier(e) · T_carrier_tool``.
+
+    Parameters
+    ----------
+    machine
+        A machine (a robot: the poses unchanged).
+    external
+        The external axes at every pose, shape (..., e), m and rad.
+    poses
+        Tool poses in the carrier frame, shape (..., 4, 4).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (..., 4, 4).
+    """
+    if not isinstance(machine, Machine):
+        return poses
+    q = np.zeros((*external.shape[:-1], machine.n_dof))
+    q[..., machine.n_arm :] = external
+    carried: np.ndarray = machine.T_base_carrier(q) @ poses
+    return carried
+
+
 def carrier_tool(robot: Robot | Machine, q: np.ndarray) -> np.ndarray:
     """The tool in the frame the placement X refers to: the base frame of a robot
     (its FK), a machine's carrier frame (:meth:`Machine.T_carrier_tool`); shape (..., 4, 4)."""

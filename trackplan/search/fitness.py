@@ -55,6 +55,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from trackplan.axes.choose import choose_axes
 from trackplan.case import Case, Objective
 from trackplan.choices import Penalty
 from trackplan.frames import placement_transform, tool_poses
@@ -63,6 +64,7 @@ from trackplan.planning.objectives import ScreenInput, screen_objective
 from trackplan.planning.result import PlanResult
 from trackplan.robots.dynamics.rne import holding_torque_ratio
 from trackplan.robots.kinematics import joint_frames
+from trackplan.robots.machine import Machine, carried_poses
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.robots.thread_sharing import ThreadSharing
 from trackplan.search.plan_calls import plan_seam
@@ -204,7 +206,7 @@ class PlacementFitness:
         self.R_base = ToolOrientation.choose(case.task.tool, geometry).base_rotations(
             self.s_grid, sample.tangent
         )  # (M, 3, 3), zero spin
-        self.weights = np.asarray(case.objective.weights, dtype=float)
+        self.weights = case.travel_weights
         self.flat = case.objective.penalty == Penalty.FLAT
         self.penalty = float(case.objective.flat_penalty)
         self.time_weight = float(case.objective.time_weight)
@@ -259,6 +261,9 @@ class PlacementFitness:
         BranchScreen
         """
         poses = tool_poses(X[:, :6], self.points, self.rotations(X[:, 6:]))
+        external = self.external_axes(X[:, :6])
+        if external is not None:
+            poses = carried_poses(self.case.machine, external, poses)
         paths = solve_path_ik_branches(self.case.robot, poses, sharing=self.sharing)
         n_poses = len(self.s_grid)
         unreachable = 1.0 - paths.reachable_fraction
@@ -285,11 +290,15 @@ class PlacementFitness:
         )
         # the joints' least interval times on the usable branches only (few of them while
         # sampling); the others keep the tool's
+        q = paths.q
+        if external is not None:  # the machine's joint vector: the arm's, then the axes'
+            shape = (*q.shape[:3], external.shape[-1])
+            q = np.concatenate([q, np.broadcast_to(external[:, None], shape)], axis=-1)
         dt = np.tile(self.tool_time, (*ok.shape, 1))  # (B, K, M - 1), s
-        steps = np.abs(np.diff(paths.q[ok], axis=1))  # (P, M - 1, n), rad
-        dt[ok] = np.fmax(self.tool_time, np.max(steps / self.case.robot.v_max, axis=2))
+        steps = np.abs(np.diff(q[ok], axis=1))  # (P, M - 1, n), rad
+        dt[ok] = np.fmax(self.tool_time, np.max(steps / self.case.machine.v_max, axis=2))
         return BranchScreen(
-            ScreenInput(self.case.robot, paths.q, dt, self.weights),
+            ScreenInput(self.case.machine, q, dt, self.weights),
             paths.branches,
             ok,
             np.where(ok, 0.0, graded),
@@ -438,6 +447,18 @@ class PlacementFitness:
             pending[todo, best[todo]] = False
             # a candidate with a clear branch is done
             pending[todo[~blocked]] = False
+
+    def external_axes(self, X: np.ndarray) -> np.ndarray | None:
+        """A machine's external axes on the screening grid at placements X (B, 6), shape
+        (B, M, e) (:func:`~trackplan.axes.choose.choose_axes` per placement), or None for
+        a robot."""
+        machine = self.case.machine
+        if not isinstance(machine, Machine):
+            return None
+        tool, downhand = self.case.task.tool, self.case.downhand
+        return np.stack(
+            [choose_axes(machine, self.geometry, tool, x, downhand).values(self.s_grid) for x in X]
+        )
 
     def rotations(self, spin: np.ndarray) -> np.ndarray:
         """``R_part_tool`` on the screening grid for spin variables (B, k), (B, M, 3, 3)."""
