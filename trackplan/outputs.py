@@ -7,6 +7,7 @@ run's files that this run does not write are removed.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -123,8 +124,10 @@ def write_search_run(
     """
     from trackplan.io.history import optimizer_summary
 
+    if result.positioner_pose is not None and case.positioner is not None:
+        case = replace(case, positioner=case.positioner.at(result.positioner_pose))
     history = {result.method: result.history.as_columns()} if len(result.history) else None
-    blocks = {**optimizer_summary(result, case.robot.joint_names), **(extra or {})}
+    blocks = {**optimizer_summary(result, case.machine.joint_names), **(extra or {})}
     return write_run(
         out_dir,
         result.final,

@@ -157,6 +157,25 @@ def placement(case: Case, values: np.ndarray | None) -> np.ndarray:
     return np.asarray(case.bounds.example, dtype=float)
 
 
+def run_positioner(case: Case, run: Path) -> Case:
+    """The case with its positioner where a run folder's ``result.json`` records it
+    (:func:`~trackplan.io.results.recorded_positioner`); the case itself for a CSV file or a
+    case without a positioner."""
+    import json
+
+    from trackplan.io.results import recorded_positioner
+    from trackplan.run_files import RESULT_FILE
+
+    file = Path(run) / RESULT_FILE
+    if case.positioner is None or not Path(run).is_dir() or not file.is_file():
+        return case
+    try:
+        summary = json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        summary = {}
+    return recorded_positioner(case, summary if isinstance(summary, dict) else {}, str(file))
+
+
 def run_placement(run: Path) -> np.ndarray | None:
     """The placement a run folder's ``result.json`` records (None for a CSV file).
 

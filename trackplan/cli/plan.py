@@ -22,6 +22,7 @@ from trackplan.cli.common import (
     placement,
     placement_option,
     run_placement,
+    run_positioner,
     timing_option,
 )
 from trackplan.errors import CaseError
@@ -118,7 +119,8 @@ def check(
     loaded = load_case(case, assume_limits=assume_limits)
     csv = verified_trajectory(run)
     X = placement(loaded, X_given if X_given is not None else run_placement(run))
-    t, q = read_trajectory_csv(csv, loaded.robot.n_dof)
+    loaded = run_positioner(loaded, run)
+    t, q = read_trajectory_csv(csv, loaded.machine.n_dof)
     sample_time = loaded.task.sample_time
     check_sample_times(t, sample_time, str(csv))
     segment = read_segments(csv)

@@ -7,6 +7,7 @@ import json
 import math
 import re
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -336,6 +337,9 @@ def plan_summary(result: PlanResult, case: Case) -> dict:
     return {
         **result_summary(result, case.machine.joint_names),
         "axes": axes_summary(case),
+        "positioner_pose": None
+        if case.positioner is None
+        else [float(v) for v in case.positioner.pose],
         "case_file": case_file(case),
         "robot_file": robot_file(case),
         "tcp": tcp_summary(case),
@@ -352,6 +356,32 @@ def axes_summary(case: Case) -> list[dict]:
         {"name": name, "kind": kind, "unit": unit}
         for name, kind, unit in zip(machine.joint_names, machine.kinds, machine.units, strict=True)
     ]
+
+
+def recorded_positioner(case: Case, summary: dict, where: str) -> Case:
+    """The case with its positioner standing where a run's ``result.json`` (``summary``)
+    records it (``positioner_pose``, the pose the run planned at, searched or given); the
+    case itself without a positioner.
+
+    Raises
+    ------
+    CaseError
+        When the case has a positioner and the run records no pose of six finite numbers.
+    """
+    if case.positioner is None:
+        return case
+    recorded = summary.get("positioner_pose")
+    try:
+        pose = np.asarray(recorded, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        pose = np.zeros(0)
+    if pose.shape != (6,) or not np.all(np.isfinite(pose)):
+        raise CaseError(
+            f"the case has a positioner, but {RESULT_FILE} records no positioner_pose "
+            f"[x, y, z, roll, pitch, yaw] (got {recorded!r}): plan the case again",
+            file=where,
+        )
+    return replace(case, positioner=case.positioner.at(pose))
 
 
 def tcp_summary(case: Case) -> dict:

@@ -20,7 +20,7 @@ import numpy as np
 from trackplan.case import PLACEMENT_KEYS, Case
 from trackplan.errors import CaseError
 from trackplan.io.export import TrajectoryTable, read_trajectory_table
-from trackplan.io.results import plan_summary
+from trackplan.io.results import plan_summary, recorded_positioner
 from trackplan.io.run_folder import verified_trajectory
 from trackplan.planning.result import PlanResult
 from trackplan.planning.seams import SeamSpin
@@ -69,7 +69,8 @@ class ReplayedRun:
 def replay_run(run: Path | str, case: Case | Path | str | None = None) -> ReplayedRun:
     """Re-plan a run folder's case where the run was planned, and check it reproduces the run.
 
-    The re-plan uses ``result.json``'s placement, time law (``timing``), sequence (order and
+    The re-plan uses ``result.json``'s placement (and ``positioner_pose``), time law
+    (``timing``), sequence (order and
     directions), and each seam's IK branch and spin (``seams[].branch``, ``seams[].spin``:
     a spin the run chose, such as a free spin optimised for its placement, is given back
     as written). It must reproduce ``trajectory.csv``: the same number of samples, and
@@ -101,9 +102,10 @@ def replay_run(run: Path | str, case: Case | Path | str | None = None) -> Replay
     folder = _run_folder(Path(run))
     csv_file = verified_trajectory(folder)
     summary = _read_summary(folder / RESULT_FILE)
-    loaded = _the_case(case, summary)
+    where = str(folder / RESULT_FILE)
+    loaded = recorded_positioner(_the_case(case, summary), summary, where)
     table = read_trajectory_table(csv_file)
-    plan = _replan(loaded, summary, str(folder / RESULT_FILE))
+    plan = _replan(loaded, summary, where)
     _check_reproduces(plan, table)
     return ReplayedRun(folder=folder, summary=summary, case=loaded, plan=plan, table=table)
 
@@ -131,7 +133,7 @@ def replay_plan(plan: PlanResult, case: Case) -> ReplayedRun:
     """
     if plan.trajectory.n_samples == 0:
         raise CaseError(f"the plan has no trajectory: {plan.message}", key="trajectory")
-    table = TrajectoryTable.from_trajectory(plan.trajectory, case.robot.joint_names)
+    table = TrajectoryTable.from_trajectory(plan.trajectory, case.machine.joint_names)
     return ReplayedRun(
         folder=None, summary=plan_summary(plan, case), case=case, plan=plan, table=table
     )

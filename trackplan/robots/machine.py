@@ -266,12 +266,16 @@ class Machine:
 
     @cached_property
     def joint_names(self) -> tuple[str, ...]:
-        """The arm's joint names, ``track``, then the positioner's axis names."""
+        """The arm's joint names, ``track``, then the positioner's axis names (each with
+        ``positioner_`` before it when one would repeat a name)."""
         names = list(self.arm.joint_names)
         if self.track is not None:
             names.append(self.track.name)
         if self.positioner is not None:
-            names.extend(self.positioner.chain.joint_names)
+            own = self.positioner.chain.joint_names
+            if set(own) & set(names):  # one name for one joint: a clash gets a prefix
+                own = tuple(f"positioner_{name}" for name in own)
+            names.extend(own)
         return tuple(names)
 
     @cached_property

@@ -32,6 +32,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.search.fitness import SCREEN_POSES, PlacementFitness
+from trackplan.search.positioner_pose import pose_indices
 from trackplan.search.screening import Screening, SeamScreen, evaluate_seams
 from trackplan.search.space import N_VAR, SearchSpace
 
@@ -58,6 +59,13 @@ def spin_slices(case: Case) -> tuple[slice, ...]:
         slices.append(slice(first, first + seam.task.tool.n_spin))
         first += seam.task.tool.n_spin
     return tuple(slices)
+
+
+def pose_slice(case: Case) -> slice:
+    """Where the positioner pose's searched variables lie in the decision vector: after
+    every seam's spin variables (empty when the pose is fixed)."""
+    first = spin_slices(case)[-1].stop
+    return slice(first, first + len(pose_indices(case)))
 
 
 def screening_poses(case: Case, geometries: SeamGeometries) -> tuple[int, ...]:
@@ -132,15 +140,21 @@ class CaseFitness:
         self.penalty = float(case.objective.flat_penalty)
         self.flat = self.seams[0].flat
         self.time_weight = float(case.objective.time_weight)
-        self.weights = np.asarray(case.objective.weights, dtype=float)
+        self.weights = case.travel_weights
         self.reversible = np.array([seam.reversible for seam in case.seams])
         self.home = case.sequencing.home
         self.feasible_count = np.zeros(len(case.seams), dtype=int)
         self.slices = spin_slices(case)
-        if space.n_var != self.slices[-1].stop:
+        pose = pose_slice(case)
+        # each seam's own variables after the placement: its spin, then the positioner pose
+        self.columns = [
+            np.r_[np.arange(part.start, part.stop), np.arange(pose.start, pose.stop)]
+            for part in self.slices
+        ]
+        if space.n_var != pose_slice(case).stop:
             raise ValueError(
                 f"the search space has {space.n_var} variables, the seams need "
-                f"{self.slices[-1].stop} (use SearchSpace.from_case)"
+                f"{pose_slice(case).stop} (use SearchSpace.from_case)"
             )
 
     def full(self, X: np.ndarray) -> np.ndarray:
@@ -173,7 +187,7 @@ class CaseFitness:
         return SeamScreen.stack(
             [
                 fitness.screen_seam(np.hstack([X[:, :N_VAR], X[:, part]]))
-                for fitness, part in zip(self.seams, self.slices, strict=True)
+                for fitness, part in zip(self.seams, self.columns, strict=True)
             ]
         )
 
@@ -207,7 +221,7 @@ class CaseFitness:
         return float(best_sequence(seam_cost, air, start, end, self.reversible).cost)
 
     def _move(self, q_from: np.ndarray, q_to: np.ndarray) -> np.ndarray:
-        robot = self.case.robot
+        robot = self.case.machine
         travel = np.sum(self.weights * np.abs(q_to - q_from), axis=-1)
         if self.time_weight == 0.0:
             return np.asarray(travel)
@@ -235,7 +249,7 @@ class CaseFitness:
             ``branch`` the first seam's branch.
         """
         screening, seams = evaluate_seams(
-            self.space, self.seams, self.slices, self.full(X), incumbent, self.air_costs
+            self.space, self.seams, self.columns, self.full(X), incumbent, self.air_costs
         )
         if seams is not None:
             self.feasible_count += seams.ok.sum(axis=1)

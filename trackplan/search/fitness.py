@@ -68,6 +68,7 @@ from trackplan.robots.machine import Machine, carried_poses
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.robots.thread_sharing import ThreadSharing
 from trackplan.search.plan_calls import plan_seam
+from trackplan.search.positioner_pose import pose_bounds, positioned
 from trackplan.search.screening import (
     FEASIBLE,
     GEOMETRY_LEVEL,
@@ -244,8 +245,9 @@ class PlacementFitness:
         """
         X = np.atleast_2d(np.asarray(X, dtype=float))
         tool = self.case.task.tool
-        if X.shape[1] == N_VAR and tool.n_spin:  # placements alone: the middle of the spin range
-            X = np.hstack([X, np.tile(tool.default_variables(), (len(X), 1))])
+        if X.shape[1] == N_VAR:  # placements alone: the middle of the spin range, the pose given
+            defaults = np.concatenate([tool.default_variables(), pose_bounds(self.case)[2]])
+            X = np.hstack([X, np.tile(defaults, (len(X), 1))])
         return evaluate_seams(self.space, [self], [slice(N_VAR, None)], X, incumbent)[0]
 
     def screen_branches(self, X: np.ndarray) -> BranchScreen:
@@ -260,8 +262,9 @@ class PlacementFitness:
         -------
         BranchScreen
         """
-        poses = tool_poses(X[:, :6], self.points, self.rotations(X[:, 6:]))
-        external = self.external_axes(X[:, :6])
+        n_spin = self.case.task.tool.n_spin
+        poses = tool_poses(X[:, :6], self.points, self.rotations(X[:, 6 : 6 + n_spin]))
+        external = self.external_axes(X[:, :6], X[:, 6 + n_spin :])
         if external is not None:
             poses = carried_poses(self.case.machine, external, poses)
         paths = solve_path_ik_branches(self.case.robot, poses, sharing=self.sharing)
@@ -448,17 +451,20 @@ class PlacementFitness:
             # a candidate with a clear branch is done
             pending[todo[~blocked]] = False
 
-    def external_axes(self, X: np.ndarray) -> np.ndarray | None:
-        """A machine's external axes on the screening grid at placements X (B, 6), shape
-        (B, M, e) (:func:`~trackplan.axes.choose.choose_axes` per placement), or None for
-        a robot."""
-        machine = self.case.machine
-        if not isinstance(machine, Machine):
+    def external_axes(self, X: np.ndarray, pose: np.ndarray) -> np.ndarray | None:
+        """A machine's external axes on the screening grid at placements X (B, 6) with the
+        positioner pose's searched variables (B, k), shape (B, M, e)
+        (:func:`~trackplan.axes.choose.choose_axes` per candidate), or None for a robot."""
+        if not isinstance(self.case.machine, Machine):
             return None
         tool, downhand = self.case.task.tool, self.case.downhand
-        return np.stack(
-            [choose_axes(machine, self.geometry, tool, x, downhand).values(self.s_grid) for x in X]
-        )
+        found = []
+        for x, variables in zip(X, pose, strict=True):
+            machine = positioned(self.case, variables).machine
+            assert isinstance(machine, Machine)
+            axes = choose_axes(machine, self.geometry, tool, x, downhand)
+            found.append(axes.values(self.s_grid))
+        return np.stack(found)
 
     def rotations(self, spin: np.ndarray) -> np.ndarray:
         """``R_part_tool`` on the screening grid for spin variables (B, k), (B, M, 3, 3)."""
@@ -472,8 +478,15 @@ class PlacementFitness:
     def plan_candidates(self, X: np.ndarray, branch: np.ndarray) -> list[PlanResult]:
         """This seam planned with the time law and checked at candidates X (B, 6 + k), each
         on its branch (B,): concurrently on the executor when one was given."""
+        n_spin = self.case.task.tool.n_spin
         jobs = [
-            (self.case, x, self.timing, int(b), self.geometry)
+            (
+                positioned(self.case, x[6 + n_spin :]),
+                x[: 6 + n_spin],
+                self.timing,
+                int(b),
+                self.geometry,
+            )
             for x, b in zip(X, branch, strict=True)
         ]
         return list(self._map(plan_candidate, jobs))

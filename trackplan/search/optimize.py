@@ -31,7 +31,7 @@ from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.result import PlanResult
 from trackplan.search.algorithms import DEFAULT_RESTARTS, make_algorithm
-from trackplan.search.case_fitness import CaseFitness, SeamSpin
+from trackplan.search.case_fitness import CaseFitness, SeamSpin, pose_slice
 from trackplan.search.driver import (
     GenerationRecord,
     ProgressCallback,
@@ -41,6 +41,7 @@ from trackplan.search.driver import (
     run_seeds,
 )
 from trackplan.search.plan_calls import SeamGeometries, plan_case, seam_geometries
+from trackplan.search.positioner_pose import positioned
 from trackplan.search.problem import PlacementProblem
 from trackplan.search.space import N_VAR, BoundHit, SearchSpace
 from trackplan.status import Status
@@ -110,6 +111,10 @@ class SearchResult:
         Seams that no evaluated placement reached feasibly, by name.
     spins
         The spin variables chosen for each seam (as written), None for a fixed spin.
+    positioner_pose
+        The positioner's pose the final plan stands it at, (x, y, z, roll, pitch, yaw),
+        shape (6,), m and rad (searched where the case gives bounds); None without a
+        positioner.
     """
 
     success: bool
@@ -133,6 +138,7 @@ class SearchResult:
     on_bounds: tuple[BoundHit, ...] = ()
     unreachable: tuple[str, ...] = ()
     spins: tuple[SeamSpin, ...] = ()
+    positioner_pose: np.ndarray | None = None
 
 
 def optimize(
@@ -274,7 +280,14 @@ def optimize(
         on_bounds=space.bound_hits(final.placement),
         unreachable=unreachable,
         spins=fitness.seam_spins(problem.archive.X[kept]),
+        positioner_pose=_positioner_pose(case, problem.archive.X[kept]),
     )
+
+
+def _positioner_pose(case: Case, X: np.ndarray) -> np.ndarray | None:
+    """The positioner pose of a candidate X (n_var,), shape (6,), or None without one."""
+    placed = positioned(case, X[pose_slice(case)])
+    return None if placed.positioner is None else np.array(placed.positioner.pose)
 
 
 def _geometries(
@@ -345,7 +358,7 @@ class _Planner:
     ) -> functools.partial[PlanResult]:
         return functools.partial(
             plan_case,
-            self.case,
+            positioned(self.case, X[pose_slice(self.case)]),
             X[:N_VAR],
             timing=self.timing,
             geometries=self.geometries,

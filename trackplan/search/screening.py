@@ -189,7 +189,7 @@ shape (B,) (0 where not feasible)."""
 def evaluate_seams(
     space: SearchSpace,
     seams: Sequence[SeamScreener],
-    slices: Sequence[slice],
+    slices: Sequence[slice] | Sequence[np.ndarray],
     X: np.ndarray,
     incumbent: float = np.inf,
     air: AirCost | None = None,
@@ -203,7 +203,8 @@ def evaluate_seams(
     seams
         One screener per seam, as written.
     slices
-        Where each seam's spin variables lie in a candidate (an empty slice for none).
+        Where each seam's own variables (its spin, the positioner pose) lie in a candidate:
+        a slice or column indices (empty for none).
     X
         Candidates, shape (B, n_var): placements (metres and radians), then the spin
         variables.

@@ -14,6 +14,7 @@ import numpy as np
 
 from trackplan.case import PLACEMENT_KEYS, Case, PlacementBounds
 from trackplan.errors import CaseError
+from trackplan.search.positioner_pose import pose_bounds
 
 N_VAR = 6
 """Number of placement variables (the spin variables of the tool follow them)."""
@@ -168,17 +169,21 @@ class SearchSpace:
         """The search space of a case: the placement (see :meth:`from_bounds`), then each
         seam's spin variables in the order written (:meth:`ToolSpec.spin_bounds` of the
         seam's tool: one for ``spin: free``, the profile's for ``free-varying``, none for
-        ``fixed``)."""
+        ``fixed``), then the positioner pose's searched keys
+        (:mod:`~trackplan.search.positioner_pose`)."""
         space = cls.from_bounds(case.bounds, case.source)
         tools = [seam.task.tool for seam in case.seams if seam.task.tool.n_spin]
-        if not tools:
+        pose_lower, pose_upper, pose_start = pose_bounds(case)
+        if not tools and not len(pose_lower):
             return space
         bounds = [tool.spin_bounds() for tool in tools]
         return cls(
-            np.concatenate([space.lower, *(lower for lower, _ in bounds)]),
-            np.concatenate([space.upper, *(upper for _, upper in bounds)]),
+            np.concatenate([space.lower, *(lower for lower, _ in bounds), pose_lower]),
+            np.concatenate([space.upper, *(upper for _, upper in bounds), pose_upper]),
             space.reach,
-            np.concatenate([space.anchor, *(tool.default_variables() for tool in tools)]),
+            np.concatenate(
+                [space.anchor, *(tool.default_variables() for tool in tools), pose_start]
+            ),
         )
 
     @property
