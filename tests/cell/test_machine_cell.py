@@ -7,6 +7,8 @@ distance between the capsules and bodies built from them.
 
 from __future__ import annotations
 
+from collections import Counter
+
 import coal
 import numpy as np
 import pytest
@@ -352,3 +354,21 @@ def test_the_positioner_tilts_its_table_into_an_obstacle() -> None:
     apart = own > 0
     np.testing.assert_allclose(d[apart], own[apart], atol=1e-6)
     assert report.violations[0].worst == pytest.approx(own.min(), abs=1e-6)
+
+
+def test_a_machine_checks_the_robots_pairs_and_the_positioners() -> None:
+    """The machine's pairs are the arm's (same names) and the positioner's against the arm's
+    links and tool, and its moving links against the obstacles."""
+    machine, _, _ = turning_machine()
+    ball = Body("ball", Shape.SPHERE, np.eye(4), [0.05, 0, 0])
+    plate = Body("plate", Shape.BOX, np.eye(4), [0.1, 0.1, 0.01])
+    tool = Capsules([0], [[[0, 0, -0.2], [0, 0, 0]]], [0.01], ("torch",))
+    cell = Cell(obstacles=(ball,), workpiece=(plate,), tool=tool, tool_contact=0.05)
+    arm_names = CellGeometry.from_cell(cell, machine.arm).pair_names()
+    names = CellGeometry.from_cell(cell, machine).pair_names()
+    own = machine.arm.collision
+    assert own is not None
+    positioner = [f"positioner {name}" for name in ("base", "link 1", "link 2")]
+    expected = [(a, p) for a in (*own.name, "torch") for p in positioner]
+    expected += [(p, "ball") for p in positioner[1:]]
+    assert Counter(names) == Counter(arm_names) + Counter(expected)

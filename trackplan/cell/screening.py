@@ -139,7 +139,8 @@ class CellGeometry:
     cell
         The cell.
     capsules
-        Link capsules, then tool capsules, then the tool capsules clipped for the workpiece.
+        Link capsules, then a machine's positioner capsules, then tool capsules, then the
+        tool capsules clipped for the workpiece.
     bodies
         Obstacles, then workpiece bodies.
     n_obstacles
@@ -154,8 +155,10 @@ class CellGeometry:
         The capsule–capsule pairs checked, shape (Q, 2): the arm's own pairs, then the
         positioner's capsules against the arm's.
     n_frames
-        Frames the capsules move with (:func:`cell_frames`): the arm's chain (base,
-        links, TCP), then a positioner's (base, links, flange).
+        Frames of the arm's chain (base, links, TCP): the TCP is frame ``n_frames − 1``.
+    n_positioner_frames
+        Frames of a machine's positioner chain (base, links, flange), 0 without one: they
+        follow the arm's in :func:`cell_frames`, frames ``n_frames`` onwards.
     """
 
     cell: Cell
@@ -169,6 +172,7 @@ class CellGeometry:
     pair_body: np.ndarray
     self_pairs: np.ndarray
     n_frames: int
+    n_positioner_frames: int = 0
 
     @classmethod
     def from_cell(cls, cell: Cell, robot: Robot | Machine) -> CellGeometry:
@@ -196,7 +200,7 @@ class CellGeometry:
             tuple(cell.tool.name[k] for k, _ in kept),
         )
         positioner = _positioner_capsules(robot)
-        capsules = links + tool + clipped + positioner
+        capsules = links + positioner + tool + clipped
         bodies = (*cell.obstacles, *cell.workpiece)
         n_obstacles = len(cell.obstacles)
         kind = np.empty(len(bodies), dtype=np.int64)
@@ -211,9 +215,9 @@ class CellGeometry:
         n_links = len(links)
         moving_links = np.flatnonzero(links.frame > 0)  # the base stands in the cell
         link_index = np.arange(n_links)
-        tool_index = n_links + np.arange(n_tool)
-        clipped_index = n_links + n_tool + np.arange(len(kept))
-        positioner_index = n_links + n_tool + len(kept) + np.arange(len(positioner))
+        positioner_index = n_links + np.arange(len(positioner))
+        tool_index = n_links + len(positioner) + np.arange(n_tool)
+        clipped_index = n_links + len(positioner) + n_tool + np.arange(len(kept))
         # the positioner's base stands in the cell: only its moving links meet obstacles
         positioner_moving = positioner_index[positioner.frame > tcp + 1]
         obstacles = np.arange(n_obstacles)
@@ -230,7 +234,7 @@ class CellGeometry:
         arm_index = np.concatenate([link_index, tool_index])
         self_pairs = np.concatenate(
             [
-                self_collision_pairs(moving),
+                arm_index[self_collision_pairs(moving)].reshape(-1, 2),
                 np.stack(np.meshgrid(arm_index, positioner_index, indexing="ij"), -1).reshape(
                     -1, 2
                 ),
@@ -247,7 +251,8 @@ class CellGeometry:
             pair_capsule=np.ascontiguousarray(pair[:, 0]),
             pair_body=np.ascontiguousarray(pair[:, 1]),
             self_pairs=np.ascontiguousarray(self_pairs),
-            n_frames=arm.n_dof + 2 + _n_positioner_frames(robot),
+            n_frames=arm.n_dof + 2,
+            n_positioner_frames=_n_positioner_frames(robot),
         )
 
     @property
@@ -354,9 +359,10 @@ class CellGeometry:
 
     def check_frames(self, frames: np.ndarray) -> None:
         """Raise ValueError when ``frames`` (..., F, 4, 4) are not the F frames laid out."""
-        if frames.shape[-3] != self.n_frames:
+        expected = self.n_frames + self.n_positioner_frames
+        if frames.shape[-3] != expected:
             raise ValueError(
-                f"the cell was laid out for {self.n_frames} frames, got {frames.shape[-3]}: "
+                f"the cell was laid out for {expected} frames, got {frames.shape[-3]}: "
                 "lay it out (CellGeometry.from_cell) for the same robot or machine"
             )
 
