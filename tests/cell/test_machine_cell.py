@@ -13,7 +13,7 @@ import coal
 import numpy as np
 import pytest
 
-from trackplan.cell.check import check_cell, pair_distances
+from trackplan.cell.check import check_cell, nearest_points, pair_distances
 from trackplan.cell.model import Body, Capsules, Cell, Shape
 from trackplan.cell.screening import CellGeometry, cell_frames, part_placements
 from trackplan.errors import CaseError
@@ -263,6 +263,17 @@ def test_the_part_on_the_flange_follows_the_positioner() -> None:
     # the same arm pose with the positioner turned away is clear of the post
     away = check_cell(geometry, machine, q[:1], TS, T_carrier_part)
     assert away.success
+    # the nearest points just before the post comes within the clearance lie on the post
+    # where the test's own kinematics put it
+    s = int(bad[0]) - 1
+    assert own[s] > cell.clearance
+    pair = part_columns[int(np.argmin(d[s, part_columns]))]
+    points, distance = nearest_points(geometry, machine, q[s], T_carrier_part, pair)
+    assert distance == pytest.approx(own[s], abs=1e-6)
+    assert np.linalg.norm(points[1] - points[0]) == pytest.approx(own[s], abs=1e-6)
+    T_part = own_positioner_frames(base, 0.0, q[s, 7])[2] @ T_carrier_part @ post.T_frame_body
+    local = np.linalg.solve(T_part, np.r_[points[1], 1.0])[:3]
+    assert np.max(np.abs(local) - post.size) == pytest.approx(0.0, abs=1e-6)
 
 
 def test_screen_joints_of_a_machine_takes_placements_per_group() -> None:

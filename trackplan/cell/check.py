@@ -86,25 +86,65 @@ def pair_distances(
             for stretch in np.split(inside, np.flatnonzero(np.diff(inside) > 1) + 1):
                 near[stretch[np.argmin(distance[stretch, p])], p] = True
     oracle = ExactDistance()
+    for s, p in zip(*np.nonzero(near), strict=True):
+        distance[s, p] = _exact(oracle, geometry, frames[s], T_part[group[s]], int(p))
+    return distance
+
+
+def _exact(
+    oracle: ExactDistance, geometry: CellGeometry, frames: np.ndarray, T_part: np.ndarray, p: int
+) -> float:
+    """Exact distance of pair p (capsule–body pairs, then self pairs) at one sample: frames
+    (F, 4, 4), the part's placement (4, 4); the oracle keeps the nearest points."""
     capsules = geometry.capsules
     n_body_pairs = len(geometry.pair_capsule)
-    for s, p in zip(*np.nonzero(near), strict=True):
-        F = frames[s]
-        if p < n_body_pairs:
-            k, o = geometry.pair_capsule[p], geometry.pair_body[p]
-            a, b = _world(F, capsules, k)
-            T_world_frame = T_part[group[s]] if o >= geometry.n_obstacles else np.eye(4)
-            distance[s, p] = oracle.capsule_body(
-                a, b, capsules.radius[k], geometry.bodies[o], T_world_frame
-            )
-        else:
-            i, j = geometry.self_pairs[p - n_body_pairs]
-            a0, b0 = _world(F, capsules, i)
-            a1, b1 = _world(F, capsules, j)
-            distance[s, p] = oracle.capsule_capsule(
-                a0, b0, capsules.radius[i], a1, b1, capsules.radius[j]
-            )
-    return distance
+    if p < n_body_pairs:
+        k, o = geometry.pair_capsule[p], geometry.pair_body[p]
+        a, b = _world(frames, capsules, k)
+        T_world_frame = T_part if o >= geometry.n_obstacles else np.eye(4)
+        return oracle.capsule_body(a, b, capsules.radius[k], geometry.bodies[o], T_world_frame)
+    i, j = geometry.self_pairs[p - n_body_pairs]
+    a0, b0 = _world(frames, capsules, i)
+    a1, b1 = _world(frames, capsules, j)
+    return oracle.capsule_capsule(a0, b0, capsules.radius[i], a1, b1, capsules.radius[j])
+
+
+def nearest_points(
+    geometry: CellGeometry,
+    robot: Robot | Machine,
+    q: np.ndarray,
+    T_carrier_part: np.ndarray,
+    pair: int,
+) -> tuple[np.ndarray, float]:
+    """The nearest points of one checked pair at one configuration (coal's witness points).
+
+    Parameters
+    ----------
+    geometry
+        The cell laid out for ``robot``.
+    robot
+        The robot or machine.
+    q
+        One configuration, shape (n,) (a machine's every column).
+    T_carrier_part
+        Placement of the definition frame in the carrier frame, shape (4, 4).
+    pair
+        Index into :meth:`CellGeometry.pair_names`.
+
+    Returns
+    -------
+    tuple
+        The points on the capsule and on the other body, shape (2, 3), in the frame of
+        the obstacles (a robot's base, a machine's cell frame), m; and the exact signed
+        distance, m.
+    """
+    q = np.asarray(q, dtype=float).reshape(1, -1)
+    frames = cell_frames(robot, q)
+    geometry.check_frames(frames)
+    T_part, group = part_placements(robot, q, T_carrier_part)
+    oracle = ExactDistance()
+    distance = _exact(oracle, geometry, frames[0], T_part[group[0]], pair)
+    return oracle.last_points, distance
 
 
 def _world(frames: np.ndarray, capsules: Capsules, k: int) -> tuple[np.ndarray, np.ndarray]:
