@@ -301,10 +301,11 @@ class CellGeometry:
         Parameters
         ----------
         frames
-            Chain frames (:func:`trackplan.robots.kinematics.joint_frames`), shape
-            (N, n + 2, 4, 4).
+            The frames the capsules move with (:func:`cell_frames`; a robot's chain frames,
+            :func:`trackplan.robots.kinematics.joint_frames`), shape (N, F, 4, 4).
         T_base_part
-            Placements, shape (G, 4, 4) (or (4, 4) for one).
+            Placements in the frame of the obstacles (a robot's base, a machine's cell),
+            shape (G, 4, 4) (or (4, 4) for one).
         group
             The placement of each sample, shape (N,), int; default all 0.
 
