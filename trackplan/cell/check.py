@@ -12,9 +12,9 @@ import numpy as np
 
 from trackplan.cell.exact import ExactDistance
 from trackplan.cell.model import Capsules, Shape
-from trackplan.cell.screening import CellGeometry
+from trackplan.cell.screening import CellGeometry, cell_frames, part_placements
 from trackplan.check_report import CellReport, Violation
-from trackplan.robots.kinematics import joint_frames
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 
 EXACT_BAND = 0.01
@@ -27,6 +27,7 @@ def pair_distances(
     geometry: CellGeometry,
     frames: np.ndarray,
     T_base_part: np.ndarray,
+    group: np.ndarray | None = None,
     *,
     exact: bool = True,
 ) -> np.ndarray:
@@ -44,9 +45,13 @@ def pair_distances(
     geometry
         The cell laid out for the robot.
     frames
-        Chain frames, shape (N, n + 2, 4, 4).
+        The frames the capsules move with (:func:`~trackplan.cell.screening.cell_frames`),
+        shape (N, F, 4, 4).
     T_base_part
-        Placement of the definition frame, shape (4, 4).
+        Placement of the definition frame in the frame of the obstacles (the robot's base,
+        a machine's cell), shape (4, 4), or one per group, shape (G, 4, 4).
+    group
+        The placement of each sample, shape (N,), int; default all 0.
     exact
         Re-measure exactly as above; False returns the screened distances.
 
@@ -55,7 +60,10 @@ def pair_distances(
     numpy.ndarray
         Shape (N, P + Q), m: capsule–body pairs, then self pairs.
     """
-    body, own = geometry.screen(frames, T_base_part)
+    frames = np.asarray(frames, dtype=float)
+    T_part = np.asarray(T_base_part, dtype=float).reshape(-1, 4, 4)
+    group = np.zeros(len(frames), np.int64) if group is None else np.asarray(group, np.int64)
+    body, own = geometry.screen(frames, T_part, group)
     distance = np.concatenate([body, own], axis=1)
     if not exact or distance.size == 0:
         return distance
@@ -78,30 +86,69 @@ def pair_distances(
             for stretch in np.split(inside, np.flatnonzero(np.diff(inside) > 1) + 1):
                 near[stretch[np.argmin(distance[stretch, p])], p] = True
     oracle = ExactDistance()
-    capsules = geometry.capsules
-    n_body_pairs = len(geometry.pair_capsule)
-    T_part = np.asarray(T_base_part, dtype=float)
     for s, p in zip(*np.nonzero(near), strict=True):
-        F = frames[s]
-        if p < n_body_pairs:
-            k, o = geometry.pair_capsule[p], geometry.pair_body[p]
-            a, b = _world(F, capsules, k)
-            T_world_frame = T_part if o >= geometry.n_obstacles else np.eye(4)
-            distance[s, p] = oracle.capsule_body(
-                a, b, capsules.radius[k], geometry.bodies[o], T_world_frame
-            )
-        else:
-            i, j = geometry.self_pairs[p - n_body_pairs]
-            a0, b0 = _world(F, capsules, i)
-            a1, b1 = _world(F, capsules, j)
-            distance[s, p] = oracle.capsule_capsule(
-                a0, b0, capsules.radius[i], a1, b1, capsules.radius[j]
-            )
+        distance[s, p] = _exact(oracle, geometry, frames[s], T_part[group[s]], int(p))
     return distance
 
 
+def _exact(
+    oracle: ExactDistance, geometry: CellGeometry, frames: np.ndarray, T_part: np.ndarray, p: int
+) -> float:
+    """Exact distance of pair p (capsule–body pairs, then self pairs) at one sample: frames
+    (F, 4, 4), the part's placement (4, 4); the oracle keeps the nearest points."""
+    capsules = geometry.capsules
+    n_body_pairs = len(geometry.pair_capsule)
+    if p < n_body_pairs:
+        k, o = geometry.pair_capsule[p], geometry.pair_body[p]
+        a, b = _world(frames, capsules, k)
+        T_world_frame = T_part if o >= geometry.n_obstacles else np.eye(4)
+        return oracle.capsule_body(a, b, capsules.radius[k], geometry.bodies[o], T_world_frame)
+    i, j = geometry.self_pairs[p - n_body_pairs]
+    a0, b0 = _world(frames, capsules, i)
+    a1, b1 = _world(frames, capsules, j)
+    return oracle.capsule_capsule(a0, b0, capsules.radius[i], a1, b1, capsules.radius[j])
+
+
+def nearest_points(
+    geometry: CellGeometry,
+    robot: Robot | Machine,
+    q: np.ndarray,
+    T_carrier_part: np.ndarray,
+    pair: int,
+) -> tuple[np.ndarray, float]:
+    """The nearest points of one checked pair at one configuration (coal's witness points).
+
+    Parameters
+    ----------
+    geometry
+        The cell laid out for ``robot``.
+    robot
+        The robot or machine.
+    q
+        One configuration, shape (n,) (a machine's every column).
+    T_carrier_part
+        Placement of the definition frame in the carrier frame, shape (4, 4).
+    pair
+        Index into :meth:`CellGeometry.pair_names`.
+
+    Returns
+    -------
+    tuple
+        The points on the capsule and on the other body, shape (2, 3), in the frame of
+        the obstacles (a robot's base, a machine's cell frame), m; and the exact signed
+        distance, m.
+    """
+    q = np.asarray(q, dtype=float).reshape(1, -1)
+    frames = cell_frames(robot, q)
+    geometry.check_frames(frames)
+    T_part, group = part_placements(robot, q, T_carrier_part)
+    oracle = ExactDistance()
+    distance = _exact(oracle, geometry, frames[0], T_part[group[0]], pair)
+    return oracle.last_points, distance
+
+
 def _world(frames: np.ndarray, capsules: Capsules, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """World end points of capsule k; frames (n + 2, 4, 4) of one sample."""
+    """World end points of capsule k; frames (F, 4, 4) of one sample."""
     T = frames[capsules.frame[k]]
     a, b = capsules.segment[k] @ T[:3, :3].T + T[:3, 3]
     return a, b
@@ -109,10 +156,10 @@ def _world(frames: np.ndarray, capsules: Capsules, k: int) -> tuple[np.ndarray, 
 
 def check_cell(
     geometry: CellGeometry,
-    robot: Robot,
+    robot: Robot | Machine,
     q: np.ndarray,
     sample_time: float,
-    T_base_part: np.ndarray,
+    T_carrier_part: np.ndarray,
 ) -> CellReport:
     """Check a sampled trajectory against the cell.
 
@@ -121,20 +168,25 @@ def check_cell(
     geometry
         The cell laid out for ``robot``.
     robot
-        The robot.
+        The robot, or a machine (arm, track, positioner; everything in the cell frame).
     q
-        Joint positions, shape (N, n), rad.
+        Joint positions, shape (N, n), rad; for a machine every column (arm, track in m,
+        positioner).
     sample_time
         Ts, s.
-    T_base_part
-        Placement of the definition frame, shape (4, 4).
+    T_carrier_part
+        Placement of the definition frame in the carrier frame (the robot's base frame; a
+        machine's positioner flange, or its cell frame without a positioner), shape (4, 4).
 
     Returns
     -------
     CellReport
     """
     q = np.asarray(q, dtype=float)
-    distance = pair_distances(geometry, joint_frames(robot, q), T_base_part)
+    frames = cell_frames(robot, q)
+    geometry.check_frames(frames)
+    T_part, group = part_placements(robot, q, T_carrier_part)
+    distance = pair_distances(geometry, frames, T_part, group)
     t = np.arange(len(q)) * sample_time
     clearance = geometry.cell.clearance
     names = geometry.pair_names()

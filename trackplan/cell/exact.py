@@ -129,6 +129,11 @@ class ExactDistance:
         length = float(np.linalg.norm(np.asarray(b1) - np.asarray(a1)))
         return self._distance(a0, b0, r0, _capsule(r1, length), capsule_pose(a1, b1))
 
+    @property
+    def last_points(self) -> np.ndarray:
+        """Nearest points of the last distance computed (capsule first), shape (2, 3), m."""
+        return self._last_points
+
     def nearest_points_body(
         self, a: np.ndarray, b: np.ndarray, radius: float, body: Body, T_world_frame: np.ndarray
     ) -> np.ndarray:

@@ -87,9 +87,11 @@ class Cell:
     Attributes
     ----------
     obstacles
-        Bodies fixed in the robot base frame.
+        Bodies fixed in the robot base frame (a machine's cell frame: the base with the
+        track at 0).
     workpiece
-        Bodies in the path's definition frame (they move with the placement).
+        Bodies in the path's definition frame (they move with the placement, and with a
+        machine's positioner flange).
     tool
         Tool capsules in the TCP frame (their ``frame`` is ignored: always the TCP).
     links

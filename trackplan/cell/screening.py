@@ -1,4 +1,4 @@
-"""The cell compiled for one robot, and batched screening distances.
+"""The cell compiled for one robot or machine, and batched screening distances.
 
 :class:`CellGeometry` lays every capsule and body out as arrays for the compiled kernel
 (:mod:`trackplan.cell._kernels`) and fixes which pairs are checked:
@@ -7,7 +7,17 @@
   and every workpiece body;
 - tool capsules against every obstacle, and against the workpiece only where they lie
   farther than ``tool_contact`` from the TCP (the process contact is allowed);
-- capsules of bodies that are not neighbours in the chain against each other.
+- capsules of bodies that are not neighbours in the chain against each other;
+- with a :class:`~trackplan.robots.machine.Machine` that has a positioner: the
+  positioner's capsules against every arm link and tool capsule, its moving links' (not its
+  base's) against every obstacle; the workpiece rides on its flange (it is clamped there:
+  not checked against the positioner).
+
+With a machine every frame is in the cell frame (the arm's base frame with the track at
+0): the arm's chain frames (:meth:`Machine.arm_frames_in_cell`), then the positioner's
+(:meth:`Machine.positioner_frames_in_cell`); the workpiece stands at
+``T_cell_carrier(q) · T_carrier_part`` at each sample (:func:`cell_frames`,
+:func:`part_placements`).
 
 Meshes go to the kernel as their bounding boxes, so a screened distance is never larger
 than the exact one; every other shape is screened exactly.
@@ -22,8 +32,75 @@ import numpy as np
 from trackplan.cell import _kernels
 from trackplan.cell.model import Body, Capsules, Cell, Shape
 from trackplan.cell.robot_bodies import builtin_link_capsules, self_collision_pairs
+from trackplan.errors import CaseError
 from trackplan.robots.kinematics import joint_frames
+from trackplan.robots.machine import Machine, arm_of
 from trackplan.robots.model import Robot
+
+POSITIONER_PREFIX = "positioner "
+"""Prefix of the positioner's capsule names in reports (``positioner link 1``)."""
+
+
+def cell_frames(robot: Robot | Machine, q: np.ndarray) -> np.ndarray:
+    """The frames the capsules move with, in the cell frame, shape (..., F, 4, 4).
+
+    For a robot, its chain frames (:func:`~trackplan.robots.kinematics.joint_frames`):
+    base, links 1..n, TCP. For a machine, the arm's chain frames moved by the track, then
+    the positioner's (base, links 1..m, flange), all in the cell frame.
+
+    Parameters
+    ----------
+    robot
+        A robot or a machine.
+    q
+        Joint positions, shape (..., n): for a machine every column (arm, track,
+        positioner), rad and m.
+    """
+    if not isinstance(robot, Machine):
+        return joint_frames(robot, q)
+    arm = robot.arm_frames_in_cell(q)
+    if robot.positioner is None:
+        return arm
+    return np.concatenate([arm, robot.positioner_frames_in_cell(q)], axis=-3)
+
+
+def part_placements(
+    robot: Robot | Machine,
+    q: np.ndarray,
+    T_carrier_part: np.ndarray,
+    group: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The workpiece's placement at each sample in the cell, and the group of each sample.
+
+    For a robot, or a machine without a positioner, the carrier is the cell (base) frame:
+    the placements are ``T_carrier_part`` and the groups ``group`` as given. With a
+    positioner the part rides on its flange: one placement per sample,
+    ``T_cell_carrier(q_s) · T_carrier_part[group_s]``.
+
+    Parameters
+    ----------
+    robot
+        A robot or a machine.
+    q
+        Joint positions, shape (N, n).
+    T_carrier_part
+        Placements of the definition frame in the carrier frame, shape (4, 4) or (G, 4, 4).
+    group
+        The placement of each sample, shape (N,), int; default all 0.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Placements in the cell frame (G', 4, 4) and the group of each sample (N,), int.
+    """
+    q = np.asarray(q, dtype=float)
+    T = np.asarray(T_carrier_part, dtype=float).reshape(-1, 4, 4)
+    n_samples = len(q)
+    group = np.zeros(n_samples, np.int64) if group is None else np.asarray(group, np.int64)
+    if not isinstance(robot, Machine) or robot.positioner is None:
+        return T, group
+    placed: np.ndarray = robot.T_cell_carrier(q) @ T[group]
+    return placed, np.arange(n_samples, dtype=np.int64)
 
 
 def clip_tool_segment(segment: np.ndarray, contact: float) -> np.ndarray | None:
@@ -62,7 +139,8 @@ class CellGeometry:
     cell
         The cell.
     capsules
-        Link capsules, then tool capsules, then the tool capsules clipped for the workpiece.
+        Link capsules, then a machine's positioner capsules, then tool capsules, then the
+        tool capsules clipped for the workpiece.
     bodies
         Obstacles, then workpiece bodies.
     n_obstacles
@@ -74,9 +152,13 @@ class CellGeometry:
     pair_capsule, pair_body
         The capsule–body pairs checked, shape (P,) each.
     self_pairs
-        The capsule–capsule pairs checked, shape (Q, 2).
+        The capsule–capsule pairs checked, shape (Q, 2): the arm's own pairs, then the
+        positioner's capsules against the arm's.
     n_frames
-        Frames of the chain (base, links, TCP).
+        Frames of the arm's chain (base, links, TCP): the TCP is frame ``n_frames − 1``.
+    n_positioner_frames
+        Frames of a machine's positioner chain (base, links, flange), 0 without one: they
+        follow the arm's in :func:`cell_frames`, frames ``n_frames`` onwards.
     """
 
     cell: Cell
@@ -90,12 +172,21 @@ class CellGeometry:
     pair_body: np.ndarray
     self_pairs: np.ndarray
     n_frames: int
+    n_positioner_frames: int = 0
 
     @classmethod
-    def from_cell(cls, cell: Cell, robot: Robot) -> CellGeometry:
-        """Lay out ``cell`` for ``robot`` (its built-in capsules unless ``cell.links``)."""
-        links = cell.links if cell.links is not None else builtin_link_capsules(robot)
-        tcp = robot.n_dof + 1
+    def from_cell(cls, cell: Cell, robot: Robot | Machine) -> CellGeometry:
+        """Lay out ``cell`` for a robot, or a machine (the arm's built-in capsules unless
+        ``cell.links``; a positioner's own capsules).
+
+        Raises
+        ------
+        CaseError
+            When the arm, or the machine's positioner, has no link capsules.
+        """
+        arm = arm_of(robot)
+        links = cell.links if cell.links is not None else builtin_link_capsules(arm)
+        tcp = arm.n_dof + 1
         n_tool = len(cell.tool)
         tool = Capsules(np.full(n_tool, tcp), cell.tool.segment, cell.tool.radius, cell.tool.name)
         clipped_rows = [
@@ -108,7 +199,8 @@ class CellGeometry:
             np.array([cell.tool.radius[k] for k, _ in kept]),
             tuple(cell.tool.name[k] for k, _ in kept),
         )
-        capsules = links + tool + clipped
+        positioner = _positioner_capsules(robot)
+        capsules = links + positioner + tool + clipped
         bodies = (*cell.obstacles, *cell.workpiece)
         n_obstacles = len(cell.obstacles)
         kind = np.empty(len(bodies), dtype=np.int64)
@@ -123,8 +215,11 @@ class CellGeometry:
         n_links = len(links)
         moving_links = np.flatnonzero(links.frame > 0)  # the base stands in the cell
         link_index = np.arange(n_links)
-        tool_index = n_links + np.arange(n_tool)
-        clipped_index = n_links + n_tool + np.arange(len(kept))
+        positioner_index = n_links + np.arange(len(positioner))
+        tool_index = n_links + len(positioner) + np.arange(n_tool)
+        clipped_index = n_links + len(positioner) + n_tool + np.arange(len(kept))
+        # the positioner's base stands in the cell: only its moving links meet obstacles
+        positioner_moving = positioner_index[positioner.frame > tcp + 1]
         obstacles = np.arange(n_obstacles)
         workpiece = n_obstacles + np.arange(len(cell.workpiece))
         pairs = [
@@ -132,9 +227,19 @@ class CellGeometry:
             np.stack(np.meshgrid(link_index, workpiece, indexing="ij"), -1),
             np.stack(np.meshgrid(tool_index, obstacles, indexing="ij"), -1),
             np.stack(np.meshgrid(clipped_index, workpiece, indexing="ij"), -1),
+            np.stack(np.meshgrid(positioner_moving, obstacles, indexing="ij"), -1),
         ]
         pair = np.concatenate([p.reshape(-1, 2) for p in pairs]).astype(np.int64)
         moving = np.concatenate([links.frame, tool.frame])
+        arm_index = np.concatenate([link_index, tool_index])
+        self_pairs = np.concatenate(
+            [
+                arm_index[self_collision_pairs(moving)].reshape(-1, 2),
+                np.stack(np.meshgrid(arm_index, positioner_index, indexing="ij"), -1).reshape(
+                    -1, 2
+                ),
+            ]
+        ).astype(np.int64)
         return cls(
             cell=cell,
             capsules=capsules,
@@ -145,8 +250,9 @@ class CellGeometry:
             T_frame_screen=T_screen,
             pair_capsule=np.ascontiguousarray(pair[:, 0]),
             pair_body=np.ascontiguousarray(pair[:, 1]),
-            self_pairs=np.ascontiguousarray(self_collision_pairs(moving)),
-            n_frames=robot.n_dof + 2,
+            self_pairs=np.ascontiguousarray(self_pairs),
+            n_frames=arm.n_dof + 2,
+            n_positioner_frames=_n_positioner_frames(robot),
         )
 
     @property
@@ -195,10 +301,11 @@ class CellGeometry:
         Parameters
         ----------
         frames
-            Chain frames (:func:`trackplan.robots.kinematics.joint_frames`), shape
-            (N, n + 2, 4, 4).
+            The frames the capsules move with (:func:`cell_frames`; a robot's chain frames,
+            :func:`trackplan.robots.kinematics.joint_frames`), shape (N, F, 4, 4).
         T_base_part
-            Placements, shape (G, 4, 4) (or (4, 4) for one).
+            Placements in the frame of the obstacles (a robot's base, a machine's cell),
+            shape (G, 4, 4) (or (4, 4) for one).
         group
             The placement of each sample, shape (N,), int; default all 0.
 
@@ -225,7 +332,65 @@ class CellGeometry:
         )
 
     def screen_joints(
-        self, robot: Robot, q: np.ndarray, T_base_part: np.ndarray, group: np.ndarray | None = None
+        self,
+        robot: Robot | Machine,
+        q: np.ndarray,
+        T_carrier_part: np.ndarray,
+        group: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`screen` of joint positions q, shape (N, n), rad."""
-        return self.screen(joint_frames(robot, q), T_base_part, group)
+        """:meth:`screen` of joint positions.
+
+        Parameters
+        ----------
+        robot
+            The robot or machine the geometry was laid out for.
+        q
+            Joint positions, shape (N, n): for a machine every column, rad and m.
+        T_carrier_part
+            Placements of the definition frame in the carrier frame (the base frame of a
+            robot, the positioner's flange or the cell frame of a machine), shape (4, 4) or
+            (G, 4, 4).
+        group
+            The placement of each sample, shape (N,), int; default all 0.
+        """
+        frames = cell_frames(robot, q)
+        self.check_frames(frames)
+        T_part, group = part_placements(robot, q, T_carrier_part, group)
+        return self.screen(frames, T_part, group)
+
+    def check_frames(self, frames: np.ndarray) -> None:
+        """Raise ValueError when ``frames`` (..., F, 4, 4) are not the F frames laid out."""
+        expected = self.n_frames + self.n_positioner_frames
+        if frames.shape[-3] != expected:
+            raise ValueError(
+                f"the cell was laid out for {expected} frames, got {frames.shape[-3]}: "
+                "lay it out (CellGeometry.from_cell) for the same robot or machine"
+            )
+
+
+def _positioner_capsules(robot: Robot | Machine) -> Capsules:
+    """A machine's positioner capsules on the frames after the arm's, named
+    ``positioner …``; none for a robot or a machine without a positioner."""
+    if not isinstance(robot, Machine) or robot.positioner is None:
+        return Capsules.empty()
+    chain = robot.positioner.chain
+    if chain.collision is None:
+        raise CaseError(
+            f"positioner {robot.positioner.model or chain.name!r} has no link capsules, so "
+            "the cell cannot check it: give collision in its file (docs/cell.md)",
+            key="positioner",
+        )
+    own = chain.collision
+    return Capsules(
+        own.frame + robot.n_arm + 2,
+        own.segment,
+        own.radius,
+        tuple(POSITIONER_PREFIX + name for name in own.name),
+    )
+
+
+def _n_positioner_frames(robot: Robot | Machine) -> int:
+    """Frames of a machine's positioner chain (base, links, flange); 0 without one."""
+    if not isinstance(robot, Machine) or robot.positioner is None:
+        return 0
+    return robot.positioner.n_dof + 2
