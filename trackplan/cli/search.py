@@ -133,7 +133,7 @@ def _optimize(
     timing = timing_option(timing)
     loaded = load_case(case, assume_limits=assume_limits)
     if worker is not None:
-        worker.prepare(loaded.robot.n_dof)
+        worker.prepare(loaded.machine.n_dof)
     if objective is not None:
         from trackplan.planning.objectives import with_objective
 
@@ -174,7 +174,7 @@ def demo(
     with plot_worker() as worker:  # forked first, as in optimize
         loaded = load_case(file)
         if worker is not None:
-            worker.prepare(loaded.robot.n_dof)
+            worker.prepare(loaded.machine.n_dof)
         code = _search_and_write(loaded, out, report=True, worker=worker)
     typer.echo(f"report: {(out / 'report.html').resolve()}")
     return code

@@ -63,7 +63,6 @@ from trackplan.paths.path_geometry import PathGeometry
 from trackplan.planning.objectives import ScreenInput, screen_objective
 from trackplan.planning.result import PlanResult
 from trackplan.robots.dynamics.rne import holding_torque_ratio
-from trackplan.robots.kinematics import joint_frames
 from trackplan.robots.machine import Machine, carried_poses
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.robots.thread_sharing import ThreadSharing
@@ -218,7 +217,7 @@ class PlacementFitness:
         if case.cell:
             from trackplan.cell.screening import CellGeometry
 
-            self.cell = CellGeometry.from_cell(case.cell, case.robot)
+            self.cell = CellGeometry.from_cell(case.cell, case.machine)
         self._map: Callable[[Callable, Iterable], Iterable] = (
             executor.map if executor is not None else map
         )
@@ -382,7 +381,7 @@ class PlacementFitness:
         violation = branches.violation
         finding = branches.finding
         if self.cell is not None:
-            first, violation = self._screen_cell(X[:, :6], branches.grid.q, values[0], violation)
+            first, violation = self._screen_cell(X, branches.grid.q, values[0], violation)
             blocked = np.isinf(first) & branches.ok
             values = [np.where(blocked, np.inf, v) for v in values]
             finding = np.where(blocked, code(Status.COLLISION), finding)
@@ -401,9 +400,10 @@ class PlacementFitness:
         Parameters
         ----------
         X
-            Placements, shape (B, 6).
+            Variables, shape (B, 6 + k): placements, spin, the positioner pose's.
         q
-            Joint paths of every branch, shape (B, K, M, n), rad.
+            Joint paths of every branch, shape (B, K, M, n), rad (a machine's whole joint
+            vector).
         J, graded
             Objective (inf where the branch is geometrically infeasible) and graded
             violation per branch, shape (B, K).
@@ -417,12 +417,13 @@ class PlacementFitness:
         assert self.cell is not None
         J = J.copy()
         graded = graded.copy()
-        T_base_part = placement_transform(X)
+        T_base_part = placement_transform(X[:, :6])
+        pose = X[:, 6 + self.case.task.tool.n_spin :]
         clearance = self.cell.cell.clearance + CELL_MARGIN
         # every CELL_STRIDE-th pose of the screening grid, and the last
         poses = np.unique(np.r_[np.arange(0, q.shape[2], CELL_STRIDE), q.shape[2] - 1])
         q = q[:, :, poses]
-        n_poses, n_dof = q.shape[2:]
+        n_poses = q.shape[2]
         pending = np.isfinite(J)
         rows = np.arange(len(X))
         while True:
@@ -430,12 +431,7 @@ class PlacementFitness:
             todo = np.flatnonzero(pending[rows, best])
             if not len(todo):
                 return J, graded
-            q_todo = q[todo, best[todo]].reshape(-1, n_dof)
-            body, own = self.cell.screen(
-                joint_frames(self.case.robot, q_todo),
-                T_base_part[todo],
-                np.repeat(np.arange(len(todo)), n_poses),
-            )
+            body, own = self._screen_poses(q[todo, best[todo]], T_base_part[todo], pose[todo])
             least = (
                 np.minimum(body.min(axis=1, initial=np.inf), own.min(axis=1, initial=np.inf))
                 .reshape(len(todo), n_poses)
@@ -450,6 +446,25 @@ class PlacementFitness:
             pending[todo, best[todo]] = False
             # a candidate with a clear branch is done
             pending[todo[~blocked]] = False
+
+    def _screen_poses(
+        self, q: np.ndarray, T_base_part: np.ndarray, pose: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Screened distances of candidates' poses: q (C, P, n), placements (C, 4, 4) and the
+        positioner pose's variables (C, k); capsule–body (C·P, pairs) and self (C·P, pairs).
+        One batched call, or one per candidate where each stands its positioner elsewhere."""
+        assert self.cell is not None
+        n_candidates, n_poses, n_dof = q.shape
+        group = np.repeat(np.arange(n_candidates), n_poses)
+        if not pose.shape[1]:
+            return self.cell.screen_joints(
+                self.case.machine, q.reshape(-1, n_dof), T_base_part, group
+            )
+        found = [
+            self.cell.screen_joints(positioned(self.case, variables).machine, q_c, T[None])
+            for q_c, T, variables in zip(q, T_base_part, pose, strict=True)
+        ]
+        return np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found])
 
     def external_axes(self, X: np.ndarray, pose: np.ndarray) -> np.ndarray | None:
         """A machine's external axes on the screening grid at placements X (B, 6) with the
