@@ -8,6 +8,8 @@ The front door (``docs/api.md``)
 --------------------------------
 load_case(file) -> Case, load_robot(file) -> Robot, builtin_robot(name) -> Robot
     Read and validate a case or robot file; the built-in robots (``docs/robots.md``).
+load_positioner(file) -> Robot, builtin_positioner(name) -> Robot
+    Read a positioner file; the built-in positioners (``docs/positioner.md``).
 plan(case, X, ...) -> PlanResult
     Plan and check a case (one seam or several) with the workpiece at placement X
     (shape (6,), m and rad).
@@ -50,6 +52,8 @@ if TYPE_CHECKING:
     from trackplan.check_report import CheckReport
     from trackplan.errors import CaseError, TrackplanError
     from trackplan.io.case_file import load_case
+    from trackplan.io.positioner_file import builtin_positioner as builtin_positioner
+    from trackplan.io.positioner_file import load_positioner as load_positioner
     from trackplan.io.robot_file import builtin_robot, load_robot
     from trackplan.planning.plan import check, plan
     from trackplan.planning.result import PlanResult
@@ -63,6 +67,10 @@ _EXPORTS = {
     "load_case": "trackplan.io.case_file",
     "load_robot": "trackplan.io.robot_file",
     "builtin_robot": "trackplan.io.robot_file",
+    # positioners: importable from here like the robots, kept out of ``__all__`` (the
+    # front door's verbs and result types)
+    "load_positioner": "trackplan.io.positioner_file",
+    "builtin_positioner": "trackplan.io.positioner_file",
     "plan": "trackplan.planning.plan",
     "check": "trackplan.planning.plan",
     "optimize": "trackplan.search.optimize",

@@ -44,7 +44,9 @@ def _schema(model: type[BaseModel], prefix: str = "") -> dict[str, object]:
         inner = _nested_model(field.annotation)
         if inner is not None and key not in ("path.segments", "paths[i].segments"):
             keys[key] = PARENT
-            is_list = origin is list or "list[" in str(field.annotation)
+            # a list of the model (not a union of some list and the model, as a pose is)
+            listed = rf"list\[[\w.]*\b{inner.__name__}\]"
+            is_list = origin is list or re.search(listed, str(field.annotation)) is not None
             keys.update(_schema(inner, f"{key}[i]." if is_list else f"{key}."))
         else:
             keys[key] = ... if field.is_required() else field.get_default(call_default_factory=True)

@@ -1,10 +1,12 @@
-"""Commands on inputs: ``validate`` (case files), ``robots`` (built-in robots), ``cases``."""
+"""Commands on inputs: ``validate`` (case files), ``robots`` (built-in robots),
+``positioners`` (built-in positioners), ``cases``."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from trackplan.cli import ExitCode
@@ -92,6 +94,67 @@ def robots(
             f"{info['reach']:.3f}",
             str(info["link_capsules"]),
             escape(str(info["source"])),
+        )
+    out.print(table)
+    return ExitCode.OK
+
+
+@app.command()
+def positioners(
+    name: Annotated[
+        str | None,
+        typer.Argument(
+            help="A built-in positioner name or a positioner file (.yaml): show its axes, "
+            "limits, flange and assumptions.",
+            show_default=False,
+        ),
+    ] = None,
+    assume_limits: AssumeLimitsOption = False,
+) -> ExitCode:
+    """List the built-in positioners (axes, ranges, speeds, assumed acceleration and jerk,
+    source), or show one positioner (docs/positioner.md)."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from trackplan.cell.robot_bodies import link_capsules_line
+    from trackplan.cli.summaries import robot_table
+    from trackplan.frames import rpy_from_matrix
+    from trackplan.io.positioner_file import (
+        builtin_positioner,
+        load_positioner_spec,
+        positioner_names,
+    )
+
+    out = console()
+    if name is not None:
+        chain = load_positioner_spec(name, Path.cwd(), case_file=None, assume_limits=assume_limits)
+        out.print(robot_table(chain))
+        xyz = " ".join(f"{v:.4g}" for v in chain.T_tip[:3, 3])
+        rpy = " ".join(f"{v + 0.0:.4g}" for v in rpy_from_matrix(chain.T_tip[:3, :3]))
+        out.print(f"flange (carrier frame) from the last axis: xyz {xyz} m, rpy {rpy} rad")
+        out.print(link_capsules_line(chain))
+        for note in chain.assumptions:
+            out.print(f"assumption: {escape(note)}")
+        return ExitCode.OK
+    table = Table(title="built-in positioners (trackplan positioners NAME for details)")
+    headers = ("name", "axes", "range °", "speed °/s", "accel. rad/s²", "jerk rad/s³", "source")
+    for header in headers:
+        table.add_column(header, justify="left" if header in ("name", "source") else "right")
+    for key in positioner_names():
+        chain = builtin_positioner(key)
+
+        def each(values: object, digits: str = "g") -> str:
+            return ", ".join(f"{v:{digits}}" for v in values)  # type: ignore[attr-defined]
+
+        ranges = zip(np.degrees(chain.q_min), np.degrees(chain.q_max), strict=True)
+        table.add_row(
+            key,
+            ", ".join(chain.joint_names),
+            ", ".join(f"[{low:.0f}, {high:.0f}]" for low, high in ranges),
+            each(np.degrees(chain.v_max), ".0f"),
+            each(chain.a_max, ".4g"),
+            each(chain.j_max, ".4g"),
+            escape(chain.source),
         )
     out.print(table)
     return ExitCode.OK

@@ -49,7 +49,45 @@ def describe_case(case: Case, file: Path | str) -> list[str]:
         f"  sequence  {sequencing.sequence}, approach {sequencing.approach:g} m, "
         f"home {'none' if sequencing.home is None else 'given'}",
         *_tcp_line(case),
+        *_axes_lines(case),
     ]
+
+
+def _axes_lines(case: Case) -> list[str]:
+    """The case's welding-cell keys: positioner, track, downhand and weaves, when given."""
+    lines = []
+    if case.positioner is not None:
+        positioner = case.positioner
+        pose = ", ".join(f"{v:.6g}" for v in positioner.pose)
+        keys = ("x", "y", "z", "roll", "pitch", "yaw")
+        searched = ", ".join(keys[k] for k in positioner.searched)
+        lines.append(
+            f"  positioner {positioner.model}: {positioner.n_dof} "
+            f"{'axis' if positioner.n_dof == 1 else 'axes'} "
+            f"({', '.join(positioner.chain.joint_names)}), pose [{pose}] m, rad"
+            + (f", searching {searched}" if searched else "")
+        )
+    if case.track is not None:
+        track = case.track
+        axis = ", ".join(f"{v:.4g}" for v in track.axis)
+        lines.append(
+            f"  track     along [{axis}], [{track.lower:g}, {track.upper:g}] m, "
+            f"{track.velocity:g} m/s, {track.acceleration:g} m/s², {track.jerk:g} m/s³"
+        )
+    if case.downhand is not None:
+        lines.append(
+            f"  downhand  slope ≤ {np.degrees(case.downhand.slope):.4g}°, rotation ≤ "
+            f"{np.degrees(case.downhand.rotation):.4g}°"
+        )
+    for seam in case.seams:
+        weave = seam.task.weave
+        if weave is not None:
+            lines.append(
+                f"  weave     {seam.name}: {weave.pattern} in the {weave.plane} plane, "
+                f"{weave.amplitude * 1e3:g} mm to each side, {weave.frequency:g} Hz"
+                + (f", dwell {weave.dwell:g} s" if weave.dwell else "")
+            )
+    return lines
 
 
 def _tcp_line(case: Case) -> list[str]:

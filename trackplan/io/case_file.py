@@ -26,6 +26,7 @@ from trackplan.case import (
     Task,
 )
 from trackplan.choices import OBJECTIVE_KINDS, Method, Penalty, Timing
+from trackplan.io.case_axes import axes_problems, load_positioner_chain, with_axes
 from trackplan.io.case_schema import (
     CaseModel,
     ObjectiveModel,
@@ -187,9 +188,9 @@ def load_case_data(
         *_objective_kind_problems(model.objective, robot),
         *_payload_problems(model.payload, robot),
         *tcp_problems(model.tcp),
+        *axes_problems(model, seams, paths),
     ]
-    # the sizes before any costly path work: a path too long for the memory budget is
-    # refused before it is built (and its tool frames sampled)
+    # sizes before any costly path work: a path too long for memory is refused unbuilt
     sizes = [] if problems else _size_problems(seams, paths, model, robot.n_dof)
     for (loc, seam), (seam_start, seam_segments) in zip(seams, paths, strict=True):
         built = not problems and not sizes
@@ -206,6 +207,7 @@ def load_case_data(
     case = dataclasses.replace(_case(model, robot, start, segments, file), robot_tool=robot_tool)
     if model.paths is not None:
         case = _with_seams(case, model, paths)
+    case = with_axes(case, model, load_positioner_chain(model, base, file, assume_limits))
     if model.cell is None:
         return case
     return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))

@@ -11,6 +11,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 from pydantic_core import PydanticCustomError
 
+from trackplan.io.case_axes import DownhandModel, PositionerModel, TrackModel, WeaveModel
 from trackplan.io.case_tcp import TcpModel
 from trackplan.io.cell_file import CellModel
 from trackplan.io.points_file import MIN_POINTS
@@ -138,7 +139,7 @@ Tolerance = Annotated[float, Field(ge=MIN_TOLERANCE)]
 
 
 class TaskModel(StrictModel):
-    """``task``: speeds (m/s), tolerance (m), sample time (s), tool orientation (rad)."""
+    """``task``: speeds (m/s), tolerance (m), sample time (s), tool orientation (rad), weave."""
 
     rated_speed: Positive
     corner_speed: Positive | None = None
@@ -147,16 +148,18 @@ class TaskModel(StrictModel):
     tool_rpy: Vec3 | None = None
     tool: ToolModel | None = None
     timing: Literal["smooth", "paper"] = "smooth"
+    weave: WeaveModel | None = None
 
 
 class SeamTaskModel(StrictModel):
-    """A seam's ``task``: overrides of the case's speeds (m/s), tolerance (m) and tool."""
+    """A seam's ``task``: overrides of the case's speeds (m/s), tolerance (m), tool and weave."""
 
     rated_speed: Positive | None = None
     corner_speed: Positive | None = None
     tolerance: Tolerance | None = None
     tool_rpy: Vec3 | None = None
     tool: ToolModel | None = None
+    weave: WeaveModel | None = None  # null turns the case's weave off for this seam
 
 
 def _csv_safe_name(name: str) -> str:
@@ -229,6 +232,9 @@ class CaseModel(StrictModel):
     objective: ObjectiveModel = Field(default_factory=ObjectiveModel)
     optimizer: OptimizerModel = Field(default_factory=OptimizerModel)
     cell: CellModel | None = None
+    positioner: PositionerModel | None = None
+    track: TrackModel | None = None
+    downhand: DownhandModel | None = None
 
 
 class SinglePathCaseModel(CaseModel):
