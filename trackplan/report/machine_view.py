@@ -40,7 +40,9 @@ POSITIONER_TRACE = "positioner"
 POSITIONER_CAPSULES_TRACE = "positioner capsules"
 WORKPIECE_TRACE = "workpiece"
 #: Most points of the part's polylines drawn in each animation frame.
-PART_POINTS = 400
+PART_POINTS = 150
+#: Decimals of the moving part's coordinates, m (0.1 mm: they are sent in every frame).
+PART_DECIMALS = 4
 
 TraceBuilder = Callable[[int], dict]
 
@@ -199,7 +201,7 @@ def machine_layers(
     def nominal_trace(k: int) -> dict:
         return {
             "type": "scatter3d",
-            **_xyz(moving_nominal[k]),
+            **_xyz(moving_nominal[k], PART_DECIMALS),
             "mode": "lines",
             "name": names["nominal"],
             "line": {"color": "#7f7f7f", "width": 3, "dash": "dash"},
@@ -209,7 +211,7 @@ def machine_layers(
     def path_trace(k: int) -> dict:
         return {
             "type": "scatter3d",
-            **_xyz(moving_path[k]),
+            **_xyz(moving_path[k], PART_DECIMALS),
             "mode": "lines",
             "name": names["path"],
             "line": {"color": "#9467bd", "width": 3},
@@ -222,7 +224,7 @@ def machine_layers(
         done = transform_points(T_carrier[k], trail[: k + 1])
         return {
             "type": "scatter3d",
-            **_xyz(done),
+            **_xyz(done, PART_DECIMALS),
             "mode": "lines",
             "name": names["trail"],
             "line": {"color": "#ff7f0e", "width": 6},
@@ -281,7 +283,7 @@ def _mesh_builder(
         )
         return {
             "type": "mesh3d",
-            **_xyz(vertices[k], 4),
+            **_xyz(vertices[k], PART_DECIMALS),
             **triangles,
             "name": name,
             "showlegend": True,
