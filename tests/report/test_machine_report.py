@@ -321,3 +321,18 @@ def test_track_alone_moves_the_base_and_keeps_the_part_still(corner, corner_resu
     (nominal,) = [trace for trace in view["data"] if trace["name"] == NOMINAL_TRACE]
     (still_nominal,) = [trace for trace in alone["data"] if trace["name"] == NOMINAL_TRACE]
     assert nominal == still_nominal  # the part does not move with the track
+
+
+def test_margins_name_the_external_axes(cell_result, cell_case):
+    from trackplan.report.html_result import margins_table
+
+    margins = {"position": np.linspace(0.1, 0.9, 9), "velocity": np.linspace(0.2, 0.6, 9)}
+    check = dataclasses.replace(
+        cell_result.check, joint_margins=margins, binding={"velocity": (7, 1.25)}
+    )
+    result = dataclasses.replace(cell_result, check=check)
+    html = re.sub(r' class="[^"]*"', "", margins_table(result, cell_case))
+    header = html.split("</thead>")[0]
+    assert "<th>joint 6</th><th>track</th><th>tilt</th><th>rotate</th>" in header
+    assert "velocity [rad/s, m/s]" in html
+    assert "track at t = 1.25 s" in html

@@ -180,12 +180,15 @@ def margins_table(result: PlanResult, case: Case) -> str:
     check = result.check
     machine = case.machine
     n, n_arm = machine.n_dof, case.robot.n_dof
+    names = [f"joint {j + 1}" if j < n_arm else esc(machine.joint_names[j]) for j in range(n)]
     rows = []
     for kind in (*LIMIT_KINDS, "torque"):
         margins = check.joint_margins.get(kind)
         if margins is None:
             continue
         name, unit = JOINT_QUANTITIES[kind]
+        if kind in LIMIT_KINDS:  # a track's column in m, m/s, …
+            unit = ", ".join(dict.fromkeys(column_units(machine, kind)))
         cells: list[Cell] = [f"{name} [{unit}]"]
         for j in range(n):
             if j < len(margins):
@@ -193,9 +196,13 @@ def margins_table(result: PlanResult, case: Case) -> str:
             else:
                 cells.append("–")
         binding = check.binding.get(kind)
-        cells.append(f"joint {binding[0]} at t = {num(binding[1])} s" if binding else "–")
+        if binding:
+            j = binding[0] - 1
+            where = names[j] if n_arm <= j < n else f"joint {binding[0]}"
+            cells.append(f"{where} at t = {num(binding[1])} s")
+        else:
+            cells.append("–")
         rows.append(cells)
-    names = [f"joint {j + 1}" if j < n_arm else esc(machine.joint_names[j]) for j in range(n)]
     joints = grid(["limit", *names, "closest to binding"], rows)
     tasks = grid(
         ["task bound", "margin"],
