@@ -151,8 +151,8 @@ def test_the_plots_drawn_with_given_kinematics_start_no_kernel(monkeypatch, corn
     pixels = {}
     with monkeypatch.context() as patched:
         for module, kernel in (
-            (path_plots, "forward_kinematics"),
-            (path_plots, "chain_points"),
+            (path_plots, "carrier_tool_frames"),
+            (path_plots, "carrier_chain_points"),
             (path_plots, "tracking_error"),
             (speed_plot, "tracking_error"),
         ):

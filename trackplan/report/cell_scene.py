@@ -11,6 +11,7 @@ from trackplan.cell.model import Body, Shape
 from trackplan.cell.screening import CellGeometry
 from trackplan.planning.result import PlanResult
 from trackplan.robots.kinematics import joint_frames
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 
 PLANE_HALF_SIZE = 1.0
@@ -127,9 +128,11 @@ def _n_links(geometry: CellGeometry) -> int:
 
 
 def closest_approach(
-    geometry: CellGeometry, robot: Robot, result: PlanResult
+    geometry: CellGeometry, robot: Robot | Machine, result: PlanResult
 ) -> tuple[np.ndarray, str] | None:
-    """The two nearest points (2, 3) of the closest pair at the closest sample, and a label."""
+    """The two nearest points (2, 3) of the closest pair at the closest sample, and a label;
+    with a machine, in the cell frame (the robot on its track, the workpiece on the
+    positioner's flange)."""
     from trackplan.cell.exact import ExactDistance
     from trackplan.frames import placement_transform
 
@@ -138,14 +141,20 @@ def closest_approach(
         return None
     names = geometry.pair_names()
     pair = names.index(cell.closest)
-    frames = joint_frames(robot, result.trajectory.q[cell.point])
+    q = result.trajectory.q[cell.point]
+    T_part = placement_transform(result.placement)
+    if isinstance(robot, Machine):
+        frames = robot.arm_frames_in_cell(q)
+        T_part = robot.T_cell_carrier(q) @ T_part
+    else:
+        frames = joint_frames(robot, q)
     capsules = geometry.capsules
     oracle = ExactDistance()
     n_body_pairs = len(geometry.pair_capsule)
     if pair < n_body_pairs:
         k, o = geometry.pair_capsule[pair], geometry.pair_body[pair]
         a, b = _apply(frames[capsules.frame[k]], capsules.segment[k])
-        T = placement_transform(result.placement) if o >= geometry.n_obstacles else np.eye(4)
+        T = T_part if o >= geometry.n_obstacles else np.eye(4)
         points = oracle.nearest_points_body(a, b, capsules.radius[k], geometry.bodies[o], T)
     else:
         i, j = geometry.self_pairs[pair - n_body_pairs]

@@ -18,6 +18,7 @@ from trackplan.planning.result import PlanResult
 from trackplan.report.html_case import case_section
 from trackplan.report.html_markup import esc, grid, html_page
 from trackplan.report.html_result import (
+    external_axes_table,
     figures_table,
     margins_table,
     references_table,
@@ -97,6 +98,19 @@ def _plots_section(paths: Sequence[Path]) -> str:
     return '<section id="plots"><h2>Plots</h2>' + "".join(items) + "</section>"
 
 
+def _external_note(case: Case) -> str:
+    """What the 3D view shows of a track and a positioner (escaped HTML), else nothing."""
+    notes = []
+    if case.track is not None:
+        notes.append(" The robot's base rides the track, drawn as a line over its range.")
+    if case.positioner is not None:
+        notes.append(
+            " The positioner (lines between its axes' frames) turns the part: the seam, the "
+            "planned path, the part frame and the workpiece move with its flange."
+        )
+    return esc("".join(notes))
+
+
 def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
     """The report's 3D view section: the robot following the path (plotly.js embedded), or
     a note when there is no trajectory. ``n_frames`` animation frames."""
@@ -115,7 +129,7 @@ def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
         '<section id="view"><h2>3D view</h2><p class="muted">The robot drawn from its DH chain '
         "(links between frame origins, a marker per joint) follows the placed path. Drag to "
         "rotate, scroll to zoom, ▶ play or move the time slider; click legend entries to show "
-        f"or hide the path, frames and reach shell.</p>{div}</section>"
+        f"or hide the path, frames and reach shell.{_external_note(case)}</p>{div}</section>"
     )
 
 
@@ -189,6 +203,7 @@ def report_page(
             '<section id="result"><h2>Result</h2>',
             '<div class="cols"><div><h3>Key figures</h3>',
             figures_table(result, case),
+            external_axes_table(result, case),
             "</div><div>",
             references_table(result),
             slowdowns_table(result),

@@ -124,12 +124,77 @@ def case_section(result: PlanResult, case: Case) -> str:
             ("case file", esc(case.source or "–")),
         ]
     )
+    external = _external_html(case)
     return (
         '<section id="case"><h2>Case</h2>'
-        f'<div class="cols"><div><h3>Robot</h3>{robot_html}</div></div>'
+        f'<div class="cols"><div><h3>Robot</h3>{robot_html}</div>{external}</div>'
         f'<div class="cols"><div><h3>Path</h3>{path_html}</div><div><h3>Task</h3>{task_html}</div>'
         f"<div><h3>Placement search</h3>{search_html}</div></div></section>"
     )
+
+
+def _external_html(case: Case) -> str:
+    """The track and the positioner of the case (``docs/positioner.md``), or nothing."""
+    parts = []
+    track = case.track
+    if track is not None:
+        parts.append(
+            key_values(
+                [
+                    ("track axis", vector(track.axis)),
+                    ("track range", f"[{num(track.lower)}, {num(track.upper)}] m"),
+                    (
+                        "track limits",
+                        f"{num(track.velocity)} m/s, {num(track.acceleration)} m/s², "
+                        f"{num(track.jerk)} m/s³",
+                    ),
+                ]
+            )
+        )
+    positioner = case.positioner
+    if positioner is not None:
+        chain = positioner.chain
+        rows = [
+            [
+                esc(chain.joint_names[j]),
+                vector(chain.origins[j][:3, 3]),
+                vector(chain.axes[j]),
+                f"[{num(chain.q_min[j])}, {num(chain.q_max[j])}]",
+                num(chain.v_max[j]),
+                num(chain.a_max[j]),
+                num(chain.j_max[j]),
+            ]
+            for j in range(chain.n_dof)
+        ]
+        searched = "" if not len(positioner.searched) else " (searched)"
+        parts.append(
+            key_values(
+                [
+                    ("positioner", esc(positioner.model or chain.name)),
+                    (
+                        "positioner pose",
+                        f"{vector(positioner.pose)} (m, rad in the cell){searched}",
+                    ),
+                    *(("assumption", esc(note)) for note in chain.assumptions),
+                    ("source", esc(chain.source or "–")),
+                ]
+            )
+            + grid(
+                [
+                    "axis",
+                    "origin xyz [m]",
+                    "axis",
+                    "q range [rad]",
+                    "q̇ max [rad/s]",
+                    "q̈ max [rad/s²]",
+                    "q⃛ max [rad/s³]",
+                ],
+                rows,
+            )
+        )
+    if not parts:
+        return ""
+    return f'<div id="external-axes-case"><h3>Track and positioner</h3>{"".join(parts)}</div>'
 
 
 def _tool_text(tool) -> str:  # type: ignore[no-untyped-def]

@@ -15,7 +15,8 @@ from trackplan.report.html_markup import (
     num,
     percent,
 )
-from trackplan.report.scene import JOINT_QUANTITIES
+from trackplan.report.scene import JOINT_QUANTITIES, column_units
+from trackplan.robots.machine import Machine
 
 
 def verdict_badge(result: PlanResult) -> str:
@@ -63,6 +64,7 @@ def figures_table(result: PlanResult, case: Case) -> str:
             percent(check.worst_margin()) if check.joint_margins or check.task_margins else "–",
         ),
         *_energy_rows(result),
+        *downhand_rows(result, case),
         ("time law, IK branch", f"{esc(result.timing)}, branch {result.branch}"),
         (
             "samples",
@@ -99,23 +101,109 @@ def _energy_rows(result: PlanResult) -> list[tuple[str, str]]:
     ]
 
 
+def external_axes_table(result: PlanResult, case: Case) -> str:
+    """The external axes of the case's machine (track, positioner): name, kind, the range
+    the trajectory uses against the axis's range, and the peak speed against its limit;
+    empty without external axes."""
+    machine = case.machine
+    if not isinstance(machine, Machine) or machine.n_external == 0:
+        return ""
+    trajectory = result.trajectory
+    units = column_units(machine, "position")
+    speed_units = column_units(machine, "velocity")
+    rows: list[list[Cell]] = []
+    for j in range(machine.n_arm, machine.n_dof):
+        unit, speed_unit = units[j], speed_units[j]
+        if trajectory.n_samples and trajectory.q.shape[1] > j:
+            low, high = np.min(trajectory.q[:, j]), np.max(trajectory.q[:, j])
+            used = f"[{num(low)}, {num(high)}] {unit}"
+            peak = f"{num(np.max(np.abs(trajectory.qd[:, j])))} {speed_unit}"
+        else:
+            used = peak = "–"
+        rows.append(
+            [
+                esc(machine.joint_names[j]),
+                esc(machine.kinds[j]),
+                used,
+                f"[{num(machine.q_min[j])}, {num(machine.q_max[j])}] {unit}",
+                peak,
+                f"{num(machine.v_max[j])} {speed_unit}",
+            ]
+        )
+    header = ["axis", "kind", "range used", "range", "peak velocity", "velocity limit"]
+    return '<h3 id="external-axes">External axes</h3>' + grid(header, rows)
+
+
+def _figure(downhand: object, *keys: str) -> float | None:
+    """The largest value of the first of ``keys`` that ``downhand`` (a mapping or an
+    object) holds, a number or per-sample values, rad; None when it holds none."""
+    for key in keys:
+        value = downhand.get(key) if isinstance(downhand, dict) else getattr(downhand, key, None)
+        if value is None:
+            continue
+        values = np.asarray(value, dtype=float).ravel()
+        values = values[np.isfinite(values)]
+        return float(np.max(np.abs(values))) if values.size else None
+    return None
+
+
+def downhand_rows(result: PlanResult, case: Case) -> list[tuple[str, str]]:
+    """The downhand figures of a result that has them (``result.downhand``: the largest
+    slope of the travel direction to the horizontal and rotation of the weld normal from
+    straight up, rad), against the case's ``downhand`` bounds when it has them; none
+    otherwise."""
+    downhand = getattr(result, "downhand", None)
+    if downhand is None:
+        return []
+    rule = case.downhand
+    rows = []
+    for label, keys, bound in (
+        ("largest downhand slope", ("max_slope", "slope"), None if rule is None else rule.slope),
+        (
+            "largest downhand rotation",
+            ("max_rotation", "rotation"),
+            None if rule is None else rule.rotation,
+        ),
+    ):
+        value = _figure(downhand, *keys)
+        if value is None:
+            continue
+        text = f"{num(value, unit='rad')} ({num(np.degrees(value))}°)"
+        if bound is not None:
+            text += f" (bound {num(np.degrees(bound))}°)"
+        rows.append((label, text))
+    return rows
+
+
 def margins_table(result: PlanResult, case: Case) -> str:
     """The unused fraction of every joint limit per joint, and of the task bounds."""
     check = result.check
-    n = case.robot.n_dof
+    machine = case.machine
+    n, n_arm = machine.n_dof, case.robot.n_dof
+    names = [f"joint {j + 1}" if j < n_arm else esc(machine.joint_names[j]) for j in range(n)]
     rows = []
     for kind in (*LIMIT_KINDS, "torque"):
         margins = check.joint_margins.get(kind)
         if margins is None:
             continue
         name, unit = JOINT_QUANTITIES[kind]
+        if kind in LIMIT_KINDS:  # a track's column in m, m/s, …
+            unit = ", ".join(dict.fromkeys(column_units(machine, kind)))
         cells: list[Cell] = [f"{name} [{unit}]"]
         for j in range(n):
-            cells.append((percent(margins[j]), margin_class(margins[j])))
+            if j < len(margins):
+                cells.append((percent(margins[j]), margin_class(margins[j])))
+            else:
+                cells.append("–")
         binding = check.binding.get(kind)
-        cells.append(f"joint {binding[0]} at t = {num(binding[1])} s" if binding else "–")
+        if binding:
+            j = binding[0] - 1
+            where = names[j] if n_arm <= j < n else f"joint {binding[0]}"
+            cells.append(f"{where} at t = {num(binding[1])} s")
+        else:
+            cells.append("–")
         rows.append(cells)
-    joints = grid(["limit", *[f"joint {j + 1}" for j in range(n)], "closest to binding"], rows)
+    joints = grid(["limit", *names, "closest to binding"], rows)
     tasks = grid(
         ["task bound", "margin"],
         [[esc(k), (percent(v), margin_class(v))] for k, v in check.task_margins.items()],

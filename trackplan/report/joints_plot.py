@@ -24,7 +24,7 @@ from trackplan.report.figure_style import (
     new_figure,
     status_line,
 )
-from trackplan.report.scene import JOINT_QUANTITIES, joint_bounds, joint_series
+from trackplan.report.scene import JOINT_QUANTITIES, column_units, joint_bounds, joint_series
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -123,9 +123,12 @@ def joints_figure(
     Parameters
     ----------
     result
-        The planned placement; time in s, joint data in rad, rad/s, rad/s², rad/s³.
+        The planned placement; time in s, joint data in rad, rad/s, rad/s², rad/s³ (a
+        track's column in m, m/s, m/s², m/s³).
     case
-        The case (robot limits).
+        The case (the limits of its machine: :attr:`~trackplan.case.Case.machine`, the
+        robot's joints, then a track and a positioner's axes, each column titled with its
+        name and unit).
     rows
         Consecutive rows (indices into ``LIMIT_KINDS``) to draw, all by default. The
         figure of some rows is the horizontal band of the full figure that holds them, to
@@ -142,8 +145,9 @@ def joints_figure(
     from matplotlib.ticker import MaxNLocator
 
     trajectory = result.trajectory
-    robot = case.robot
+    robot = case.machine
     n = robot.n_dof
+    n_arm = case.robot.n_dof
     rows = list(range(len(LIMIT_KINDS)) if rows is None else rows)
     if not rows or rows != list(range(rows[0], rows[0] + len(rows))):
         raise ValueError(f"joints_figure draws consecutive rows, not {rows}")
@@ -161,6 +165,7 @@ def joints_figure(
         values = joint_series(trajectory, kind)
         lower, upper = joint_bounds(robot, kind)
         margins = result.check.joint_margins.get(kind)
+        units = column_units(robot, kind)
         for j in range(n):
             ax = axes[band_row, j]
             series = values[:, j]
@@ -200,7 +205,7 @@ def joints_figure(
                         label="violation window",
                         gid="violation-window",
                     )
-            if margins is not None and np.isfinite(margins[j]):
+            if margins is not None and j < len(margins) and np.isfinite(margins[j]):
                 # above the panel, clear of the data (a boxed label inside cost a tenth
                 # of the figure)
                 ax.set_title(
@@ -213,7 +218,10 @@ def joints_figure(
                 )
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3, lw=0.5)
-            if row == 0:
+            if j >= n_arm:  # an external axis: its name and its own unit on every row
+                title = f"{robot.joint_names[j]} [{units[j]}]" if row == 0 else f"[{units[j]}]"
+                ax.set_title(title, loc="left", fontsize=9 if row == 0 else 7, y=1.0, pad=2.0)
+            elif row == 0:
                 ax.set_title(f"joint {j + 1}", loc="left", fontsize=9, y=1.0)
             if j == 0:
                 name, unit = JOINT_QUANTITIES[kind]

@@ -27,7 +27,8 @@ from trackplan.report.figure_style import (
 )
 from trackplan.report.scene import (
     FRAME_STYLES,
-    chain_points,
+    carrier_chain_points,
+    carrier_tool_frames,
     equal_limits,
     frame_indices,
     path_points,
@@ -36,7 +37,6 @@ from trackplan.report.scene import (
     triad_lines,
     violation_samples,
 )
-from trackplan.robots.kinematics import forward_kinematics
 from trackplan.tool import SpinMode, ToolFrame
 
 if TYPE_CHECKING:
@@ -90,13 +90,12 @@ def plot_kinematics(
     none = np.zeros((0, 4, 4))
     if n_samples == 0:
         return PlotKinematics(np.zeros((0, 3)), none, none, np.zeros(0))
-    robot = case.robot
-    path_frames = forward_kinematics(robot, q[frame_indices(n_samples, n_path_frames)])
+    path_frames = carrier_tool_frames(case, q[frame_indices(n_samples, n_path_frames)])
     tool_frames = none
     if shows_tool(case):
-        tool_frames = forward_kinematics(robot, q[frame_indices(n_samples, n_tool_frames)])
+        tool_frames = carrier_tool_frames(case, q[frame_indices(n_samples, n_tool_frames)])
     return PlotKinematics(
-        chain_points(robot, q[0]), path_frames, tool_frames, tracking_error(result, case)
+        carrier_chain_points(case, q[0]), path_frames, tool_frames, tracking_error(result, case)
     )
 
 
@@ -197,13 +196,15 @@ def path_figure(
     scene = [shell, points_part, points_base]
     if trajectory.n_samples:
         if kinematics is None:
-            chain = chain_points(case.robot, trajectory.q[0])
+            chain = carrier_chain_points(case, trajectory.q[0])
         else:
             chain = kinematics.chain_start
         ax_cell.plot(*chain.T, "o-", color="0.2", lw=3.0, ms=4, gid="robot", label="robot at t = 0")
         scene.append(chain)
     _set_equal(ax_cell, np.vstack(scene))
-    ax_cell.set_title("work cell (robot base frame)", fontsize=10, y=1.0)
+    # with a positioner the path is drawn relative to its flange (trajectory.tool_position)
+    where = "positioner flange" if case.positioner is not None else "robot base frame"
+    ax_cell.set_title(f"work cell ({where})", fontsize=10, y=1.0)
 
     ax_path.plot(*points_base.T, color=AFTER_COLOR, lw=2.0, gid="path-zoom")
     ax_path.plot(*points_base[0], "o", color="tab:green", ms=6, label="start", gid="start")
@@ -212,7 +213,7 @@ def path_figure(
     if trajectory.n_samples:
         if kinematics is None:
             idx = frame_indices(trajectory.n_samples, n_tool_frames)
-            T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+            T_tool = carrier_tool_frames(case, trajectory.q[idx])
         else:
             T_tool = kinematics.path_frames
         _plot_triads(ax_path, triad_lines(T_tool, 0.08 * extent), "tool-frames", "tool frames")
@@ -279,7 +280,7 @@ def tool_figure(
         extent = float(np.max(np.ptp(points_base, axis=0))) if len(points_base) > 1 else 0.1
         if kinematics is None:
             idx = frame_indices(trajectory.n_samples, n_frames)
-            T_tool = forward_kinematics(case.robot, trajectory.q[idx])
+            T_tool = carrier_tool_frames(case, trajectory.q[idx])
         else:
             T_tool = kinematics.tool_frames
         _plot_triads(ax_frames, triad_lines(T_tool, 0.06 * extent), "tool-frames", "tool frames")

@@ -200,7 +200,7 @@ def _serve(connection: Connection) -> None:
     except (EOFError, OSError):
         return
     result, run_case, history, out_dir, kinematics = message[1]
-    if run_case.robot.n_dof != n_dof:
+    if run_case.machine.n_dof != n_dof:
         canvases = {}
     try:
         plots = plot_figures(result, run_case, history, kinematics, canvases)

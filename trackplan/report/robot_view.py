@@ -23,18 +23,23 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.frames import placement_transform
 from trackplan.planning.result import PlanResult
+from trackplan.report.machine_view import (
+    arm_frames,
+    cell_chain_points,
+    machine_layers,
+    moves_the_part,
+)
 from trackplan.report.scene import (
     FRAME_STYLES,
-    chain_points,
     equal_limits,
     frame_indices,
     nominal_polyline,
     path_points,
+    plotly_xyz,
     sphere_wireframe,
     transform_points,
     triad_lines,
 )
-from trackplan.robots.kinematics import joint_frames
 
 if TYPE_CHECKING:
     import plotly.graph_objects as go
@@ -53,9 +58,7 @@ DECIMALS = 5  # 10 µm: keeps the page small, far below anything visible
 
 def _xyz(points: np.ndarray, decimals: int = DECIMALS) -> dict[str, list[float | None]]:
     """Plotly coordinates from points (M, 3), NaN rows as gaps (None)."""
-    columns = np.round(points, decimals).T.astype(object)
-    columns[np.isnan(points.T.astype(float))] = None
-    return {axis: columns[i].tolist() for i, axis in enumerate("xyz")}
+    return plotly_xyz(points, decimals)
 
 
 def frame_name(k: int) -> str:
@@ -78,15 +81,17 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
     geometry = CellGeometry.from_cell(case.cell, case.robot)
     T_base_part = placement_transform(result.placement)
     traces: list = []
+    # with a positioner the workpiece moves with it (machine_view)
+    workpiece = () if moves_the_part(case) else case.cell.workpiece
     for label, bodies, T, color, opacity in (
         ("obstacles", case.cell.obstacles, np.eye(4), "#8c8c8c", 0.35),
-        ("workpiece", case.cell.workpiece, T_base_part, "#c49a6c", 0.6),
+        ("workpiece", workpiece, T_base_part, "#c49a6c", 0.6),
     ):
         if not bodies:
             continue
         vertices, faces = merge([body_mesh(body, T) for body in bodies])
         traces.append(_mesh_trace(vertices, faces, label, color, opacity))
-    closest = closest_approach(geometry, case.robot, result)
+    closest = closest_approach(geometry, case.machine, result)
     if closest is not None:
         points, label = closest
         traces.append(
@@ -101,7 +106,7 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
                 "hoverinfo": "text",
             }
         )
-    frames = joint_frames(case.robot, result.trajectory.q[idx])
+    frames = arm_frames(case, result.trajectory.q[idx])
 
     def capsules_trace(k: int) -> dict:
         vertices, faces = robot_capsules_mesh(geometry, frames[k])
@@ -210,7 +215,7 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
         raise ValueError("no trajectory to animate")
     robot = case.robot
     idx = frame_indices(trajectory.n_samples, n_frames)
-    chains = chain_points(robot, trajectory.q[idx])  # (F, n + 2, 3)
+    chains = cell_chain_points(case, trajectory.q[idx])  # (F, n + 2, 3), cell frame
     tool = trajectory.tool_position[idx]
     _, points_base = path_points(result, case)
     T_base_part = placement_transform(result.placement)
@@ -260,6 +265,8 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
             "hoverinfo": "skip",
             "visible": "legendonly",
         },
+    ]
+    fixed_part: list[dict] = [
         {
             "type": "scatter3d",
             **_xyz(nominal),
@@ -281,7 +288,7 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
         lines = triad_lines(T, axis_length if label == "base frame" else 0.6 * axis_length)
         colors, dash = FRAME_STYLES[label]
         for axis, color in enumerate(colors):
-            static.append(
+            (static if label == "base frame" else fixed_part).append(
                 {
                     "type": "scatter3d",
                     **_xyz(lines[axis]),
@@ -294,7 +301,22 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
                     "hoverinfo": "text",
                 }
             )
-    builders = [robot_trace, trail_trace]
+    # the external axes: the track's rail, the positioner and, with one, the part moving on
+    # its flange in place of the fixed part's path, trail and frame
+    layers = machine_layers(
+        result,
+        case,
+        idx,
+        {"nominal": NOMINAL_TRACE, "path": PATH_TRACE, "trail": TRAIL_TRACE},
+        0.6 * axis_length,
+    )
+    static += layers.static
+    builders: list[Callable[[int], dict]] = [robot_trace]
+    if moves_the_part(case):
+        builders += layers.builders
+    else:
+        static += fixed_part
+        builders.append(trail_trace)
     if case.cell is not None:
         cell_static, capsules_trace = _cell_traces(result, case, idx)
         static += cell_static
@@ -361,8 +383,9 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
             },
         ],
     }
+    fixed = [] if moves_the_part(case) else [points_base, nominal]
     limits = equal_limits(
-        np.vstack([chains.reshape(-1, 3), points_base, nominal, [[0.0, 0.0, 0.0]]])
+        np.vstack([chains.reshape(-1, 3), *fixed, layers.points, [[0.0, 0.0, 0.0]]])
     )
     scene_axes = {
         f"{axis}axis": {

@@ -15,7 +15,8 @@ from trackplan.case import Case
 from trackplan.frames import placement_transform
 from trackplan.paths import NominalPath
 from trackplan.planning.result import PlanResult, Trajectory, Violation
-from trackplan.robots.kinematics import joint_frames
+from trackplan.robots.kinematics import forward_kinematics, joint_frames
+from trackplan.robots.machine import Machine
 from trackplan.robots.model import Robot
 
 #: Display name and unit of each joint limit kind.
@@ -26,6 +27,29 @@ JOINT_QUANTITIES = {
     "jerk": ("jerk", "rad/s³"),
     "torque": ("torque", "N·m"),
 }
+
+
+LINEAR_UNITS = {
+    "position": "m",
+    "velocity": "m/s",
+    "acceleration": "m/s²",
+    "jerk": "m/s³",
+}
+"""Unit of each limit kind for a linear axis (a track)."""
+
+
+def column_units(robot: Robot | Machine, kind: str) -> tuple[str, ...]:
+    """The unit of every column of the joint vector for one limit kind: the robot's joints
+    and a positioner's axes in rad, rad/s, …; a track in m, m/s, m/s², m/s³.
+
+    Returns
+    -------
+    tuple of str
+        Length n (the robot's or the machine's joints).
+    """
+    angular = JOINT_QUANTITIES[kind][1]
+    units = getattr(robot, "units", ("rad",) * robot.n_dof)
+    return tuple(LINEAR_UNITS[kind] if unit == "m" else angular for unit in units)
 
 
 def joint_series(trajectory: Trajectory, kind: str) -> np.ndarray:
@@ -51,7 +75,7 @@ def joint_series(trajectory: Trajectory, kind: str) -> np.ndarray:
     }[kind]
 
 
-def joint_bounds(robot: Robot, kind: str) -> tuple[np.ndarray, np.ndarray]:
+def joint_bounds(robot: Robot | Machine, kind: str) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper bound of one joint limit kind.
 
     Returns
@@ -64,6 +88,14 @@ def joint_bounds(robot: Robot, kind: str) -> tuple[np.ndarray, np.ndarray]:
         return robot.q_min, robot.q_max
     limit = robot.limits(kind)
     return -limit, limit
+
+
+def plotly_xyz(points: np.ndarray, decimals: int = 5) -> dict[str, list[float | None]]:
+    """Plotly coordinates ``{"x": [...], "y": [...], "z": [...]}`` from points (M, 3), m,
+    rounded to ``decimals`` (10 µm by default), NaN rows as gaps (None)."""
+    columns = np.round(points, decimals).T.astype(object)
+    columns[np.isnan(points.T.astype(float))] = None
+    return {axis: columns[i].tolist() for i, axis in enumerate("xyz")}
 
 
 def transform_points(T: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -159,6 +191,39 @@ def chain_points(robot: Robot, q: np.ndarray) -> np.ndarray:
         Shape (..., n + 2, 3), m, base frame.
     """
     return joint_frames(robot, q)[..., :3, 3]
+
+
+def carrier_tool_frames(case: Case, q: np.ndarray) -> np.ndarray:
+    """The tool frames relative to the part's carrier (the positioner's flange; the cell
+    without a positioner; the robot's base for a robot alone), the frame of
+    ``trajectory.tool_position``.
+
+    Parameters
+    ----------
+    q
+        Joint vectors, shape (..., n) (the machine's joints, or the robot's).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (..., 4, 4).
+    """
+    machine = case.machine
+    if isinstance(machine, Machine):
+        return machine.T_carrier_tool(q)
+    return forward_kinematics(machine, q)
+
+
+def carrier_chain_points(case: Case, q: np.ndarray) -> np.ndarray:
+    """:func:`chain_points` of the robot (on its track) in the carrier frame
+    (:func:`carrier_tool_frames`), shape (..., n_arm + 2, 3), m."""
+    machine = case.machine
+    if not isinstance(machine, Machine):
+        return chain_points(machine, q)
+    frames = np.linalg.inv(machine.T_cell_carrier(q))[..., None, :, :] @ (
+        machine.arm_frames_in_cell(q)
+    )
+    return frames[..., :3, 3]
 
 
 def sphere_wireframe(radius: float, n_meridians: int = 12, n_parallels: int = 7) -> np.ndarray:
