@@ -133,6 +133,39 @@ class CellReport:
         return Status.FEASIBLE if self.success else Status.COLLISION
 
 
+@dataclass(frozen=True, kw_only=True)
+class DownhandFigures:
+    """The weld's position reached over the samples (the downhand rule, ``docs/positioner.md``).
+
+    Attributes
+    ----------
+    max_slope
+        Largest angle of the travel direction to the horizontal, rad.
+    max_rotation
+        Largest angle of the weld normal to straight up, rad.
+    slope, rotation
+        The rule's bounds, rad.
+    share
+        Share of the samples within both bounds, in [0, 1].
+    """
+
+    max_slope: float
+    max_rotation: float
+    slope: float
+    rotation: float
+    share: float
+
+    def as_dict(self) -> dict[str, float]:
+        """The figures as result.json writes them (rad, share)."""
+        return {
+            "max_slope": self.max_slope,
+            "max_rotation": self.max_rotation,
+            "slope": self.slope,
+            "rotation": self.rotation,
+            "share": self.share,
+        }
+
+
 @dataclass(frozen=True, eq=False, kw_only=True)
 class CheckReport:
     """What the checker found, sample by sample.
@@ -161,6 +194,8 @@ class CheckReport:
     unchecked
         The status of a report with nothing checked (no trajectory: ``success`` false and
         no violations): why there was no trajectory. Ignored otherwise.
+    downhand
+        The weld's slope and rotation reached, when the task has a downhand rule.
     """
 
     success: bool
@@ -172,6 +207,7 @@ class CheckReport:
     binding: dict[str, tuple[int, float]] = field(default_factory=dict)
     cell: CellReport | None = None
     unchecked: Status = Status.UNREACHABLE
+    downhand: DownhandFigures | None = None
 
     @classmethod
     def of_nothing(cls, status: Status) -> CheckReport:

@@ -21,6 +21,7 @@ from scipy.spatial.transform import Rotation
 
 from trackplan.case import Case
 from trackplan.cell.model import Body, Cell, Shape
+from trackplan.check_report import DownhandFigures
 from trackplan.derivatives import backward_derivatives
 from trackplan.planning.result import PlanResult, Trajectory
 from trackplan.report.html import write_report
@@ -271,14 +272,15 @@ def test_summary_lists_the_external_axes(tmp_path, cell_result, cell_case):
 
 
 def test_downhand_figures_shown_when_the_result_has_them(cell_case):
-    assert downhand_rows(SimpleNamespace(), cell_case) == []
-    figures = {"slope": np.array([0.01, -0.05, 0.02]), "rotation": np.array([0.1, 0.12])}
-    rows = dict(downhand_rows(SimpleNamespace(downhand=figures), cell_case))
-    assert rows["largest downhand slope"].startswith("0.05 rad (2.865°)")
-    assert rows["largest downhand rotation"].startswith("0.12 rad (6.875°)")
-    object_form = SimpleNamespace(max_slope=0.2, max_rotation=0.3)
-    rows = dict(downhand_rows(SimpleNamespace(downhand=object_form), cell_case))
-    assert set(rows) == {"largest downhand slope", "largest downhand rotation"}
+    figures = DownhandFigures(
+        max_slope=0.05, max_rotation=0.12, slope=0.1745, rotation=0.1745, share=0.75
+    )
+    result = SimpleNamespace(check=SimpleNamespace(downhand=figures))
+    rows = dict(downhand_rows(result, cell_case))
+    assert rows["largest downhand slope"].startswith("0.05 rad (2.865°")
+    assert rows["largest downhand rotation"].startswith("0.12 rad (6.875°")
+    assert rows["samples downhand"] == "75 %"
+    assert downhand_rows(SimpleNamespace(check=SimpleNamespace(downhand=None)), cell_case) == []
 
 
 def test_arm_only_report_has_no_external_axes(corner, corner_result):

@@ -262,6 +262,7 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
         },
         "binding": {kind: {"joint": j, "t": t} for kind, (j, t) in check.binding.items()},
         **_cell_summary(check),
+        **({} if check.downhand is None else {"downhand": check.downhand.as_dict()}),
         "violations": [
             {
                 "limit": v.limit,

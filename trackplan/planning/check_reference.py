@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from trackplan.axes.rules import Downhand
 from trackplan.paths import NominalPath
 from trackplan.tool import ToolSpec
 
@@ -37,6 +38,9 @@ class TrackingReference:
         (K, 3): nominal arc lengths (m) and the extra tool axis deviation allowed (rad).
     orientation_tolerance
         Largest tool axis error, and spin error of a fixed spin, rad.
+    downhand
+        The downhand rule to hold at every sample (:class:`~trackplan.axes.rules.Downhand`),
+        or None.
     """
 
     nominal: NominalPath
@@ -48,3 +52,4 @@ class TrackingReference:
     corner_intervals: np.ndarray
     tool_zones: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     orientation_tolerance: float = ORIENTATION_TOLERANCE
+    downhand: Downhand | None = None

@@ -12,9 +12,10 @@ from dataclasses import replace
 import numpy as np
 
 from trackplan._kernels import read_only
-from trackplan.check_report import Violation
+from trackplan.check_report import DownhandFigures, Violation
 from trackplan.motion import JointSamples
 from trackplan.planning import _kernels
+from trackplan.planning.check_downhand import check_downhand
 from trackplan.planning.check_reference import TrackingReference
 from trackplan.planning.check_tool import check_tool
 from trackplan.planning.check_violations import (
@@ -67,7 +68,7 @@ def speed_slack(sample_time: float) -> float:
 
 def check_task(
     motion: JointSamples, ref: TrackingReference
-) -> tuple[tuple[dict[str, float], list[Violation]], float, float]:
+) -> tuple[tuple[dict[str, float], list[Violation]], float, float, DownhandFigures | None]:
     """Tracking, orientation, Cartesian speed and coverage checks.
 
     Parameters
@@ -81,7 +82,8 @@ def check_task(
     -------
     tuple
         ((the margin per task kind, the violations found), the largest tracking error, m,
-        the largest tool axis error, rad).
+        the largest tool axis error, rad, and the downhand figures when the task has the
+        rule).
     """
     robot, q, sample_time = motion.robot, motion.q, motion.sample_time
     T_base_part = np.ascontiguousarray(ref.T_base_part, dtype=float)
@@ -155,7 +157,11 @@ def check_task(
     coverage = coverage_violations(ref, t, s_nominal, piece, speed, sample_time)
     margins["coverage"] = 1.0 if not coverage else -1.0
     violations.extend(coverage)
-    return (margins, violations), worst, orientation_error
+    downhand = None
+    if ref.downhand is not None:
+        downhand, margins["downhand"], flat = check_downhand(motion, ref, s_nominal, piece, t)
+        violations.extend(flat)
+    return (margins, violations), worst, orientation_error, downhand
 
 
 def machine_task_frames(

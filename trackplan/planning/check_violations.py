@@ -24,6 +24,7 @@ UNITS = {
     "speed": "m/s",
     "coverage": "m",
     "clearance": "m",
+    "downhand": "rad",
 }
 RELATIVE_SLACK = 1e-9
 """Values within this relative amount of a limit count as meeting it (float round-off)."""

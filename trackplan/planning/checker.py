@@ -89,10 +89,11 @@ def check_motion(
     margins, binding, violations = check_joint_limits(motion, t)
 
     task_margins: dict[str, float] = {}
+    downhand = None
     max_tracking = 0.0
     max_orientation = 0.0
     if reference is not None:
-        task, max_tracking, max_orientation = check_task(motion, reference)
+        task, max_tracking, max_orientation, downhand = check_task(motion, reference)
         task_margins, task_violations = task
         violations.extend(task_violations)
 
@@ -114,6 +115,7 @@ def check_motion(
         max_orientation_error=max_orientation,
         binding=binding,
         cell=cell_report,
+        downhand=downhand,
     )
 
 

@@ -78,6 +78,7 @@ def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> Tra
         corner_speed=case.task.corner_speed,
         corner_intervals=geometry.corner_intervals(),
         tool_zones=_transition_zones(case.task.tool, geometry, case.task.tolerance),
+        downhand=case.downhand,
     )
 
 

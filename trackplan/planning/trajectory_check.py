@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.case import Case
+from trackplan.check_report import DownhandFigures
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform
 from trackplan.paths.nominal import NominalPath
@@ -125,8 +126,24 @@ def check_spans(
         max_orientation_error=orientation,
         binding=whole.binding,
         cell=cell_report,
+        downhand=merged_downhand([own.downhand for own in seam_checks]),
     )
     return report, tuple(seam_checks)
+
+
+def merged_downhand(figures: list[DownhandFigures | None]) -> DownhandFigures | None:
+    """The seams' downhand figures as one: the largest angles, the share over every seam
+    (each seam's share weighted alike); None when no seam has the rule."""
+    found = [f for f in figures if f is not None]
+    if not found:
+        return None
+    return DownhandFigures(
+        max_slope=max(f.max_slope for f in found),
+        max_rotation=max(f.max_rotation for f in found),
+        slope=found[0].slope,
+        rotation=found[0].rotation,
+        share=float(np.mean([f.share for f in found])),
+    )
 
 
 def spans_from_segments(

@@ -134,44 +134,24 @@ def external_axes_table(result: PlanResult, case: Case) -> str:
     return '<h3 id="external-axes">External axes</h3>' + grid(header, rows)
 
 
-def _figure(downhand: object, *keys: str) -> float | None:
-    """The largest value of the first of ``keys`` that ``downhand`` (a mapping or an
-    object) holds, a number or per-sample values, rad; None when it holds none."""
-    for key in keys:
-        value = downhand.get(key) if isinstance(downhand, dict) else getattr(downhand, key, None)
-        if value is None:
-            continue
-        values = np.asarray(value, dtype=float).ravel()
-        values = values[np.isfinite(values)]
-        return float(np.max(np.abs(values))) if values.size else None
-    return None
-
-
 def downhand_rows(result: PlanResult, case: Case) -> list[tuple[str, str]]:
-    """The downhand figures of a result that has them (``result.downhand``: the largest
-    slope of the travel direction to the horizontal and rotation of the weld normal from
-    straight up, rad), against the case's ``downhand`` bounds when it has them; none
-    otherwise."""
-    downhand = getattr(result, "downhand", None)
-    if downhand is None:
+    """The downhand figures of a result whose task has the rule (``result.check.downhand``:
+    the largest slope of the travel direction to the horizontal and rotation of the weld
+    normal from straight up, against the bounds, and the share of samples within both);
+    none otherwise."""
+    figures = result.check.downhand
+    if figures is None:
         return []
-    rule = case.downhand
     rows = []
-    for label, keys, bound in (
-        ("largest downhand slope", ("max_slope", "slope"), None if rule is None else rule.slope),
-        (
-            "largest downhand rotation",
-            ("max_rotation", "rotation"),
-            None if rule is None else rule.rotation,
-        ),
+    for label, value, bound in (
+        ("largest downhand slope", figures.max_slope, figures.slope),
+        ("largest downhand rotation", figures.max_rotation, figures.rotation),
     ):
-        value = _figure(downhand, *keys)
-        if value is None:
-            continue
-        text = f"{num(value, unit='rad')} ({num(np.degrees(value))}°)"
-        if bound is not None:
-            text += f" (bound {num(np.degrees(bound))}°)"
+        text = (
+            f"{num(value, unit='rad')} ({num(np.degrees(value))}°, bound {num(np.degrees(bound))}°)"
+        )
         rows.append((label, text))
+    rows.append(("samples downhand", f"{num(100.0 * figures.share)} %"))
     return rows
 
 
