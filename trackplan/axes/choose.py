@@ -1,0 +1,280 @@
+"""The external axes' motion along one seam: the positioner keeps the weld downhand, the
+track carries the arm along (``docs/positioner.md``, "Downhand and the track").
+
+:func:`choose_axes` is the one call the planner makes per seam and placement X. It returns
+one smooth profile per external axis over the planned path's arc length
+(:class:`~trackplan.axes.profile.AxesProfile`), or an :class:`AxesFailure` that names the
+stretch where the weld cannot be held downhand with the given axes.
+
+- **Positioner with ``downhand``.** Held still (:func:`~trackplan.axes.pointwise.hold_values`)
+  when that already meets the rule. Otherwise the pointwise closed form
+  (:func:`~trackplan.axes.pointwise.upright_branches`) turns the weld normal straight up at
+  every sample; each branch is made continuous (unwrapped) and its free winding chosen at
+  the start so that it stays inside every axis's range, nearest to the hold value; the
+  branch with the least travel wins. A constant at the middle of that motion is taken when
+  it meets the rule; else a B-spline is fitted with 8, 16, 32 … coefficients until the
+  fitted profile meets the rule on a grid twice as dense as the fit's (where the pointwise
+  solution itself meets it, within :data:`FIT_SLACK`).
+- **Positioner without ``downhand``**: held still at the hold value.
+- **Track**: the arm's base abreast of the TCP along the track's axis, ``t(s) = axis ·
+  p_cell_tool(s) − TRACK_LEAD``, clipped to the range, fitted with one coefficient per
+  :data:`TRACK_SPACING` of seam.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from trackplan.axes.figures import (
+    SeamDirections,
+    angles_in_cell,
+    carrier_points,
+    describe_excess,
+)
+from trackplan.axes.fit import fit_coefficients
+from trackplan.axes.pointwise import fill_undetermined, hold_values, upright_branches
+from trackplan.axes.profile import AxesProfile
+from trackplan.axes.rules import Downhand
+from trackplan.paths.path_geometry import PathGeometry
+from trackplan.profiles import DEGREE, Profile
+from trackplan.robots.machine import Machine
+from trackplan.status import Status
+from trackplan.tool.spec import ToolSpec
+
+SAMPLE_STEP = 1e-3
+"""Arc-length step of the fit's samples, m (at least 201, at most 4001 samples)."""
+FIT_SLACK = 1e-3
+"""How far the fitted profile may exceed the pointwise solution's angle where that is
+already at or over the bound (a rule of 0° cannot be met by a spline exactly), rad."""
+MAX_COEFFICIENTS = 512
+"""Most coefficients of a positioner axis's profile."""
+TRACK_LEAD = 0.0
+"""The arm's preferred offset along the track's axis behind the TCP, m: 0 keeps the base
+abreast of the TCP, where a welding arm has its reach to both sides."""
+TRACK_SPACING = 0.25
+"""Seam length per coefficient of the track's profile, m: a smooth ramp, no wiggles."""
+TAU = 2.0 * np.pi
+
+
+@dataclass(frozen=True)
+class AxesFailure:
+    """Why a seam cannot be held downhand with the given axes (the planner's exit 3).
+
+    Attributes
+    ----------
+    status
+        :attr:`~trackplan.status.Status.LIMITS_VIOLATED` (the downhand bounds),
+        :attr:`~trackplan.status.Status.POSITION_LIMITS` (every branch leaves an axis's
+        range) or :attr:`~trackplan.status.Status.NOT_CONVERGED` (no fit met the rule).
+    message
+        One line naming the stretch (s from–to, m) and the angle reached.
+    """
+
+    status: Status
+    message: str
+
+
+def sample_grid(length: float) -> np.ndarray:
+    """Arc lengths at which the profiles are solved and checked, shape (2N − 1,), m: the
+    fit uses every other one."""
+    n = int(np.clip(np.ceil(length / SAMPLE_STEP) + 1, 201, 4001))
+    return np.linspace(0.0, length, 2 * n - 1)
+
+
+def choose_axes(
+    machine: Machine,
+    geometry: PathGeometry,
+    tool: ToolSpec,
+    X: np.ndarray,
+    downhand: Downhand | None,
+) -> AxesProfile | AxesFailure:
+    """The track's and the positioner's profiles along one seam at placement X.
+
+    Parameters
+    ----------
+    machine
+        The arm with its external axes.
+    geometry
+        The seam's planned path.
+    tool
+        The seam's tool spec (its weld normals).
+    X
+        The part's placement in the carrier frame, shape (6,).
+    downhand
+        The downhand rule, or None.
+
+    Returns
+    -------
+    AxesProfile | AxesFailure
+        One profile per external axis (track first), or why the rule cannot be met.
+
+    Raises
+    ------
+    CaseError
+        With ``downhand`` and a seam without a weld normal.
+    """
+    length = float(geometry.planned.length)
+    s = sample_grid(length)
+    X = np.asarray(X, dtype=float)
+    directions = SeamDirections.sample(geometry, tool, X, s) if downhand is not None else None
+    positioner = machine.positioner
+    if positioner is None:
+        values = np.zeros((len(s), 0))
+        profiles: tuple[Profile, ...] = ()
+        if downhand is not None and directions is not None:
+            R = np.broadcast_to(np.eye(3), (len(s), 3, 3))
+            failure = _rule_failure(
+                s, R, directions, downhand, "there is no positioner to turn the part"
+            )
+            if failure is not None:
+                return failure
+    elif downhand is None or directions is None:
+        hold = hold_values(positioner.chain)
+        values = np.broadcast_to(hold, (len(s), len(hold)))
+        profiles = tuple(Profile.constant(v, length) for v in hold)
+    else:
+        chosen = _downhand_positioner(machine, directions, downhand, length)
+        if isinstance(chosen, AxesFailure):
+            return chosen
+        profiles = chosen
+        values = np.stack([p.value(s) for p in profiles], axis=1)
+    if machine.track is not None:
+        position = directions.position if directions is not None else carrier_points(geometry, X, s)
+        profiles = (_track_profile(machine, values, position, s, length), *profiles)
+    return AxesProfile(profiles)
+
+
+def _carrier_rotations(machine: Machine, values: np.ndarray) -> np.ndarray:
+    """The carrier's rotation in the cell (M, 3, 3) at positioner angles (M, n)."""
+    q = np.zeros((len(values), machine.n_dof))
+    q[:, machine.positioner_columns] = values
+    R: np.ndarray = machine.T_cell_carrier(q)[:, :3, :3]
+    return R
+
+
+def _rule_failure(
+    s: np.ndarray,
+    R: np.ndarray,
+    directions: SeamDirections,
+    downhand: Downhand,
+    reason: str,
+) -> AxesFailure | None:
+    """The failure where the angles under carrier rotations R (M, 3, 3) exceed the rule."""
+    slope, rotation = angles_in_cell(R, directions.normal, directions.tangent)
+    for what, value, bound in (
+        ("rotation", rotation, downhand.rotation),
+        ("slope", slope, downhand.slope),
+    ):
+        message = describe_excess(s, value, bound, what, reason)
+        if message is not None:
+            return AxesFailure(Status.LIMITS_VIOLATED, message)
+    return None
+
+
+def _wind(values: np.ndarray, lower: np.ndarray, upper: np.ndarray, hold: np.ndarray) -> tuple:
+    """Continuous angles (M, n) shifted by whole turns into [lower, upper] (n,) each,
+    nearest to ``hold`` (n,); with the axes that no turn brings inside, shape (n,) bool."""
+    low, high = values.min(axis=0), values.max(axis=0)
+    k_min = np.ceil((lower - low) / TAU - 1e-12)
+    k_max = np.floor((upper - high) / TAU + 1e-12)
+    k_best = np.round((hold - 0.5 * (low + high)) / TAU)
+    k = np.clip(k_best, k_min, np.maximum(k_min, k_max))
+    return values + TAU * k, k_min > k_max
+
+
+def _downhand_positioner(
+    machine: Machine, directions: SeamDirections, downhand: Downhand, length: float
+) -> tuple[Profile, ...] | AxesFailure:
+    """The positioner's profiles that keep the weld downhand, or why they cannot."""
+    assert machine.positioner is not None
+    chain = machine.positioner.chain
+    s = directions.s
+    hold = hold_values(chain)
+    held = np.broadcast_to(hold, (len(s), len(hold)))
+    if _rule_failure(s, _carrier_rotations(machine, held), directions, downhand, "") is None:
+        return tuple(Profile.constant(v, length) for v in hold)
+    R_pose = machine.positioner.T_cell_base[:3, :3]
+    candidates = []
+    for branch in upright_branches(chain, R_pose, directions.normal, hold):
+        continuous = np.unwrap(fill_undetermined(branch, hold), axis=0)
+        wound, outside = _wind(continuous, chain.q_min, chain.q_max, hold)
+        travel = float(np.abs(np.diff(wound, axis=0)).sum())
+        candidates.append((bool(outside.any()), travel, wound, outside))
+    candidates.sort(key=lambda c: (c[0], c[1]))
+    outside_any, _, solution, outside = candidates[0]
+    if outside_any:
+        j = int(np.flatnonzero(outside)[0])
+        lo, hi = np.degrees(solution[:, j].min()), np.degrees(solution[:, j].max())
+        return AxesFailure(
+            Status.POSITION_LIMITS,
+            f"downhand: the positioner's axis {chain.joint_names[j]} must sweep "
+            f"{lo:.1f}° to {hi:.1f}° along the seam (s = 0.000–{length:.3f} m), more than "
+            f"its range [{np.degrees(chain.q_min[j]):.1f}°, "
+            f"{np.degrees(chain.q_max[j]):.1f}°] holds",
+        )
+    R = _carrier_rotations(machine, solution)
+    failure = _rule_failure(
+        s, R, directions, downhand, "the positioner's axes cannot turn it further"
+    )
+    if failure is not None:
+        return failure
+    pointwise_slope, pointwise_rotation = angles_in_cell(R, directions.normal, directions.tangent)
+    slope_bound = np.maximum(downhand.slope, pointwise_slope + FIT_SLACK)
+    rotation_bound = np.maximum(downhand.rotation, pointwise_rotation + FIT_SLACK)
+
+    def meets(values: np.ndarray) -> bool:
+        slope, rotation = angles_in_cell(
+            _carrier_rotations(machine, values), directions.normal, directions.tangent
+        )
+        return bool(np.all(slope <= slope_bound) and np.all(rotation <= rotation_bound))
+
+    middle = 0.5 * (solution.min(axis=0) + solution.max(axis=0))
+    if meets(np.broadcast_to(middle, solution.shape)):
+        return tuple(Profile.constant(v, length) for v in middle)
+    k = 2 * (DEGREE + 1)
+    fitted = solution
+    while True:
+        coefficients = fit_coefficients(s[::2], solution[::2], length, k, chain.q_min, chain.q_max)
+        profiles = tuple(Profile(coefficients[:, j], length) for j in range(chain.n_dof))
+        fitted = np.stack([p.value(s) for p in profiles], axis=1)
+        if meets(fitted):
+            return profiles
+        if k >= min(MAX_COEFFICIENTS, (len(s) + 1) // 4):
+            break
+        k *= 2
+    slope, rotation = angles_in_cell(
+        _carrier_rotations(machine, fitted), directions.normal, directions.tangent
+    )
+    over = (slope > slope_bound) | (rotation > rotation_bound)
+    where = s[over]
+    return AxesFailure(
+        Status.NOT_CONVERGED,
+        f"downhand: no smooth positioner profile of up to {k} coefficients keeps the weld "
+        f"within the rule at s = {where.min():.3f}–{where.max():.3f} m (rotation reached "
+        f"{np.degrees(rotation.max()):.1f}°, slope {np.degrees(slope.max()):.1f}°): the "
+        "pointwise solution turns too fast there",
+    )
+
+
+def _track_profile(
+    machine: Machine,
+    positioner: np.ndarray,
+    position: np.ndarray,
+    s: np.ndarray,
+    length: float,
+) -> Profile:
+    """The track's profile: the base abreast of the TCP, clipped to the range, smoothed."""
+    track = machine.track
+    assert track is not None
+    q = np.zeros((len(s), machine.n_dof))
+    q[:, machine.positioner_columns] = positioner
+    T = machine.T_cell_carrier(q)
+    tcp = np.einsum("mij,mj->mi", T[:, :3, :3], position) + T[:, :3, 3]
+    target = np.clip(tcp @ track.axis - TRACK_LEAD, track.lower, track.upper)
+    k = int(np.clip(np.ceil(length / TRACK_SPACING) + DEGREE, DEGREE + 1, 64))
+    coefficients = fit_coefficients(
+        s, target[:, None], length, k, np.array([track.lower]), np.array([track.upper])
+    )
+    return Profile(coefficients[:, 0], length)

@@ -1,0 +1,64 @@
+"""Smooth profiles through sampled axis positions: least-squares clamped cubic B-splines.
+
+A profile (:class:`~trackplan.profiles.Profile`) is a clamped cubic B-spline on uniform
+knots over [0, length]. :func:`fit_coefficients` fits its coefficients to samples by least
+squares with a small penalty on its second derivative's coefficients (it damps wiggles
+between samples, which the time law would pay for in d²q/ds² and d³q/ds³), then clips the
+coefficients to the axis's range: by the convex-hull property the curve stays inside it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from trackplan.profiles import clamped_knots
+from trackplan.profiles.bspline import DEGREE
+
+SMOOTHING = 1e-6
+"""Weight of the second derivative's squared coefficients (times the knot spacing to the
+fourth) against the mean squared error of the samples: a second derivative of 1 rad per
+knot spacing squared costs as much as an error of 1 mrad at every sample."""
+
+
+def design_matrix(s: np.ndarray, length: float, n_coefficients: int) -> np.ndarray:
+    """B-spline basis of a profile with ``n_coefficients`` at ``s`` (M,), shape (M, k)."""
+    from scipy.interpolate import BSpline  # scipy on demand (startup time)
+
+    knots = clamped_knots(n_coefficients, length)
+    basis: np.ndarray = BSpline.design_matrix(
+        np.clip(np.asarray(s, dtype=float), 0.0, length), knots, DEGREE
+    ).toarray()
+    return basis
+
+
+def second_derivative_map(n_coefficients: int, length: float) -> np.ndarray:
+    """The matrix (k − 2, k) from a profile's coefficients to those of its second
+    derivative in s (a linear spline): zero for a straight line, unit / m²."""
+    knots, degree = clamped_knots(n_coefficients, length), DEGREE
+    D = np.eye(n_coefficients)
+    for _ in range(2):  # as profile_values differentiates
+        spans = (knots[degree + 1 : -1] - knots[1 : -degree - 1]) / degree
+        D = np.diff(D, axis=0) / spans[:, None]
+        knots, degree = knots[1:-1], degree - 1
+    return D
+
+
+def fit_coefficients(
+    s: np.ndarray,
+    values: np.ndarray,
+    length: float,
+    n_coefficients: int,
+    lower: np.ndarray,
+    upper: np.ndarray,
+) -> np.ndarray:
+    """Coefficients (k, n) of profiles through samples ``values`` (M, n) at ``s`` (M,),
+    clipped to [lower, upper] (n,) each."""
+    values = np.asarray(values, dtype=float)
+    basis = design_matrix(s, length, n_coefficients)
+    D = second_derivative_map(n_coefficients, length)
+    spacing = length / (n_coefficients - DEGREE)
+    A = np.vstack([basis, np.sqrt(SMOOTHING * len(s)) * spacing**2 * D])
+    b = np.vstack([values, np.zeros((len(D), values.shape[1]))])
+    coefficients, *_ = np.linalg.lstsq(A, b, rcond=None)
+    clipped: np.ndarray = np.clip(coefficients, lower, upper)
+    return clipped
