@@ -308,3 +308,30 @@ def test_the_track_comes_first_and_follows_the_turning_part():
     p = (T[:3, :3] @ _rz(0.0 * s[:1])[0] @ [0.0, 0.0, 0.0]) + T[:3, 3]
     assert np.ptp(e[:, 0]) < 0.1 * 2 * 0.06 + 0.02  # far less than the pipe's diameter
     assert abs(float(np.mean(e[:, 0])) - p[0]) < 0.25  # near the positioner's x
+
+
+def test_a_normal_that_swings_through_the_rotate_axis_keeps_one_smooth_branch(two_axis):
+    """A seam along x whose normal swings across it (in the y-z plane) from −40° through
+    straight up to +40°: the two closed-form branches meet where the tilt passes 0, and
+    the least motion is to tilt through it with the table's rotation still (not to flip
+    the table by 180° there)."""
+    from trackplan.paths.specs import PointsSpec
+
+    x = np.linspace(0.0, 0.2, 21)
+    lean = np.radians(np.linspace(-40.0, 40.0, 21))
+    normals = np.column_stack([0 * x, np.sin(lean), np.cos(lean)])
+    points = np.column_stack([x, 0 * x, 0 * x])
+    geometry = PathGeometry.build(
+        points[0], [PointsSpec(points[1:], normals[1:], start_normal=normals[0])], 5e-4
+    )
+    profile = choose_axes(two_axis, geometry, cells.seam_tool(), np.zeros(6), RULE)
+    assert isinstance(profile, AxesProfile)
+    s = np.linspace(0.0, geometry.planned.length, 2001)
+    e = profile.values(s)
+    assert np.ptp(e[:, 1]) < math.radians(1.0)  # the table does not turn
+    assert np.ptp(e[:, 0]) > math.radians(40.0)  # the tilt takes the swing
+    R = _table_rotation(POSE, e[:, 0], e[:, 1])
+    lean_s = np.interp(geometry.planned.sample(s).position[:, 0], x, lean)
+    n = np.column_stack([0 * s, np.sin(lean_s), np.cos(lean_s)])
+    rotation = np.arccos(np.clip(np.einsum("mk,mk->m", R[:, 2, :], n), -1.0, 1.0))
+    assert rotation.max() <= RULE.rotation + 0.02  # the normal's interpolation: ≈ 1°/mm

@@ -7,7 +7,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.axes.cells import tilt_rotate_chain, turntable_chain
-from trackplan.axes.pointwise import fill_undetermined, hold_values, upright_branches
+from trackplan.axes.pointwise import (
+    crossed_branches,
+    fill_undetermined,
+    hold_values,
+    upright_branches,
+)
 from trackplan.robots.model import Robot
 
 UP_TOL = 1e-9
@@ -78,7 +83,7 @@ def test_two_axes_in_general_position_turn_a_reachable_normal_exactly_up(seed):
     R_pose = _random_rotation(rng)
     p = rng.uniform(-np.pi, np.pi, (12, 2))
     m = np.stack([_flange_rotation(chain, R_pose, row).T @ [0, 0, 1.0] for row in p])
-    branches = upright_branches(chain, R_pose, m)
+    branches, _ = upright_branches(chain, R_pose, m)
     assert branches.shape == (2, 12, 2)
     for branch in branches:
         up = np.stack(
@@ -93,7 +98,8 @@ def test_the_tilt_rotate_positioner_turns_a_45_degree_normal_up_with_a_45_degree
     chain = tilt_rotate_chain()
     phi = np.linspace(0.0, 2 * np.pi, 9)
     m = np.column_stack([np.cos(phi), np.sin(phi), np.ones(9)]) / np.sqrt(2.0)
-    branches = upright_branches(chain, np.eye(3), m)
+    branches, gamma = upright_branches(chain, np.eye(3), m)
+    np.testing.assert_allclose(gamma, np.sin(np.pi / 4), atol=1e-12)  # far from meeting
     np.testing.assert_allclose(np.abs(branches[..., 0]), np.pi / 4, atol=1e-12)
     assert np.all(np.sign(branches[0, :, 0]) == -np.sign(branches[1, :, 0]))
 
@@ -106,7 +112,7 @@ def test_one_axis_comes_as_near_to_up_as_its_turn_allows():
     rng = np.random.default_rng(3)
     m = rng.normal(size=(20, 3))
     m /= np.linalg.norm(m, axis=1, keepdims=True)
-    (best,) = upright_branches(chain, tilt, m)
+    (best,), _ = upright_branches(chain, tilt, m)
     grid = np.radians(np.arange(-180.0, 180.0, 0.01))
     z_of = np.array([(_flange_rotation(chain, tilt, [g]) @ m.T)[2] for g in grid])  # (G, 20)
     ours = np.array(
@@ -120,7 +126,7 @@ def test_an_angle_that_does_not_matter_is_nan_and_filled_from_its_neighbours():
     determined angle (or the hold value when none is)."""
     chain = tilt_rotate_chain()
     m = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.6, 0.0, 0.8]])
-    (first, _) = upright_branches(chain, np.eye(3), m)
+    (first, _), _ = upright_branches(chain, np.eye(3), m)
     assert np.isnan(first[:2, 1]).all() and np.isfinite(first[2]).all()
     filled = fill_undetermined(first, hold_values(chain))
     np.testing.assert_array_equal(filled[:2, 1], first[2, 1])
@@ -142,3 +148,13 @@ def test_hold_values_are_zero_inside_the_range_else_the_middle():
         j_max=chain.j_max,
     )
     np.testing.assert_array_equal(hold_values(shifted), [1.0, 0.0])
+
+
+def test_crossed_branches_swap_where_the_branches_meet():
+    """|γ| dips to 0 at sample 4 and again at 8: the crossed paths swap there."""
+    gamma = np.array([0.5, 0.3, 0.1, 0.03, 0.0, 0.04, 0.2, 0.04, 0.01, 0.3])
+    branches = np.stack([np.zeros((10, 1)), np.ones((10, 1))])
+    crossed = crossed_branches(branches, gamma)
+    np.testing.assert_array_equal(crossed[0, :, 0], [0, 0, 0, 0, 1, 1, 1, 1, 0, 0])
+    np.testing.assert_array_equal(crossed[1, :, 0], 1 - crossed[0, :, 0])
+    np.testing.assert_array_equal(crossed_branches(branches, gamma + 1.0), branches)

@@ -9,7 +9,9 @@ stretch where the weld cannot be held downhand with the given axes.
 - **Positioner with ``downhand``.** Held still (:func:`~trackplan.axes.pointwise.hold_values`)
   when that already meets the rule. Otherwise the pointwise closed form
   (:func:`~trackplan.axes.pointwise.upright_branches`) turns the weld normal straight up at
-  every sample; each branch is made continuous (unwrapped) and its free winding chosen at
+  every sample; each branch, and each path that passes from one branch to the other where
+  they meet (:func:`~trackplan.axes.pointwise.crossed_branches`), is made continuous
+  (unwrapped) and its free winding chosen at
   the start so that it stays inside every axis's range, nearest to the hold value; the
   branch with the least travel wins. A constant at the middle of that motion is taken when
   it meets the rule; else a B-spline is fitted with 8, 16, 32 … coefficients until the
@@ -34,7 +36,12 @@ from trackplan.axes.figures import (
     describe_excess,
 )
 from trackplan.axes.fit import fit_coefficients
-from trackplan.axes.pointwise import fill_undetermined, hold_values, upright_branches
+from trackplan.axes.pointwise import (
+    crossed_branches,
+    fill_undetermined,
+    hold_values,
+    upright_branches,
+)
 from trackplan.axes.profile import AxesProfile
 from trackplan.axes.rules import Downhand
 from trackplan.paths.path_geometry import PathGeometry
@@ -196,8 +203,11 @@ def _downhand_positioner(
     if _rule_failure(s, _carrier_rotations(machine, held), directions, downhand, "") is None:
         return tuple(Profile.constant(v, length) for v in hold)
     R_pose = machine.positioner.T_cell_base[:3, :3]
+    branches, gamma = upright_branches(chain, R_pose, directions.normal, hold)
+    if len(branches) == 2:
+        branches = np.concatenate([branches, crossed_branches(branches, gamma)])
     candidates = []
-    for branch in upright_branches(chain, R_pose, directions.normal, hold):
+    for branch in branches:
         continuous = np.unwrap(fill_undetermined(branch, hold), axis=0)
         wound, outside = _wind(continuous, chain.q_min, chain.q_max, hold)
         travel = float(np.abs(np.diff(wound, axis=0)).sum())

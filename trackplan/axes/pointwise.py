@@ -20,6 +20,9 @@ import numpy as np
 
 from trackplan.robots.model import Robot
 
+MEET = 0.05
+"""|γ| (the share of the cones' common vector across both axes) below which the two
+branches meet closely enough for a smooth path to pass from one to the other."""
 PARALLEL = 1e-9
 """|component across an axis| below which a vector counts as on the axis (its angle free)."""
 UP = np.array([0.0, 0.0, 1.0])
@@ -62,7 +65,7 @@ def _prefix(chain: Robot, R_pose: np.ndarray, held: np.ndarray, first_free: int)
 
 def upright_branches(
     chain: Robot, R_pose: np.ndarray, normal: np.ndarray, held: np.ndarray | None = None
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
     """The positioner angles that turn carrier-frame normals straight up in the cell.
 
     Parameters
@@ -79,9 +82,12 @@ def upright_branches(
 
     Returns
     -------
-    numpy.ndarray
+    branches
         Shape (B, M, n), rad in (−π, π]: B = 2 branches (γ ≥ 0 and γ ≤ 0) with two or
         more axes, 1 with one axis; NaN where an axis's angle does not matter.
+    gamma
+        |γ| per sample, shape (M,): where it passes near 0 the branches meet (zeros with
+        one axis).
     """
     n = chain.n_dof
     held = hold_values(chain) if held is None else np.asarray(held, dtype=float)
@@ -95,7 +101,7 @@ def upright_branches(
     if n == 1:
         # Rot(a_1, p) u = w  ⇔  p turns u onto w
         angle = _turn_angle(chain.axes[0], u, w)
-        return angle[None, :, None]
+        return angle[None, :, None], np.zeros(M)
     a1 = chain.axes[first_free]
     O2 = chain.origins[first_free + 1, :3, :3]
     b = O2 @ chain.axes[first_free + 1]  # the second free axis in the first one's frame
@@ -116,7 +122,25 @@ def upright_branches(
         p2 = _turn_angle(b, u2, c)  # Rot(b, p2) u2 = c
         p1 = _turn_angle(a1, c, w)  # Rot(a1, p1) c = w
         branches.append(np.column_stack([fixed, p1, p2]))
-    return np.stack(branches)
+    return np.stack(branches), gamma * np.sqrt(sine2)
+
+
+def crossed_branches(branches: np.ndarray, gamma: np.ndarray) -> np.ndarray:
+    """The two branches (2, M, n) swapped at every place they meet (the smallest |γ| of
+    each run of samples below :data:`MEET`), shape (2, M, n): the paths that pass through
+    a meeting smoothly instead of turning back."""
+    near = np.concatenate([[False], gamma < MEET, [False]])
+    edges = np.flatnonzero(np.diff(near.astype(np.int8)))
+    starts, ends = edges[0::2], edges[1::2]
+    if len(starts) == 0:
+        return branches
+    index = np.arange(len(gamma))
+    runs = (index[None, :] >= starts[:, None]) & (index[None, :] < ends[:, None])
+    meets = np.argmin(np.where(runs, gamma[None, :], np.inf), axis=1)
+    swapped = (np.searchsorted(meets, index, side="right") % 2).astype(bool)[:, None]
+    first = np.where(swapped, branches[1], branches[0])
+    second = np.where(swapped, branches[0], branches[1])
+    return np.stack([first, second])
 
 
 def fill_undetermined(angles: np.ndarray, default: np.ndarray) -> np.ndarray:
