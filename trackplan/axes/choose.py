@@ -14,9 +14,11 @@ stretch where the weld cannot be held downhand with the given axes.
   (unwrapped) and its free winding chosen at
   the start so that it stays inside every axis's range, nearest to the hold value; the
   branch with the least travel wins. A constant at the middle of that motion is taken when
-  it meets the rule; else a B-spline is fitted with 8, 16, 32 … coefficients until the
-  fitted profile meets the rule on a grid twice as dense as the fit's (where the pointwise
-  solution itself meets it, within :data:`FIT_SLACK`).
+  it meets the rule; else B-splines are fitted with 8, 16, 32 and 64 coefficients (more
+  while none meets the rule), each checked on a grid twice as dense as the fit's (the rule,
+  or the pointwise solution's angle plus :data:`FIT_SLACK` where that is over the rule),
+  and of those that meet it the one that lets the seam run fastest on the axes' velocity
+  and acceleration limits wins (fewer wiggles, less d²e/ds²).
 - **Positioner without ``downhand``**: held still at the hold value.
 - **Track**: the arm's base abreast of the TCP along the track's axis, ``t(s) = axis ·
   p_cell_tool(s) − TRACK_LEAD``, clipped to the range, fitted with one coefficient per
@@ -47,6 +49,7 @@ from trackplan.axes.rules import Downhand
 from trackplan.paths.path_geometry import PathGeometry
 from trackplan.profiles import DEGREE, Profile
 from trackplan.robots.machine import Machine
+from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.tool.spec import ToolSpec
 
@@ -57,6 +60,9 @@ FIT_SLACK = 1e-3
 already at or over the bound (a rule of 0° cannot be met by a spline exactly), rad."""
 MAX_COEFFICIENTS = 512
 """Most coefficients of a positioner axis's profile."""
+FIT_TRIES = (8, 16, 32, 64)
+"""Coefficient counts every one of which is fitted (more only while none meets the rule);
+of those that meet the rule the one that lets the seam run fastest wins."""
 TRACK_LEAD = 0.0
 """The arm's preferred offset along the track's axis behind the TCP, m: 0 keeps the base
 abreast of the TCP, where a welding arm has its reach to both sides."""
@@ -243,17 +249,20 @@ def _downhand_positioner(
     middle = 0.5 * (solution.min(axis=0) + solution.max(axis=0))
     if meets(np.broadcast_to(middle, solution.shape)):
         return tuple(Profile.constant(v, length) for v in middle)
-    k = 2 * (DEGREE + 1)
+    k = FIT_TRIES[0]
     fitted = solution
-    while True:
+    met: list[tuple[float, tuple[Profile, ...]]] = []
+    largest = min(MAX_COEFFICIENTS, (len(s) + 1) // 4)
+    while k <= largest and (not met or k <= FIT_TRIES[-1]):
         coefficients = fit_coefficients(s[::2], solution[::2], length, k, chain.q_min, chain.q_max)
         profiles = tuple(Profile(coefficients[:, j], length) for j in range(chain.n_dof))
         fitted = np.stack([p.value(s) for p in profiles], axis=1)
         if meets(fitted):
-            return profiles
-        if k >= min(MAX_COEFFICIENTS, (len(s) + 1) // 4):
-            break
+            met.append((_seam_speed(chain, profiles, s), profiles))
         k *= 2
+    if met:
+        return max(met, key=lambda pair: pair[0])[1]
+    k //= 2
     slope, rotation = angles_in_cell(
         _carrier_rotations(machine, fitted), directions.normal, directions.tangent
     )
@@ -266,6 +275,17 @@ def _downhand_positioner(
         f"{np.degrees(rotation.max()):.1f}°, slope {np.degrees(slope.max()):.1f}°): the "
         "pointwise solution turns too fast there",
     )
+
+
+def _seam_speed(chain: Robot, profiles: tuple[Profile, ...], s: np.ndarray) -> float:
+    """The fastest seam speed (m/s) the profiles allow on the axes' velocity and
+    acceleration limits alone: ``min_j min(v_j / |e_j'|, sqrt(a_j / |e_j''|))``."""
+    rate = np.stack([np.abs(p.derivative(s, 1)).max() for p in profiles])
+    curvature = np.stack([np.abs(p.derivative(s, 2)).max() for p in profiles])
+    with np.errstate(divide="ignore"):
+        by_velocity = np.where(rate > 0.0, chain.v_max / rate, np.inf)
+        by_acceleration = np.where(curvature > 0.0, np.sqrt(chain.a_max / curvature), np.inf)
+    return float(np.minimum(by_velocity, by_acceleration).min())
 
 
 def _track_profile(

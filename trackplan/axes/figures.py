@@ -11,6 +11,7 @@ into the verdict's wording.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -54,19 +55,33 @@ class SeamDirections:
             When the seam has no weld normal (``task.tool.normal`` or a segment's own).
         """
         s = np.asarray(s, dtype=float)
-        fields = segment_fields(tool, geometry.nominal)
-        if any(isinstance(f, ConstantNormal) and not np.any(f.normal) for f in fields):
-            raise CaseError(
-                "needs a weld normal: give task.tool.normal (frame: seam) or a normal on "
-                "every segment (arc weld_normal, points nx,ny,nz)",
-                key="downhand",
-            )
-        sample = geometry.planned.sample(s)
-        normal = SeamNormal.from_geometry(tool, geometry)(s, sample.position)
-        tangent = SeamTangent.from_geometry(geometry)(s, sample.tangent)
+        normal, tangent, position = _in_part(geometry, tool, s.tobytes())
         T = placement_transform(np.asarray(X, dtype=float))
         R = T[:3, :3]
-        return cls(s, normal @ R.T, tangent @ R.T, sample.position @ R.T + T[:3, 3])
+        return cls(s, normal @ R.T, tangent @ R.T, position @ R.T + T[:3, 3])
+
+
+@lru_cache(maxsize=16)
+def _in_part(
+    geometry: PathGeometry, tool: ToolSpec, s_bytes: bytes
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The weld normals, travel directions and points (M, 3) each in the part frame at the
+    arc lengths ``s`` given as bytes: the same for every placement of a seam, so a search
+    samples them once (geometry and tool spec are immutable, hashed by identity)."""
+    s = np.frombuffer(s_bytes, dtype=float)
+    fields = segment_fields(tool, geometry.nominal)
+    if any(isinstance(f, ConstantNormal) and not np.any(f.normal) for f in fields):
+        raise CaseError(
+            "needs a weld normal: give task.tool.normal (frame: seam) or a normal on "
+            "every segment (arc weld_normal, points nx,ny,nz)",
+            key="downhand",
+        )
+    sample = geometry.planned.sample(s)
+    normal = SeamNormal.from_geometry(tool, geometry)(s, sample.position)
+    tangent = SeamTangent.from_geometry(geometry)(s, sample.tangent)
+    for array in (normal, tangent, sample.position):
+        array.flags.writeable = False
+    return normal, tangent, sample.position
 
 
 def carrier_points(geometry: PathGeometry, X: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -9,6 +9,8 @@ coefficients to the axis's range: by the convex-hull property the curve stays in
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from trackplan.profiles import clamped_knots
@@ -20,15 +22,13 @@ fourth) against the mean squared error of the samples: a second derivative of 1 
 knot spacing squared costs as much as an error of 1 mrad at every sample."""
 
 
-def design_matrix(s: np.ndarray, length: float, n_coefficients: int) -> np.ndarray:
-    """B-spline basis of a profile with ``n_coefficients`` at ``s`` (M,), shape (M, k)."""
+def design_matrix(s: np.ndarray, length: float, n_coefficients: int) -> Any:
+    """B-spline basis of a profile with ``n_coefficients`` at ``s`` (M,): a sparse
+    (M, k) matrix (four entries a row)."""
     from scipy.interpolate import BSpline  # scipy on demand (startup time)
 
     knots = clamped_knots(n_coefficients, length)
-    basis: np.ndarray = BSpline.design_matrix(
-        np.clip(np.asarray(s, dtype=float), 0.0, length), knots, DEGREE
-    ).toarray()
-    return basis
+    return BSpline.design_matrix(np.clip(np.asarray(s, dtype=float), 0.0, length), knots, DEGREE)
 
 
 def second_derivative_map(n_coefficients: int, length: float) -> np.ndarray:
@@ -57,8 +57,9 @@ def fit_coefficients(
     basis = design_matrix(s, length, n_coefficients)
     D = second_derivative_map(n_coefficients, length)
     spacing = length / (n_coefficients - DEGREE)
-    A = np.vstack([basis, np.sqrt(SMOOTHING * len(s)) * spacing**2 * D])
-    b = np.vstack([values, np.zeros((len(D), values.shape[1]))])
-    coefficients, *_ = np.linalg.lstsq(A, b, rcond=None)
+    penalty = SMOOTHING * len(s) * spacing**4
+    # the normal equations: BᵀB is banded and the penalty keeps them well conditioned
+    normal = (basis.T @ basis).toarray() + penalty * (D.T @ D)
+    coefficients = np.linalg.solve(normal, basis.T @ values)
     clipped: np.ndarray = np.clip(coefficients, lower, upper)
     return clipped
