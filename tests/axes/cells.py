@@ -58,6 +58,22 @@ def turntable_chain() -> Robot:
     )
 
 
+def head_stock_chain() -> Robot:
+    """A one-axis head-stock turning the part about the horizontal +x axis 0.8 m up,
+    ±360° (the two-axis head-tailstock's drive)."""
+    return Robot(
+        name="test-head-stock",
+        origins=np.stack([_translation(0.0, 0.0, 0.8)]),
+        axes=np.array([[1.0, 0.0, 0.0]]),
+        q_min=np.radians([-360.0]),
+        q_max=np.radians([360.0]),
+        v_max=np.radians([90.0]),
+        a_max=np.array([5.0]),
+        j_max=np.array([50.0]),
+        joint_names=("spin",),
+    )
+
+
 def machine(
     chain: Robot | None = None,
     pose: tuple[float, ...] = (0.8, 0.0, -0.6, 0.0, 0.0, 0.0),
@@ -79,6 +95,15 @@ def pipe_fillet(radius: float = 0.06) -> PathGeometry:
     pipe's outward radial, carried round the arc."""
     arc = ArcSpec(
         np.zeros(3), np.array([0.0, 0.0, 1.0]), 2 * math.pi, weld_normal=np.array([1.0, 0, 1])
+    )
+    return PathGeometry.build(np.array([radius, 0.0, 0.0]), [arc], TOLERANCE)
+
+
+def pipe_butt(radius: float = 0.08) -> PathGeometry:
+    """A circumferential butt weld round a pipe (axis +z of the part frame): the weld
+    normal is the pipe's outward radial, carried round the arc."""
+    arc = ArcSpec(
+        np.zeros(3), np.array([0.0, 0.0, 1.0]), 2 * math.pi, weld_normal=np.array([1.0, 0, 0])
     )
     return PathGeometry.build(np.array([radius, 0.0, 0.0]), [arc], TOLERANCE)
 

@@ -158,6 +158,26 @@ def test_a_tilted_plate_gets_one_constant_tilt(two_axis):
     assert (R[0] @ [0.0, 0.0, 1.0])[2] >= math.cos(RULE.rotation)
 
 
+def test_a_head_stock_keeps_a_butt_weld_on_top_of_a_lying_pipe():
+    """One horizontal axis (the chain's +x) under a pipe lying along it (X turns the
+    pipe's axis onto x): the radial weld normal is made exactly vertical at every sample
+    by a full turn, the travel direction horizontal; checked with own rotations."""
+    machine = cells.machine(cells.head_stock_chain(), (0.8, 0.0, -0.6, 0.0, 0.0, 0.0))
+    geometry = cells.pipe_butt()
+    X = np.array([0.0, 0.0, 0.0, 0.0, math.pi / 2, 0.0])
+    profile = choose_axes(machine, geometry, cells.seam_tool(), X, RULE)
+    assert isinstance(profile, AxesProfile) and profile.n_axes == 1
+    s = np.linspace(0.0, geometry.planned.length, 2001)
+    sample = geometry.planned.sample(s)
+    radial = sample.position / np.linalg.norm(sample.position, axis=1, keepdims=True)
+    R = _rx(profile.values(s)[:, 0]) @ _ry(np.array(math.pi / 2))
+    n_z = np.einsum("mk,mk->m", R[:, 2, :], radial)
+    t_z = np.einsum("mk,mk->m", R[:, 2, :], sample.tangent)
+    assert np.arccos(np.clip(n_z, -1.0, 1.0)).max() < math.radians(0.5)
+    assert np.arcsin(np.abs(t_z)).max() < math.radians(0.5)
+    assert np.ptp(profile.values(s)) == pytest.approx(2 * math.pi, abs=1e-2)
+
+
 def test_a_turntable_cannot_make_a_tilted_normal_vertical():
     machine = cells.machine(cells.turntable_chain())
     geometry = cells.pipe_fillet()
@@ -169,6 +189,8 @@ def test_a_turntable_cannot_make_a_tilted_normal_vertical():
         f"{geometry.planned.length:.3f} m (rotation ≤ 10.0°): the positioner's axes cannot "
         "turn it further"
     )
+    assert (failure.s_from, failure.s_to) == (0.0, pytest.approx(geometry.planned.length))
+    assert failure.reached == pytest.approx(math.pi / 4, abs=1e-6)
 
 
 def test_a_turntable_names_only_the_stretch_that_leans_too_far():
@@ -260,8 +282,11 @@ def test_a_full_turn_that_starts_badly_is_out_of_the_rotate_range(two_axis):
     X = np.array([0.01, -0.02, 0.0, 0.3, -0.2, -1.0])
     failure = choose_axes(two_axis, cells.saddle(), cells.seam_tool(), X, RULE)
     assert isinstance(failure, AxesFailure) and failure.status is Status.POSITION_LIMITS
-    assert "axis rotate must sweep" in failure.message
-    assert "[-200.0°, 200.0°]" in failure.message
+    assert failure.message.startswith(
+        "downhand: the positioner's axis rotate must turn from 102.2° to 462.2° (a sweep of "
+        "360.0°) at s = 0.000–0.320 m"
+    )
+    assert failure.message.endswith("inside its range [-200.0°, 200.0°]")
 
 
 # --------------------------------------------------------------------------- the track

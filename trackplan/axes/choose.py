@@ -83,10 +83,17 @@ class AxesFailure:
         range) or :attr:`~trackplan.status.Status.NOT_CONVERGED` (no fit met the rule).
     message
         One line naming the stretch (s from–to, m) and the angle reached.
+    s_from, s_to
+        The stretch, m (None when the failure is not about a stretch).
+    reached
+        The angle reached over the stretch, rad (None likewise).
     """
 
     status: Status
     message: str
+    s_from: float | None = None
+    s_to: float | None = None
+    reached: float | None = None
 
 
 def sample_grid(length: float) -> np.ndarray:
@@ -180,9 +187,11 @@ def _rule_failure(
         ("rotation", rotation, downhand.rotation),
         ("slope", slope, downhand.slope),
     ):
-        message = describe_excess(s, value, bound, what, reason)
-        if message is not None:
-            return AxesFailure(Status.LIMITS_VIOLATED, message)
+        excess = describe_excess(s, value, bound, what, reason)
+        if excess is not None:
+            return AxesFailure(
+                Status.LIMITS_VIOLATED, excess.message, excess.s_from, excess.s_to, excess.reached
+            )
     return None
 
 
@@ -225,10 +234,12 @@ def _downhand_positioner(
         lo, hi = np.degrees(solution[:, j].min()), np.degrees(solution[:, j].max())
         return AxesFailure(
             Status.POSITION_LIMITS,
-            f"downhand: the positioner's axis {chain.joint_names[j]} must sweep "
-            f"{lo:.1f}° to {hi:.1f}° along the seam (s = 0.000–{length:.3f} m), more than "
-            f"its range [{np.degrees(chain.q_min[j]):.1f}°, "
-            f"{np.degrees(chain.q_max[j]):.1f}°] holds",
+            f"downhand: the positioner's axis {chain.joint_names[j]} must turn from "
+            f"{lo:.1f}° to {hi:.1f}° (a sweep of {hi - lo:.1f}°) at s = 0.000–{length:.3f} m "
+            "to hold the weld downhand, and no whole turn of its start brings that inside "
+            f"its range [{np.degrees(chain.q_min[j]):.1f}°, {np.degrees(chain.q_max[j]):.1f}°]",
+            0.0,
+            length,
         )
     R = _carrier_rotations(machine, solution)
     failure = _rule_failure(
@@ -274,6 +285,9 @@ def _downhand_positioner(
         f"within the rule at s = {where.min():.3f}–{where.max():.3f} m (rotation reached "
         f"{np.degrees(rotation.max()):.1f}°, slope {np.degrees(slope.max()):.1f}°): the "
         "pointwise solution turns too fast there",
+        float(where.min()),
+        float(where.max()),
+        float(max(rotation.max(), slope.max())),
     )
 
 

@@ -148,31 +148,52 @@ def stretches(s: np.ndarray, over: np.ndarray) -> list[tuple[float, float]]:
     return [(float(s[a]), float(s[b])) for a, b in zip(starts, ends, strict=True)]
 
 
+@dataclass(frozen=True)
+class Excess:
+    """Where an angle exceeds its bound most: the stretch and the angle reached there.
+
+    Attributes
+    ----------
+    message
+        The verdict's sentence.
+    s_from, s_to
+        The stretch's ends, m.
+    reached
+        The smallest angle over the stretch (the angle the axes cannot go below), rad.
+    """
+
+    message: str
+    s_from: float
+    s_to: float
+    reached: float
+
+
 def describe_excess(
     s: np.ndarray,
     value: np.ndarray,
     bound: float,
     what: str,
     reason: str,
-) -> str | None:
-    """The verdict's sentence for the stretch where ``value`` (M,) rad exceeds ``bound``
-    most (None when it never does); ``what`` is ``rotation`` or ``slope``."""
+) -> Excess | None:
+    """The stretch where ``value`` (M,) rad exceeds ``bound`` most, with the verdict's
+    sentence (None when it never does); ``what`` is ``rotation`` or ``slope``."""
     over = value > bound
     if not over.any():
         return None
     runs = stretches(s, over)
     worst = max(runs, key=lambda run: float(value[(s >= run[0]) & (s <= run[1])].max()))
     inside = (s >= worst[0]) & (s <= worst[1])
-    reached = np.degrees(float(value[inside].min()))
+    reached = float(value[inside].min())
     peak = np.degrees(float(value[inside].max()))
     subject = (
         "the weld normal stays {:.1f}° from straight up"
         if what == "rotation"
         else "the travel direction stays {:.1f}° from the horizontal"
-    ).format(reached)
+    ).format(np.degrees(reached))
     more = f" ({len(runs)} stretches in all)" if len(runs) > 1 else ""
-    up_to = f" (up to {peak:.1f}°)" if peak - reached >= 0.05 else ""
-    return (
+    up_to = f" (up to {peak:.1f}°)" if peak - np.degrees(reached) >= 0.05 else ""
+    message = (
         f"downhand: {subject}{up_to} at s = {worst[0]:.3f}–{worst[1]:.3f} m "
         f"({what} ≤ {np.degrees(bound):.1f}°){more}: {reason}"
     )
+    return Excess(message, worst[0], worst[1], reached)
