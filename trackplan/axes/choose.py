@@ -11,14 +11,14 @@ stretch where the weld cannot be held downhand with the given axes.
   (:func:`~trackplan.axes.pointwise.upright_branches`) turns the weld normal straight up at
   every sample; each branch, and each path that passes from one branch to the other where
   they meet (:func:`~trackplan.axes.pointwise.crossed_branches`), is made continuous
-  (unwrapped) and its free winding chosen at
-  the start so that it stays inside every axis's range, nearest to the hold value; the
-  branch with the least travel wins. A constant at the middle of that motion is taken when
-  it meets the rule; else B-splines are fitted with 8, 16, 32 and 64 coefficients (more
-  while none meets the rule), each checked on a grid twice as dense as the fit's (the rule,
-  or the pointwise solution's angle plus :data:`FIT_SLACK` where that is over the rule),
-  and of those that meet it the one that lets the seam run fastest on the axes' velocity
-  and acceleration limits wins (fewer wiggles, less d²e/ds²).
+  (unwrapped) and its free winding chosen at the start so that it stays inside every
+  axis's range, nearest to the hold value; the candidate with the least travel wins. A
+  constant at the middle of that motion is taken when it meets the rule; else B-splines are
+  fitted to it with 8, 16, 32 and 64 coefficients (more while none meets the rule) and the
+  :data:`SMOOTHINGS`, each checked on a grid twice as dense as the fit's (the rule with
+  :data:`FIT_SLACK` to spare), and of those that meet it the one that lets the seam run
+  fastest on the axes' velocity and acceleration limits wins: the least motion the rule's
+  bounds leave room for, no needless wiggles.
 - **Positioner without ``downhand``**: held still at the hold value.
 - **Track**: the arm's base abreast of the TCP along the track's axis, ``t(s) = axis ·
   p_cell_tool(s) − TRACK_LEAD``, clipped to the range, fitted with one coefficient per
@@ -37,7 +37,7 @@ from trackplan.axes.figures import (
     carrier_points,
     describe_excess,
 )
-from trackplan.axes.fit import fit_coefficients
+from trackplan.axes.fit import SplineFit, fit_coefficients
 from trackplan.axes.pointwise import (
     crossed_branches,
     fill_undetermined,
@@ -56,13 +56,18 @@ from trackplan.tool.spec import ToolSpec
 SAMPLE_STEP = 1e-3
 """Arc-length step of the fit's samples, m (at least 201, at most 4001 samples)."""
 FIT_SLACK = 1e-3
-"""How far the fitted profile may exceed the pointwise solution's angle where that is
-already at or over the bound (a rule of 0° cannot be met by a spline exactly), rad."""
+"""The fitted profile meets each bound of the rule with this much to spare, rad; where the
+pointwise solution is within this of the bound or over it (a rule of 0° cannot be met by a
+spline exactly), it may exceed the pointwise solution's angle by this much."""
 MAX_COEFFICIENTS = 512
 """Most coefficients of a positioner axis's profile."""
 FIT_TRIES = (8, 16, 32, 64)
 """Coefficient counts every one of which is fitted (more only while none meets the rule);
 of those that meet the rule the one that lets the seam run fastest wins."""
+SMOOTHINGS = (1e-6, 1e-3, 1.0, 1e3)
+"""Weights of the second derivative tried with each coefficient count
+(:func:`~trackplan.axes.fit.fit_coefficients`): the heavier ones flatten the motion where
+the rule's bounds leave room (a positioner that need not follow the exact "straight up")."""
 TRACK_LEAD = 0.0
 """The arm's preferred offset along the track's axis behind the TCP, m: 0 keeps the base
 abreast of the TCP, where a welding arm has its reach to both sides."""
@@ -248,8 +253,8 @@ def _downhand_positioner(
     if failure is not None:
         return failure
     pointwise_slope, pointwise_rotation = angles_in_cell(R, directions.normal, directions.tangent)
-    slope_bound = np.maximum(downhand.slope, pointwise_slope + FIT_SLACK)
-    rotation_bound = np.maximum(downhand.rotation, pointwise_rotation + FIT_SLACK)
+    slope_bound = np.maximum(downhand.slope - FIT_SLACK, pointwise_slope + FIT_SLACK)
+    rotation_bound = np.maximum(downhand.rotation - FIT_SLACK, pointwise_rotation + FIT_SLACK)
 
     def meets(values: np.ndarray) -> bool:
         slope, rotation = angles_in_cell(
@@ -262,17 +267,19 @@ def _downhand_positioner(
         return tuple(Profile.constant(v, length) for v in middle)
     k = FIT_TRIES[0]
     fitted = solution
-    met: list[tuple[float, tuple[Profile, ...]]] = []
+    met: list[tuple[float, int, np.ndarray]] = []
     largest = min(MAX_COEFFICIENTS, (len(s) + 1) // 4)
     while k <= largest and (not met or k <= FIT_TRIES[-1]):
-        coefficients = fit_coefficients(s[::2], solution[::2], length, k, chain.q_min, chain.q_max)
-        profiles = tuple(Profile(coefficients[:, j], length) for j in range(chain.n_dof))
-        fitted = np.stack([p.value(s) for p in profiles], axis=1)
-        if meets(fitted):
-            met.append((_seam_speed(chain, profiles, s), profiles))
+        fitter = SplineFit(s[::2], s, length, k)
+        for smoothing in SMOOTHINGS:
+            coefficients, fitted = fitter.fit(solution[::2], chain.q_min, chain.q_max, smoothing)
+            if meets(fitted):
+                rate, curvature = fitter.rate_bounds(coefficients)
+                met.append((_seam_speed(chain, rate, curvature), -k, coefficients))
         k *= 2
     if met:
-        return max(met, key=lambda pair: pair[0])[1]
+        best = max(met, key=lambda m: (m[0], m[1]))[2]
+        return tuple(Profile(best[:, j], length) for j in range(chain.n_dof))
     k //= 2
     slope, rotation = angles_in_cell(
         _carrier_rotations(machine, fitted), directions.normal, directions.tangent
@@ -291,11 +298,10 @@ def _downhand_positioner(
     )
 
 
-def _seam_speed(chain: Robot, profiles: tuple[Profile, ...], s: np.ndarray) -> float:
-    """The fastest seam speed (m/s) the profiles allow on the axes' velocity and
-    acceleration limits alone: ``min_j min(v_j / |e_j'|, sqrt(a_j / |e_j''|))``."""
-    rate = np.stack([np.abs(p.derivative(s, 1)).max() for p in profiles])
-    curvature = np.stack([np.abs(p.derivative(s, 2)).max() for p in profiles])
+def _seam_speed(chain: Robot, rate: np.ndarray, curvature: np.ndarray) -> float:
+    """The fastest seam speed (m/s) that profiles with |e'| ≤ rate and |e''| ≤ curvature
+    (n,) each allow on the axes' velocity and acceleration limits alone:
+    ``min_j min(v_j / |e_j'|, sqrt(a_j / |e_j''|))``."""
     with np.errstate(divide="ignore"):
         by_velocity = np.where(rate > 0.0, chain.v_max / rate, np.inf)
         by_acceleration = np.where(curvature > 0.0, np.sqrt(chain.a_max / curvature), np.inf)
