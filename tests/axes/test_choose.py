@@ -255,7 +255,7 @@ def endless():
     return cells.machine(cells.tilt_rotate_chain(rotate_range=400.0), POSE)
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=10, deadline=None)
 @given(
     xy=st.tuples(st.floats(-0.05, 0.05), st.floats(-0.05, 0.05)),
     rpy=st.tuples(st.floats(-0.6, 0.6), st.floats(-0.6, 0.6), st.floats(-math.pi, math.pi)),

@@ -158,3 +158,31 @@ def test_crossed_branches_swap_where_the_branches_meet():
     np.testing.assert_array_equal(crossed[0, :, 0], [0, 0, 0, 0, 1, 1, 1, 1, 0, 0])
     np.testing.assert_array_equal(crossed[1, :, 0], 1 - crossed[0, :, 0])
     np.testing.assert_array_equal(crossed_branches(branches, gamma + 1.0), branches)
+
+
+def test_two_parallel_axes_act_as_one():
+    """Two parallel vertical axes (not in general position): one branch, the second axis
+    held, and the first as near to up as a turntable gets (brute force over 0.01°)."""
+    tilt = _rodrigues(np.array([1.0, 0, 0]), np.radians(20.0))
+    offset = np.eye(4)
+    offset[:3, 3] = 0.3, 0.0, 0.0
+    chain = Robot(
+        name="parallel",
+        origins=np.stack([np.eye(4), offset]),
+        axes=np.array([[0.0, 0, 1], [0.0, 0, 1]]),
+        q_min=[-4.0, -4.0],
+        q_max=[4.0, 4.0],
+        v_max=[1.0, 1.0],
+        a_max=[1.0, 1.0],
+        j_max=[1.0, 1.0],
+    )
+    m = np.random.default_rng(5).normal(size=(10, 3))
+    m /= np.linalg.norm(m, axis=1, keepdims=True)
+    branches, _ = upright_branches(chain, tilt, m)
+    assert branches.shape == (1, 10, 2) and np.all(branches[0, :, 1] == 0.0)
+    grid = np.radians(np.arange(-180.0, 180.0, 0.01))
+    best = np.array([(_flange_rotation(chain, tilt, [g, 0.0]) @ m.T)[2] for g in grid])
+    ours = np.array(
+        [(_flange_rotation(chain, tilt, row) @ v)[2] for row, v in zip(branches[0], m, strict=True)]
+    )
+    assert np.all(ours >= best.max(axis=0) - 1e-8)

@@ -84,7 +84,8 @@ def upright_branches(
     -------
     branches
         Shape (B, M, n), rad in (−π, π]: B = 2 branches (γ ≥ 0 and γ ≤ 0) with two or
-        more axes, 1 with one axis; NaN where an axis's angle does not matter.
+        more axes, 1 with one axis or two parallel ones (the last held); NaN where an
+        axis's angle does not matter.
     gamma
         |γ| per sample, shape (M,): where it passes near 0 the branches meet (zeros with
         one axis).
@@ -107,8 +108,13 @@ def upright_branches(
     b = O2 @ chain.axes[first_free + 1]  # the second free axis in the first one's frame
     u2 = u @ O2.T
     k = float(a1 @ b)
+    if 1.0 - k * k < PARALLEL:  # parallel axes turn the normal alike: the first one alone
+        turned = u2 @ axis_rotation(b, np.array(held[first_free + 1])).T
+        p1 = _turn_angle(a1, turned, w)
+        last = np.full(M, held[first_free + 1])
+        return np.column_stack([fixed, p1, last])[None], np.zeros(M)
     cross = np.cross(a1, b)
-    sine2 = max(1.0 - k * k, 1e-12)
+    sine2 = 1.0 - k * k
     A = w @ a1  # c · a1 is kept by the first rotation
     B = u2 @ b  # c · b is kept by the second one
     alpha = (A - k * B) / sine2
