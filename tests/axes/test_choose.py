@@ -381,3 +381,24 @@ def test_a_tighter_rule_is_met_as_tightly(two_axis, degrees):
     slope, rotation = _independent_angles("saddle", geometry, np.zeros(6), profile, s)
     assert slope.max() <= rule.slope + ANGLE_TOL
     assert rotation.max() <= rule.rotation + ANGLE_TOL
+
+
+def test_a_climb_steeper_than_the_slope_bound_trades_rotation_for_slope(two_axis):
+    """A seam climbing 14° across a plate whose normal is +z (the normal not square to the
+    travel): with the normal straight up the travel slopes 14°, over the 10° bound; the
+    positioner leans the part back by 4 to 10° instead, both angles within the rule."""
+    from trackplan.paths.specs import LineSpec
+
+    climb = math.radians(14.0)
+    to = np.array([0.2, 0.0, 0.2 * math.tan(climb)])
+    geometry = PathGeometry.build(np.zeros(3), [LineSpec(to)], cells.TOLERANCE)
+    X = np.zeros(6)
+    profile = choose_axes(two_axis, geometry, cells.plate_tool(), X, RULE)
+    assert isinstance(profile, AxesProfile)
+    s = np.linspace(0.0, geometry.planned.length, 501)
+    e = profile.values(s)
+    R = _table_rotation(POSE, e[:, 0], e[:, 1])
+    t = to / np.linalg.norm(to)
+    slope = np.arcsin(np.abs(R[:, 2, :] @ t))
+    rotation = np.arccos(np.clip(R[:, 2, :] @ [0.0, 0.0, 1.0], -1.0, 1.0))
+    assert slope.max() <= RULE.slope and rotation.max() <= RULE.rotation

@@ -12,7 +12,9 @@ stretch where the weld cannot be held downhand with the given axes.
   every sample; each branch, and each path that passes from one branch to the other where
   they meet (:func:`~trackplan.axes.pointwise.crossed_branches`), is made continuous
   (unwrapped) and its free winding chosen at the start so that it stays inside every
-  axis's range, nearest to the hold value; the candidate with the least travel wins. A
+  axis's range, nearest to the hold value; the candidate with the least travel wins.
+  Samples over a bound (the normal not square to the travel) are leaned by
+  :func:`~trackplan.axes.polish.polish`, trading rotation for slope. A
   constant at the middle of that motion is taken when it meets the rule; else B-splines are
   fitted to it with 8, 16, 32 and 64 coefficients (more while none meets the rule) and the
   :data:`SMOOTHINGS`, each checked on a grid twice as dense as the fit's (the rule with
@@ -44,6 +46,7 @@ from trackplan.axes.pointwise import (
     hold_values,
     upright_branches,
 )
+from trackplan.axes.polish import polish
 from trackplan.axes.profile import AxesProfile
 from trackplan.axes.rules import Downhand
 from trackplan.paths.path_geometry import PathGeometry
@@ -246,6 +249,7 @@ def _downhand_positioner(
             0.0,
             length,
         )
+    solution = _lean(machine, directions, downhand, solution)
     R = _carrier_rotations(machine, solution)
     failure = _rule_failure(
         s, R, directions, downhand, "the positioner's axes cannot turn it further"
@@ -296,6 +300,32 @@ def _downhand_positioner(
         float(where.max()),
         float(max(rotation.max(), slope.max())),
     )
+
+
+def _lean(
+    machine: Machine, directions: SeamDirections, downhand: Downhand, solution: np.ndarray
+) -> np.ndarray:
+    """The pointwise solution (M, n) with the samples over a bound (within
+    :data:`FIT_SLACK` of it) leaned by :func:`~trackplan.axes.polish.polish` to trade
+    rotation for slope, kept inside the axes' ranges."""
+    assert machine.positioner is not None
+    chain = machine.positioner.chain
+    slope, rotation = angles_in_cell(
+        _carrier_rotations(machine, solution), directions.normal, directions.tangent
+    )
+    over = (slope > downhand.slope - FIT_SLACK) | (rotation > downhand.rotation - FIT_SLACK)
+    if not over.any():
+        return solution
+    normal, tangent = directions.normal[over], directions.tangent[over]
+
+    def angles(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return angles_in_cell(_carrier_rotations(machine, values), normal, tangent)
+
+    target = 2.0 * FIT_SLACK
+    leaned = polish(angles, solution[over], downhand.slope - target, downhand.rotation - target)
+    result = solution.copy()
+    result[over] = np.clip(leaned, chain.q_min, chain.q_max)
+    return result
 
 
 def _seam_speed(chain: Robot, rate: np.ndarray, curvature: np.ndarray) -> float:
