@@ -106,14 +106,14 @@ def test_the_tilt_rotate_positioner_turns_a_45_degree_normal_up_with_a_45_degree
 
 def test_one_axis_comes_as_near_to_up_as_its_turn_allows():
     """A turntable tilted by 20° about x: its angle brings the normal nearest to straight
-    up, against a brute-force search over a 0.01° grid."""
+    up: at least as near as the best of a brute-force search over a 0.1° grid."""
     chain = turntable_chain()
     tilt = _rodrigues(np.array([1.0, 0, 0]), np.radians(20.0))
     rng = np.random.default_rng(3)
     m = rng.normal(size=(20, 3))
     m /= np.linalg.norm(m, axis=1, keepdims=True)
     (best,), _ = upright_branches(chain, tilt, m)
-    grid = np.radians(np.arange(-180.0, 180.0, 0.01))
+    grid = np.radians(np.arange(-180.0, 180.0, 0.1))
     z_of = np.array([(_flange_rotation(chain, tilt, [g]) @ m.T)[2] for g in grid])  # (G, 20)
     ours = np.array(
         [(_flange_rotation(chain, tilt, row) @ v)[2] for row, v in zip(best, m, strict=True)]
@@ -162,7 +162,7 @@ def test_crossed_branches_swap_where_the_branches_meet():
 
 def test_two_parallel_axes_act_as_one():
     """Two parallel vertical axes (not in general position): one branch, the second axis
-    held, and the first as near to up as a turntable gets (brute force over 0.01°)."""
+    held, and the first as near to up as a turntable gets (brute force over 0.1°)."""
     tilt = _rodrigues(np.array([1.0, 0, 0]), np.radians(20.0))
     offset = np.eye(4)
     offset[:3, 3] = 0.3, 0.0, 0.0
@@ -180,7 +180,7 @@ def test_two_parallel_axes_act_as_one():
     m /= np.linalg.norm(m, axis=1, keepdims=True)
     branches, _ = upright_branches(chain, tilt, m)
     assert branches.shape == (1, 10, 2) and np.all(branches[0, :, 1] == 0.0)
-    grid = np.radians(np.arange(-180.0, 180.0, 0.01))
+    grid = np.radians(np.arange(-180.0, 180.0, 0.1))
     best = np.array([(_flange_rotation(chain, tilt, [g, 0.0]) @ m.T)[2] for g in grid])
     ours = np.array(
         [(_flange_rotation(chain, tilt, row) @ v)[2] for row, v in zip(branches[0], m, strict=True)]

@@ -203,7 +203,9 @@ def _rule_failure(
     return None
 
 
-def _wind(values: np.ndarray, lower: np.ndarray, upper: np.ndarray, hold: np.ndarray) -> tuple:
+def _wind(
+    values: np.ndarray, lower: np.ndarray, upper: np.ndarray, hold: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Continuous angles (M, n) shifted by whole turns into [lower, upper] (n,) each,
     nearest to ``hold`` (n,); with the axes that no turn brings inside, shape (n,) bool."""
     low, high = values.min(axis=0), values.max(axis=0)
