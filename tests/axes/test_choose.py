@@ -402,3 +402,18 @@ def test_a_climb_steeper_than_the_slope_bound_trades_rotation_for_slope(two_axis
     slope = np.arcsin(np.abs(R[:, 2, :] @ t))
     rotation = np.arccos(np.clip(R[:, 2, :] @ [0.0, 0.0, 1.0], -1.0, 1.0))
     assert slope.max() <= RULE.slope and rotation.max() <= RULE.rotation
+
+
+def test_the_shipped_pipe_fillet_case_is_held_downhand(two_axis):
+    """cases/pipe-fillet.yaml as the case loader reads it (its arc's weld_normal, the
+    seam-frame tool with a drag angle) on the two-axis positioner, pipe on the table."""
+    from tests.conftest import CASES
+    from trackplan.io.case_file import load_case
+
+    case = load_case(CASES / "pipe-fillet.yaml")
+    geometry = PathGeometry.from_case(case)
+    profile = choose_axes(two_axis, geometry, case.task.tool, np.zeros(6), RULE)
+    assert isinstance(profile, AxesProfile)
+    s = np.linspace(0.0, geometry.planned.length, 2001)
+    slope, rotation = _independent_angles("pipe", geometry, np.zeros(6), profile, s)
+    assert slope.max() <= RULE.slope and rotation.max() <= RULE.rotation
