@@ -8,11 +8,13 @@ here depends on which law runs.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.axes.choose import choose_axes
+from trackplan.axes.choose import AxesFailure, choose_axes
+from trackplan.axes.profile import AxesProfile
 from trackplan.case import Case
 from trackplan.derived import derived
 from trackplan.errors import CaseError
@@ -25,11 +27,11 @@ from trackplan.planning.energy import motion_energy
 from trackplan.planning.objectives import joint_travel
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.planning.tool_zones import transition_zones
-from trackplan.robots.machine import Machine
+from trackplan.robots.machine import Machine, machine_of
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.task import Task
-from trackplan.timing import TimedPath, time_law
+from trackplan.timing import TimedPath, TimeLaw, time_law
 from trackplan.tool import (
     SpinMode,
     SpinProfile,
@@ -192,9 +194,24 @@ def plan_seam(
     tool = ToolOrientation.choose(case.task.tool, geometry, spin)
     machine = case.machine
     axes = None
-    if isinstance(machine, Machine):
-        axes = choose_axes(machine, geometry, case.task.tool, X, case.downhand)
+    failure = None
+    if isinstance(machine, Machine) or case.downhand is not None:
+        # the external axes' motion, and whether the weld can be held downhand at all
+        chosen = choose_axes(machine_of(machine), geometry, case.task.tool, X, case.downhand)
+        if isinstance(chosen, AxesFailure):  # planned with the axes held, to show it
+            failure = chosen
+            chosen = choose_axes(machine_of(machine), geometry, case.task.tool, X, None)
+            assert isinstance(chosen, AxesProfile)
+        axes = chosen if isinstance(machine, Machine) else None
     joint_path = JointPath.solve(machine, geometry, X, tool, branch, axes)
+    if failure is not None:
+        planned = _planned(case, joint_path, law, geometry)
+        return replace(planned, success=False, status=failure.status, message=failure.message)
+    return _planned(case, joint_path, law, geometry)
+
+
+def _planned(case: Case, joint_path: JointPath, law: TimeLaw, geometry: PathGeometry) -> PlanResult:
+    """The seam timed by ``law`` along its joint path, checked; or why it has no trajectory."""
     if not joint_path.success:
         message = joint_path.message + _twist_note(joint_path)
         return _unplanned(case, joint_path, law.timing, joint_path.status, message)

@@ -55,7 +55,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from trackplan.axes.choose import choose_axes
+from trackplan.axes.choose import AxesFailure, choose_axes
+from trackplan.axes.profile import AxesProfile
 from trackplan.case import Case, Objective
 from trackplan.choices import Penalty
 from trackplan.frames import placement_transform, tool_poses
@@ -91,6 +92,10 @@ GA, the free-spin circle ends 3.5 % higher (seeds 1, 2) and the payload case's h
 torque peaks slip between poses (every screened optimum failed the final torque check)."""
 CURVED_POSES = 9
 """Poses at least in every curved zone (arcs, corner blends) of the screening grid."""
+AXES_LEVEL = 2.5
+"""Graded violation of a candidate whose external axes cannot keep the downhand rule:
+``2.5 + min(1, reached / π)`` (in [2.5, 3.5]), ``reached`` the angle over the bound where
+the positioner gives up; above every geometric failure, below the reach's."""
 CLEARANCE_LEVEL = 0.25
 """Graded violation of a placement whose only problem is the clearance, before its shortfall."""
 CLEARANCE_SCALE = 0.05
@@ -263,7 +268,7 @@ class PlacementFitness:
         """
         n_spin = self.case.task.tool.n_spin
         poses = tool_poses(X[:, :6], self.points, self.rotations(X[:, 6 : 6 + n_spin]))
-        external = self.external_axes(X[:, :6], X[:, 6 + n_spin :])
+        external, failed = self.external_axes(X[:, :6], X[:, 6 + n_spin :])
         if external is not None:
             poses = carried_poses(self.case.machine, external, poses)
         paths = solve_path_ik_branches(self.case.robot, poses, sharing=self.sharing)
@@ -290,6 +295,12 @@ class PlacementFitness:
             ],
             code(Status.POSITION_LIMITS),
         )
+        for b, failure in failed.items():  # the external axes cannot keep the rule
+            ok[b] = False
+            graded[b] = AXES_LEVEL + (
+                1.0 if failure.reached is None else min(1.0, failure.reached / np.pi)
+            )
+            finding[b] = code(failure.status)
         # the joints' least interval times on the usable branches only (few of them while
         # sampling); the others keep the tool's
         q = paths.q
@@ -466,20 +477,29 @@ class PlacementFitness:
         ]
         return np.concatenate([f[0] for f in found]), np.concatenate([f[1] for f in found])
 
-    def external_axes(self, X: np.ndarray, pose: np.ndarray) -> np.ndarray | None:
+    def external_axes(
+        self, X: np.ndarray, pose: np.ndarray
+    ) -> tuple[np.ndarray | None, dict[int, AxesFailure]]:
         """A machine's external axes on the screening grid at placements X (B, 6) with the
         positioner pose's searched variables (B, k), shape (B, M, e)
-        (:func:`~trackplan.axes.choose.choose_axes` per candidate), or None for a robot."""
+        (:func:`~trackplan.axes.choose.choose_axes` per candidate; None for a robot), and
+        the candidates whose axes cannot keep the downhand rule, by row (their axes held,
+        to grade how far they are from the rest)."""
         if not isinstance(self.case.machine, Machine):
-            return None
+            return None, {}
         tool, downhand = self.case.task.tool, self.case.downhand
         found = []
-        for x, variables in zip(X, pose, strict=True):
+        failed: dict[int, AxesFailure] = {}
+        for b, (x, variables) in enumerate(zip(X, pose, strict=True)):
             machine = positioned(self.case, variables).machine
             assert isinstance(machine, Machine)
             axes = choose_axes(machine, self.geometry, tool, x, downhand)
+            if isinstance(axes, AxesFailure):
+                failed[b] = axes
+                axes = choose_axes(machine, self.geometry, tool, x, None)
+                assert isinstance(axes, AxesProfile)
             found.append(axes.values(self.s_grid))
-        return np.stack(found)
+        return np.stack(found), failed
 
     def rotations(self, spin: np.ndarray) -> np.ndarray:
         """``R_part_tool`` on the screening grid for spin variables (B, k), (B, M, 3, 3)."""
