@@ -6,7 +6,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from trackplan.cli import ExitCode
@@ -136,6 +135,8 @@ def positioners(
         for note in chain.assumptions:
             out.print(f"assumption: {escape(note)}")
         return ExitCode.OK
+    import numpy as np
+
     table = Table(title="built-in positioners (trackplan positioners NAME for details)")
     headers = ("name", "axes", "range °", "speed °/s", "accel. rad/s²", "jerk rad/s³", "source")
     for header in headers:
