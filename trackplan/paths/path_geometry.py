@@ -25,7 +25,11 @@ GEOMETRIC_STEP = 2e-3
 CURVED_GRID_POINTS = 80
 """Grid intervals on each curved zone at least (blends change their derivatives fast)."""
 MAX_ZONE_POINTS = 2000
-"""Grid intervals on one straight zone at most (a long line needs no finer grid)."""
+"""Grid intervals on one straight zone at most (a long line needs no finer grid), unless a
+weave needs more."""
+WEAVE_GRID_POINTS = 48
+"""Grid intervals per weave period λ at least: the time law sees the weave's joint
+accelerations and jerks on the grid (a triangle's turn-around spans 10 of them)."""
 
 PathMode = Literal["g2", "paper"]
 """``g2``: curvature-continuous blends; ``paper``: the paper's tangent arcs (Eq. 10)."""
@@ -37,6 +41,19 @@ class Toleranced(Protocol):
     @property
     def tolerance(self) -> float:
         """ρ, the largest distance of the planned path from the nominal one, m."""
+        ...
+
+
+class Oscillation(Protocol):
+    """A lateral oscillation laid over arc length (:class:`trackplan.tool.weave.WeaveTrack`)."""
+
+    @property
+    def wavelength(self) -> float:
+        """λ, its spatial period, m."""
+        ...
+
+    def offset(self, s: np.ndarray) -> np.ndarray:
+        """The lateral offset at arc lengths ``s`` (M,), m, shape (M,)."""
         ...
 
 
@@ -69,12 +86,18 @@ class PathGeometry:
         The path as the user gave it.
     planned
         The path the tool follows (blended corners).
+    mode
+        How corners are rounded.
+    weave
+        The weave the tool point adds across the planned path (``task.weave`` at the
+        rated speed), or None; the planning grid resolves it.
     """
 
     nominal: NominalPath
     planned: Path
 
     mode: PathMode = "g2"
+    weave: Oscillation | None = None
 
     @classmethod
     def build(
@@ -83,6 +106,7 @@ class PathGeometry:
         segments: Sequence[SegmentSpec],
         tolerance: float,
         mode: PathMode = "g2",
+        weave: Oscillation | None = None,
     ) -> PathGeometry:
         """Build the nominal and planned paths of a start point and segments.
 
@@ -97,9 +121,11 @@ class PathGeometry:
         mode
             How corners are rounded; a time law names the mode it needs
             (:attr:`trackplan.timing.TimeLaw.path_mode`).
+        weave
+            The weave laid over the planned path, or None.
         """
         nominal = NominalPath.from_specs(start, segments)
-        return cls(nominal, build_path(nominal, tolerance, mode=mode), mode)
+        return cls(nominal, build_path(nominal, tolerance, mode=mode), mode, weave)
 
     @classmethod
     def from_case(cls, case: PathSource, mode: PathMode = "g2") -> PathGeometry:
@@ -111,8 +137,13 @@ class PathGeometry:
             A case or one of its seams: its start, segments and ``task.tolerance``.
         mode
             How corners are rounded.
+
+        A task with a ``weave`` (and a ``rated_speed``) lays it over the planned path
+        (:meth:`trackplan.tool.weave.Weave.along`).
         """
-        return cls.build(case.start, case.segments, case.task.tolerance, mode)
+        weave = getattr(case.task, "weave", None)
+        track = None if weave is None else weave.along(case.task.rated_speed)  # type: ignore[attr-defined]
+        return cls.build(case.start, case.segments, case.task.tolerance, mode, track)
 
     def zones(self) -> list[tuple[float, float, str]]:
         """Zones of the planned path with stops inserted as zero-length zones."""
@@ -161,7 +192,8 @@ class PathGeometry:
         Straight zones get a step of about :data:`GEOMETRIC_STEP` (at most
         :data:`MAX_ZONE_POINTS` intervals), curved ones at least :data:`CURVED_GRID_POINTS`
         intervals; each grid holds both ends of its zone, so a boundary appears in the
-        grids of both zones it separates. A stop is one point.
+        grids of both zones it separates. A stop is one point. With a weave, every zone's
+        step is at most λ / :data:`WEAVE_GRID_POINTS` (no cap on the count).
 
         Returns
         -------
@@ -179,6 +211,8 @@ class PathGeometry:
                 n = int(np.clip(n, 8, MAX_ZONE_POINTS))
             else:
                 n = max(n, CURVED_GRID_POINTS)
+            if self.weave is not None:
+                n = max(n, int(np.ceil(span * WEAVE_GRID_POINTS / self.weave.wavelength)))
             grids.append(np.linspace(s0, s1, n + 1))
         return grids
 

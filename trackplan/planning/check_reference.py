@@ -8,6 +8,7 @@ import numpy as np
 
 from trackplan.paths import NominalPath
 from trackplan.tool import ToolSpec
+from trackplan.tool.weave import WovenPath
 
 ORIENTATION_TOLERANCE = 1e-3
 """Largest tool orientation error accepted, rad."""
@@ -37,6 +38,9 @@ class TrackingReference:
         (K, 3): nominal arc lengths (m) and the extra tool axis deviation allowed (rad).
     orientation_tolerance
         Largest tool axis error, and spin error of a fixed spin, rad.
+    weave
+        The task's weave over the planned path, or None: the tracking and speed checks
+        read the weave's centre line, and the lateral offset is held to the weave.
     """
 
     nominal: NominalPath
@@ -48,3 +52,4 @@ class TrackingReference:
     corner_intervals: np.ndarray
     tool_zones: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     orientation_tolerance: float = ORIENTATION_TOLERANCE
+    weave: WovenPath | None = None
