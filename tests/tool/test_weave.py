@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pytest
+
+import trackplan
+from trackplan.errors import CaseError
 
 from trackplan.paths.path_geometry import WEAVE_GRID_POINTS, PathGeometry
 from trackplan.paths.specs import LineSpec
@@ -16,6 +22,8 @@ from trackplan.tool.weave import (
     weave_offsets,
     weave_shape,
 )
+
+CASES = Path(__file__).parents[2] / "cases"
 
 STEP = 1e-5
 """Phase step of the finite differences, periods."""
@@ -116,3 +124,16 @@ def test_tool_plane_follows_the_tools_y_axis() -> None:
         geometry.weave.offset(s)[:, None] * rotations[:, :, 1],
         atol=1e-15,  # type: ignore[union-attr]
     )
+
+
+def test_a_weave_wider_than_a_curve_is_refused_in_one_line() -> None:
+    """kuka-weld's sharp corner is blended with a radius of about 1.6 mm (tolerance
+    0.5 mm): a 2 mm weave would fold on its inner side."""
+    case = trackplan.load_case(CASES / "kuka-weld.yaml")
+    task = dataclasses.replace(case.task, weave=Weave(amplitude=0.002, frequency=2.0))
+    with pytest.raises(CaseError, match=r"task\.weave\.amplitude: .*radius 0\.0016 m") as error:
+        PathGeometry.from_case(dataclasses.replace(case, task=task))
+    assert "\n" not in str(error.value)
+    # a 1 mm weave fits
+    task = dataclasses.replace(case.task, weave=Weave(amplitude=0.001, frequency=2.0))
+    assert PathGeometry.from_case(dataclasses.replace(case, task=task)).weave is not None

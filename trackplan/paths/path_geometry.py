@@ -16,6 +16,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
+from trackplan.errors import CaseError
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.planned import Path, build_path
 from trackplan.paths.specs import SegmentSpec
@@ -50,6 +51,11 @@ class Oscillation(Protocol):
     @property
     def wavelength(self) -> float:
         """λ, its spatial period, m."""
+        ...
+
+    @property
+    def amplitude(self) -> float:
+        """Its largest offset to either side, m."""
         ...
 
     def offset(self, s: np.ndarray) -> np.ndarray:
@@ -123,9 +129,34 @@ class PathGeometry:
             (:attr:`trackplan.timing.TimeLaw.path_mode`).
         weave
             The weave laid over the planned path, or None.
+
+        Raises
+        ------
+        CaseError
+            When the weave's amplitude reaches the radius of a curve of the planned path
+            (the woven path would fold on the curve's inner side).
         """
         nominal = NominalPath.from_specs(start, segments)
-        return cls(nominal, build_path(nominal, tolerance, mode=mode), mode, weave)
+        geometry = cls(nominal, build_path(nominal, tolerance, mode=mode), mode, weave)
+        if weave is not None:
+            geometry._check_weave(weave)
+        return geometry
+
+    def _check_weave(self, weave: Oscillation) -> None:
+        """Refuse a weave at least as wide as the radius of the planned path's tightest
+        curve (on the planning grid), in one line."""
+        s = np.concatenate(self.zone_grids())
+        curvature = np.linalg.norm(self.planned.sample(s).curvature, axis=1)
+        worst = int(np.argmax(curvature))
+        if weave.amplitude * curvature[worst] < 1.0:
+            return
+        raise CaseError(
+            f"{weave.amplitude:g} m reaches the radius {1.0 / curvature[worst]:.2g} m of the "
+            f"planned path's tightest curve at s = {s[worst]:.4g} m: the weave would fold "
+            "there; give a smaller amplitude, a larger tolerance (wider corner blends) or "
+            "split the seam at the corner",
+            key="task.weave.amplitude",
+        )
 
     @classmethod
     def from_case(cls, case: PathSource, mode: PathMode = "g2") -> PathGeometry:

@@ -105,6 +105,11 @@ class WeaveTrack:
     weave: Weave
     wavelength: float
 
+    @property
+    def amplitude(self) -> float:
+        """The weave's amplitude, m."""
+        return self.weave.amplitude
+
     def offset(self, s: np.ndarray) -> np.ndarray:
         """The lateral offset w(s) at arc lengths ``s`` (M,), m, shape (M,): 0 at s = 0,
         rising first, ±amplitude at the turn-arounds, C2 in s."""
