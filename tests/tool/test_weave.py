@@ -10,7 +10,6 @@ import pytest
 
 import trackplan
 from trackplan.errors import CaseError
-
 from trackplan.paths.path_geometry import WEAVE_GRID_POINTS, PathGeometry
 from trackplan.paths.specs import LineSpec
 from trackplan.tool import ToolOrientation, ToolSpec
