@@ -14,11 +14,14 @@ import pytest
 import yaml
 
 import trackplan
+from tests.programs.roundtrip import PlannedRun
 from trackplan.case import Case
+from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.motion import JointSamples
 from trackplan.planning.checker import check_motion
 from trackplan.planning.seam_plan import case_geometry, tracking_reference
+from trackplan.programs import build_program
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.tool.weave import Weave
 
@@ -98,3 +101,16 @@ def test_a_wrong_weave_fails_the_check(tmp_path: Path, wrong: dict[str, float] |
     assert not checked.success
     assert any(v.limit == "weave" for v in checked.violations)
     assert checked.task_margins["weave"] < 0.0
+
+
+@pytest.mark.slow
+def test_a_weaving_run_exports_joints_not_path_moves(tmp_path: Path) -> None:
+    """Path moves along the centre line would drop the weave: the Cartesian form is
+    refused in one line, the joint form carries the planned joints, weave included."""
+    case = _case(tmp_path)
+    result = trackplan.plan(case, case.bounds.example)
+    run = PlannedRun(case=case, plan=result)
+    with pytest.raises(CaseError, match=r"--motion: .*weave.*--motion joint"):
+        build_program(run)
+    program = build_program(run, motion="joint", period=0.02)
+    assert program.motion == "joint"
