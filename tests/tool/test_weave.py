@@ -11,7 +11,7 @@ import pytest
 import trackplan
 from trackplan.errors import CaseError
 from trackplan.paths.path_geometry import WEAVE_GRID_POINTS, PathGeometry
-from trackplan.paths.specs import LineSpec
+from trackplan.paths.specs import ArcSpec, LineSpec
 from trackplan.tool import ToolOrientation, ToolSpec
 from trackplan.tool.weave import (
     TRIANGLE_ROUNDING,
@@ -136,3 +136,20 @@ def test_a_weave_wider_than_a_curve_is_refused_in_one_line() -> None:
     # a 1 mm weave fits
     task = dataclasses.replace(case.task, weave=Weave(amplitude=0.001, frequency=2.0))
     assert PathGeometry.from_case(dataclasses.replace(case, task=task)).weave is not None
+
+
+def test_unweave_on_an_arc_is_exact() -> None:
+    """A 4 mm weave round a 30 mm arc: the samples' arc lengths and centre line to well
+    below the IK's tolerance (the checker's speed differences of centre points read them)."""
+    weave = Weave(pattern="sine", amplitude=0.004, frequency=2.0)
+    arc = ArcSpec(center=np.array([0.0, 0.03, 0.0]), normal=np.array([0.0, 0.0, 1.0]), angle=1.5)
+    geometry = PathGeometry.build(np.zeros(3), [arc], 5e-4, weave=weave.along(0.02))
+    spec = ToolSpec(frame="seam", normal=np.array([0.0, 0.0, 1.0]))
+    tool = ToolOrientation.choose(spec, geometry)
+    s, position, tangent = geometry.planned.points(np.linspace(0.0, geometry.planned.length, 301))
+    rotations = tool.rotations(s, tangent)
+    woven = WovenPath(geometry.weave, geometry.planned, tool)  # type: ignore[arg-type]
+    points = position + weave_offsets(woven.track, tool, s, tangent, rotations)
+    centre, lateral, expected, found = woven.unweave(points, rotations)
+    np.testing.assert_allclose(found, s, atol=1e-12)
+    np.testing.assert_allclose(centre, position, atol=1e-12)

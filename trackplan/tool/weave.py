@@ -232,7 +232,7 @@ def weave_offsets(
 
 LOCATE_STEP = 2.5e-4
 """Spacing of the planned-path points a sample is first located on, m (at most λ / 40)."""
-LOCATE_ITERATIONS = 4
+LOCATE_ITERATIONS = 5
 """Newton steps that refine a sample's arc length on the woven path."""
 
 
@@ -284,13 +284,18 @@ class WovenPath:
         s = grid[nearest]
         length, h = self.planned.length, 1e-3 * self.track.wavelength
         for _ in range(LOCATE_ITERATIONS):
-            _, centre, tangent = self.planned.points(s)
+            sample = self.planned.sample(s)
+            tangent = sample.tangent
             axis = self.axes(s, R_part_tool)
             w = self.track.offset(s)
             slope = (self.track.offset(s + h) - self.track.offset(s - h)) / (2.0 * h)
-            f = np.einsum("nk,nk->n", points - centre - w[:, None] * axis, tangent)
+            rest = points - sample.position - w[:, None] * axis
+            f = np.einsum("nk,nk->n", rest, tangent)
+            # −f'(s), with t' = κ and a' · t = −a · κ for an axis across the path
+            bend = np.einsum("nk,nk->n", rest + w[:, None] * axis, sample.curvature)
             along = np.einsum("nk,nk->n", axis, tangent)
-            s = np.clip(s + f / np.maximum(1.0 + slope * along, 0.2), 0.0, length)
+            step = f / np.maximum(1.0 + slope * along - bend, 0.2)
+            s = np.clip(s + step, 0.0, length)
         return s
 
     def unweave(
