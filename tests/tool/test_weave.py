@@ -19,6 +19,7 @@ from trackplan.tool.weave import (
     WeavePattern,
     WovenPath,
     weave_offsets,
+    weave_reached,
     weave_shape,
 )
 
@@ -153,3 +154,27 @@ def test_unweave_on_an_arc_is_exact() -> None:
     centre, lateral, expected, found = woven.unweave(points, rotations)
     np.testing.assert_allclose(found, s, atol=1e-12)
     np.testing.assert_allclose(centre, position, atol=1e-12)
+
+
+def test_weave_reached_from_samples_at_and_below_the_rated_speed() -> None:
+    """A sine weave sampled at 4 ms: 1.2 s at the rated speed 0.02 m/s, then 2.4 s at
+    half of it. The amplitude is the weave's; the frequency is read where the seam runs at
+    its rated speed (2 Hz), not the slower stretch's 1 Hz."""
+    weave = Weave(pattern="sine", amplitude=0.002, frequency=2.0)
+    geometry = _line(weave)
+    tool = ToolOrientation.choose(
+        ToolSpec(frame="seam", normal=np.array([0.0, 0.0, 1.0])), geometry
+    )
+    t = np.arange(0.0, 3.6, 0.004)
+    s = np.where(t < 1.2, 0.02 * t, 0.024 + 0.01 * (t - 1.2))
+    s, position, tangent = geometry.planned.points(s)
+    rotations = tool.rotations(s, tangent)
+    woven = WovenPath(geometry.weave, geometry.planned, tool)  # type: ignore[arg-type]
+    points = position + weave_offsets(woven.track, tool, s, tangent, rotations)
+    reached = weave_reached(woven, points, rotations, 0.004, 0.02)
+    assert reached.amplitude == pytest.approx(0.002, rel=1e-3)
+    assert reached.frequency == pytest.approx(2.0, rel=1e-6)
+    assert reached.as_dict()["pattern"] == "sine"
+    # never at the rated speed: every period counts
+    slow = weave_reached(woven, points[t >= 1.2], rotations[t >= 1.2], 0.004, 0.02)
+    assert slow.frequency == pytest.approx(1.0, rel=1e-6)

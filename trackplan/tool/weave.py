@@ -349,8 +349,9 @@ class WeaveReached:
     amplitude
         Half the spread of the lateral offset along the weave's axis, m.
     frequency
-        Rising zero crossings of the lateral offset per second where the seam runs at
-        its rated speed, Hz (NaN without two such crossings).
+        One over the mean time between rising zero crossings of the lateral offset, over
+        the periods run wholly at the rated speed (at least :data:`RATED_SHARE` of it), or
+        over every period when none is, Hz (NaN without two crossings).
     pattern, plane
         The weave's.
     """
@@ -395,15 +396,15 @@ def weave_reached(
     pattern, plane = str(weave.track.weave.pattern), str(weave.track.weave.plane)
     if len(lateral) < 2:
         return WeaveReached(0.0, math.nan, pattern, plane)
+    amplitude = float(lateral.max() - lateral.min()) / 2.0
     speed = np.zeros(len(centre))
     speed[1:] = np.linalg.norm(np.diff(centre, axis=0), axis=1) / sample_time
-    rated = speed >= RATED_SHARE * rated_speed
-    rated[:-1] &= rated[1:]
-    spread = lateral[rated] if rated.sum() > 1 else lateral
-    amplitude = float(spread.max() - spread.min()) / 2.0
+    slow = np.cumsum(speed < RATED_SHARE * rated_speed)  # slow samples up to each sample
     k = np.flatnonzero((lateral[:-1] < 0.0) & (lateral[1:] >= 0.0))  # rising crossings
     t_cross = (k - lateral[k] / (lateral[k + 1] - lateral[k])) * sample_time
-    both = rated[k[1:]] & rated[k[:-1]]
-    periods = np.diff(t_cross)[both]
+    periods = np.diff(t_cross)
+    steady = slow[k[1:] + 1] == slow[k[:-1]]  # every sample of the period at the rated speed
+    if steady.any():
+        periods = periods[steady]
     frequency = 1.0 / float(periods.mean()) if len(periods) else math.nan
     return WeaveReached(amplitude, frequency, pattern, plane)
