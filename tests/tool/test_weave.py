@@ -154,6 +154,8 @@ def test_unweave_on_an_arc_is_exact() -> None:
     centre, lateral, expected, found = woven.unweave(points, rotations)
     np.testing.assert_allclose(found, s, atol=1e-12)
     np.testing.assert_allclose(centre, position, atol=1e-12)
+    np.testing.assert_allclose(lateral, expected, atol=1e-12)
+    assert np.abs(expected).max() == pytest.approx(0.004, rel=1e-3)
 
 
 def test_weave_reached_from_samples_at_and_below_the_rated_speed() -> None:
