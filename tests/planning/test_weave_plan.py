@@ -18,6 +18,7 @@ from tests.programs.roundtrip import PlannedRun
 from trackplan.case import Case
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
+from trackplan.io.results import result_summary
 from trackplan.motion import JointSamples
 from trackplan.planning.checker import check_motion
 from trackplan.planning.seam_plan import case_geometry, tracking_reference
@@ -81,6 +82,13 @@ def test_weave_2mm_2hz_reached_within_every_limit(tmp_path: Path) -> None:
     assert result.weave is not None
     assert result.weave.amplitude == pytest.approx(0.002, rel=0.05)
     assert result.weave.frequency == pytest.approx(2.0, rel=0.01)
+    stated = result_summary(result, case.robot.joint_names)["weave"]
+    assert stated == {
+        "amplitude": result.weave.amplitude,
+        "frequency": result.weave.frequency,
+        "pattern": "triangle",
+        "plane": "seam",
+    }
 
 
 @pytest.mark.slow
