@@ -18,7 +18,7 @@ from tests.programs.roundtrip import PlannedRun
 from trackplan.case import Case
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
-from trackplan.io.results import result_summary
+from trackplan.io.results import result_summary, seams_summary
 from trackplan.motion import JointSamples
 from trackplan.planning.checker import check_motion
 from trackplan.planning.seam_plan import case_geometry, tracking_reference
@@ -122,3 +122,23 @@ def test_a_weaving_run_exports_joints_not_path_moves(tmp_path: Path) -> None:
         build_program(run)
     program = build_program(run, motion="joint", period=0.02)
     assert program.motion == "joint"
+
+
+@pytest.mark.slow
+def test_one_weaving_seam_of_several() -> None:
+    """bracket-4-fillets with its first rib weaving 2 mm at 2 Hz: the cycle stays
+    feasible, the rib's plan and result.json's seam state the weave, the others none. The
+    puma560's joint 3 jerk slows the rib at the turn-arounds, so its frequency is lower."""
+    case = trackplan.load_case(CASE.parent / "bracket-4-fillets.yaml")
+    seams = list(case.paths)
+    weave = Weave(amplitude=0.002, frequency=2.0)
+    seams[0] = dataclasses.replace(seams[0], task=dataclasses.replace(seams[0].task, weave=weave))
+    case = dataclasses.replace(case, paths=tuple(seams))
+    result = trackplan.plan(case, case.bounds.example)
+    assert result.success, result.message
+    stated = {seam["name"]: seam["weave"] for seam in seams_summary(result, case)["seams"]}
+    rib = stated.pop("rib-left")
+    assert rib["amplitude"] == pytest.approx(0.002, rel=0.01)
+    assert 1.0 < rib["frequency"] < 2.0
+    assert set(stated.values()) == {None}
+    assert all(check.success for check in result.seam_checks)
