@@ -25,6 +25,7 @@ from trackplan.robots.path_ik import PathIK, branch_joints_along, solve_path_ik
 from trackplan.status import Status
 from trackplan.stencils import stencil_derivatives, stencil_points
 from trackplan.tool import ToolFrame, ToolOrientation
+from trackplan.tool.weave import WeaveTrack, weave_offsets
 
 STENCIL_FRACTION = 0.1
 """Stencil spacing as a share of the grid step: small against the scale on which the
@@ -114,7 +115,10 @@ class JointPath:
         grid = _planning_grid(geometry)
         arm = arm_of(robot)
         rotations = _rotations(tool, grid.points.ravel(), grid.tangents)
-        poses = tool_poses(placement, grid.positions, rotations)
+        positions = _woven(
+            geometry, tool, grid.points.ravel(), grid.positions, grid.tangents, rotations
+        )
+        poses = tool_poses(placement, positions, rotations)
         external = _external(robot, axes, grid.points.ravel())
         if external is not None:
             poses = _carried(robot, external) @ poses
@@ -169,7 +173,9 @@ class JointPath:
     def poses(self, s: np.ndarray) -> np.ndarray:
         """Tool poses in the arm's base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
         s_path, position, tangent = self.geometry.planned.points(np.asarray(s, dtype=float))
-        poses = tool_poses(self.placement, position, _rotations(self.tool, s_path, tangent))
+        rotations = _rotations(self.tool, s_path, tangent)
+        position = _woven(self.geometry, self.tool, s_path, position, tangent, rotations)
+        poses = tool_poses(self.placement, position, rotations)
         external = _external(self.robot, self.axes, np.asarray(s, dtype=float))
         if external is None:
             return poses
@@ -197,6 +203,7 @@ class JointPath:
         s = np.asarray(s, dtype=float)
         s_path, position, tangent = self.geometry.planned.points(s)
         rotations = _rotations(self.tool, s_path, tangent)
+        position = _woven(self.geometry, self.tool, s_path, position, tangent, rotations)
         R_base_tool, p_base_tool = tool_pose_parts(self.placement, position, rotations)
         grid, q_grid = self._distinct_grid
         external = _external(self.robot, self.axes, s)
@@ -303,6 +310,22 @@ def _rotations(tool: ToolOrientation, s: np.ndarray, tangent: np.ndarray) -> np.
         # the one rotation of the held tool, kept on its spec (read-only)
         return derived(tool.spec, ("held rotation", spin), held)
     return tool.rotations(s, tangent)
+
+
+def _woven(
+    geometry: PathGeometry,
+    tool: ToolOrientation,
+    s: np.ndarray,
+    position: np.ndarray,
+    tangent: np.ndarray,
+    rotations: np.ndarray,
+) -> np.ndarray:
+    """The tool points at arc lengths ``s`` (M,): the planned path's ``position`` (M, 3)
+    plus the geometry's weave across it (:func:`trackplan.tool.weave.weave_offsets`), m."""
+    weave = geometry.weave
+    if not isinstance(weave, WeaveTrack):
+        return position
+    return position + weave_offsets(weave, tool, s, tangent, rotations)
 
 
 @dataclass(frozen=True, eq=False)

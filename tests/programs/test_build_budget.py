@@ -32,6 +32,9 @@ NOT_FEASIBLE_HERE = {
 }
 """Shipped cases whose stored placement does not plan feasibly (exported with force)."""
 
+WEAVING = {"kuka-weld-weave": "a weaving seam exports the joint form only (docs/positioner.md)"}
+"""Shipped cases with no Cartesian program."""
+
 
 def assert_targets_are_fk(program: Program, run_placement: np.ndarray, robot: Robot) -> None:
     """Every Cartesian target is the FK of its planned joints, in the model's base frame
@@ -53,6 +56,8 @@ def assert_targets_are_fk(program: Program, run_placement: np.ndarray, robot: Ro
 @pytest.mark.slow
 @pytest.mark.parametrize("name", SHIPPED)
 def test_every_shipped_case_keeps_its_budget(name: str) -> None:
+    if name in WEAVING:
+        pytest.skip(f"{name}: {WEAVING[name]}")
     run = planned_run(name)
     assert run.plan.success == (name not in NOT_FEASIBLE_HERE), run.plan.message
     if run.plan.trajectory.n_samples < 2:

@@ -234,3 +234,24 @@ def test_key_figures_give_the_top_speed_when_no_sample_runs_at_the_rated_speed(
     )
     assert figures["rated speed fraction"] == f"{100 * corner_result.rated_speed_fraction:.1f} %"
     assert "top speed" not in figures
+
+
+def test_key_figures_state_the_weave_reached(corner, corner_result):
+    """A weaving plan's key figures carry one row with the weave reached; others none."""
+    import dataclasses
+
+    from trackplan.report.html import report_page
+    from trackplan.tool.weave import WeaveReached
+
+    woven = dataclasses.replace(
+        corner_result, weave=WeaveReached(0.0019998, 2.0004, "triangle", "seam")
+    )
+    figures = dict(
+        row[:2] for row in _table_after(report_page(woven, corner, [], ""), "<h3>Key figures</h3>")
+    )
+    assert figures["weave reached"] == "2 mm at 2 Hz (triangle, plane seam)"
+    figures = dict(
+        row[:2]
+        for row in _table_after(report_page(corner_result, corner, [], ""), "<h3>Key figures</h3>")
+    )
+    assert "weave reached" not in figures

@@ -253,6 +253,7 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
         "rated_speed_fraction": float(result.rated_speed_fraction),
         "min_corner_speed": float(result.min_corner_speed),
         **_energy_summary(result),
+        "weave": None if result.weave is None else result.weave.as_dict(),
         "margins": {
             **{
                 kind: dict(zip(joint_names, map(float, values), strict=True))
@@ -510,6 +511,7 @@ def seams_summary(result: PlanResult, case: Case) -> dict:
                 "spin": plan.joint_path.tool.spin.as_dict(),
                 "feasible": bool(own.success),
                 "slowdowns": [slowdown_record(d) for d in plan.slowdowns],
+                "weave": None if plan.weave is None else plan.weave.as_dict(),
             }
         )
     moves = [

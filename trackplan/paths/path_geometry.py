@@ -16,6 +16,7 @@ from typing import Literal, Protocol
 
 import numpy as np
 
+from trackplan.errors import CaseError
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.planned import Path, build_path
 from trackplan.paths.specs import SegmentSpec
@@ -25,7 +26,11 @@ GEOMETRIC_STEP = 2e-3
 CURVED_GRID_POINTS = 80
 """Grid intervals on each curved zone at least (blends change their derivatives fast)."""
 MAX_ZONE_POINTS = 2000
-"""Grid intervals on one straight zone at most (a long line needs no finer grid)."""
+"""Grid intervals on one straight zone at most (a long line needs no finer grid), unless a
+weave needs more."""
+WEAVE_GRID_POINTS = 48
+"""Grid intervals per weave period λ at least: the time law sees the weave's joint
+accelerations and jerks on the grid (a triangle's turn-around spans 10 of them)."""
 
 PathMode = Literal["g2", "paper"]
 """``g2``: curvature-continuous blends; ``paper``: the paper's tangent arcs (Eq. 10)."""
@@ -37,6 +42,24 @@ class Toleranced(Protocol):
     @property
     def tolerance(self) -> float:
         """ρ, the largest distance of the planned path from the nominal one, m."""
+        ...
+
+
+class Oscillation(Protocol):
+    """A lateral oscillation laid over arc length (:class:`trackplan.tool.weave.WeaveTrack`)."""
+
+    @property
+    def wavelength(self) -> float:
+        """λ, its spatial period, m."""
+        ...
+
+    @property
+    def amplitude(self) -> float:
+        """Its largest offset to either side, m."""
+        ...
+
+    def offset(self, s: np.ndarray) -> np.ndarray:
+        """The lateral offset at arc lengths ``s`` (M,), m, shape (M,)."""
         ...
 
 
@@ -69,12 +92,18 @@ class PathGeometry:
         The path as the user gave it.
     planned
         The path the tool follows (blended corners).
+    mode
+        How corners are rounded.
+    weave
+        The weave the tool point adds across the planned path (``task.weave`` at the
+        rated speed), or None; the planning grid resolves it.
     """
 
     nominal: NominalPath
     planned: Path
 
     mode: PathMode = "g2"
+    weave: Oscillation | None = None
 
     @classmethod
     def build(
@@ -83,6 +112,7 @@ class PathGeometry:
         segments: Sequence[SegmentSpec],
         tolerance: float,
         mode: PathMode = "g2",
+        weave: Oscillation | None = None,
     ) -> PathGeometry:
         """Build the nominal and planned paths of a start point and segments.
 
@@ -97,9 +127,36 @@ class PathGeometry:
         mode
             How corners are rounded; a time law names the mode it needs
             (:attr:`trackplan.timing.TimeLaw.path_mode`).
+        weave
+            The weave laid over the planned path, or None.
+
+        Raises
+        ------
+        CaseError
+            When the weave's amplitude reaches the radius of a curve of the planned path
+            (the woven path would fold on the curve's inner side).
         """
         nominal = NominalPath.from_specs(start, segments)
-        return cls(nominal, build_path(nominal, tolerance, mode=mode), mode)
+        geometry = cls(nominal, build_path(nominal, tolerance, mode=mode), mode, weave)
+        if weave is not None:
+            geometry._check_weave(weave)
+        return geometry
+
+    def _check_weave(self, weave: Oscillation) -> None:
+        """Refuse a weave at least as wide as the radius of the planned path's tightest
+        curve (on the planning grid), in one line."""
+        s = np.concatenate(self.zone_grids())
+        curvature = np.linalg.norm(self.planned.sample(s).curvature, axis=1)
+        worst = int(np.argmax(curvature))
+        if weave.amplitude * curvature[worst] < 1.0:
+            return
+        raise CaseError(
+            f"{weave.amplitude:g} m reaches the radius {1.0 / curvature[worst]:.2g} m of the "
+            f"planned path's tightest curve at s = {s[worst]:.4g} m: the weave would fold "
+            "there; give a smaller amplitude, a larger tolerance (wider corner blends) or "
+            "split the seam at the corner",
+            key="task.weave.amplitude",
+        )
 
     @classmethod
     def from_case(cls, case: PathSource, mode: PathMode = "g2") -> PathGeometry:
@@ -111,8 +168,13 @@ class PathGeometry:
             A case or one of its seams: its start, segments and ``task.tolerance``.
         mode
             How corners are rounded.
+
+        A task with a ``weave`` (and a ``rated_speed``) lays it over the planned path
+        (:meth:`trackplan.tool.weave.Weave.along`).
         """
-        return cls.build(case.start, case.segments, case.task.tolerance, mode)
+        weave = getattr(case.task, "weave", None)
+        track = None if weave is None else weave.along(case.task.rated_speed)  # type: ignore[attr-defined]
+        return cls.build(case.start, case.segments, case.task.tolerance, mode, track)
 
     def zones(self) -> list[tuple[float, float, str]]:
         """Zones of the planned path with stops inserted as zero-length zones."""
@@ -161,7 +223,8 @@ class PathGeometry:
         Straight zones get a step of about :data:`GEOMETRIC_STEP` (at most
         :data:`MAX_ZONE_POINTS` intervals), curved ones at least :data:`CURVED_GRID_POINTS`
         intervals; each grid holds both ends of its zone, so a boundary appears in the
-        grids of both zones it separates. A stop is one point.
+        grids of both zones it separates. A stop is one point. With a weave, every zone's
+        step is at most λ / :data:`WEAVE_GRID_POINTS` (no cap on the count).
 
         Returns
         -------
@@ -179,6 +242,8 @@ class PathGeometry:
                 n = int(np.clip(n, 8, MAX_ZONE_POINTS))
             else:
                 n = max(n, CURVED_GRID_POINTS)
+            if self.weave is not None:
+                n = max(n, int(np.ceil(span * WEAVE_GRID_POINTS / self.weave.wavelength)))
             grids.append(np.linspace(s0, s1, n + 1))
         return grids
 

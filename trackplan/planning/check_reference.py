@@ -9,6 +9,7 @@ import numpy as np
 from trackplan.axes.rules import Downhand
 from trackplan.paths import NominalPath
 from trackplan.tool import ToolSpec
+from trackplan.tool.weave import WovenPath
 
 ORIENTATION_TOLERANCE = 1e-3
 """Largest tool orientation error accepted, rad."""
@@ -41,6 +42,9 @@ class TrackingReference:
     downhand
         The downhand rule to hold at every sample (:class:`~trackplan.axes.rules.Downhand`),
         or None.
+    weave
+        The task's weave over the planned path, or None: the tracking and speed checks
+        read the weave's centre line, and the lateral offset is held to the weave.
     """
 
     nominal: NominalPath
@@ -53,3 +57,4 @@ class TrackingReference:
     tool_zones: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     orientation_tolerance: float = ORIENTATION_TOLERANCE
     downhand: Downhand | None = None
+    weave: WovenPath | None = None

@@ -33,6 +33,11 @@ from trackplan.planning.tracking import (
 )
 from trackplan.robots.machine import Machine
 from trackplan.robots.path_ik import _NEWTON_TOL as NEWTON_TOLERANCE
+from trackplan.tool.weave import WovenPath, tool_rotations
+
+WEAVE_TOLERANCE = 0.05
+"""Largest difference of a sample's lateral offset from the weave's, as a share of the
+amplitude."""
 
 IK_POSITION_TOLERANCE = NEWTON_TOLERANCE
 """Largest distance between a sample's tool point (FK of its joints) and the path point the
@@ -112,6 +117,11 @@ def check_task(
     t = np.arange(len(q)) * sample_time
     violations: list[Violation] = []
     margins: dict[str, float] = {}
+    if ref.weave is not None:  # the checks below read the weave's centre line
+        p_part, velocity, speed, p_between, weave_found = unweave_samples(
+            ref.weave, p_part, x_part, z_part, p_between, t_between, t, margins
+        )
+        violations.extend(weave_found)
 
     # tracking error and the position along the nominal path, in order of travel
     s_nominal, distance, piece = locate_on_nominal(
@@ -219,6 +229,64 @@ def machine_task_frames(
     q_between = q[period] + fraction[:, None] * (q[period + 1] - q[period])
     between = (machine.T_carrier_tool(q_between)[:, :3, 3] - origin) @ R
     return points, velocity, speed, x_axis, z_axis, between, period + fraction
+
+
+def unweave_samples(
+    weave: WovenPath,
+    p_part: np.ndarray,
+    x_part: np.ndarray,
+    z_part: np.ndarray,
+    p_between: np.ndarray,
+    t_between: np.ndarray,
+    t: np.ndarray,
+    margins: dict[str, float],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[Violation]]:
+    """The weave's centre line of the tool points, and the weave check.
+
+    Each sample is located on the planned path (:meth:`WovenPath.unweave`) and the weave's
+    offset there taken off; its lateral offset must be the weave's within
+    :data:`WEAVE_TOLERANCE` of the amplitude (the ``weave`` margin and violation).
+
+    Parameters
+    ----------
+    weave
+        The task's weave over the planned path.
+    p_part, x_part, z_part
+        The tool points and x and z axes at the samples, definition frame, (N, 3).
+    p_between, t_between
+        The tool points between the samples (B, 3) and their times in periods (B,).
+    t
+        Sample times, (N,), s.
+    margins
+        The task margins, updated with ``weave``.
+
+    Returns
+    -------
+    tuple
+        The centre points (N, 3), m, their backward-difference velocities (N, 3), m/s, and
+        speeds (N,), m/s, the centre points between the samples (B, 3), m, and the weave
+        violations.
+    """
+    rotations = tool_rotations(x_part, z_part)
+    centre, lateral, expected, _ = weave.unweave(p_part, rotations)
+    error = np.abs(lateral - expected)
+    bound = WEAVE_TOLERANCE * weave.track.weave.amplitude
+    worst = float(error.max()) if len(error) else 0.0
+    margins["weave"] = float(met(1.0 - worst / bound, RELATIVE_SLACK))
+    found = []
+    if worst > bound * (1 + RELATIVE_SLACK):
+        over = violation_over("weave", None, t, error, error / bound, bound)
+        message = over.message.replace("weave", "weave: the lateral offset is off by", 1)
+        found.append(replace(over, message=message))
+    sample_time = float(t[1] - t[0]) if len(t) > 1 else 1.0
+    velocity = np.zeros_like(centre)
+    velocity[1:] = np.diff(centre, axis=0) / sample_time
+    speed = np.linalg.norm(velocity, axis=1)
+    between = p_between
+    if len(p_between):
+        k = np.clip(np.floor(t_between).astype(int), 0, len(rotations) - 1)
+        between = weave.unweave(p_between, rotations[k])[0]
+    return centre, velocity, speed, between, found
 
 
 def speed_verdict(

@@ -23,6 +23,7 @@ UNITS = {
     "spin rate": "rad/m",
     "speed": "m/s",
     "coverage": "m",
+    "weave": "m",
     "clearance": "m",
     "downhand": "rad",
 }

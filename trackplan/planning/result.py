@@ -21,6 +21,7 @@ from trackplan.planning.sequence import Sequence
 from trackplan.robots.model import LIMIT_KINDS
 from trackplan.status import Status
 from trackplan.timing.protocol import SlowDown
+from trackplan.tool.weave import WeaveReached
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -239,6 +240,9 @@ class PlanResult:
         retract moves, m (0 without moves).
     unplanned
         Seam plans that failed (seam name → plan), when the seams could not be joined.
+    weave
+        The weave the samples reached (amplitude, frequency; ``task.weave``), or None; a
+        case of several seams has each seam's on its plan in :attr:`seams`.
     """
 
     case_name: str
@@ -268,6 +272,7 @@ class PlanResult:
     air_time: float = float("nan")
     approach_deviation: float = 0.0
     unplanned: dict[str, PlanResult] = field(default_factory=dict)
+    weave: WeaveReached | None = None
 
     @property
     def planned_path(self) -> Path:

@@ -39,6 +39,7 @@ from trackplan.tool import (
     ToolSpec,
     tool_axis_twist,
 )
+from trackplan.tool.weave import WeaveReached, WeaveTrack, WovenPath, weave_reached
 
 if TYPE_CHECKING:  # the cell's compiled screening only for cases with a cell
     from trackplan.cell.screening import CellGeometry
@@ -81,6 +82,20 @@ def tracking_reference(case: Case, geometry: PathGeometry, X: np.ndarray) -> Tra
         corner_intervals=geometry.corner_intervals(),
         tool_zones=_transition_zones(case.task.tool, geometry, case.task.tolerance),
         downhand=case.downhand,
+        weave=woven_path(case.task.tool, geometry),
+    )
+
+
+def woven_path(spec: ToolSpec, geometry: PathGeometry) -> WovenPath | None:
+    """The geometry's weave (``task.weave``) over its planned path, or None; built once per
+    geometry and tool spec."""
+    weave = geometry.weave
+    if not isinstance(weave, WeaveTrack):
+        return None
+    return derived(
+        geometry,
+        ("woven path", id(spec)),
+        lambda: WovenPath(weave, geometry.planned, ToolOrientation.choose(spec, geometry)),
     )
 
 
@@ -330,6 +345,24 @@ def _checked(case: Case, joint_path: JointPath, timed: TimedPath) -> PlanResult:
         references={},
         joint_path=joint_path,
         energy=None if motion.torque is None else motion_energy(motion),
+        weave=_weave_reached(case, geometry, joint_path, motion),
+    )
+
+
+def _weave_reached(
+    case: Case, geometry: PathGeometry, joint_path: JointPath, motion: JointSamples
+) -> WeaveReached | None:
+    """The weave the samples reached (:func:`trackplan.tool.weave.weave_reached`), or None."""
+    woven = woven_path(case.task.tool, geometry)
+    if woven is None or not len(motion.q):
+        return None
+    T_part_tool = np.linalg.inv(joint_path.T_base_part) @ motion.T_base_tool
+    return weave_reached(
+        woven,
+        T_part_tool[:, :3, 3],
+        T_part_tool[:, :3, :3],
+        motion.sample_time,
+        case.task.rated_speed,
     )
 
 

@@ -86,12 +86,20 @@ def build_program(
     ------
     CaseError
         A run that is not feasible without ``force`` (key ``--force``), a run without a
-        trajectory, an unknown form (``--motion``) or a period that is no multiple of the
+        trajectory, an unknown form or the Cartesian form of a weaving seam
+        (``--motion``) or a period that is no multiple of the
         sample time (``--period``).
     """
     case, plan = replayed.case, replayed.plan
     if motion not in MOTION_FORMS:
         raise CaseError(f"must be one of {', '.join(MOTION_FORMS)}, got {motion!r}", key="--motion")
+    if motion == "cartesian" and any(seam.task.weave is not None for seam in case.seams):
+        raise CaseError(
+            "a weaving seam is not written as path moves (they follow the centre line; "
+            "the controller's weave function is not written): export --motion joint, the "
+            "planned joints with the weave",
+            key="--motion",
+        )
     if not plan.success and not force:
         raise CaseError(
             f"the run is not feasible ({plan.message}): exporting it needs --force",

@@ -65,6 +65,7 @@ def figures_table(result: PlanResult, case: Case) -> str:
         ),
         *_energy_rows(result),
         *downhand_rows(result, case),
+        *_weave_rows(result),
         ("time law, IK branch", f"{esc(result.timing)}, branch {result.branch}"),
         (
             "samples",
@@ -84,6 +85,18 @@ def _rated_speed_row(result: PlanResult, rated_speed: float) -> tuple[str, str]:
     top = float(np.max(result.trajectory.speed, initial=0.0))
     of_rated = f" ({percent(top / rated_speed)} of v_r)" if rated_speed > 0 else ""
     return "top speed", num(top, scale=1e3, unit="mm/s") + of_rated
+
+
+def _weave_rows(result: PlanResult) -> list[tuple[str, str]]:
+    """The weave reached (``docs/positioner.md#weaving``), when the task weaves."""
+    weave = result.weave
+    if weave is None:
+        return []
+    reached = (
+        f"{num(weave.amplitude, scale=1e3, unit='mm')} at {num(weave.frequency, unit='Hz')} "
+        f"({esc(weave.pattern)}, plane {esc(weave.plane)})"
+    )
+    return [("weave reached", reached)]
 
 
 def _energy_rows(result: PlanResult) -> list[tuple[str, str]]:
