@@ -15,6 +15,7 @@ import numpy as np
 from trackplan.check_report import DownhandFigures, Violation
 from trackplan.motion import JointSamples
 from trackplan.paths import NominalPath
+from trackplan.paths.specs import PointsSpec
 from trackplan.planning.check_reference import TrackingReference
 from trackplan.planning.check_violations import RELATIVE_SLACK, met
 from trackplan.robots.machine import Machine
@@ -34,7 +35,7 @@ def weld_directions(
         When neither the segments nor the tool give a normal (the case loader refuses a
         downhand rule without one).
     """
-    tangent = nominal.tangents(s, piece)
+    tangent = smooth_tangents(nominal, s, piece)
     if declares_normals(nominal.segments):
         normal = nominal_normals(spec, nominal, s, piece)
     elif spec.normals is not None:
@@ -45,6 +46,35 @@ def weld_directions(
         raise ValueError("the downhand rule needs the weld's normal (task.tool.normal)")
     normal = normal / np.linalg.norm(normal, axis=1, keepdims=True)
     return normal, tangent
+
+
+def smooth_tangents(nominal: NominalPath, s: np.ndarray, piece: np.ndarray) -> np.ndarray:
+    """Unit travel directions on the nominal path at arc lengths ``s`` (N,) on pieces
+    ``piece`` (N,), shape (N, 3): the tangent of a line or arc, and along the polyline of a
+    sampled curve (``points``) the direction of the curve the points sample: at each point
+    the mean of its two edges' directions, in between linear in the arc length (the edges'
+    own directions jump from edge to edge, by the curve's turn between two points)."""
+    table = nominal.table
+    n_pieces = table.n_pieces
+    middle = table.s_start + 0.5 * table.length
+    edge = nominal.tangents(middle, np.arange(n_pieces))  # (P, 3): each piece's mid tangent
+    segment = nominal.segment_index
+    sampled = np.array([isinstance(spec, PointsSpec) for spec in nominal.segments])[segment]
+    # the mean direction at each piece's start and end where its neighbour samples the same curve
+    before = np.r_[False, (segment[1:] == segment[:-1]) & sampled[1:] & sampled[:-1]]
+    after = np.r_[before[1:], False]
+    start = np.where(before[:, None], edge + np.roll(edge, 1, axis=0), edge)
+    end = np.where(after[:, None], edge + np.roll(edge, -1, axis=0), edge)
+    start /= np.linalg.norm(start, axis=1, keepdims=True)
+    end /= np.linalg.norm(end, axis=1, keepdims=True)
+    tangent = nominal.tangents(s, piece)
+    on_points = sampled[piece]
+    if on_points.any():
+        k = piece[on_points]
+        u = np.clip((s[on_points] - table.s_start[k]) / table.length[k], 0.0, 1.0)[:, None]
+        blended = (1.0 - u) * start[k] + u * end[k]
+        tangent[on_points] = blended / np.linalg.norm(blended, axis=1, keepdims=True)
+    return tangent
 
 
 def weld_angles(
