@@ -4,11 +4,15 @@ with a positioner, and the refusals (``docs/export.md``, *External axes*)."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
+import trackplan
 from tests.programs.external_programs import (
     CARRIER_PART,
     ROTATE,
@@ -26,8 +30,10 @@ from tests.programs.roundtrip import POSITION_TOLERANCE, frame_difference, targe
 from tests.programs.urscript_programs import cartesian_program as ur_cartesian_program
 from tests.programs.urscript_programs import ur_robot
 from trackplan.errors import CaseError
+from trackplan.io.export import TrajectoryTable
 from trackplan.programs.model import ExternalAxis, Program
 from trackplan.robots.model import Robot
+from trackplan.writers import ExportSource
 from trackplan.writers.fanuc import render_fanuc
 from trackplan.writers.krl import render_krl
 from trackplan.writers.rapid import render_rapid
@@ -201,3 +207,32 @@ def test_arm_only_programs_state_no_external_axes() -> None:
     assert "E1" not in text and "EK(" not in text
     (rapid,) = render_rapid(program, robot=robot).values()
     assert "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]" in rapid
+
+
+def test_the_trajectory_exports_carry_every_axis_by_name(tmp_path: Path) -> None:
+    """csv, json and ros write the external axes as joints after the arm's, named."""
+    names = ("j1", "j2", "j3", "j4", "j5", "j6", "track", "tilt", "rotate")
+    k, n = 5, len(names)
+    q = np.arange(k * n, dtype=float).reshape(k, n) / 7.0
+    table = TrajectoryTable(
+        joint_names=names,
+        t=np.arange(k) * 0.004,
+        q=q,
+        qd=q / 2.0,
+        qdd=q / 3.0,
+        qddd=q / 4.0,
+        tool_position=np.zeros((k, 3)),
+        speed=np.zeros(k),
+    )
+    source = ExportSource(table=table)
+    csv_file = trackplan.export(source, tmp_path / "t.csv", format="csv")
+    rows = np.loadtxt(csv_file, delimiter=",", skiprows=1)
+    assert csv_file.read_text().splitlines()[0] == "t," + ",".join(names)
+    np.testing.assert_allclose(rows[:, 1:], q, rtol=1e-15)
+    content = json.loads(trackplan.export(source, tmp_path / "t.json", format="json").read_text())
+    assert content["joint_names"] == list(names)
+    np.testing.assert_allclose(content["positions"], q, rtol=1e-15)
+    ros_file = trackplan.export(source, tmp_path / "t.yaml", format="ros")
+    message = yaml.load(ros_file.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    assert message["joint_names"] == list(names)
+    np.testing.assert_allclose([p["positions"] for p in message["points"]], q, rtol=1e-15)
