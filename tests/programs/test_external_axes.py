@@ -139,12 +139,15 @@ def test_krl_with_a_track_only_keeps_its_fixed_base() -> None:
     assert parsed.coupled == ""
 
 
-def test_rapid_with_a_positioner_moves_the_work_object_with_stn1() -> None:
+def test_rapid_with_a_positioner_moves_the_work_object_with_stn_1() -> None:
     robot = puma()
     program = source(robot, "cartesian", TRACK_AND_POSITIONER)
     (text,) = render_rapid(program, robot=robot).values()
     parsed = parse_rapid({"m.mod": text})
-    assert parsed.coupled == "STN1"
+    assert parsed.coupled == "STN_1"
+    assert (
+        'wobjdata wobj_weld_cell:=[FALSE,FALSE,"STN_1",[[0,0,0],[1,0,0,0]],[[50,-20,120],' in text
+    )
     distance, angle = frame_difference(parsed.base, CARRIER_PART)
     assert distance < POSITION_TOLERANCE and angle < 1e-8
     robtarget = next(line for line in text.splitlines() if "MoveL [[" in line)

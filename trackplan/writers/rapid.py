@@ -56,10 +56,11 @@ RAPID = Drives(
 """RAPID drives ABB and generic six-axis arms (a generic robot as an ABB arm would), with
 up to six external axes (``eax_a`` … ``eax_f``), a positioner in coordinated motion."""
 
-MECHANICAL_UNIT = "STN1"
-"""The positioner's mechanical unit, which moves the work object's user frame
-(``wobjdata.ufmec``; ABB's default name of a first positioner station). The header states
-it; an integrator renames it where the cell's differs."""
+MECHANICAL_UNIT = "STN_1"
+"""The positioner's mechanical unit, which moves the work object (``wobjdata.ufmec``; the
+name of ABB's own example of a coordinated work object, MultiMove application manual
+3HAC021272-001, *Coordinated work objects*). The header states it; an integrator renames
+it to the cell's unit."""
 
 N_AXES = 6
 """Robot axes of a ``robjoint``; the confdata here is defined for six-axis arms."""
@@ -311,9 +312,9 @@ def _external_header(program: Program) -> list[str]:
     lines = [f"extjoint: {mapping}; 9E+09 for the others (the controller's axis order)"]
     if program.coordinated:
         lines.append(
-            f"the work object's user frame is the part on the positioner's flange, moved by "
-            f'mechanical unit "{MECHANICAL_UNIT}" (ufprog FALSE, ufmec): coordinated '
-            "motion; rename the unit to the cell's positioner"
+            f'the work object moves with mechanical unit "{MECHANICAL_UNIT}" (ufprog FALSE, '
+            "ufmec; coordinated motion): its user frame is the unit's flange from the system "
+            "parameters, its object frame the part there; rename the unit to the cell's"
         )
     return lines
 
@@ -361,11 +362,15 @@ def _module_text(
     lines.append(
         f"  PERS tooldata {names.tool}:=[TRUE,{_pose(program.tool)},{tload}];",
     )
-    # a positioner moves the user frame: ufprog FALSE, ufmec its mechanical unit
-    moved = f'FALSE,"{MECHANICAL_UNIT}"' if program.coordinated else 'TRUE,""'
-    lines.append(
-        f"  PERS wobjdata {names.wobj}:=[FALSE,{moved},{_pose(program.base)},[[0,0,0],[1,0,0,0]]];"
-    )
+    identity = "[[0,0,0],[1,0,0,0]]"
+    if program.coordinated:
+        # a positioner moves the work object: ufprog FALSE, ufmec its mechanical unit;
+        # the user frame is then the unit's, from the system parameters, and the part
+        # on its flange is the object frame (RAPID reference, wobjdata)
+        frames = f'FALSE,"{MECHANICAL_UNIT}",{identity},{_pose(program.base)}'
+    else:
+        frames = f'TRUE,"",{_pose(program.base)},{identity}'
+    lines.append(f"  PERS wobjdata {names.wobj}:=[FALSE,{frames}];")
     lines.append(f"  LOCAL CONST speeddata tpv_joint:={JOINT_SPEED};")
     for mm_s, value in data.speeds.items():
         lines.append(f"  LOCAL CONST speeddata tpv_{mm_s.replace('.', '_')}:={value};")
