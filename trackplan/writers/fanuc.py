@@ -74,7 +74,9 @@ TP = Drives(
 )
 """TP drives FANUC and generic robots, J1 … J6 of motion group 1, a track as group 1's
 extended axis E1 and a positioner as motion group 2; path moves with a positioner
-(coordinated motion) are refused."""
+(coordinated motion) are refused. Layout as controllers write it (``docs/export-fanuc.md``):
+``E1= … mm`` after ``R`` (WILDER-SYSTEMS-LLC/git-ftp ``tool_4_dropoff_leave.ls``),
+``GP2:`` blocks and ``DEFAULT_GROUP = 1,1,…`` (JuniorNatalin/VASC ``up222.ls``)."""
 
 MAX_AXES = 6
 """Robot axes of motion group 1 written (J1…J6)."""

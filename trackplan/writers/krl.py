@@ -59,7 +59,10 @@ KRL = Drives(
     coordinated=True,
 )
 """KRL drives KUKA and generic robots of up to six axes (A1 … A6) and up to six external
-axes (E1 … E6), a positioner in coordinated motion (``EK``)."""
+axes (E1 … E6), a positioner in coordinated motion (``EK``). Sources
+(``docs/export-krl.md``): visose/Robots ``KRLPostProcessor.cs`` (``E1 …`` in the point
+aggregates, ``$BASE = EK(MACHINE_DEF[i].ROOT, MACHINE_DEF[i].MECH_TYPE, frame)``,
+``$ACT_EX_AX``, ``$VEL_EXTAX``); robot-forum.com thread 40359."""
 
 MAX_AXES = 6
 """Robot axes A1 … A6 of an E6AXIS."""

@@ -1,11 +1,13 @@
 """ABB RAPID: a :class:`~trackplan.programs.model.Program` as one module ``NAME.mod``.
 
 The module holds the header comment, the tool (``PERS tooldata``, tframe = the TCP) and
-the work object (``PERS wobjdata``, uframe = the placement), the speeds and zones of the
+the work object (``PERS wobjdata``, uframe = the placement; with a positioner the object
+frame, moved by its mechanical unit), the speeds and zones of the
 program as ``LOCAL CONST speeddata`` / ``zonedata``, ``PROC main()`` and, when the program
 is split, ``LOCAL PROC partK()`` called in order from ``main``. Targets are written inline:
-``jointtarget`` ``[[j1..j6],[9E+09 × 6]]`` in degrees, ``robtarget``
-``[[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[9E+09 × 6]]`` in mm in the work object. Files are
+``jointtarget`` ``[[j1..j6],[eax]]`` in degrees, ``robtarget``
+``[[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[eax]]`` in mm in the work object, ``eax`` the
+external axes (mm, degrees) and ``9E+09`` for the unused ones. Files are
 ASCII (a subset of the ISO 8859-1 the controller reads). See ``docs/export-rapid.md``.
 """
 
@@ -54,7 +56,9 @@ RAPID = Drives(
     coordinated=True,
 )
 """RAPID drives ABB and generic six-axis arms (a generic robot as an ABB arm would), with
-up to six external axes (``eax_a`` … ``eax_f``), a positioner in coordinated motion."""
+up to six external axes (``eax_a`` … ``eax_f``, ``9E9`` unused), a positioner in
+coordinated motion (``wobjdata`` ``ufprog`` FALSE, ``ufmec``; RAPID reference *wobjdata*,
+visose/Robots ``RapidPostProcessor.cs``)."""
 
 MECHANICAL_UNIT = "STN_1"
 """The positioner's mechanical unit, which moves the work object (``wobjdata.ufmec``; the
