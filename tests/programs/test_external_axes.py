@@ -27,6 +27,7 @@ from tests.programs.parsed import ParsedProgram
 from tests.programs.rapid_parser import parse_rapid
 from tests.programs.rapid_programs import cartesian_program, joint_program, puma
 from tests.programs.roundtrip import POSITION_TOLERANCE, frame_difference, target_pairs
+from tests.programs.stand_in import stand_in
 from tests.programs.urscript_programs import cartesian_program as ur_cartesian_program
 from tests.programs.urscript_programs import ur_robot
 from trackplan.errors import CaseError
@@ -239,3 +240,25 @@ def test_the_trajectory_exports_carry_every_axis_by_name(tmp_path: Path) -> None
     message = yaml.load(ros_file.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     assert message["joint_names"] == list(names)
     np.testing.assert_allclose([p["positions"] for p in message["points"]], q, rtol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("format", "motion", "key"),
+    [("urscript", "cartesian", "--format"), ("fanuc", "cartesian", "--motion")],
+)
+def test_an_export_that_refuses_writes_nothing(
+    tmp_path: Path, format: str, motion: str, key: str
+) -> None:
+    """Through ``trackplan.export``: one CaseError (exit 2 on the command line), no file."""
+    robot = ur_robot() if format == "urscript" else puma()
+
+    def build(**_: object) -> Program:
+        if format == "urscript":
+            return with_external(ur_cartesian_program(robot), TRACK_ONLY)
+        return source(robot, motion, TRACK_AND_POSITIONER)
+
+    output = tmp_path / "out"
+    with pytest.raises(CaseError) as raised:
+        trackplan.export(stand_in(build, robot), output, format=format, motion=motion)
+    assert raised.value.key == key
+    assert not output.exists() or not any(output.iterdir())
