@@ -14,6 +14,9 @@ from tests.programs.fanuc_parser import parse_fanuc
 from tests.programs.krl_parser import parse_krl
 from tests.programs.rapid_parser import parse_rapid
 from tests.programs.roundtrip import PlannedRun, planned_run, target_pairs
+from trackplan.errors import CaseError
+from trackplan.frames import placement_transform
+from trackplan.io.robot_file import builtin_robot
 from trackplan.planning.result import SEAM
 from trackplan.programs import build_program
 from trackplan.programs.model import (
@@ -26,7 +29,8 @@ from trackplan.programs.model import (
     SplineMove,
     Target,
 )
-from trackplan.robots.machine import Track
+from trackplan.robots.controller import ControllerConvention
+from trackplan.robots.machine import Positioner, Track
 from trackplan.writers.fanuc import render_fanuc
 from trackplan.writers.krl import render_krl
 from trackplan.writers.rapid import render_rapid
@@ -175,3 +179,49 @@ def test_a_run_planned_with_a_track_reads_back_from_every_language(motion: str) 
         np.testing.assert_allclose(
             [move.external[0] for move in moves], plan.trajectory.q[:, robot.n_dof], atol=1e-12
         )
+
+
+def test_with_a_positioner_the_base_is_the_part_on_its_flange() -> None:
+    """A positioner carries the part: the program's base is the placement itself (the part
+    in the carrier frame), not the part in the controller's world; TP writes the joint
+    form's positioner axes as motion group 2 and refuses the Cartesian form."""
+    shipped = planned_run("paper-corner")
+    world = np.eye(4)
+    world[2, 3] = 0.525  # a controller world above the base, as the M-20iA's
+    convention = ControllerConvention(
+        vendor="generic", signs=np.ones(6), offsets=np.zeros(6), world=world
+    )
+    robot = dataclasses.replace(shipped.case.robot, controller=convention)
+    chain = builtin_robot("puma560")
+    case = dataclasses.replace(
+        shipped.case,
+        robot=robot,
+        positioner=Positioner(chain=chain, pose=np.zeros(6), model="stand-in"),
+    )
+    trajectory = shipped.plan.trajectory
+    turn = np.linspace(-1.0, 1.0, trajectory.n_samples)[:, None] * np.arange(1, 7) / 10.0
+    wide = dataclasses.replace(
+        trajectory,
+        q=np.column_stack([trajectory.q, turn]),
+        qd=np.column_stack([trajectory.qd, np.zeros_like(turn)]),
+        qdd=np.column_stack([trajectory.qdd, np.zeros_like(turn)]),
+        qddd=np.column_stack([trajectory.qddd, np.zeros_like(turn)]),
+    )
+    run = PlannedRun(case=case, plan=dataclasses.replace(shipped.plan, trajectory=wide))
+    part = placement_transform(shipped.plan.placement)
+    assert not np.allclose(robot.convention.world_from_base(part), part)
+    flange_line = "base (part frame on the positioner's flange)"
+    for motion in ("cartesian", "joint"):
+        program = build_program(run, motion=motion)
+        assert program.coordinated
+        assert [axis.kind for axis in program.external_axes] == ["positioner"] * 6
+        np.testing.assert_allclose(program.base, part, atol=1e-15)
+        assert any(line.startswith(flange_line) for line in program.header)
+    # every 25th sample keeps the listing short for the parser
+    joint = build_program(run, motion="joint", period=25 * trajectory.sample_time)
+    parsed = parse_fanuc(render_fanuc(joint, robot=robot))
+    assert parsed.coupled == "GP2"
+    for got, want in target_pairs(parsed, joint):
+        np.testing.assert_allclose(got.external, np.degrees(want.external), atol=0.5e-4 + 1e-9)
+    with pytest.raises(CaseError, match="--motion joint"):
+        render_fanuc(build_program(run, motion="cartesian"), robot=robot)
