@@ -132,6 +132,7 @@ def test_krl_cartesian_with_a_positioner_couples_the_base_through_ek() -> None:
     main = next(text for name, text in files.items() if name.endswith(".src"))
     assert "$BASE = EK(MACHINE_DEF[2].ROOT, MACHINE_DEF[2].MECH_TYPE, TPBASE)" in main
     assert "$ACT_EX_AX = 3" in main
+    assert "; KRL: $BASE = the part frame on the positioner's flange," in main
 
 
 def test_krl_with_a_track_only_keeps_its_fixed_base() -> None:

@@ -368,8 +368,13 @@ def _external_header(program: Program) -> list[str]:
 def _header(program: Program, n_parts: int) -> list[str]:
     """The header comment lines (ASCII, without the ``;``)."""
     lines = [ascii_comment(line) for line in program.header]
+    where = (
+        "on the positioner's flange"
+        if program.coordinated
+        else "in $WORLD (with $ROBROOT = $WORLD)"
+    )
     lines.append(
-        "KRL: $BASE = the part frame in $WORLD (with $ROBROOT = $WORLD), $TOOL = the TCP in "
+        f"KRL: $BASE = the part frame {where}, $TOOL = the TCP in "
         "$FLANGE; X Y Z mm, A B C deg with R = Rz(A) Ry(B) Rx(C)"
     )
     if program.motion == "joint":
