@@ -263,3 +263,31 @@ def test_an_export_that_refuses_writes_nothing(
         trackplan.export(stand_in(build, robot), output, format=format, motion=motion)
     assert raised.value.key == key
     assert not output.exists() or not any(output.iterdir())
+
+
+def test_the_json_export_states_each_joints_unit_from_the_runs_axes(tmp_path: Path) -> None:
+    """A run whose result.json lists ``axes`` (a track among them): the JSON export gives
+    each joint's unit; a run without external axes keeps the JSON as it was."""
+    names = ("j1", "j2", "track", "tilt")
+    table = TrajectoryTable(
+        joint_names=names,
+        t=np.zeros(2),
+        q=np.zeros((2, 4)),
+        qd=np.zeros((2, 4)),
+        qdd=np.zeros((2, 4)),
+        qddd=np.zeros((2, 4)),
+        tool_position=np.zeros((2, 3)),
+        speed=np.zeros(2),
+    )
+    kinds = (("robot", "rad"), ("robot", "rad"), ("track", "m"), ("positioner", "rad"))
+    axes = [{"name": n, "kind": k, "unit": u} for n, (k, u) in zip(names, kinds, strict=True)]
+    (tmp_path / "result.json").write_text(json.dumps({"axes": axes}))
+    written = trackplan.export(
+        ExportSource(table=table, folder=tmp_path), tmp_path / "t.json", format="json"
+    )
+    assert json.loads(written.read_text())["joint_units"] == ["rad", "rad", "m", "rad"]
+    (tmp_path / "result.json").write_text(json.dumps({"axes": axes[:2] + axes[3:] * 2}))
+    again = trackplan.export(
+        ExportSource(table=table, folder=tmp_path), tmp_path / "u.json", format="json"
+    )
+    assert "joint_units" not in json.loads(again.read_text())
