@@ -100,6 +100,7 @@ class Record:
     utool: int
     config: str | None
     fields: dict[str, float]
+    group2: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass
@@ -186,8 +187,11 @@ class _ToListing(Transformer[Token, Listing]):
 
     def position(self, items: list[object]) -> tuple[int, Record]:
         index = int(str(items[0]))
-        groups = [item for item in items if isinstance(item, tuple)]
-        return index, next(record for group, record in groups if group == "GP1")
+        groups = dict(item for item in items if isinstance(item, tuple))
+        record = groups["GP1"]
+        if "GP2" in groups:
+            record.group2 = groups["GP2"].fields
+        return index, record
 
     def group(self, items: list[object]) -> tuple[str, Record]:
         group, uframe, utool = str(items[0]), int(str(items[1])), int(str(items[2]))
@@ -250,6 +254,7 @@ class _State:
     utool: int = 0
     base: np.ndarray | None = None
     tool: np.ndarray | None = None
+    coupled: str = ""
 
 
 def parse_fanuc(files: dict[str, str], *, strict: bool = True) -> ParsedProgram:
@@ -288,6 +293,7 @@ def parse_fanuc(files: dict[str, str], *, strict: bool = True) -> ParsedProgram:
         targets=targets,
         header=_header(main),
         files=list(files),
+        coupled=state.coupled,
     )
 
 
@@ -357,6 +363,12 @@ def _motion(listing: Listing, motion: Motion, state: _State, targets: list[Parse
                 target.joints = np.radians(joints)
             if record.config is not None:
                 target.config = parse_config(record.config)
+            # group 1's extended axes E1 … (mm or deg), then group 2's axes J1 …
+            extended = [record.fields[f"E{i}"] for i in range(1, 4) if f"E{i}" in record.fields]
+            group2 = [record.group2[f"J{i}"] for i in range(1, 10) if f"J{i}" in record.group2]
+            target.external = np.array(extended + group2, dtype=float)
+            if group2:
+                state.coupled = "GP2"
         targets.append(target)
 
 

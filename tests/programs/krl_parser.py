@@ -195,6 +195,7 @@ class _State:
     vel_axis: dict[int, float] = field(default_factory=dict)
     cdis: float = 0.0
     targets: list[ParsedTarget] = field(default_factory=list)
+    coupled: str = ""
 
 
 @dataclass
@@ -260,6 +261,7 @@ def parse_krl(files: dict[str, str]) -> ParsedProgram:
         targets=state.targets,
         header=main.header,
         files=sorted(files),
+        coupled=state.coupled,
     )
 
 
@@ -347,7 +349,17 @@ def _value(target: Any, local: dict[str, Any]) -> Any:
 def _assign(statement: Tree[Any], local: dict[str, Any], state: _State) -> None:
     name, value = statement.children
     value = _value(value, local) if isinstance(value, str) else value
-    if name == "$BASE" and isinstance(value, dict):
+    if name == "$BASE" and isinstance(value, Tree) and value.data == "call":
+        # $BASE = EK(MACHINE_DEF[i].ROOT, MACHINE_DEF[i].MECH_TYPE, frame): the frame on
+        # the external kinematics' flange, moved with it
+        function, args = value.children
+        if str(function).upper() == "EK" and isinstance(args, Tree):
+            root, _, frame = args.children
+            state.coupled = str(root).rsplit(".", 1)[0]
+            coupled = _value(frame, local)
+            if isinstance(coupled, dict):
+                state.base = frame_pose(coupled)
+    elif name == "$BASE" and isinstance(value, dict):
         state.base = frame_pose(value)
     elif name == "$TOOL" and isinstance(value, dict):
         state.tool = frame_pose(value)
@@ -366,6 +378,8 @@ def _target(kind: str, value: Any, part: str, config_ok: bool = True) -> ParsedT
     target = ParsedTarget(kind=kind, part=part)
     if value is None:
         return target
+    external = [value[f"E{i}"] for i in range(1, 7) if f"E{i}" in value]
+    target.external = np.array(external, dtype=float)
     if "A1" in value:
         axes = [value[f"A{i}"] for i in range(1, 7) if f"A{i}" in value]
         target.joints = np.deg2rad(np.array(axes, dtype=float))

@@ -41,6 +41,11 @@ class ParsedTarget:
         Time of a timed move, s, else None.
     part
         The name of the routine (procedure, subprogram, function) it is in.
+    external
+        The external axes as written, in the language's units (mm for a track, degrees
+        for a rotary axis; the parser does not know which axis is which), in the
+        language's order (KRL E1 …, RAPID eax_a …, FANUC E1 of group 1 then group 2's
+        J1 …), the unused ones (RAPID 9E9) left out; empty when none.
     """
 
     kind: str
@@ -51,6 +56,7 @@ class ParsedTarget:
     zone: float | None = None
     duration: float | None = None
     part: str = ""
+    external: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass
@@ -72,6 +78,9 @@ class ParsedProgram:
         The header comment lines, without comment marks.
     files
         The file names read.
+    coupled
+        The mechanism the base moves with (coordinated motion: KRL ``EK``'s machine,
+        RAPID's ``ufmec``, FANUC's motion group 2), empty when the base is fixed.
     """
 
     name: str
@@ -80,3 +89,4 @@ class ParsedProgram:
     targets: list[ParsedTarget]
     header: list[str] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
+    coupled: str = ""

@@ -229,6 +229,7 @@ def parse_rapid(files: dict[str, str]) -> ParsedProgram:
         targets=state.targets,
         header=header,
         files=list(files),
+        coupled=state.coupled,
     )
 
 
@@ -254,6 +255,7 @@ class _Run:
     base: np.ndarray | None = None
     tool: np.ndarray | None = None
     cartesian: bool = False
+    coupled: str = ""
 
     def value(self, item: Any) -> Any:
         if isinstance(item, Name):
@@ -280,12 +282,15 @@ class _Run:
         tool_value = self.value(tool)
         tool_pose = pose_matrix(tool_value[1]) if isinstance(tool_value, list) else np.eye(4)
         wobj = self.value(call.options.get("wobj", Name("wobj0")))
+        coupled = ""
         if isinstance(wobj, list):
             base = pose_matrix(wobj[3]) @ pose_matrix(wobj[4])
+            # ufprog FALSE: the user frame moves with the mechanical unit ufmec
+            coupled = str(wobj[2]) if not _true(wobj[1]) else ""
         else:
             base = np.eye(4)
         if self.tool is None or (cartesian and not self.cartesian):
-            self.tool, self.base = tool_pose, base
+            self.tool, self.base, self.coupled = tool_pose, base, coupled
         self.cartesian |= cartesian
 
     def speed_zone(self, call: Call, speed: Any, zone: Any) -> tuple[float | None, float]:
@@ -314,9 +319,17 @@ class _Run:
         v_tcp, radius = self.speed_zone(call, speed, zone)
         duration = float(self.value(call.options["t"])) if "t" in call.options else None
         if word == "moveabsj":
-            joints = np.radians(np.asarray(self.value(args[0])[0], dtype=float))
+            value = self.value(args[0])
+            joints = np.radians(np.asarray(value[0], dtype=float))
             self.targets.append(
-                ParsedTarget(kind="joint", joints=joints, zone=radius, duration=duration, part=proc)
+                ParsedTarget(
+                    kind="joint",
+                    joints=joints,
+                    zone=radius,
+                    duration=duration,
+                    part=proc,
+                    external=_extjoint(value[1]),
+                )
             )
             return
         kinds = ["circular_via", "circular_end"] if word == "movec" else ["linear"]
@@ -338,8 +351,22 @@ class _Run:
                     zone=radius if last else None,
                     duration=duration if last else None,
                     part=proc,
+                    external=_extjoint(target[3]),
                 )
             )
+
+
+def _extjoint(values: list[Any]) -> np.ndarray:
+    """The used external axes of an ``extjoint`` (mm, degrees): those below 9E9, which
+    marks an axis not used."""
+    return np.array([float(v) for v in values if abs(float(v)) < 8.9e9], dtype=float)
+
+
+def _true(value: Any) -> bool:
+    """A RAPID bool as read (``TRUE``/``FALSE`` names or Python bools)."""
+    if isinstance(value, Name):
+        return value.text.upper() == "TRUE"
+    return bool(value)
 
 
 __all__ = [

@@ -100,6 +100,8 @@ class ExpectedTarget:
     speed
         The move's speed: m/s for a Cartesian move, share of the joint rates for a joint
         move.
+    external
+        The external axes there (the program's, SI units), shape (e,).
     """
 
     kind: str
@@ -108,6 +110,7 @@ class ExpectedTarget:
     pose: np.ndarray | None = None
     duration: float | None = None
     speed: float | None = None
+    external: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def expected_targets(program: Program) -> list[ExpectedTarget]:
@@ -122,6 +125,7 @@ def expected_targets(program: Program) -> list[ExpectedTarget]:
             model_joints=target.model_joints,
             pose=target.pose,
             speed=speed,
+            external=target.external,
         )
 
     for move in program.moves():
@@ -133,6 +137,7 @@ def expected_targets(program: Program) -> list[ExpectedTarget]:
                     model_joints=move.model_joints,
                     duration=move.duration,
                     speed=move.speed,
+                    external=move.external,
                 )
             )
         elif isinstance(move, LinearMove):

@@ -4,8 +4,9 @@
 and makes the program every writer prints: in the Cartesian form the seams as path moves
 (:mod:`trackplan.programs.cartesian`), in the joint form the planned joint trajectory
 itself (:mod:`trackplan.programs.joint_form`). The frames are those of the run: the base is
-the placement (the part frame) in the controller's world, the tool the robot's TCP in the
-flange.
+the placement (the part frame) in the controller's world (with a positioner: the part
+frame on the positioner's flange), the tool the robot's TCP in the flange; the external
+axes (track, positioner) ride along on every joint move and target.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.planning.result import PlanResult
 from trackplan.programs.cartesian import cartesian_sections
+from trackplan.programs.external import external_axes
 from trackplan.programs.header import header_lines
 from trackplan.programs.joint_form import joint_sections, sample_step
 from trackplan.programs.model import MOTION_FORMS, Budget, Program, Section
@@ -112,7 +114,12 @@ def build_program(
         )
     robot = case.robot
     convention = robot.convention
-    base = convention.world_from_base(placement_transform(plan.placement))
+    external = external_axes(case)
+    coordinated = any(axis.kind == "positioner" for axis in external)
+    # with a positioner the placement puts the part on its flange (the carrier frame):
+    # the base is the part there, and the controller moves it with the positioner
+    part = placement_transform(plan.placement)
+    base = part if coordinated else convention.world_from_base(part)
     tool = np.array(robot.T_flange_tool, dtype=float)
     sample_time = float(plan.trajectory.sample_time)
     sections: tuple[Section, ...]
@@ -132,6 +139,7 @@ def build_program(
         form=motion,
         budget=budget,
         period=written_period,
+        external=external,
     )
     return Program(
         name=name or case.name,
@@ -148,6 +156,7 @@ def build_program(
         budget=budget,
         feasible=bool(plan.success),
         v_max=np.array(robot.v_max, dtype=float),
+        external_axes=external,
     )
 
 

@@ -23,6 +23,7 @@ from trackplan.check_report import CheckReport
 from trackplan.paths.planned import Path
 from trackplan.planning.result import SEAM, PlanResult, SeamPlan, Span
 from trackplan.programs.chords import spline_points
+from trackplan.programs.external import interpolate_columns, rated_velocities
 from trackplan.programs.model import (
     Budget,
     CircularMove,
@@ -108,34 +109,50 @@ def cartesian_sections(case: Case, plan: PlanResult) -> tuple[tuple[Section, ...
         if span.kind == SEAM:
             seam = next(seams)
             check = next(checks, seam.plan.check)
-            moves, budget = seam_moves(case, seam, check)
+            moves, budget = seam_moves(case, seam, check, _span_external(case, plan, span))
             budgets.append(budget)
         else:
-            moves = span_joint_moves(robot, plan, span)
+            moves = span_joint_moves(robot, plan, span, rated_velocities(case))
         sections.append(Section(kind=span.kind, label=span.label, moves=moves))
     worst = min(budgets, key=lambda budget: budget.slack)
     return tuple(sections), worst
 
 
-def span_joint_moves(robot: Robot, plan: PlanResult, span: Span) -> tuple[Move, ...]:
+def _span_external(case: Case, plan: PlanResult, span: Span) -> np.ndarray | None:
+    """The external axes over a seam's span of the trajectory, shape (K, e), or None for
+    an arm alone."""
+    n = case.robot.n_dof
+    if plan.trajectory.q.shape[1] == n:
+        return None
+    return plan.trajectory.q[span.first : span.last + 1, n:]
+
+
+def span_joint_moves(
+    robot: Robot, plan: PlanResult, span: Span, v_max: np.ndarray | None = None
+) -> tuple[Move, ...]:
     """An approach, retract or air span as joint moves to its end (through its via, when
-    it has one), each at the span's peak joint rate share and stopping at its end."""
+    it has one), each at the span's peak joint rate share (of ``v_max``, every axis's
+    rated velocity; default the arm's) and stopping at its end."""
     q = plan.trajectory.q
     qd = plan.trajectory.qd
+    rated = np.asarray(robot.v_max if v_max is None else v_max, dtype=float)
     ends = [span.last]
     if span.via is not None:
-        distance = np.linalg.norm(q[span.first : span.last + 1] - span.via, axis=1)
+        via = np.asarray(span.via, dtype=float)
+        distance = np.linalg.norm(q[span.first : span.last + 1, : len(via)] - via, axis=1)
         ends.insert(0, span.first + int(np.argmin(distance)))
     moves: list[Move] = []
     before = span.first
     for end in ends:
-        share = speed_share(robot, qd[before + 1 : end + 1])
+        share = speed_share(rated[: qd.shape[1]], qd[before + 1 : end + 1])
         moves.append(joint_move(robot, q[end], share))
         before = end
     return tuple(moves)
 
 
-def seam_moves(case: Case, seam: SeamPlan, check: CheckReport) -> tuple[tuple[Move, ...], Budget]:
+def seam_moves(
+    case: Case, seam: SeamPlan, check: CheckReport, external: np.ndarray | None = None
+) -> tuple[tuple[Move, ...], Budget]:
     """The path moves of one seam and its tolerance budget.
 
     Parameters
@@ -147,6 +164,10 @@ def seam_moves(case: Case, seam: SeamPlan, check: CheckReport) -> tuple[tuple[Mo
         direction: a reversed seam's runs end to start).
     check
         The seam's check (its largest tracking error).
+    external
+        The external axes over the seam's span of the trajectory, shape (K, e), one row
+        per sample of the seam's own trajectory, or None (an arm alone): each target
+        carries them interpolated at its arc length.
 
     Returns
     -------
@@ -169,7 +190,9 @@ def seam_moves(case: Case, seam: SeamPlan, check: CheckReport) -> tuple[tuple[Mo
     chord = max((spec.chord for spec in specs), default=0.0)
     zone = zone_within(room - chord)
     all_s = np.concatenate([spec.s for spec in specs])
-    targets = path_targets(robot, joint_path, all_s)
+    targets = path_targets(
+        robot, joint_path, all_s, _external_at(seam, robot.n_dof, external, all_s)
+    )
     speeds = _speeds(seam, specs)
     stops = np.asarray(path.stops, dtype=float)
     moves: list[Move] = []
@@ -197,6 +220,25 @@ def seam_moves(case: Case, seam: SeamPlan, check: CheckReport) -> tuple[tuple[Mo
         tolerance=tolerance, tracking_error=tracking, chord_error=chord, zone=written_zone
     )
     return tuple(moves), budget
+
+
+def _external_at(
+    seam: SeamPlan, n_arm: int, external: np.ndarray | None, s: np.ndarray
+) -> np.ndarray | None:
+    """The external axes at arc lengths ``s`` (M,) of a seam, shape (M, e), or None.
+
+    From the seam's own trajectory when it carries the external axes, else from its span
+    of the run's trajectory (``external``), sample for sample."""
+    if external is None:
+        return None
+    trajectory = seam.plan.trajectory
+    columns = trajectory.q[:, n_arm:] if trajectory.q.shape[1] > n_arm else external
+    if len(columns) != len(trajectory.s):
+        raise ValueError(
+            f"the seam's trajectory has {len(trajectory.s)} samples and its span "
+            f"{len(columns)}: the external axes cannot be placed on its targets"
+        )
+    return interpolate_columns(trajectory.s, columns, s)
 
 
 def _stretches(path: Path, chord_limit: float) -> list[_Stretch]:

@@ -9,7 +9,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.frames import rpy_from_matrix
 from trackplan.planning.result import PlanResult
-from trackplan.programs.model import Budget
+from trackplan.programs.model import Budget, ExternalAxis
 
 
 def trackplan_version() -> str:
@@ -41,6 +41,7 @@ def header_lines(
     form: str,
     budget: Budget | None = None,
     period: float | None = None,
+    external: tuple[ExternalAxis, ...] = (),
 ) -> tuple[str, ...]:
     """The header lines, without comment marks.
 
@@ -58,6 +59,8 @@ def header_lines(
         The worst seam's tolerance budget (Cartesian form).
     period
         Time per move, s (joint form).
+    external
+        The external axes (track, positioner), in the program's order.
     """
     robot = case.robot
     X = np.asarray(plan.placement, dtype=float)
@@ -76,11 +79,18 @@ def header_lines(
         f"{convention.source or 'joints and world as the model'}",
         f"placement X: [{_numbers(X[:3], 6)}] m, [{_numbers(X[3:], 6)}] rad = "
         f"[{_numbers(1e3 * X[:3], 3)}] mm, [{_numbers(np.degrees(X[3:]), 4)}] deg",
-        f"base (part frame in the controller world): {frame_text(base)}",
+        (
+            f"base (part frame on the positioner's flange): {frame_text(base)}"
+            if any(axis.kind == "positioner" for axis in external)
+            else f"base (part frame in the controller world): {frame_text(base)}"
+        ),
         f"tool (TCP in the flange): {frame_text(tool)}",
         verdict,
         f"duration: {plan.duration:.3f} s (sample time {plan.trajectory.sample_time:g} s)",
     ]
+    if external:
+        listed = ", ".join(f"{axis.name} ({axis.kind}, {axis.unit})" for axis in external)
+        lines.append(f"external axes, in order: {listed}")
     if form == "cartesian":
         lines.append("form: cartesian (path moves in the part frame; joint moves between seams)")
     else:

@@ -18,6 +18,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.errors import CaseError
 from trackplan.planning.result import SEAM, PlanResult
+from trackplan.programs.external import rated_velocities
 from trackplan.programs.model import JointMove, Move, Section
 from trackplan.programs.targets import (
     MIN_SPEED_SHARE,
@@ -91,10 +92,13 @@ def joint_sections(case: Case, plan: PlanResult, step: int) -> tuple[Section, ..
     q, qd, t = trajectory.q, trajectory.qd, trajectory.t
     index = sample_indices(trajectory.n_samples, step)
     zones = _zones(case, plan, index)
+    n = robot.n_dof
     q_written = q[index]  # a copy: the moves' rows are their own
-    theta = robot.convention.to_controller(q_written)
-    # each move's peak joint rate share over the samples after the one before it
-    rates = np.max(np.abs(qd) / robot.v_max, axis=1)
+    theta = robot.convention.to_controller(q_written[:, :n])
+    outside = q_written[:, n:]  # the external axes (none for an arm alone)
+    # each move's peak joint rate share (external axes included) over the samples after
+    # the one before it
+    rates = np.max(np.abs(qd) / rated_velocities(case)[: qd.shape[1]], axis=1)
     peaks = np.maximum.reduceat(rates, index[:-1] + 1) if len(index) > 1 else np.zeros(0)
     shares = np.clip(np.concatenate([[0.0], peaks]), MIN_SPEED_SHARE, 1.0)
     durations = np.concatenate([[0.0], np.diff(t[index])])
@@ -105,10 +109,11 @@ def joint_sections(case: Case, plan: PlanResult, step: int) -> tuple[Section, ..
         moves: tuple[Move, ...] = tuple(
             JointMove(
                 joints=theta[m],
-                model_joints=q_written[m],
+                model_joints=q_written[m, :n],
                 speed=float(shares[m]),
                 duration=float(durations[m]),
                 zone=float(zones[m]),
+                external=outside[m],
             )
             for m in inside.tolist()
         )

@@ -245,7 +245,8 @@ class Program:
     n_dof
         Number of robot joints.
     base
-        The part frame in the controller's world frame, shape (4, 4), m.
+        The part frame in the controller's world frame, shape (4, 4), m; with a
+        positioner (:attr:`coordinated`) the part frame in the positioner's flange frame.
     tool
         The TCP in the flange, shape (4, 4), m.
     sections
@@ -283,6 +284,13 @@ class Program:
     feasible: bool = True
     v_max: np.ndarray = field(default_factory=lambda: np.zeros(0))
     external_axes: tuple[ExternalAxis, ...] = ()
+
+    @property
+    def coordinated(self) -> bool:
+        """True when a positioner carries the part: :attr:`base` is then the part frame in
+        the positioner's flange frame (the carrier), and the controller must move the base
+        with the positioner (coordinated motion: KRL ``EK``, RAPID ``ufmec``)."""
+        return any(axis.kind == "positioner" for axis in self.external_axes)
 
     def moves(self) -> Iterator[Move]:
         """Every move in order."""
@@ -392,6 +400,7 @@ __all__ = [
     "MOTION_FORMS",
     "Budget",
     "CircularMove",
+    "ExternalAxis",
     "JointMove",
     "LinearMove",
     "MotionForm",

@@ -42,24 +42,28 @@ def joint_move(
     zone: float = 0.0,
     duration: float | None = None,
 ) -> JointMove:
-    """A joint move to the model joints ``q_model`` (n,), rad, in the controller's
-    convention."""
-    q_model = np.array(q_model, dtype=float)
+    """A joint move to the model joints ``q_model``, rad, in the controller's convention:
+    shape (n,) for the arm, or (n + e,) with the external axes after the arm's
+    (:attr:`JointMove.external`, SI units)."""
+    q = np.array(q_model, dtype=float)
+    n = robot.n_dof
     return JointMove(
-        joints=robot.convention.to_controller(q_model),
-        model_joints=q_model,
+        joints=robot.convention.to_controller(q[:n]),
+        model_joints=q[:n],
         speed=float(speed),
         duration=duration,
         zone=float(zone),
+        external=q[n:],
     )
 
 
-def speed_share(robot: Robot, qd: np.ndarray) -> float:
-    """The peak joint rate of samples ``qd`` (K, n), rad/s, as a share of the rated
-    velocities: the largest over joints and samples, in [:data:`MIN_SPEED_SHARE`, 1]."""
+def speed_share(v_max: np.ndarray, qd: np.ndarray) -> float:
+    """The peak joint rate of samples ``qd`` (K, n), rad/s (m/s for a track), as a share
+    of the rated velocities ``v_max`` (n,): the largest over joints and samples, in
+    [:data:`MIN_SPEED_SHARE`, 1]."""
     if len(qd) == 0:
         return MIN_SPEED_SHARE
-    share = float(np.max(np.abs(qd) / robot.v_max))
+    share = float(np.max(np.abs(qd) / v_max))
     return float(np.clip(share, MIN_SPEED_SHARE, 1.0))
 
 
@@ -91,8 +95,11 @@ def seam_budget(case: Case, seam_index: int, check: CheckReport) -> tuple[float,
     return tolerance, tracking
 
 
-def path_targets(robot: Robot, joint_path: JointPath, s: np.ndarray) -> list[Target]:
-    """Targets at arc lengths ``s`` (M,), m, of a seam's planned path.
+def path_targets(
+    robot: Robot, joint_path: JointPath, s: np.ndarray, external: np.ndarray | None = None
+) -> list[Target]:
+    """Targets at arc lengths ``s`` (M,), m, of a seam's planned path, with the external
+    axes ``external`` (M, e) there (None: none).
 
     The pose is the planned TCP in the part frame there (the planned path's point and the
     tool orientation, spin included); the joints are the path IK on the plan's branch at
@@ -103,14 +110,15 @@ def path_targets(robot: Robot, joint_path: JointPath, s: np.ndarray) -> list[Tar
     s = np.asarray(s, dtype=float)
     _, position, _ = joint_path.geometry.planned.points(s)
     rotation = joint_path.R_part_tool(s)
-    q_model = joint_path.joints(s)
+    q_model = joint_path.joints(s)[:, : robot.n_dof]
+    outside = np.zeros((len(s), 0)) if external is None else np.asarray(external, dtype=float)
     q_controller = robot.convention.to_controller(q_model)
     poses = np.zeros((len(s), 4, 4))
     poses[:, :3, :3] = rotation
     poses[:, :3, 3] = position
     poses[:, 3, 3] = 1.0
     return [
-        Target(pose=poses[k], joints=q_controller[k], model_joints=q_model[k])
+        Target(pose=poses[k], joints=q_controller[k], model_joints=q_model[k], external=outside[k])
         for k in range(len(s))
     ]
 

@@ -39,6 +39,13 @@ class Drives:
         The controller families it drives (its own, and ``generic`` where it can).
     min_axes, max_axes
         The robot axes it drives.
+    max_external
+        The external axes (track, positioner) it writes.
+    no_external
+        Why it writes none (the refusal's reason), when ``max_external`` is 0.
+    coordinated
+        True when it moves the part frame with a positioner in path moves (coordinated
+        motion); False refuses ``--motion cartesian`` with a positioner.
     """
 
     format: str
@@ -46,6 +53,9 @@ class Drives:
     vendors: tuple[str, ...]
     min_axes: int = 6
     max_axes: int = 6
+    max_external: int = 0
+    no_external: str = ""
+    coordinated: bool = False
 
 
 def check_drivable(program: Program, drives: Drives) -> None:
@@ -83,6 +93,42 @@ def check_drivable(program: Program, drives: Drives) -> None:
             f"{program.n_dof} joints: --format csv, json or ros export any robot's joints",
             key="--format",
         )
+    check_external(program, drives)
 
 
-__all__ = ["NATIVE_FORMATS", "VENDOR_NAMES", "Drives", "check_drivable"]
+def check_external(program: Program, drives: Drives) -> None:
+    """Refuse a program whose external axes the language cannot write.
+
+    Raises
+    ------
+    CaseError
+        One line: a language that writes no external axes (key ``--format``), more
+        external axes than it writes (key ``--format``), or a Cartesian program with a
+        positioner in a language that writes no coordinated motion (key ``--motion``).
+    """
+    axes = program.external_axes
+    if not axes:
+        return
+    listed = ", ".join(axis.name for axis in axes)
+    if drives.max_external == 0:
+        raise CaseError(
+            f"{drives.language}: {drives.no_external or 'it writes no external axes'}, and "
+            f"the case has {len(axes)} ({listed}): --format csv, json or ros export every "
+            "axis",
+            key="--format",
+        )
+    if len(axes) > drives.max_external:
+        raise CaseError(
+            f"{drives.language} writes at most {drives.max_external} external axes, and the "
+            f"case has {len(axes)} ({listed}): --format csv, json or ros export every axis",
+            key="--format",
+        )
+    if program.motion == "cartesian" and program.coordinated and not drives.coordinated:
+        raise CaseError(
+            f"{drives.language} programs here write no coordinated motion with a positioner "
+            "(the path moves would not follow the turning part): use --motion joint",
+            key="--motion",
+        )
+
+
+__all__ = ["NATIVE_FORMATS", "VENDOR_NAMES", "Drives", "check_drivable", "check_external"]

@@ -22,6 +22,7 @@ import numpy as np
 from trackplan.errors import CaseError
 from trackplan.programs.model import (
     CircularMove,
+    ExternalAxis,
     JointMove,
     LinearMove,
     Move,
@@ -35,9 +36,12 @@ from trackplan.programs.names import ascii_comment, program_identifier
 from trackplan.robots.model import Robot
 from trackplan.run_files import RESULT_FILE
 from trackplan.writers.drivable import Drives, check_drivable
+from trackplan.writers.external import language_values
 from trackplan.writers.fanuc_config import (
     cartesian_record,
     config_strings,
+    extended_fields,
+    group_block,
     joint_record,
     number,
     xyzwpr,
@@ -61,11 +65,21 @@ COMMENT_WIDTH = 20
 ATTR_COMMENT_LENGTH = 16
 """Characters of the ``/ATTR`` COMMENT (the program comment on the SELECT screen)."""
 
-TP = Drives(format="fanuc", language="TP", vendors=("fanuc", "generic"), min_axes=1)
-"""TP drives FANUC and generic robots, J1 … J6 of motion group 1."""
+TP = Drives(
+    format="fanuc",
+    language="TP",
+    vendors=("fanuc", "generic"),
+    min_axes=1,
+    max_external=6,
+)
+"""TP drives FANUC and generic robots, J1 … J6 of motion group 1, a track as group 1's
+extended axis E1 and a positioner as motion group 2; path moves with a positioner
+(coordinated motion) are refused. Layout as controllers write it (``docs/export-fanuc.md``):
+``E1= … mm`` after ``R`` (WILDER-SYSTEMS-LLC/git-ftp ``tool_4_dropoff_leave.ls``),
+``GP2:`` blocks and ``DEFAULT_GROUP = 1,1,…`` (JuniorNatalin/VASC ``up222.ls``)."""
 
 MAX_AXES = 6
-"""Robot axes of motion group 1 written (J1…J6); external axes are not written."""
+"""Robot axes of motion group 1 written (J1…J6)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -148,7 +162,7 @@ def render_fanuc(
     configs = _configurations(program, robot)
     header = _header_lines(program, options)
     if len(parts) == 1:
-        listing = _Listing()
+        listing = _Listing(external=program.external_axes)
         listing.comments(header)
         listing.instruction("")
         _frame_setup(listing, program, options)
@@ -156,7 +170,7 @@ def render_fanuc(
         return {f"{name}.ls": listing.text(name, program, options)}
     names = _part_names(name, len(parts))
     files: dict[str, str] = {}
-    main = _Listing()
+    main = _Listing(external=program.external_axes)
     main.comments(header)
     main.instruction("")
     _frame_setup(main, program, options)
@@ -164,7 +178,7 @@ def render_fanuc(
         main.instruction(f"CALL {part_name}")
     files[f"{name}.ls"] = main.text(name, program, options)
     for part, part_name in zip(parts, names, strict=True):
-        listing = _Listing()
+        listing = _Listing(external=program.external_axes)
         listing.comments([f"{name} part {part.index} of {len(parts)}"])
         listing.instruction(f"UFRAME_NUM={options.uframe}")
         listing.instruction(f"UTOOL_NUM={options.utool}")
@@ -223,6 +237,13 @@ def _run_time(source: ExportSource) -> datetime | None:
 def _check_drivable(program: Program, robot: Robot | None) -> None:
     """Refuse a robot TP does not drive (one line, key ``--format``)."""
     check_drivable(program, TP)
+    tracks = sum(axis.kind == "track" for axis in program.external_axes)
+    if tracks > 1:
+        raise CaseError(
+            f"TP writes one track (extended axis E1 of group 1), and the case has {tracks}: "
+            "--format csv, json or ros export every axis",
+            key="--format",
+        )
     cartesian = any(not isinstance(move, JointMove) for move in program.moves())
     if cartesian and program.n_dof != MAX_AXES:
         raise CaseError(
@@ -270,7 +291,24 @@ def _header_lines(program: Program, options: FanucOptions) -> list[str]:
         f"frames: UFRAME[{options.uframe}] = base, UTOOL[{options.utool}] = tool, "
         f"assembled in PR[{options.register}] (all three overwritten)",
         f"stops FINE, blends CNT{options.cnt}: a speed share, not mm (deviation not bounded)",
+        *_external_header(program),
     ]
+
+
+def _external_header(program: Program) -> list[str]:
+    """The header lines on the external axes (none for an arm alone)."""
+    axes = program.external_axes
+    if not axes:
+        return []
+    track = [axis.name for axis in axes if axis.kind == "track"]
+    turning = [axis.name for axis in axes if axis.kind != "track"]
+    lines = []
+    if track:
+        lines.append(f"external: {track[0]} = E1 of group 1 (mm, an integrated extended axis)")
+    if turning:
+        listed = ", ".join(f"J{i + 1} = {name}" for i, name in enumerate(turning))
+        lines.append(f"external: motion group 2 = the positioner, {listed} (deg)")
+    return lines
 
 
 def _part_names(name: str, n_parts: int) -> list[str]:
@@ -322,7 +360,7 @@ def _part_moves(
         listing.comments([f"{section.kind}: {section.label}"])
         for move in section.moves:
             if isinstance(move, JointMove):
-                index = listing.joint_position(move.joints, options)
+                index = listing.joint_position(move.joints, options, move.external)
                 if move.duration is not None:
                     term = "FINE" if move is last_move else "CNT100"
                     listing.motion("J", f"P[{index}] {number(move.duration, 3)}sec {term}")
@@ -358,9 +396,22 @@ def _last_move(program: Program) -> Move | None:
 class _Listing:
     """The ``/MN`` instructions and ``/POS`` records of one ``.ls`` file."""
 
+    external: tuple[ExternalAxis, ...] = ()
     lines: list[str] = field(default_factory=list)
     positions: list[str] = field(default_factory=list)
     n_instructions: int = 0
+
+    def axis_fields(self, external: np.ndarray, options: FanucOptions) -> dict[str, str]:
+        """The record's ``extended`` (a track as E1 of group 1, mm) and ``group2`` (the
+        positioner's axes in motion group 2, deg) of external axes (m, rad)."""
+        if not self.external:
+            return {}
+        values = language_values(self.external, external)
+        track = np.array([a.kind == "track" for a in self.external], dtype=bool)
+        return {
+            "extended": extended_fields(values[track]),
+            "group2": group_block(values[~track], options.uframe, options.utool),
+        }
 
     def _number(self) -> str:
         self.n_instructions += 1
@@ -387,11 +438,21 @@ class _Listing:
         self.lines.append(f"{self._number()}C P[{via}] ")
         self.lines.append(f"    :  P[{end}] {rest} ;")
 
-    def joint_position(self, joints: np.ndarray, options: FanucOptions) -> int:
-        """Add a joint-represented position; its number."""
+    def joint_position(
+        self, joints: np.ndarray, options: FanucOptions, external: np.ndarray
+    ) -> int:
+        """Add a joint-represented position (and the external axes); its number."""
         index = len(self.positions) + 1
         degrees = np.degrees(np.asarray(joints, dtype=float))
-        self.positions.append(joint_record(index, degrees, options.uframe, options.utool))
+        self.positions.append(
+            joint_record(
+                index,
+                degrees,
+                options.uframe,
+                options.utool,
+                **self.axis_fields(external, options),
+            )
+        )
         return index
 
     def cartesian_position(
@@ -401,7 +462,12 @@ class _Listing:
         index = len(self.positions) + 1
         self.positions.append(
             cartesian_record(
-                index, xyzwpr(target.pose), configs[id(target)], options.uframe, options.utool
+                index,
+                xyzwpr(target.pose),
+                configs[id(target)],
+                options.uframe,
+                options.utool,
+                **self.axis_fields(target.external, options),
             )
         )
         return index
@@ -431,7 +497,7 @@ class _Listing:
             "      BUSY_LAMP_OFF\t= 0,",
             "      ABORT_REQUEST\t= 0,",
             "      PAUSE_REQUEST\t= 0;",
-            "DEFAULT_GROUP\t= 1,*,*,*,*;",
+            f"DEFAULT_GROUP\t= 1,{'1' if program.coordinated else '*'},*,*,*;",
             "CONTROL_CODE\t= 00000000 00000000;",
             "/MN",
         ]

@@ -162,7 +162,16 @@ def number(value: float, decimals: int) -> str:
     return fixed(value, decimals)
 
 
-def cartesian_record(index: int, values: np.ndarray, config: str, uframe: int, utool: int) -> str:
+def cartesian_record(
+    index: int,
+    values: np.ndarray,
+    config: str,
+    uframe: int,
+    utool: int,
+    *,
+    extended: str = "",
+    group2: str = "",
+) -> str:
     """A ``/POS`` record of a Cartesian position.
 
     Parameters
@@ -175,6 +184,10 @@ def cartesian_record(index: int, values: np.ndarray, config: str, uframe: int, u
         The configuration string, without quotes.
     uframe, utool
         The user frame and tool frame numbers the position is taught in.
+    extended
+        Group 1's extended axes (:func:`extended_fields`), or empty.
+    group2
+        The ``GP2`` block (:func:`group_block`), or empty.
     """
     decimals = (3, 3, 3, 4, 4, 4)
     x, y, z, w, p, r = (number(float(v), d) for v, d in zip(values, decimals, strict=True))
@@ -183,12 +196,23 @@ def cartesian_record(index: int, values: np.ndarray, config: str, uframe: int, u
         "   GP1:\n"
         f"\tUF : {uframe}, UT : {utool},\t\tCONFIG : '{config}',\n"
         f"\tX = {x:>12}  mm,\tY = {y:>12}  mm,\tZ = {z:>12}  mm,\n"
-        f"\tW = {w:>12} deg,\tP = {p:>12} deg,\tR = {r:>12} deg\n"
-        "};"
+        f"\tW = {w:>12} deg,\tP = {p:>12} deg,\tR = {r:>12} deg"
+        + (f",\n\t{extended}" if extended else "")
+        + "\n"
+        + group2
+        + "};"
     )
 
 
-def joint_record(index: int, degrees: np.ndarray, uframe: int, utool: int) -> str:
+def joint_record(
+    index: int,
+    degrees: np.ndarray,
+    uframe: int,
+    utool: int,
+    *,
+    extended: str = "",
+    group2: str = "",
+) -> str:
     """A ``/POS`` record of a joint position (``J1 = … deg``).
 
     Parameters
@@ -199,17 +223,43 @@ def joint_record(index: int, degrees: np.ndarray, uframe: int, utool: int) -> st
         Controller joints, shape (n,), degrees (printed to 1e-4°).
     uframe, utool
         The user frame and tool frame numbers.
+    extended
+        Group 1's extended axes (:func:`extended_fields`), or empty.
+    group2
+        The ``GP2`` block (:func:`group_block`), or empty.
     """
+    body = _joint_rows(degrees)
+    if extended:
+        body += f",\n\t{extended}"
+    return f"P[{index}]{{\n   GP1:\n\tUF : {uframe}, UT : {utool},\n{body}\n{group2}}};"
+
+
+def _joint_rows(degrees: np.ndarray) -> str:
+    """``J1= … deg`` fields, three to a row."""
     fields = [f"J{i + 1}= {number(float(v), 4):>12} deg" for i, v in enumerate(degrees)]
     rows = [",\t".join(fields[k : k + 3]) for k in range(0, len(fields), 3)]
-    body = ",\n".join(f"\t{row}" for row in rows)
-    return f"P[{index}]{{\n   GP1:\n\tUF : {uframe}, UT : {utool},\n{body}\n}};"
+    return ",\n".join(f"\t{row}" for row in rows)
+
+
+def extended_fields(millimetres: np.ndarray) -> str:
+    """Group 1's extended axes ``E1= … mm`` (a track), empty for none."""
+    return ",\t".join(f"E{i + 1}= {number(float(v), 3):>12}  mm" for i, v in enumerate(millimetres))
+
+
+def group_block(degrees: np.ndarray, uframe: int, utool: int) -> str:
+    """A ``GP2`` block of a position: the positioner's axes ``J1= … deg`` (motion group
+    2), empty for none."""
+    if len(degrees) == 0:
+        return ""
+    return f"   GP2:\n\tUF : {uframe}, UT : {utool},\n{_joint_rows(degrees)}\n"
 
 
 __all__ = [
     "arm_configuration",
     "cartesian_record",
     "config_strings",
+    "extended_fields",
+    "group_block",
     "joint_record",
     "number",
     "turn_numbers",

@@ -22,6 +22,7 @@ import numpy as np
 from trackplan.errors import CaseError
 from trackplan.programs.model import (
     CircularMove,
+    ExternalAxis,
     JointMove,
     LinearMove,
     Move,
@@ -34,6 +35,7 @@ from trackplan.programs.model import (
 from trackplan.programs.names import ascii_comment, program_identifier
 from trackplan.robots.model import Robot
 from trackplan.writers.drivable import Drives, check_drivable
+from trackplan.writers.external import language_values, unit_names
 from trackplan.writers.krl_config import frame_values, real, status_turn
 from trackplan.writers.protocol import write_text_files
 from trackplan.writers.source import ExportSource
@@ -48,11 +50,27 @@ zone changes), below the page length integrators' post-processors keep
 MAX_NAME = 24
 """KRL's longest program (module) name."""
 
-KRL = Drives(format="krl", language="KRL", vendors=("kuka", "generic"), min_axes=1)
-"""KRL drives KUKA and generic robots of up to six axes (A1 … A6)."""
+KRL = Drives(
+    format="krl",
+    language="KRL",
+    vendors=("kuka", "generic"),
+    min_axes=1,
+    max_external=6,
+    coordinated=True,
+)
+"""KRL drives KUKA and generic robots of up to six axes (A1 … A6) and up to six external
+axes (E1 … E6), a positioner in coordinated motion (``EK``). Sources
+(``docs/export-krl.md``): visose/Robots ``KRLPostProcessor.cs`` (``E1 …`` in the point
+aggregates, ``$BASE = EK(MACHINE_DEF[i].ROOT, MACHINE_DEF[i].MECH_TYPE, frame)``,
+``$ACT_EX_AX``, ``$VEL_EXTAX``); robot-forum.com thread 40359."""
 
 MAX_AXES = 6
-"""Robot axes A1 … A6 of an E6AXIS (external axes E1 … E6 are not written)."""
+"""Robot axes A1 … A6 of an E6AXIS."""
+
+POSITIONER_MACHINE = 2
+"""``MACHINE_DEF[2]``: the positioner's external kinematics in the controller's machine
+data (``MACHINE_DEF[1]`` is the robot). The index is the controller's configuration: the
+header states it, and an integrator changes it where the cell's differs."""
 
 KEYWORDS = frozenset(
     """AND ANIN ANOUT B_AND B_NOT B_OR B_EXOR BOOL BRAKE C_DIS C_ORI C_PTP C_SPL C_VEL CASE
@@ -129,27 +147,20 @@ def render_krl(program: Program, *, robot: Robot, max_points: int | None = None)
         )
     parts = split_program(program, max_points or DEFAULT_MAX_POINTS)
     configurations = _configurations(program, robot)
-    main = _Module(name, configurations)
+    main = _Module(name, configurations, program.external_axes)
     main.data.append(f"DECL FRAME TPBASE={{{_frame(program.base)}}}")
     main.data.append(f"DECL FRAME TPTOOL={{{_frame(program.tool)}}}")
     main.code.extend(f"; {line}" for line in _header(program, len(parts)))
-    main.code.extend(
-        [
-            ";FOLD INI",
-            "  BAS(#INITMOV, 0)",
-            ";ENDFOLD (INI)",
-            "$BASE = TPBASE",
-            "$TOOL = TPTOOL",
-            "$IPO_MODE = #BASE",
-        ]
-    )
+    main.code.extend([";FOLD INI", "  BAS(#INITMOV, 0)", ";ENDFOLD (INI)"])
+    main.code.extend(_base_lines(program))
+    main.code.extend(["$TOOL = TPTOOL", "$IPO_MODE = #BASE"])
     files: dict[str, str] = {}
     if len(parts) == 1:
         main.add_sections(parts[0].sections, program.n_dof)
     else:
         for part, part_name in zip(parts, part_names(name, len(parts)), strict=True):
             main.code.append(f"{part_name}( )")
-            module = _Module(part_name, configurations)
+            module = _Module(part_name, configurations, program.external_axes)
             module.code.append(f"; part {part.index} of {len(parts)} of {name}")
             module.add_sections(part.sections, program.n_dof)
             files.update(module.files())
@@ -162,6 +173,7 @@ class _Module:
 
     name: str
     configurations: dict[int, tuple[int, int]]
+    external: tuple[ExternalAxis, ...] = ()
     code: list[str] = field(default_factory=list)
     data: list[str] = field(default_factory=list)
     n_points: int = 0
@@ -201,20 +213,32 @@ class _Module:
         self.data.append(f"DECL {kind} {name}={{{values}}}")
         return name
 
-    def axis_point(self, joints: np.ndarray) -> str:
-        """An E6AXIS of controller joints (rad)."""
+    def axis_point(self, joints: np.ndarray, external: np.ndarray) -> str:
+        """An E6AXIS of controller joints (rad) and external axes (m, rad)."""
         values = ",".join(
             f"A{i + 1} {real(v, DIGITS_DEG)}" for i, v in enumerate(np.rad2deg(joints))
         )
-        return self.point("E6AXIS", values)
+        return self.point("E6AXIS", values + self.external_values(external))
 
     def pose_point(self, target: Target) -> str:
-        """An E6POS of a Cartesian target, with Status and Turn when known."""
+        """An E6POS of a Cartesian target, with Status and Turn when known, and its
+        external axes."""
         values = _frame(target.pose)
         if id(target) in self.configurations:
             status, turn = self.configurations[id(target)]
             values += f",S {status},T {turn}"
-        return self.point("E6POS", values)
+        return self.point("E6POS", values + self.external_values(target.external))
+
+    def external_values(self, external: np.ndarray) -> str:
+        """``,E1 …,E2 …`` of the external axes: a track in mm, rotary axes in degrees
+        (empty without external axes)."""
+        if not self.external:
+            return ""
+        values = language_values(self.external, external)
+        return "".join(
+            f",E{i + 1} {real(v, DIGITS_MM if axis.unit == 'm' else DIGITS_DEG)}"
+            for i, (axis, v) in enumerate(zip(self.external, values, strict=True))
+        )
 
     def set_speed(self, speed: float) -> None:
         """``$VEL.CP`` (m/s) when it changes."""
@@ -228,6 +252,7 @@ class _Module:
         text = _percent(share)
         if text != self.vel_axis:
             self.code.extend(f"$VEL_AXIS[{i}] = {text}" for i in range(1, n_dof + 1))
+            self.code.extend(f"$VEL_EXTAX[{i}] = {text}" for i in range(1, len(self.external) + 1))
             self.vel_axis = text
 
     def approximation(self, zone: float, suffix: str = "C_DIS") -> str:
@@ -244,7 +269,7 @@ class _Module:
         """One untimed move: PTP, LIN, CIRC or a SPLINE block."""
         if isinstance(move, JointMove):
             self.set_axis_speed(move.speed, n_dof)
-            point = self.axis_point(move.joints)
+            point = self.axis_point(move.joints, move.external)
             self.code.append(f"PTP {point}{self.approximation(move.zone)}")
         elif isinstance(move, LinearMove):
             self.set_speed(move.speed)
@@ -265,9 +290,12 @@ class _Module:
         self.set_axis_speed(moves[0].speed, n_dof)
         lines = []
         for move in moves:
-            point = self.axis_point(move.joints)
+            point = self.axis_point(move.joints, move.external)
             text = _percent(move.speed)
-            extra = ", ".join(f"$VEL_AXIS[{i}] = {text}" for i in range(1, n_dof + 1))
+            extra = ", ".join(
+                [f"$VEL_AXIS[{i}] = {text}" for i in range(1, n_dof + 1)]
+                + [f"$VEL_EXTAX[{i}] = {text}" for i in range(1, len(self.external) + 1)]
+            )
             lines.append(f"  SPTP {point}" + (f" WITH {extra}" if text != self.vel_axis else ""))
         suffix = self.approximation(moves[-1].zone, "C_SPL")
         self.code.extend(["PTP_SPLINE", *lines, f"ENDSPLINE{suffix}"])
@@ -296,11 +324,57 @@ def _timed(move: Move) -> bool:
     return isinstance(move, JointMove) and move.duration is not None
 
 
+def _base_lines(program: Program) -> list[str]:
+    """The ``$BASE`` of the program: the part frame, or with a positioner (Cartesian
+    form) the part frame on the positioner's flange, moved with it by the external
+    kinematics ``EK`` (coordinated motion); the joint form moves axes only and sets no
+    base then."""
+    if not program.coordinated:
+        return ["$BASE = TPBASE"]
+    if program.motion == "joint":
+        return []
+    machine = f"MACHINE_DEF[{POSITIONER_MACHINE}]"
+    return [
+        f"$BASE = EK({machine}.ROOT, {machine}.MECH_TYPE, TPBASE)",
+        f"$ACT_EX_AX = {len(program.external_axes)}",
+    ]
+
+
+def _external_header(program: Program) -> list[str]:
+    """The header lines on the external axes (none for an arm alone)."""
+    axes = program.external_axes
+    if not axes:
+        return []
+    units = unit_names(axes)
+    mapping = ", ".join(
+        f"E{i + 1} = {axis.name} ({unit})"
+        for i, (axis, unit) in enumerate(zip(axes, units, strict=True))
+    )
+    lines = [
+        f"external axes: {mapping}; $EX_AX_NUM and the machine data must map them so "
+        "(track first, then the positioner's axes)"
+    ]
+    if program.coordinated and program.motion == "cartesian":
+        lines.append(
+            f"TPBASE is the part frame on the positioner's flange; $BASE = EK(...) couples "
+            f"it to the positioner's kinematics MACHINE_DEF[{POSITIONER_MACHINE}] "
+            "(coordinated motion): set the index to the cell's positioner"
+        )
+    elif program.coordinated:
+        lines.append("TPBASE is the part frame on the positioner's flange (not used by PTP)")
+    return lines
+
+
 def _header(program: Program, n_parts: int) -> list[str]:
     """The header comment lines (ASCII, without the ``;``)."""
     lines = [ascii_comment(line) for line in program.header]
+    where = (
+        "on the positioner's flange"
+        if program.coordinated
+        else "in $WORLD (with $ROBROOT = $WORLD)"
+    )
     lines.append(
-        "KRL: $BASE = the part frame in $WORLD (with $ROBROOT = $WORLD), $TOOL = the TCP in "
+        f"KRL: $BASE = the part frame {where}, $TOOL = the TCP in "
         "$FLANGE; X Y Z mm, A B C deg with R = Rz(A) Ry(B) Rx(C)"
     )
     if program.motion == "joint":
@@ -313,6 +387,7 @@ def _header(program: Program, n_parts: int) -> list[str]:
             "S, T: KUKA Status and Turn of the planned joints; LIN, CIRC and SPL keep the "
             "start's, so the PTP to the planned joints holds the branch"
         )
+    lines.extend(_external_header(program))
     if n_parts > 1:
         lines.append(f"parts: {n_parts}, called in order")
     return lines

@@ -1,11 +1,13 @@
 """ABB RAPID: a :class:`~trackplan.programs.model.Program` as one module ``NAME.mod``.
 
 The module holds the header comment, the tool (``PERS tooldata``, tframe = the TCP) and
-the work object (``PERS wobjdata``, uframe = the placement), the speeds and zones of the
+the work object (``PERS wobjdata``, uframe = the placement; with a positioner the object
+frame, moved by its mechanical unit), the speeds and zones of the
 program as ``LOCAL CONST speeddata`` / ``zonedata``, ``PROC main()`` and, when the program
 is split, ``LOCAL PROC partK()`` called in order from ``main``. Targets are written inline:
-``jointtarget`` ``[[j1..j6],[9E+09 × 6]]`` in degrees, ``robtarget``
-``[[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[9E+09 × 6]]`` in mm in the work object. Files are
+``jointtarget`` ``[[j1..j6],[eax]]`` in degrees, ``robtarget``
+``[[x,y,z],[q1..q4],[cf1,cf4,cf6,cfx],[eax]]`` in mm in the work object, ``eax`` the
+external axes (mm, degrees) and ``9E+09`` for the unused ones. Files are
 ASCII (a subset of the ISO 8859-1 the controller reads). See ``docs/export-rapid.md``.
 """
 
@@ -32,6 +34,7 @@ from trackplan.programs.model import (
 from trackplan.programs.names import ascii_comment, program_identifier
 from trackplan.robots.model import Robot
 from trackplan.writers.drivable import Drives, check_drivable
+from trackplan.writers.external import language_values, unit_names
 from trackplan.writers.protocol import write_text_files
 from trackplan.writers.rapid_config import confdata, number, numbers, quaternion
 from trackplan.writers.source import ExportSource
@@ -45,8 +48,23 @@ FlexPendant."""
 MAX_IDENTIFIER = 32
 """Longest RAPID identifier (RAPID overview, *Basic elements: identifiers*)."""
 
-RAPID = Drives(format="rapid", language="RAPID", vendors=("abb", "generic"))
-"""RAPID drives ABB and generic six-axis arms (a generic robot as an ABB arm would)."""
+RAPID = Drives(
+    format="rapid",
+    language="RAPID",
+    vendors=("abb", "generic"),
+    max_external=6,
+    coordinated=True,
+)
+"""RAPID drives ABB and generic six-axis arms (a generic robot as an ABB arm would), with
+up to six external axes (``eax_a`` … ``eax_f``, ``9E9`` unused), a positioner in
+coordinated motion (``wobjdata`` ``ufprog`` FALSE, ``ufmec``; RAPID reference *wobjdata*,
+visose/Robots ``RapidPostProcessor.cs``)."""
+
+MECHANICAL_UNIT = "STN_1"
+"""The positioner's mechanical unit, which moves the work object (``wobjdata.ufmec``; the
+name of ABB's own example of a coordinated work object, MultiMove application manual
+3HAC021272-001, *Coordinated work objects*). The header states it; an integrator renames
+it to the cell's unit."""
 
 N_AXES = 6
 """Robot axes of a ``robjoint``; the confdata here is defined for six-axis arms."""
@@ -199,7 +217,7 @@ def _move_lines(
     """The instructions of one move."""
     tool = f"{names.tool}\\WObj:={names.wobj}"
     if isinstance(move, JointMove):
-        target = f"[[{numbers(np.degrees(move.joints), DEG)}],[{','.join([UNUSED] * 6)}]]"
+        target = f"[[{numbers(np.degrees(move.joints), DEG)}],{_extjoint(program, move.external)}]"
         zone = move.zone
         if move.duration is not None:
             if zone <= 0.0 and isinstance(following, JointMove) and following.duration:
@@ -244,32 +262,65 @@ def _robtargets(program: Program, robot: Robot) -> dict[int, str]:
         np.stack([target.model_joints for target in targets]),
     )
     orients = quaternion(poses[:, :3, :3])
-    unused = ",".join([UNUSED] * 6)
     return {
         id(target): f"[[{numbers(pose[:3, 3] * 1000.0, MM)}],[{numbers(orient, QUAT)}],"
-        f"[{','.join(str(int(c)) for c in fields)}],[{unused}]]"
+        f"[{','.join(str(int(c)) for c in fields)}],{_extjoint(program, target.external)}]"
         for target, pose, orient, fields in zip(targets, poses, orients, conf, strict=True)
     }
 
 
+def _extjoint(program: Program, external: np.ndarray) -> str:
+    """``extjoint`` ``[eax_a, …, eax_f]``: the external axes in order (a track in mm,
+    rotary axes in degrees), ``9E+09`` for the axes not used."""
+    axes = program.external_axes
+    values = language_values(axes, external)
+    written = [
+        number(v, MM if axis.unit == "m" else DEG) for axis, v in zip(axes, values, strict=True)
+    ]
+    return f"[{','.join(written + [UNUSED] * (6 - len(written)))}]"
+
+
 def _joint_time(move: JointMove, previous: np.ndarray, program: Program) -> float:
-    """Time of a joint move at its share of each joint's rated velocity, s."""
-    travel = np.abs(np.asarray(move.model_joints) - previous)
-    return float(np.max(travel / (move.speed * program.v_max))) or 0.001
+    """Time of a joint move at its share of each joint's rated velocity (the external
+    axes' included), s."""
+    rated = np.concatenate([program.v_max, [axis.v_max for axis in program.external_axes]])
+    travel = np.abs(_end_joints(move) - previous)
+    return float(np.max(travel / (move.speed * rated))) or 0.001
 
 
 def _end_joints(move: Move) -> np.ndarray:
-    """Model joints where a move ends."""
+    """Model joints and external axes where a move ends."""
     if isinstance(move, JointMove):
-        return np.asarray(move.model_joints, dtype=float)
-    end = move.targets[-1] if isinstance(move, SplineMove) else move.target
-    return np.asarray(end.model_joints, dtype=float)
+        end_joints, external = move.model_joints, move.external
+    else:
+        end = move.targets[-1] if isinstance(move, SplineMove) else move.target
+        end_joints, external = end.model_joints, end.external
+    return np.concatenate([np.asarray(end_joints, dtype=float), np.asarray(external, float)])
 
 
 def _pose(transform: np.ndarray) -> str:
     """RAPID ``pose`` ``[[x,y,z],[q1..q4]]`` of a transform (mm)."""
     position = numbers(transform[:3, 3] * 1000.0, MM)
     return f"[[{position}],[{numbers(quaternion(transform[:3, :3]), QUAT)}]]"
+
+
+def _external_header(program: Program) -> list[str]:
+    """The header lines on the external axes (none for an arm alone)."""
+    axes = program.external_axes
+    if not axes:
+        return []
+    mapping = ", ".join(
+        f"eax_{letter} = {axis.name} ({unit})"
+        for letter, axis, unit in zip("abcdef", axes, unit_names(axes), strict=False)
+    )
+    lines = [f"extjoint: {mapping}; 9E+09 for the others (the controller's axis order)"]
+    if program.coordinated:
+        lines.append(
+            f'the work object moves with mechanical unit "{MECHANICAL_UNIT}" (ufprog FALSE, '
+            "ufmec; coordinated motion): its user frame is the unit's flange from the system "
+            "parameters, its object frame the part there; rename the unit to the cell's"
+        )
+    return lines
 
 
 def _tload(program: Program, robot: Robot) -> tuple[str, str]:
@@ -307,6 +358,7 @@ def _module_text(
         "confdata [cf1,cf4,cf6,cfx] from the planned joints; ConfL/ConfJ \\On and the "
         "MoveAbsJ to the planned start hold the planned branch",
     ]
+    header.extend(_external_header(program))
     if not program.feasible:
         header.append("WARNING: the run is NOT feasible (written with --force)")
     lines.extend(f"  ! {ascii_comment(line)}".rstrip() for line in header)
@@ -314,9 +366,15 @@ def _module_text(
     lines.append(
         f"  PERS tooldata {names.tool}:=[TRUE,{_pose(program.tool)},{tload}];",
     )
-    lines.append(
-        f'  PERS wobjdata {names.wobj}:=[FALSE,TRUE,"",{_pose(program.base)},[[0,0,0],[1,0,0,0]]];'
-    )
+    identity = "[[0,0,0],[1,0,0,0]]"
+    if program.coordinated:
+        # a positioner moves the work object: ufprog FALSE, ufmec its mechanical unit;
+        # the user frame is then the unit's, from the system parameters, and the part
+        # on its flange is the object frame (RAPID reference, wobjdata)
+        frames = f'FALSE,"{MECHANICAL_UNIT}",{identity},{_pose(program.base)}'
+    else:
+        frames = f'TRUE,"",{_pose(program.base)},{identity}'
+    lines.append(f"  PERS wobjdata {names.wobj}:=[FALSE,{frames}];")
     lines.append(f"  LOCAL CONST speeddata tpv_joint:={JOINT_SPEED};")
     for mm_s, value in data.speeds.items():
         lines.append(f"  LOCAL CONST speeddata tpv_{mm_s.replace('.', '_')}:={value};")

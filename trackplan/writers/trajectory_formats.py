@@ -6,7 +6,9 @@ Each writes one file, ``options["file_name"]`` in the folder it is given (defaul
 - ``csv`` → ``trajectory.export.csv``: ``t,<joint names>``, one row per sample (s, rad);
   the header is quoted as the ``csv`` module quotes, and a name that a spreadsheet would
   take for a formula gets a leading ``'`` (:func:`~trackplan.io.csv_cells.neutralised`).
-- ``json`` → ``trajectory.json``: joint names, units and every column as arrays.
+- ``json`` → ``trajectory.json``: joint names, units and every column as arrays; with
+  external axes (a run whose ``result.json`` lists ``axes``) each joint's position unit
+  (``joint_units``: ``rad``, or ``m`` for a track).
 - ``ros`` → ``trajectory.ros.yaml``: a ``trajectory_msgs/msg/JointTrajectory`` as YAML.
 """
 
@@ -23,6 +25,7 @@ import yaml
 from trackplan.io.csv_cells import neutralised
 from trackplan.io.csv_table import write_csv_table
 from trackplan.io.export import TrajectoryTable
+from trackplan.run_files import RESULT_FILE
 from trackplan.writers.source import ExportSource
 
 UNITS = {
@@ -78,6 +81,9 @@ class JsonWriter:
             "tool_position": table.tool_position.tolist(),
             "speed": table.speed.tolist(),
         }
+        joint_units = _joint_units(source)
+        if joint_units is not None:
+            content["joint_units"] = joint_units
         # one key per line keeps the file readable without a line per number
         body = ",\n".join(
             f"  {json.dumps(key)}: {json.dumps(value)}" for key, value in content.items()
@@ -108,6 +114,25 @@ class RosWriter:
         )
         (folder / name).write_text(text, encoding="utf-8")
         return (name,)
+
+
+def _joint_units(source: ExportSource) -> list[str] | None:
+    """Each joint's position unit from the run's ``result.json`` ``axes`` (name, kind,
+    unit) when it lists external axes and matches the table; else None (every joint
+    rad, as ``units`` says)."""
+    if source.folder is None:
+        return None
+    try:
+        summary = json.loads((source.folder / RESULT_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    axes = summary.get("axes") if isinstance(summary, dict) else None
+    if not isinstance(axes, list) or len(axes) != source.table.q.shape[1]:
+        return None
+    units = [axis.get("unit") if isinstance(axis, dict) else None for axis in axes]
+    if not all(unit in ("rad", "m") for unit in units) or all(unit == "rad" for unit in units):
+        return None
+    return [str(unit) for unit in units]
 
 
 def _file_name(writer: CsvWriter | JsonWriter | RosWriter, options: dict[str, Any]) -> str:

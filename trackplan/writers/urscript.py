@@ -74,7 +74,12 @@ SERVO_LOOKAHEAD_TIME = 0.1
 SERVO_GAIN = 300.0
 """``servoj`` ``gain`` (range [100, 2000]; the URScript manual's default)."""
 
-URSCRIPT = Drives(format="urscript", language="URScript", vendors=("ur",))
+URSCRIPT = Drives(
+    format="urscript",
+    language="URScript",
+    vendors=("ur",),
+    no_external="Universal Robots controllers drive no external axes",
+)
 """URScript drives Universal Robots arms: ``movej`` and ``servoj`` take 6 values."""
 
 RESERVED = frozenset(
