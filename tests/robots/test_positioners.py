@@ -82,6 +82,19 @@ def test_two_axis_500_is_the_motopos_d500_of_its_source() -> None:
     )
 
 
+@pytest.mark.parametrize("name", ["two-axis-500", "one-axis-turntable"])
+def test_the_d500s_drives_have_the_motopos_data_sheets_ranges_and_speeds(name: str) -> None:
+    chain = builtin_positioner(name)
+    assert "MOTOPOS-D500B-A00" in chain.source and "KAE-C945-431G" in chain.source
+    # data sheet p. 7, MOTOPOS-D500B-A00: tilted axis ±135° at 80 °/s, rotation ±200° at 160 °/s
+    # (the xacro rounds the radians to 4 decimals: 0.01° at most)
+    sheet = {"tilt": (135.0, 80.0), "rotate": (200.0, 160.0)}
+    for i, joint in enumerate(chain.joint_names):
+        np.testing.assert_allclose(np.degrees(chain.q_max[i]), sheet[joint][0], atol=0.01)
+        np.testing.assert_allclose(np.degrees(-chain.q_min[i]), sheet[joint][0], atol=0.01)
+        np.testing.assert_allclose(np.degrees(chain.v_max[i]), sheet[joint][1], atol=0.01)
+
+
 def test_head_tailstock_has_the_mh185_headstocks_range_and_speed() -> None:
     chain = builtin_positioner("head-tailstock")
     assert "motoman_motopos_mh185_rotisserie_support" in chain.source
