@@ -26,7 +26,9 @@ from trackplan.io.positioner_file import (
 from trackplan.io.robot_file import builtin_names, builtin_robot, robot_to_yaml
 from trackplan.robots.kinematics import forward_kinematics, joint_frames
 
-LIBRARY = ("head-tailstock", "one-axis-turntable", "two-axis-500")
+LIBRARY = ("head-tailstock", "one-axis-turntable", "skyhook-500", "two-axis-500")
+# the acceleration time of each: the MH(T)185 manual's 0.3 s, else the robots' assumed 0.25 s
+ACCELERATION_TIME = {"head-tailstock": 0.3}
 
 
 def rotation(axis: list[float], angle: float) -> np.ndarray:
@@ -37,7 +39,7 @@ def rotation(axis: list[float], angle: float) -> np.ndarray:
 # --------------------------------------------------------------------------- the library
 
 
-def test_the_library_lists_the_three_positioners_and_no_robot_among_them() -> None:
+def test_the_library_lists_the_four_positioners_and_no_robot_among_them() -> None:
     assert positioner_names() == LIBRARY
     assert not set(LIBRARY) & set(builtin_names())
 
@@ -46,10 +48,13 @@ def test_the_library_lists_the_three_positioners_and_no_robot_among_them() -> No
 def test_each_builtin_positioner_states_its_source_and_assumptions(name: str) -> None:
     chain = builtin_positioner(name)
     assert chain.name == name and 1 <= chain.n_dof <= MAX_POSITIONER_AXES
-    assert "PB-283_MotoPos D250-D500 DX.pdf" in chain.source
-    assert any("acceleration and jerk limits are assumed" in note for note in chain.assumptions)
-    # the assumed rule: the rated velocity in 0.25 s, the acceleration in 0.1 s
-    np.testing.assert_allclose(chain.a_max, chain.v_max / 0.25, rtol=1e-4)
+    assert "ros-industrial/motoman" in chain.source
+    assert any("jerk" in note and "assumed" in note for note in chain.assumptions)
+    # the rated velocity in the acceleration time (assumed 0.25 s unless published), the
+    # acceleration in 0.1 s (assumed)
+    np.testing.assert_allclose(
+        chain.a_max, chain.v_max / ACCELERATION_TIME.get(name, 0.25), rtol=1e-4
+    )
     np.testing.assert_allclose(chain.j_max, chain.a_max / 0.1, rtol=1e-4)
     assert chain.collision is not None and len(chain.collision) >= 10
     assert not chain.has_tool
@@ -75,6 +80,89 @@ def test_two_axis_500_is_the_motopos_d500_of_its_source() -> None:
         [[-1, -0.15], [0, 0], [0, 0.38]],
         atol=1e-12,
     )
+
+
+@pytest.mark.parametrize("name", ["two-axis-500", "one-axis-turntable"])
+def test_the_d500s_drives_have_the_motopos_data_sheets_ranges_and_speeds(name: str) -> None:
+    chain = builtin_positioner(name)
+    assert "MOTOPOS-D500B-A00" in chain.source and "KAE-C945-431G" in chain.source
+    # data sheet p. 7, MOTOPOS-D500B-A00: tilted axis ±135° at 80 °/s, rotation ±200° at 160 °/s
+    # (the xacro rounds the radians to 4 decimals: 0.01° at most)
+    sheet = {"tilt": (135.0, 80.0), "rotate": (200.0, 160.0)}
+    for i, joint in enumerate(chain.joint_names):
+        np.testing.assert_allclose(np.degrees(chain.q_max[i]), sheet[joint][0], atol=0.01)
+        np.testing.assert_allclose(np.degrees(-chain.q_min[i]), sheet[joint][0], atol=0.01)
+        np.testing.assert_allclose(np.degrees(chain.v_max[i]), sheet[joint][1], atol=0.01)
+
+
+def test_head_tailstock_has_the_mh185_headstocks_range_and_speed() -> None:
+    chain = builtin_positioner("head-tailstock")
+    assert "motoman_motopos_mh185_rotisserie_support" in chain.source
+    # manual 168961-1CD, Table 3-1: 12.4 rpm, rated acceleration time 0.3 s; the URDF of
+    # pull request 317: joint_1 within ±2π rad
+    np.testing.assert_allclose(chain.q_max, [2 * np.pi], atol=5e-5)
+    np.testing.assert_allclose(chain.q_min, [-2 * np.pi], atol=5e-5)
+    np.testing.assert_allclose(chain.v_max, [12.4 / 60 * 2 * np.pi], atol=5e-5)
+    np.testing.assert_allclose(np.degrees(chain.v_max), [74.4], atol=5e-3)
+    np.testing.assert_allclose(chain.a_max, [12.4 / 60 * 2 * np.pi / 0.3], rtol=1e-4)
+    # the faceplate: 0.100 m out along the horizontal spindle (+x), 0.900 m up, z along +x
+    for angle in (0.0, 1.2, -3.0):
+        R = rotation([1, 0, 0], angle) @ rotation([0, 1, 0], np.pi / 2)
+        expected = np.eye(4)
+        expected[:3, :3] = R
+        expected[:3, 3] = [0.100, 0, 0.900]
+        T = forward_kinematics(chain, np.array([angle]))
+        np.testing.assert_allclose(T, expected, atol=1e-12)
+
+
+def test_skyhook_500_is_the_motopos_d500b_c00_of_its_data_sheet() -> None:
+    chain = builtin_positioner("skyhook-500")
+    assert chain.joint_names == ("tilt", "rotate")
+    assert "MOTOPOS-D500B-C00" in chain.source and "KAE-C945-431G" in chain.source
+    # data sheet p. 8: tilted axis ±180° at 1.92 rad/s, rotation axis ±360° at 2.18 rad/s
+    np.testing.assert_allclose(chain.q_max, np.radians([180.0, 360.0]), atol=5e-5)
+    np.testing.assert_allclose(chain.q_min, np.radians([-180.0, -360.0]), atol=5e-5)
+    np.testing.assert_allclose(chain.v_max, [1.92, 2.18], atol=1e-12)
+    # (its °/s are rounded: 2.18 rad/s is 124.9 °/s, within 0.1 of the 125 it prints)
+    np.testing.assert_allclose(np.degrees(chain.v_max), [110.0, 125.0], atol=0.1)
+    for tilt, turn in [(0.0, 0.0), (np.pi / 2, 0.0), (0.4, -1.1), (-2.9, 5.0)]:
+        # drawing: tilted axis +x 0.665 m up; table face 0.390 m below it, turning about its z
+        R = rotation([1, 0, 0], tilt) @ rotation([0, 0, 1], turn)
+        expected = np.eye(4)
+        expected[:3, :3] = R
+        expected[:3, 3] = [0, 0, 0.665] + rotation([1, 0, 0], tilt) @ [0, 0, -0.390]
+        T = forward_kinematics(chain, np.array([tilt, turn]))
+        np.testing.assert_allclose(T, expected, atol=1e-12)
+    # at zero the table faces up 0.275 m above the floor; tilted a quarter turn about +x its
+    # face looks along +y at the axis height, 0.390 m from the axis
+    np.testing.assert_allclose(
+        forward_kinematics(chain, np.zeros(2))[:3, 2:], [[0, 0], [0, 0], [1, 0.275]], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        forward_kinematics(chain, np.array([np.pi / 2, 0.0]))[:3, 2:],
+        [[0, 0], [-1, 0.39], [0, 0.665]],
+        atol=1e-12,
+    )
+
+
+def test_the_skyhook_table_stays_clear_of_its_drive_housing_over_the_axis_ranges() -> None:
+    chain = builtin_positioner("skyhook-500")
+    capsules = chain.collision
+    assert capsules is not None
+    base = np.flatnonzero(capsules.frame == 0)
+    table = np.flatnonzero(capsules.frame == 2)
+    gaps = []
+    for tilt in np.linspace(chain.q_min[0], chain.q_max[0], 13):
+        for turn in np.linspace(chain.q_min[1], chain.q_max[1], 9):
+            frames = joint_frames(chain, np.array([tilt, turn]))
+            ends = np.einsum("kij,kpj->kpi", frames[capsules.frame, :3, :3], capsules.segment)
+            ends += frames[capsules.frame, :3, 3][:, None, :]
+            gaps += [
+                segment_segment(*ends[i], *ends[j]) - capsules.radius[i] - capsules.radius[j]
+                for i in base
+                for j in table
+            ]
+    assert min(gaps) > 0.45  # docs/positioner.md: 0.52 m at the closest
 
 
 @pytest.mark.parametrize(
