@@ -6,9 +6,9 @@ import enum
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from trackplan.choices import choose
 from trackplan.errors import CaseError
@@ -16,6 +16,9 @@ from trackplan.paths.planned import Path
 from trackplan.tool.orientation import ToolOrientation
 from trackplan.tool.rotations import rotation_x, rotation_y
 from trackplan.tool.spec import ToolFrame
+
+if TYPE_CHECKING:  # scipy's tree only where a weaving seam is checked (startup time)
+    from scipy.spatial import cKDTree
 
 
 class WeavePattern(enum.StrEnum):
@@ -260,6 +263,8 @@ class WovenPath:
         length = self.planned.length
         step = min(LOCATE_STEP, self.track.wavelength / 40.0)
         s = np.linspace(0.0, length, max(2, int(np.ceil(length / step)) + 1))
+        from scipy.spatial import cKDTree  # only a weaving seam's check needs the tree
+
         return cKDTree(self.planned.sample(s).position), s
 
     def axes(self, s: np.ndarray, R_part_tool: np.ndarray) -> np.ndarray:
