@@ -72,13 +72,15 @@ def zone_within(room: float) -> float:
     there is no room)."""
     if not room > 0.0:
         return 0.0
-    return math.floor(room / ZONE_STEP + 1e-9) * ZONE_STEP
+    # a room of whole steps to round-off is that many steps, never more than the room
+    return min(math.floor(room / ZONE_STEP + 1e-9) * ZONE_STEP, room)
 
 
 def zones_within(room: np.ndarray) -> np.ndarray:
     """:func:`zone_within` of each value of ``room`` (M,), m, shape (M,)."""
     room = np.asarray(room, dtype=float)
-    floored: np.ndarray = np.floor(np.where(room > 0.0, room, 0.0) / ZONE_STEP + 1e-9) * ZONE_STEP
+    kept = np.where(room > 0.0, room, 0.0)
+    floored: np.ndarray = np.minimum(np.floor(kept / ZONE_STEP + 1e-9) * ZONE_STEP, kept)
     return floored
 
 
