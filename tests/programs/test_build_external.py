@@ -9,7 +9,6 @@ import dataclasses
 import numpy as np
 import pytest
 
-import trackplan
 from tests.programs.fanuc_parser import parse_fanuc
 from tests.programs.krl_parser import parse_krl
 from tests.programs.rapid_parser import parse_rapid
@@ -151,16 +150,13 @@ def test_every_cartesian_target_carries_the_track_at_its_arc_length(
 @pytest.mark.slow
 @pytest.mark.parametrize("motion", ["cartesian", "joint"])
 def test_a_run_planned_with_a_track_reads_back_from_every_language(motion: str) -> None:
-    """A shipped case planned with a track: KRL, RAPID and TP carry the planned track
+    """The shipped case on a track, planned: KRL, RAPID and TP carry the planned track
     values on every target, read back by their own parsers (mm, within the print)."""
-    shipped = planned_run("paper-corner")
-    case = dataclasses.replace(shipped.case, track=TRACK)
-    plan = trackplan.plan(case, np.asarray(shipped.plan.placement, dtype=float))
-    if plan.trajectory.q.shape[1] == case.robot.n_dof:
-        pytest.skip(
-            "the planner does not move the track on this branch yet (issue 29's pipeline): "
-            "the integrator's branch runs this test"
-        )
+    shipped = planned_run("track-long-seam")
+    assert shipped.plan.success, shipped.plan.message
+    # the KR10 as a generic robot, so that every language drives it
+    robot = dataclasses.replace(shipped.case.robot, controller=None)
+    case, plan = dataclasses.replace(shipped.case, robot=robot), shipped.plan
     run = PlannedRun(case=case, plan=plan)
     program = build_program(run, motion=motion)
     track = program.external_axes[0]
