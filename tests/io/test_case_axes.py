@@ -234,3 +234,41 @@ def test_plan_refuses_a_bad_value_as_one_line(
     assert code == 2 and "Traceback" not in err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and expected in lines[0], err
+
+
+# --------------------------------------------------------------------------- objective
+
+
+def test_external_weights_weigh_the_external_axes_in_the_travel(tmp_path: Path) -> None:
+    case = load_case(write(tmp_path, {"track": TRACK, "objective": {"external_weights": [0.5]}}))
+    np.testing.assert_array_equal(case.objective.external_weights, [0.5])
+    assert case.travel_weights[-1] == 0.5
+    assert len(case.travel_weights) == case.machine.n_dof
+    plain = load_case(write(tmp_path, {"track": TRACK}))
+    assert plain.travel_weights[-1] == 0.0  # by default only the arm's travel counts
+
+
+@pytest.mark.parametrize(
+    ("changes", "expected"),
+    [
+        (
+            {"track": TRACK, "objective": {"external_weights": [0.5, 1.0]}},
+            "objective.external_weights: expected 1 weights (the track, then the "
+            "positioner's axes), got 2",
+        ),
+        (
+            {"objective": {"external_weights": [0.5]}},
+            "objective.external_weights: weights the external axes' travel, and the case "
+            "has no track or positioner",
+        ),
+        (
+            {"track": TRACK, "objective": {"kind": "copper"}},
+            "objective.kind: copper needs",
+        ),
+    ],
+)
+def test_objective_against_the_external_axes_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], changes: dict[str, Any], expected: str
+) -> None:
+    line = validate_fails(capsys, str(write(tmp_path, changes)))
+    assert expected in line

@@ -35,6 +35,7 @@ from pydantic import Discriminator, Tag
 
 from trackplan.axes.rules import Downhand
 from trackplan.case import PLACEMENT_KEYS, Case
+from trackplan.errors import CaseError
 from trackplan.io.positioner_file import load_positioner_spec
 from trackplan.io.yaml_input import (
     Coordinate,
@@ -197,6 +198,7 @@ def axes_problems(
         problems += _track_problems(model.track)
     if model.downhand is not None:
         problems += _downhand_problems(model, seams, paths)
+    problems += _objective_problems(model)
     sample_time = model.task.sample_time
     problems += _weave_problems(model.task.weave, ("task", "weave"), sample_time)
     for loc, seam in seams:
@@ -314,6 +316,38 @@ def as_weave(weave: WeaveModel | None) -> Weave | None:
     return Weave(pattern, plane, weave.amplitude, weave.frequency, weave.dwell)
 
 
+TORQUE_KINDS = ("energy", "copper")
+"""Objectives that read the arm's torques: not computed for an arm on a moving base."""
+
+
+def _objective_problems(model: Any) -> list[Problem]:
+    """``objective`` against the external axes: a torque objective refused with a track or a
+    positioner; ``external_weights`` only with them (its length is checked once the
+    positioner is loaded)."""
+    objective = model.objective
+    external = model.track is not None or model.positioner is not None
+    problems: list[Problem] = []
+    kinds = set((objective.mix or {}) if objective.kind == "weighted" else [objective.kind])
+    torque = sorted(kinds & set(TORQUE_KINDS))
+    if external and torque:
+        problems.append(
+            (
+                ("objective", "kind"),
+                f"{', '.join(torque)} needs the arm's joint torques, which trackplan does not "
+                "compute for an arm on a track or with a positioner: use travel or time",
+            )
+        )
+    if objective.external_weights is not None and not external:
+        problems.append(
+            (
+                ("objective", "external_weights"),
+                "weights the external axes' travel, and the case has no track or positioner: "
+                "remove it",
+            )
+        )
+    return problems
+
+
 def with_axes(case: Case, model: Any, chain: Robot | None) -> Case:
     """The case with its positioner, track, downhand rule and weaves (checked values)."""
     weave = as_weave(model.task.weave)
@@ -346,8 +380,26 @@ def with_axes(case: Case, model: Any, chain: Robot | None) -> Case:
     downhand = None
     if model.downhand is not None:
         downhand = Downhand(model.downhand.slope, model.downhand.rotation)
+    objective = case.objective
+    given = model.objective.external_weights
+    if given is not None:
+        n_external = (track is not None) + (0 if chain is None else chain.n_dof)
+        if len(given) != n_external:
+            raise CaseError(
+                f"expected {n_external} weights (the track, then the positioner's axes), "
+                f"got {len(given)}: {show(given)}",
+                file=case.source,
+                key="objective.external_weights",
+            )
+        objective = dataclasses.replace(objective, external_weights=np.array(given, dtype=float))
     return dataclasses.replace(
-        case, task=task, paths=seams, positioner=positioner, track=track, downhand=downhand
+        case,
+        task=task,
+        paths=seams,
+        positioner=positioner,
+        track=track,
+        downhand=downhand,
+        objective=objective,
     )
 
 

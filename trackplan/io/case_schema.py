@@ -200,6 +200,7 @@ class ObjectiveModel(StrictModel):
     kind: Literal["travel", "energy", "copper", "time", "weighted"] = "travel"
     mix: dict[str, NonNegative] | None = None
     weights: list[NonNegative] | None = None
+    external_weights: list[NonNegative] | None = None
     time_weight: NonNegative = 0.0
     penalty: Literal["graded", "flat"] = "graded"
     flat_penalty: Positive = 1.0e6
