@@ -169,7 +169,8 @@ def weave_shape(pattern: WeavePattern, u: np.ndarray, dwell: float = 0.0) -> np.
     rise = np.clip(v / tau, 0.0, 1.0)
     fall = np.clip((v - 0.5) / tau, 0.0, 1.0)
     step = _smooth_step(rise) - _smooth_step(fall)  # 0 → 1 → 0
-    return 2.0 * step - 1.0
+    shape: np.ndarray = 2.0 * step - 1.0
+    return shape
 
 
 def _smooth_step(x: np.ndarray) -> np.ndarray:
@@ -301,7 +302,8 @@ class WovenPath:
             along = np.einsum("nk,nk->n", axis, tangent)
             step = f / np.maximum(1.0 + slope * along - bend, 0.2)
             s = np.clip(s + step, 0.0, length)
-        return s
+        located: np.ndarray = s
+        return located
 
     def unweave(
         self, points: np.ndarray, R_part_tool: np.ndarray
