@@ -269,29 +269,40 @@ def _part_frame_builders(T_part: np.ndarray, length: float) -> list[TraceBuilder
     return [axis_builder(axis) for axis in range(3)]
 
 
+def animated_mesh(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    k: int,
+    style: dict[str, object],
+    decimals: int = PART_DECIMALS,
+) -> dict:
+    """Frame k of an animated plotly mesh: its vertices (V, 3) with the triangles (T, 3),
+    which are the same in every frame, carried by the first frame only; ``style`` holds the
+    trace's name, colour, opacity and the like."""
+    triangles = (
+        {"i": faces[:, 0].tolist(), "j": faces[:, 1].tolist(), "k": faces[:, 2].tolist()}
+        if k == 0
+        else {}
+    )
+    return {"type": "mesh3d", **_xyz(vertices, decimals), **triangles, **style}
+
+
 def _mesh_builder(
     vertices: np.ndarray, faces: np.ndarray, name: str, color: str, opacity: float
 ) -> TraceBuilder:
     """An animated mesh: vertices (F, V, 3) per frame, the same triangles (T, 3) in every
     frame (only the first frame carries them)."""
+    style = {
+        "name": name,
+        "showlegend": True,
+        "color": color,
+        "opacity": opacity,
+        "flatshading": True,
+        "hoverinfo": "name",
+    }
 
     def build(k: int) -> dict:
-        triangles = (
-            {"i": faces[:, 0].tolist(), "j": faces[:, 1].tolist(), "k": faces[:, 2].tolist()}
-            if k == 0
-            else {}
-        )
-        return {
-            "type": "mesh3d",
-            **_xyz(vertices[k], PART_DECIMALS),
-            **triangles,
-            "name": name,
-            "showlegend": True,
-            "color": color,
-            "opacity": opacity,
-            "flatshading": True,
-            "hoverinfo": "name",
-        }
+        return animated_mesh(vertices[k], faces, k, style)
 
     return build
 

@@ -24,6 +24,7 @@ from trackplan.case import Case
 from trackplan.frames import placement_transform
 from trackplan.planning.result import PlanResult
 from trackplan.report.machine_view import (
+    animated_mesh,
     arm_frames,
     cell_chain_points,
     machine_layers,
@@ -108,24 +109,17 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
         )
     frames = arm_frames(case, result.trajectory.q[idx])
 
+    style = {
+        "name": CAPSULES_TRACE,
+        "showlegend": True,
+        "color": "#4c72b0",
+        "opacity": 0.35,
+        "hoverinfo": "skip",
+    }
+
     def capsules_trace(k: int) -> dict:
         vertices, faces = robot_capsules_mesh(geometry, frames[k])
-        # the triangles are the same in every frame: only the first carries them
-        triangles = (
-            {"i": faces[:, 0].tolist(), "j": faces[:, 1].tolist(), "k": faces[:, 2].tolist()}
-            if k == 0
-            else {}
-        )
-        return {
-            "type": "mesh3d",
-            **_xyz(vertices, 3),
-            **triangles,
-            "name": CAPSULES_TRACE,
-            "showlegend": True,
-            "color": "#4c72b0",
-            "opacity": 0.35,
-            "hoverinfo": "skip",
-        }
+        return animated_mesh(vertices, faces, k, style, 3)
 
     return traces, capsules_trace
 
