@@ -80,6 +80,19 @@ def test_box_has_six_plane_regions_and_twelve_boundaries(box: Path) -> None:
     assert np.allclose(part.edges[edge - 1].start[[0, 2]], [0.1, 0.025], atol=TOL)
 
 
+def test_boundaries_of_many_mesh_edges_are_chained_end_to_end(tmp_path: Path) -> None:
+    fine = trimesh.creation.box(extents=(0.2, 0.1, 0.05)).subdivide().subdivide()
+    part = read_mesh_part(write(fine, tmp_path / "fine.stl"), scale=1.0)
+    assert len(part.faces) == 6 and len(part.edges) == 12
+    lengths = sorted(e.length for e in part.edges)
+    assert lengths == pytest.approx([0.05] * 4 + [0.1] * 4 + [0.2] * 4, rel=1e-6)
+    for edge in part.edges:
+        pts = part.edge_points(edge.id, 1e-4)
+        assert len(pts) == 5  # 4 mesh edges, in order: evenly spaced from start to end
+        expected = np.linspace(edge.start, edge.end, 5)
+        assert np.allclose(pts, expected, atol=TOL)
+
+
 def test_ids_do_not_depend_on_the_triangle_order(box: Path, tmp_path: Path) -> None:
     mesh = trimesh.creation.box(extents=(0.2, 0.1, 0.05))
     shuffled = trimesh.Trimesh(
@@ -140,6 +153,7 @@ def test_normals_are_outward_and_interpolated_across_the_region(tmp_path: Path) 
     error = np.degrees(np.arccos(np.clip(np.sum(normals * radial, axis=1), -1, 1)))
     assert error.max() < 1e-3
     # a facet's own normal would be off by up to 2.8° between its vertices
+    assert part.face_normals(1, np.zeros((0, 3))).shape == (0, 3)
     top = next(f for f in part.faces if f.normal is not None and f.normal[2] > 0.5)
     assert np.allclose(part.face_normals(top.id, [[0.01, 0.0, 0.3]]), [[0, 0, 1]], atol=1e-9)
 
@@ -197,8 +211,9 @@ def test_refusals_are_one_line(box: Path, tmp_path: Path) -> None:
     assert "carries no unit" in one_line(exc)
     with pytest.raises(CaseError, match="scale must be > 0") as exc:
         read_mesh_part(box, scale=0.0)
-    with pytest.raises(CaseError, match=r"part\.feature_angle") as exc:
-        read_mesh_part(box, scale=1.0, feature_angle=0.0)
+    for angle in (0.0, math.pi, math.nan):
+        with pytest.raises(CaseError, match=r"part\.feature_angle: .* in \(0, π\) rad"):
+            read_mesh_part(box, scale=1.0, feature_angle=angle)
     with pytest.raises(CaseError, match="not found") as exc:
         read_mesh_part(tmp_path / "missing.stl", scale=1.0, case_file="case.yaml")
     assert one_line(exc).startswith("case.yaml: part.file: ")

@@ -100,6 +100,8 @@ class MeshPart:
 
         sub, index = self._region_mesh(self._face(face))
         pts = np.atleast_2d(np.asarray(points, dtype=float)).reshape(-1, 3)
+        if len(pts) == 0:
+            return np.zeros((0, 3))
         closest, _, tri = trimesh.proximity.closest_point(sub, pts)
         tri = np.asarray(tri, dtype=np.int64)
         bary = trimesh.triangles.points_to_barycentric(sub.triangles[tri], closest)
@@ -172,7 +174,8 @@ def read_mesh_part(
 
     if not (math.isfinite(feature_angle) and 0.0 < feature_angle < math.pi):
         raise refuse(
-            f"feature angle must lie in (0, 180)°, got {math.degrees(feature_angle):g}°",
+            f"feature angle must lie in (0, π) rad, got {feature_angle:g} rad "
+            f"(the default is {math.radians(20.0):.4f} rad, 20°)",
             "part.feature_angle",
         )
     if scale is not None and not (math.isfinite(scale) and scale > 0.0):
