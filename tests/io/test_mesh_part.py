@@ -158,6 +158,18 @@ def test_normals_are_outward_and_interpolated_across_the_region(tmp_path: Path) 
     assert np.allclose(part.face_normals(top.id, [[0.01, 0.0, 0.3]]), [[0, 0, 1]], atol=1e-9)
 
 
+def test_an_inside_out_mesh_is_turned_outward(tmp_path: Path) -> None:
+    box = trimesh.creation.box(extents=(0.2, 0.1, 0.05))
+    inverted = trimesh.Trimesh(box.vertices, box.faces[:, ::-1], process=False)
+    assert inverted.volume < 0
+    part = read_mesh_part(write(inverted, tmp_path / "inverted.stl"), scale=1.0)
+    for face in part.faces:
+        assert np.dot(face.normal, face.centroid) > 0
+        assert np.dot(part.face_normals(face.id, face.centroid[None])[0], face.centroid) > 0
+    tess = part.tessellation(1e-4)
+    assert trimesh.Trimesh(tess.vertices, tess.triangles).volume == pytest.approx(1e-3)
+
+
 def test_nearest_face_and_its_distance(box: Path) -> None:
     part = read_mesh_part(box, scale=1.0)
     face, distance = part.nearest_face(np.array([0.0, 0.0, 0.125]))
@@ -235,7 +247,7 @@ def test_a_non_manifold_mesh_is_refused(tmp_path: Path) -> None:
     # three triangles on one edge: a fin
     vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]]
     fin = trimesh.Trimesh(vertices, [[0, 1, 2], [1, 0, 3], [0, 1, 4]], process=False)
-    with pytest.raises(CaseError, match="not a manifold: 1 edges") as exc:
+    with pytest.raises(CaseError, match=r"not a manifold: .* triangles: 1 ") as exc:
         read_mesh_part(write(fin, tmp_path / "fin.ply"), scale=1.0)
     one_line(exc)
 

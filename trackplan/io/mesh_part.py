@@ -12,7 +12,7 @@ point is its vertex normals interpolated across the nearest triangle (``docs/cad
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -45,7 +45,7 @@ class MeshPart:
     corner_normals: np.ndarray
     polylines: tuple[np.ndarray, ...]
     feature_angle: float
-    _cache: dict[int, Any]
+    _cache: dict[int, Any] = field(default_factory=dict, repr=False)
 
     @property
     def exact(self) -> bool:
@@ -228,9 +228,9 @@ def _load(file: Path, refuse: Any) -> Any:
     if len(bad):
         where = mesh.vertices[mesh.edges_unique[bad[0]]].mean(axis=0)
         raise refuse(
-            f"mesh file {str(file)!r} is not a manifold: {len(bad)} edges are shared by more "
-            f"than two triangles (the first near {np.array2string(where, precision=4)} in file "
-            "units); export the part as one closed or open surface"
+            f"mesh file {str(file)!r} is not a manifold: edges shared by more than two "
+            f"triangles: {len(bad)} (the first near {np.array2string(where, precision=4)} in "
+            "file units); export the part as one closed or open surface"
         )
     trimesh.repair.fix_normals(mesh, multibody=True)
     if not mesh.is_winding_consistent:
@@ -310,7 +310,6 @@ def _build(
         corner_normals=corner_normals,
         polylines=polylines,
         feature_angle=feature_angle,
-        _cache={},
     )
 
 
