@@ -31,14 +31,47 @@ def box(tmp_path: Path) -> Path:
 
 def pipe_on_plate() -> trimesh.Trimesh:
     """A plate 0.2 x 0.2 x 0.01 m (top at z = 0) and a pipe of radius 0.03 m, 0.1 m high,
-    standing on it: 64 facets round, 5.625° apart."""
+    standing on it, fused by trimesh's boolean engine: 64 facets round, 5.625° apart."""
+    pytest.importorskip("manifold3d", reason="no boolean engine for trimesh")
     plate = trimesh.creation.box(extents=(0.2, 0.2, 0.01))
     plate.apply_translation((0.0, 0.0, -0.005))
-    if not trimesh.boolean.engines_available:
-        pytest.skip("no boolean engine for trimesh (manifold3d)")
     pipe = trimesh.creation.cylinder(radius=0.03, height=0.1, sections=64)
     pipe.apply_translation((0.0, 0.0, 0.05))
-    return trimesh.boolean.union([plate, pipe])
+    return trimesh.boolean.union([plate, pipe], engine="manifold")
+
+
+def pipe_on_disc(n: int = 64) -> trimesh.Trimesh:
+    """The same union built by hand: a disc plate of radius 0.1 m (top at z = 0, 0.01 m
+    thick) and a pipe of radius 0.03 m, 0.1 m high, both with n facets round."""
+    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+
+    def ring(r: float, z: float) -> np.ndarray:
+        return np.column_stack([r * np.cos(t), r * np.sin(t), np.full(n, z)])
+
+    centres = [[0.0, 0.0, -0.01], [0.0, 0.0, 0.1]]
+    vertices = np.vstack(
+        [ring(0.1, -0.01), ring(0.1, 0.0), ring(0.03, 0.0), ring(0.03, 0.1), centres]
+    )
+    k = np.arange(n)
+    k1 = (k + 1) % n
+    A, B, C, D = (k + i * n for i in range(4))  # rings: plate bottom, plate top, foot, top
+    A1, B1, C1, D1 = (k1 + i * n for i in range(4))
+    bottom, top = np.full(n, 4 * n), np.full(n, 4 * n + 1)
+    faces = np.vstack(
+        [
+            np.column_stack([bottom, A1, A]),  # plate bottom, -z
+            np.column_stack([A, A1, B1]),  # plate rim, radial
+            np.column_stack([A, B1, B]),
+            np.column_stack([C, B, B1]),  # plate top round the pipe's foot, +z
+            np.column_stack([C, B1, C1]),
+            np.column_stack([C, C1, D1]),  # pipe wall, radial
+            np.column_stack([C, D1, D]),
+            np.column_stack([top, D, D1]),  # pipe cap, +z
+        ]
+    )
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    assert mesh.is_watertight and mesh.volume > 0
+    return mesh
 
 
 def test_box_has_six_plane_regions_and_twelve_boundaries(box: Path) -> None:
@@ -180,24 +213,30 @@ def test_nearest_face_and_its_distance(box: Path) -> None:
     assert distance == pytest.approx(0.01, abs=TOL)
 
 
-def test_pipe_on_plate_fillet_is_one_closed_boundary(tmp_path: Path) -> None:
-    part = read_mesh_part(write(pipe_on_plate(), tmp_path / "pipe.stl"), scale=1.0)
-    # plate top (with the pipe's foot), bottom, 4 sides; pipe wall and cap
-    assert len(part.faces) == 8
+@pytest.mark.parametrize("make", [pipe_on_disc, pipe_on_plate])
+def test_pipe_on_plate_fillet_is_one_closed_boundary(make, tmp_path: Path) -> None:
+    part = read_mesh_part(write(make(), tmp_path / "pipe.stl"), scale=1.0)
+    # plate top (with the pipe's foot), bottom, sides (4 of a box, 1 of a disc); pipe wall, cap
+    assert len(part.faces) == (5 if make is pipe_on_disc else 8)
     plate, _ = part.nearest_face(np.array([0.06, 0.0, 0.0005]))
     pipe, _ = part.nearest_face(np.array([0.0305, 0.0, 0.02]))
     assert part.faces[plate - 1].normal == pytest.approx([0, 0, 1])
     assert part.faces[pipe - 1].normal is None
     (seam,) = part.shared_edges(plate, pipe)
     edge = part.edges[seam - 1]
-    assert edge.closed
+    assert edge.closed and edge.faces == tuple(sorted((plate, pipe)))
     pts = part.edge_points(seam, 1e-5)
+    assert len(pts) == 65
     assert np.allclose(pts[:, 2], 0.0, atol=TOL)
     assert np.allclose(np.hypot(pts[:, 0], pts[:, 1]), 0.03, atol=TOL)
+    assert edge.length == pytest.approx(64 * 2 * 0.03 * math.sin(math.pi / 64), rel=1e-6)
     # the weld normals the seam would use: the plate's +z, the pipe's radial
     assert np.allclose(part.face_normals(plate, pts), [0, 0, 1], atol=1e-9)
     radial = np.column_stack([pts[:, :2] / 0.03, np.zeros(len(pts))])
     assert np.allclose(part.face_normals(pipe, pts), radial, atol=1e-6)
+    # every boundary is closed: round the pipe's cap, its foot, and the plate's
+    if make is pipe_on_disc:
+        assert len(part.edges) == 4 and all(e.closed for e in part.edges)
 
 
 def test_an_open_mesh_has_its_border_as_an_edge(tmp_path: Path) -> None:
