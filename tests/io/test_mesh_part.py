@@ -151,6 +151,15 @@ def test_scale_converts_file_units_to_metres(tmp_path: Path) -> None:
     assert sorted(set(tess.face.tolist())) == [1, 2, 3, 4, 5, 6]
 
 
+def test_a_unit_the_file_carries_is_honoured(tmp_path: Path) -> None:
+    mesh = trimesh.creation.box(extents=(200.0, 100.0, 50.0))
+    mesh.units = "mm"
+    part = read_mesh_part(write(mesh, tmp_path / "mm.glb"))  # glTF keeps trimesh's unit
+    assert part.faces[0].area == pytest.approx(0.02, rel=1e-9)
+    with pytest.raises(CaseError, match=r"part\.scale: .* carries no unit"):
+        read_mesh_part(write(trimesh.creation.box(), tmp_path / "box.off"))
+
+
 def test_cylinder_wall_is_one_region_above_its_facet_angle(tmp_path: Path) -> None:
     cylinder = trimesh.creation.cylinder(radius=0.03, height=0.1, sections=64)
     path = write(cylinder, tmp_path / "cyl.stl")

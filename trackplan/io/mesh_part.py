@@ -180,18 +180,21 @@ def read_mesh_part(
         )
     if scale is not None and not (math.isfinite(scale) and scale > 0.0):
         raise refuse(f"scale must be > 0 (file units to metres), got {scale:g}", "part.scale")
+    no_unit = refuse(
+        f"mesh file {str(file)!r} carries no unit: set part.scale, its units in metres "
+        "(0.001 for millimetres, 1 for metres)",
+        "part.scale",
+    )
+    if scale is None and file.suffix.lower() in MESH_SUFFIXES:
+        raise no_unit
     mesh = _load(file, refuse)
     if scale is None:
-        units = getattr(mesh, "units", None)
-        if units is None or file.suffix.lower() in MESH_SUFFIXES:
-            raise refuse(
-                f"mesh file {str(file)!r} carries no unit: set part.scale, its units in metres "
-                "(0.001 for millimetres, 1 for metres)",
-                "part.scale",
-            )
         import trimesh
 
-        scale = float(trimesh.units.unit_conversion(units, "meters"))
+        try:
+            scale = float(trimesh.units.unit_conversion(mesh.units, "meters"))
+        except Exception:
+            raise no_unit from None
     vertices = np.asarray(mesh.vertices, dtype=float) * scale
     triangles = np.asarray(mesh.faces, dtype=np.int64)
     return _build(str(file), mesh, vertices, triangles, feature_angle)
