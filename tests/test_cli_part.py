@@ -72,3 +72,12 @@ def test_bad_part_files_are_one_line_and_exit_2(
     assert captured.out == ""
     assert captured.err.count("\n") == 1 and message in captured.err
     assert captured.err.startswith(str(path))
+
+
+def test_an_empty_out_is_refused_before_reading(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["part", PIPE, "--out", ""]) == 2
+    assert capsys.readouterr().err.startswith("--out: an empty name is not a folder")
+    assert list(tmp_path.iterdir()) == []

@@ -335,6 +335,9 @@ def test_a_missing_file_an_unknown_suffix_and_bad_ids_are_refused(
 def test_a_missing_opencascade_is_one_line_saying_how_to_install_it(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    from trackplan.io.step_part import _occ
+
     monkeypatch.setitem(sys.modules, "OCP", None)
+    _occ.cache_clear()  # the OCP modules are looked up once per process
     with pytest.raises(CaseError, match="pip install cadquery-ocp"):
         read_step_part(PARTS / "pipe-plate.step")

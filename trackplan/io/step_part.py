@@ -12,6 +12,7 @@ it; a missing OCP is one line (exit 2) saying how to install it.
 
 from __future__ import annotations
 
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +42,7 @@ _CURVE_KINDS = {
 }
 
 
+@cache
 def _occ() -> Any:
     """The OCP modules this reader uses, as one namespace; CaseError when OCP is missing."""
     try:
@@ -357,7 +359,7 @@ class StepPart:
             raise CaseError(f"the chord error must be > 0 m, got {chord_error}")
         if self._meshed != chord_error:
             occ.BRepTools.Clean_s(self._shape)
-            occ.BRepMesh_IncrementalMesh(self._shape, float(chord_error), False, 0.5, False)
+            occ.BRepMesh_IncrementalMesh(self._shape, float(chord_error), False, 0.5, True)
             self._meshed = chord_error
         vertices, triangles, owner = [], [], []
         count = 0
@@ -367,12 +369,17 @@ class StepPart:
             mesh = occ.BRep_Tool.Triangulation_s(face, location)
             if mesh is None:
                 continue
-            transform = location.Transformation()
+            node, triangle = mesh.Node, mesh.Triangle
             nodes = np.array(
-                [_xyz(mesh.Node(k).Transformed(transform)) for k in range(1, mesh.NbNodes() + 1)]
+                [node(k).Coord() for k in range(1, mesh.NbNodes() + 1)], dtype=float
             ).reshape(-1, 3)
+            if not location.IsIdentity():
+                T = location.Transformation()
+                rows = [[T.Value(r, c) for c in range(1, 5)] for r in range(1, 4)]
+                matrix = np.array(rows)
+                nodes = nodes @ matrix[:, :3].T + matrix[:, 3]
             tris = np.array(
-                [mesh.Triangle(k).Get() for k in range(1, mesh.NbTriangles() + 1)], dtype=int
+                [triangle(k).Get() for k in range(1, mesh.NbTriangles() + 1)], dtype=int
             ).reshape(-1, 3)
             tris = tris - 1 + count
             if self._reversed(face):
