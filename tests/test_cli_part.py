@@ -34,6 +34,7 @@ def test_part_json_lists_the_same_in_metres(capsys: pytest.CaptureFixture[str]) 
     assert np.isclose(pipe["area"], 2 * np.pi * 0.06 * 0.15) and pipe["normal"] is None
     (foot,) = [e for e in listing["edges"] if sorted(e["faces"]) == sorted([top["id"], pipe["id"]])]
     assert foot["kind"] == "circle" and np.isclose(foot["length"], 2 * np.pi * 0.06)
+    assert (top["id"], pipe["id"], foot["id"]) == (3, 7, 10)  # as docs/cad.md names them
     assert np.allclose(foot["start"], [0.06, 0, 0]) and np.allclose(foot["end"], foot["start"])
 
 

@@ -182,6 +182,21 @@ def test_tessellation_is_outward_and_within_its_chord_error(pipe: StepPart) -> N
     assert len(finer.triangles) > len(mesh.triangles)
 
 
+@pytest.mark.parametrize("name", ["pipe", "tee", "saddle"])
+def test_edge_points_run_from_the_edges_start_to_its_end(
+    name: str, request: pytest.FixtureRequest
+) -> None:
+    part: StepPart = request.getfixturevalue(name)
+    for edge in part.edges:
+        if edge.length == 0:
+            continue
+        points = part.edge_points(edge.id, 1e-4)
+        assert np.allclose(points[0], edge.start, atol=POINT), edge.id
+        assert np.allclose(points[-1], edge.end, atol=POINT), edge.id
+        polyline = np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1))
+        assert edge.length * (1 - 1e-3) <= polyline <= edge.length * (1 + 1e-9), edge.id
+
+
 def test_ids_are_stable_for_a_file(pipe: StepPart) -> None:
     again = read_step_part(PARTS / "pipe-plate.step")
     assert [(f.kind, round(f.area, 12)) for f in again.faces] == [
