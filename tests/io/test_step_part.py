@@ -356,3 +356,36 @@ def test_a_missing_opencascade_is_one_line_saying_how_to_install_it(
     _occ.cache_clear()  # the OCP modules are looked up once per process
     with pytest.raises(CaseError, match="pip install cadquery-ocp"):
         read_step_part(PARTS / "pipe-plate.step")
+
+
+def test_spheres_cones_and_tori_and_a_degenerated_edge(tmp_path: Path) -> None:
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCone, BRepPrimAPI_MakeSphere, BRepPrimAPI_MakeTorus
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    from OCP.STEPControl import STEPControl_StepModelType, STEPControl_Writer
+
+    up = gp_Dir(0, 0, 1)
+    ball = BRepPrimAPI_MakeSphere(50.0).Shape()  # mm
+    cone = BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(0, 0, 40), up), 30.0, 10.0, 50.0).Shape()
+    ring = BRepPrimAPI_MakeTorus(gp_Ax2(gp_Pnt(200, 0, 0), up), 40.0, 10.0).Shape()
+    shape = BRepAlgoAPI_Fuse(BRepAlgoAPI_Fuse(ball, cone).Shape(), ring).Shape()
+    writer = STEPControl_Writer()
+    writer.Transfer(shape, STEPControl_StepModelType.STEPControl_AsIs)
+    writer.Write(str(tmp_path / "round.step"))
+    part = read_step_part(tmp_path / "round.step")
+    kinds = {f.kind: f for f in part.faces}
+    assert set(kinds) == {"sphere", "cone", "torus", "plane"}
+    assert np.isclose(kinds["torus"].area, 4 * np.pi**2 * 0.04 * 0.01)
+    assert np.allclose(np.abs(kinds["torus"].axis), [0, 0, 1])
+    assert np.allclose(np.abs(kinds["cone"].axis), [0, 0, 1]) and kinds["sphere"].axis is None
+    pole = [e for e in part.edges if e.length == 0]  # the sphere's bottom pole
+    assert len(pole) == 1 and pole[0].kind == "other"
+    assert np.allclose(part.edge_points(pole[0].id, 1e-4), [[0, 0, -0.05]] * 2, atol=POINT)
+    sphere = kinds["sphere"].id
+    on_ball = np.array([[0.05, 0, 0], [0, -0.03, -0.04]])
+    assert np.max(angles(part.face_normals(sphere, on_ball), on_ball / 0.05)) < ANGLE
+    mesh = part.tessellation(1e-4)
+    v = mesh.vertices[mesh.triangles]
+    volume = np.sum(np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2]))) / 6
+    ring_volume = 2 * np.pi**2 * 0.04 * 0.01**2
+    assert ring_volume + 4 / 3 * np.pi * 0.05**3 < volume < ring_volume + 0.0007

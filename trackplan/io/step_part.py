@@ -268,8 +268,8 @@ class StepPart:
     def edge_points(self, edge: int, max_chord_error: float) -> np.ndarray:
         """Points along an edge from its start to its end (m): its ends for a line, else
         close enough that the polyline stays within ``max_chord_error`` (m) of the curve."""
-        info = self._edges[self._index(edge, self._edges, "edge")]
-        if info.kind == "line":
+        info = self._edge_info(edge)
+        if info.kind == "line" or info.length == 0:  # a line, or a degenerated edge (a pole)
             return np.stack([info.start, info.end])
         if not max_chord_error > 0:
             raise CaseError(f"the chord error must be > 0 m, got {max_chord_error}")
@@ -284,7 +284,7 @@ class StepPart:
 
     def edge_circle(self, edge: int) -> Circle | None:
         """The exact circle of a circular edge in its own direction, else None."""
-        info = self._edges[self._index(edge, self._edges, "edge")]
+        info = self._edge_info(edge)
         if info.kind != "circle":
             return None
         curve, u0, u1, backwards = self._curve(edge)
@@ -395,10 +395,7 @@ class StepPart:
             face=np.concatenate(owner) if owner else np.zeros(0, dtype=int),
         )
 
-    def _index(self, number: int, items: tuple[Any, ...], what: str) -> int:
-        """The list index of an id, after checking it."""
-        if what == "edge":
-            self._edge(number)
-        else:
-            self._face(number)
-        return int(number) - 1
+    def _edge_info(self, edge: int) -> Edge:
+        """The listed edge of an id, after checking it."""
+        self._edge(edge)
+        return self._edges[int(edge) - 1]
