@@ -32,6 +32,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from OCP.APIHeaderSection import APIHeaderSection_MakeHeader
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
 from OCP.collections import List_TopoDS_Shape
@@ -40,9 +41,12 @@ from OCP.IFSelect import IFSelect_ReturnStatus
 from OCP.Interface import Interface_Static
 from OCP.Message import Message, Message_Gravity
 from OCP.STEPControl import STEPControl_StepModelType, STEPControl_Writer
+from OCP.TCollection import TCollection_HAsciiString
 from OCP.TopoDS import TopoDS_Shape
 
 HERE = Path(__file__).resolve().parent
+TIME_STAMP = "2026-12-07T00:00:00"
+"""The files' header time stamp, fixed so that a rerun rewrites the same files."""
 
 
 def box(x0: float, y0: float, z0: float, dx: float, dy: float, dz: float) -> TopoDS_Shape:
@@ -117,6 +121,9 @@ def write_step(shape: TopoDS_Shape, path: Path) -> None:
     Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     writer = STEPControl_Writer()
     writer.Transfer(shape, STEPControl_StepModelType.STEPControl_AsIs)
+    header = APIHeaderSection_MakeHeader(writer.Model())
+    header.SetName(TCollection_HAsciiString(path.stem))
+    header.SetTimeStamp(TCollection_HAsciiString(TIME_STAMP))  # the same bytes on every run
     if writer.Write(str(path)) != IFSelect_ReturnStatus.IFSelect_RetDone:
         raise RuntimeError(f"cannot write {path}")
 
