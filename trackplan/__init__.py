@@ -10,6 +10,8 @@ load_case(file) -> Case, load_robot(file) -> Robot, builtin_robot(name) -> Robot
     Read and validate a case or robot file; the built-in robots (``docs/robots.md``).
 load_positioner(file) -> Robot, builtin_positioner(name) -> Robot
     Read a positioner file; the built-in positioners (``docs/positioner.md``).
+load_part(file) -> PartModel
+    Read a part's CAD model, STEP or mesh: its faces and edges (``docs/cad.md``).
 plan(case, X, ...) -> PlanResult
     Plan and check a case (one seam or several) with the workpiece at placement X
     (shape (6,), m and rad).
@@ -52,6 +54,7 @@ if TYPE_CHECKING:
     from trackplan.check_report import CheckReport
     from trackplan.errors import CaseError, TrackplanError
     from trackplan.io.case_file import load_case
+    from trackplan.io.part_file import load_part as load_part
     from trackplan.io.positioner_file import builtin_positioner as builtin_positioner
     from trackplan.io.positioner_file import load_positioner as load_positioner
     from trackplan.io.robot_file import builtin_robot, load_robot
@@ -71,6 +74,8 @@ _EXPORTS = {
     # front door's verbs and result types)
     "load_positioner": "trackplan.io.positioner_file",
     "builtin_positioner": "trackplan.io.positioner_file",
+    # a part's CAD model (STEP or mesh), importable from here, outside ``__all__``
+    "load_part": "trackplan.io.part_file",
     "plan": "trackplan.planning.plan",
     "check": "trackplan.planning.plan",
     "optimize": "trackplan.search.optimize",

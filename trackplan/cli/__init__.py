@@ -2,6 +2,7 @@
 
 Commands, one module per group, each a thin parse → API → save → exit code:
 :mod:`~trackplan.cli.cases` (``validate``, ``robots``, ``cases``),
+:mod:`~trackplan.cli.parts` (``part``),
 :mod:`~trackplan.cli.plan` (``plan``, ``check``, ``export``) and
 :mod:`~trackplan.cli.search` (``optimize``, ``demo``). Text summaries are in
 :mod:`~trackplan.cli.summaries`, argument checks in :mod:`~trackplan.cli.common`.

@@ -32,6 +32,7 @@ from trackplan.allocator import keep_freed_memory
 from trackplan.cli import ExitCode
 from trackplan.cli import batch as _batch  # noqa: F401  (registers its commands)
 from trackplan.cli import cases as _cases  # noqa: F401
+from trackplan.cli import parts as _parts  # noqa: F401
 from trackplan.cli import plan as _plan  # noqa: F401
 from trackplan.cli import search as _search  # noqa: F401
 from trackplan.cli.common import app, error, refuse_empty_outputs
