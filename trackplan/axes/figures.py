@@ -11,10 +11,10 @@ into the verdict's wording.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
+from trackplan.derived import derived
 from trackplan.errors import CaseError
 from trackplan.frames import placement_transform
 from trackplan.paths.path_geometry import PathGeometry
@@ -55,19 +55,24 @@ class SeamDirections:
             When the seam has no weld normal (``task.tool.normal`` or a segment's own).
         """
         s = np.asarray(s, dtype=float)
-        normal, tangent, position = _in_part(geometry, tool, s.tobytes())
+        s_bytes = s.tobytes()
+        # sampled once per seam, tool spec and grid: every placement of a search reuses it;
+        # the spec is kept alive with its values (its id stays its own)
+        _, (normal, tangent, position) = derived(
+            geometry,
+            ("seam directions", id(tool), s_bytes),
+            lambda: (tool, _in_part(geometry, tool, s_bytes)),
+        )
         T = placement_transform(np.asarray(X, dtype=float))
         R = T[:3, :3]
         return cls(s, normal @ R.T, tangent @ R.T, position @ R.T + T[:3, 3])
 
 
-@lru_cache(maxsize=16)
 def _in_part(
     geometry: PathGeometry, tool: ToolSpec, s_bytes: bytes
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The weld normals, travel directions and points (M, 3) each in the part frame at the
-    arc lengths ``s`` given as bytes: the same for every placement of a seam, so a search
-    samples them once (geometry and tool spec are immutable, hashed by identity)."""
+    arc lengths ``s`` given as bytes (the same for every placement of a seam)."""
     s = np.frombuffer(s_bytes, dtype=float)
     fields = segment_fields(tool, geometry.nominal)
     if any(isinstance(f, ConstantNormal) and not np.any(f.normal) for f in fields):
