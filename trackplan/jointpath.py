@@ -121,7 +121,7 @@ class JointPath:
         poses = tool_poses(placement, positions, rotations)
         external = _external(robot, axes, grid.points.ravel())
         if external is not None:
-            poses = _carried(robot, external) @ poses
+            poses = _machine(robot).base_carrier_at(external) @ poses
         ik = solve_path_ik(arm, poses[None], branch=branch)
         q_points = ik.q[0].reshape(*grid.points.shape, arm.n_dof)
         if external is not None:
@@ -179,7 +179,7 @@ class JointPath:
         external = _external(self.robot, self.axes, np.asarray(s, dtype=float))
         if external is None:
             return poses
-        carried: np.ndarray = _carried(self.robot, external) @ poses
+        carried: np.ndarray = _machine(self.robot).base_carrier_at(external) @ poses
         return carried
 
     def joints(self, s: np.ndarray) -> np.ndarray:
@@ -211,7 +211,7 @@ class JointPath:
             return branch_joints_along(
                 self.arm, R_base_tool, p_base_tool, self.branch, s, grid, q_grid
             )
-        carrier = _carried(self.robot, external)
+        carrier = _machine(self.robot).base_carrier_at(external)
         R_base_tool = carrier[:, :3, :3] @ R_base_tool
         p_base_tool = np.einsum("mij,mj->mi", carrier[:, :3, :3], p_base_tool) + carrier[:, :3, 3]
         n_arm = self.arm.n_dof
@@ -286,12 +286,10 @@ def _external(robot: Robot | Machine, axes: AxesProfile | None, s: np.ndarray) -
     return axes.values(s)
 
 
-def _carried(machine: Robot | Machine, external: np.ndarray) -> np.ndarray:
-    """``T_base_carrier`` at the external axes' positions (M, e), shape (M, 4, 4)."""
-    assert isinstance(machine, Machine)
-    q = np.zeros((len(external), machine.n_dof))
-    q[:, machine.n_arm :] = external
-    return machine.T_base_carrier(q)
+def _machine(robot: Robot | Machine) -> Machine:
+    """The machine of a joint path that has external axes."""
+    assert isinstance(robot, Machine)
+    return robot
 
 
 def _rotations(tool: ToolOrientation, s: np.ndarray, tangent: np.ndarray) -> np.ndarray:

@@ -333,6 +333,13 @@ class Machine:
         q = np.asarray(q, dtype=float)
         return forward_kinematics(self.arm, q[..., : self.n_arm])
 
+    def base_carrier_at(self, external: np.ndarray) -> np.ndarray:
+        """:meth:`T_base_carrier` at the external axes' positions alone, shape (..., e) (the
+        arm's joints do not move the carrier), shape (..., 4, 4)."""
+        q = np.zeros((*np.shape(external)[:-1], self.n_dof))
+        q[..., self.n_arm :] = external
+        return self.T_base_carrier(q)
+
     def T_cell_tool(self, q: np.ndarray) -> np.ndarray:
         """The tool in the cell frame, shape (..., 4, 4)."""
         T: np.ndarray = self.T_cell_base(q) @ self.T_base_tool(q)
@@ -382,9 +389,7 @@ def carried_poses(machine: Robot | Machine, external: np.ndarray, poses: np.ndar
     """
     if not isinstance(machine, Machine):
         return poses
-    q = np.zeros((*external.shape[:-1], machine.n_dof))
-    q[..., machine.n_arm :] = external
-    carried: np.ndarray = machine.T_base_carrier(q) @ poses
+    carried: np.ndarray = machine.base_carrier_at(external) @ poses
     return carried
 
 
