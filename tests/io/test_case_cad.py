@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import yaml
 
-from tests.cad.parts import AnalyticPart, pipe_on_plate, t_joint
+from tests.cad.parts import AnalyticPart, curved_wall, pipe_on_plate, t_joint
 from tests.conftest import CASES
 from trackplan.cli import ExitCode, main
 from trackplan.errors import CaseError
@@ -43,6 +43,7 @@ def parts(monkeypatch: pytest.MonkeyPatch) -> dict[str, AnalyticPart]:
     monkeypatch.setitem(sys.modules, "trackplan.io.part_file", module)
     table["pipe.step"] = pipe_on_plate()
     table["tee.step"] = t_joint()
+    table["wall.step"] = curved_wall()
     return table
 
 
@@ -127,6 +128,26 @@ def test_bad_cad_input_is_one_line_at_its_key(
     assert main(["validate", str(file)]) == ExitCode.BAD_INPUT
     err = capsys.readouterr().err.strip()
     assert "Traceback" not in err and key in err
+
+
+def test_a_sampled_edge_keeps_within_a_tenth_of_the_seams_tolerance(
+    tmp_path: Path, parts: dict
+) -> None:
+    cad = {"between": [{"face": 1}, {"face": 2}]}
+    file = _case(tmp_path, part={"file": "wall.step"}, cad=cad, task={"tolerance": 0.0002})
+    (piece,) = load_case(file).paths[0].segments
+    assert isinstance(piece, PointsSpec) and piece.normals is not None
+    assert parts["wall.step"].queried == [pytest.approx(0.00002)]
+
+
+def test_a_degenerate_derived_seam_is_refused_at_its_cad_key(tmp_path: Path, parts: dict) -> None:
+    wall = parts["wall.step"]
+    repeated = np.array([[-0.05, 0.02, 0], [0, 0, 0], [0, 0, 0], [0.05, 0.02, 0]])
+    wall.edge_points = lambda edge, chord: repeated  # type: ignore[method-assign]
+    cad = {"between": [{"face": 1}, {"face": 2}]}
+    with pytest.raises(CaseError, match="derived seam is degenerate at segments") as error:
+        load_case(_case(tmp_path, part={"file": "wall.step"}, cad=cad))
+    assert error.value.key == "paths[0].cad"
 
 
 def test_cad_without_a_part_is_refused(tmp_path: Path, parts: dict) -> None:

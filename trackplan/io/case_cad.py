@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -25,7 +26,7 @@ from trackplan.cad.seams import CadSeam, FaceRef, SeamError, derive_seam, seam_s
 from trackplan.case import Case
 from trackplan.cell.model import Body, Shape
 from trackplan.errors import CaseError
-from trackplan.io.case_schema import CadSeamModel, FaceRefModel, PartFileModel, Tolerance
+from trackplan.io.case_schema import MIN_TOLERANCE, CadSeamModel, FaceRefModel, PartFileModel
 from trackplan.io.yaml_input import (
     Loc,
     key_path,
@@ -34,6 +35,7 @@ from trackplan.io.yaml_input import (
     read_text,
     validate_model,
 )
+from trackplan.paths import check_segments
 from trackplan.paths.specs import ArcSpec, LineSpec, SegmentSpec
 
 PART_CHORD_ERROR = 0.0005
@@ -47,7 +49,7 @@ class _View(BaseModel):
 
 
 class _TaskView(_View):
-    tolerance: Tolerance | None = None
+    tolerance: Any = None  # the case schema checks it; a bad one derives with the default
 
 
 class _SeamView(_View):
@@ -63,7 +65,7 @@ class _CaseView(_View):
 
     part: PartFileModel | None = None
     paths: list[_SeamView] | None = None
-    task: _TaskView = _TaskView()
+    task: Any = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,10 +109,6 @@ def expand_cad(data: Any, file: str | None, base: Path) -> tuple[Any, CadCase | 
     has_cad = any(isinstance(entry, dict) and "cad" in entry for entry in entries)
     if "part" not in data and not has_cad:
         return data, None
-    if not all(isinstance(entry, dict) for entry in entries) or not isinstance(
-        data.get("task"), dict
-    ):
-        return data, None  # the case schema reports it
     view = validate_model(_CaseView, data, file)
     problems: list[tuple[Loc, str]] = []
     for k, seam in enumerate(view.paths or []):
@@ -144,6 +142,13 @@ def expand_cad(data: Any, file: str | None, base: Path) -> tuple[Any, CadCase | 
             raise CaseError(
                 exc.message, file=file, key=key_path(("paths", k, "cad", *exc.where))
             ) from None
+        for key, message in check_segments(start, segments):  # e.g. a mesh's repeated point
+            where = key_path(("paths", k, "cad"))
+            raise CaseError(
+                f"the derived seam is degenerate at {key.removeprefix('path.')}: {message}",
+                file=file,
+                key=where,
+            )
         derived.append(CadPath(k, str(seam.name), start, segments))
         out["paths"][k] = _plain_entry(entries[k], start, segments)
     return out, CadCase(part, view.part.body, tuple(derived))
@@ -188,10 +193,13 @@ def describe_cad(cad: CadCase) -> list[str]:
 
 
 def _tolerance(view: _CaseView, seam: _SeamView) -> float:
-    """The seam's path tolerance: its own, the case's, else the default 1 mm."""
-    for task in (seam.task, view.task):
-        if task is not None and task.tolerance is not None:
-            return task.tolerance
+    """The seam's path tolerance: its own, the case's, else the default 1 mm (also for a
+    bad value, which the case schema then refuses)."""
+    case_task = view.task.get("tolerance") if isinstance(view.task, dict) else None
+    for value in (None if seam.task is None else seam.task.tolerance, case_task):
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            if math.isfinite(value) and value >= MIN_TOLERANCE:
+                return float(value)
     return 0.001
 
 
@@ -207,15 +215,39 @@ def _read_part(model: PartFileModel, base: Path, file: str | None) -> PartModel:
             file=file,
             key="part.file",
         ) from None
+    path = base / model.file
     try:
-        part: PartModel = load_part(
-            base / model.file, scale=model.scale, feature_angle=model.feature_angle
-        )
+        stat = path.stat()
+        stamp = (str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    except OSError:
+        stamp = (str(path), -1, -1)  # the reader says what is wrong with it
+    try:
+        if stamp[1] < 0:
+            part: PartModel = load_part(path, scale=model.scale, feature_angle=model.feature_angle)
+        else:
+            part = _cached_part(load_part, stamp, model.scale, model.feature_angle)
     except CaseError as exc:  # the part file's own problem, located at part.file
         if exc.key is not None:
             raise
         raise CaseError(exc.one_line(), file=file, key="part.file") from None
     return part
+
+
+_PARTS: dict[tuple[object, ...], PartModel] = {}
+"""Parts read in this process, by file, modification time, size, scale and feature angle:
+``validate`` and ``seams`` read a case twice, a study many times."""
+MAX_CACHED_PARTS = 4
+
+
+def _cached_part(
+    load_part: Any, stamp: tuple[str, int, int], scale: float | None, feature_angle: float
+) -> PartModel:
+    key = (*stamp, scale, feature_angle, load_part)
+    if key not in _PARTS:
+        while len(_PARTS) >= MAX_CACHED_PARTS:
+            _PARTS.pop(next(iter(_PARTS)))
+        _PARTS[key] = load_part(stamp[0], scale=scale, feature_angle=feature_angle)
+    return _PARTS[key]
 
 
 def as_cad_seam(model: CadSeamModel) -> CadSeam:
