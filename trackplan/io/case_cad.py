@@ -225,7 +225,7 @@ def _read_part(model: PartFileModel, base: Path, file: str | None) -> PartModel:
         if stamp[1] < 0:
             part: PartModel = load_part(path, scale=model.scale, feature_angle=model.feature_angle)
         else:
-            part = _cached_part(load_part, stamp, model.scale, model.feature_angle)
+            part = _cached_part(load_part, path, stamp, model.scale, model.feature_angle)
     except CaseError as exc:  # the part file's own problem, located at part.file
         if exc.key is not None:
             raise
@@ -240,13 +240,17 @@ MAX_CACHED_PARTS = 4
 
 
 def _cached_part(
-    load_part: Any, stamp: tuple[str, int, int], scale: float | None, feature_angle: float
+    load_part: Any,
+    path: Path,
+    stamp: tuple[str, int, int],
+    scale: float | None,
+    feature_angle: float,
 ) -> PartModel:
     key = (*stamp, scale, feature_angle, load_part)
     if key not in _PARTS:
         while len(_PARTS) >= MAX_CACHED_PARTS:
             _PARTS.pop(next(iter(_PARTS)))
-        _PARTS[key] = load_part(stamp[0], scale=scale, feature_angle=feature_angle)
+        _PARTS[key] = load_part(path, scale=scale, feature_angle=feature_angle)
     return _PARTS[key]
 
 
