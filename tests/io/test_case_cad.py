@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+import trimesh
 import yaml
 
 from tests.cad.parts import AnalyticPart, curved_wall, pipe_on_plate, t_joint
@@ -318,7 +319,6 @@ pipes: 0.59° measured)."""
 )
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_the_stl_export_of_a_shipped_part_gives_the_same_seam(tmp_path: Path, name: str) -> None:
-    import trimesh
     from trackplan.io.part_file import load_part
 
     mesh = load_part(PARTS / name).tessellation(MESH_CHORD)
