@@ -183,7 +183,7 @@ def test_validate_prints_each_cad_seam(
 ) -> None:
     assert main(["validate", str(_case(tmp_path, cad=FOOT))]) == ExitCode.OK
     out = capsys.readouterr().out
-    assert "part pipe.step: 3 faces, 2 edges, exact (STEP B-rep)" in out
+    assert "part pipe.step: 3 faces, 2 edges, exact (STEP B-rep); not a body of the cell" in out
     assert f"CAD seam foot (paths[0]): {2 * np.pi * 0.06:.4f} m, 1 arc, closed" in out
 
 

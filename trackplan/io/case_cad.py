@@ -89,6 +89,8 @@ class CadCase:
     part: PartModel
     body: bool
     paths: tuple[CadPath, ...]
+    cell: bool = False
+    """Whether the case has a ``cell`` (the part is a body of it only then)."""
 
 
 def expand_cad(data: Any, file: str | None, base: Path) -> tuple[Any, CadCase | None]:
@@ -151,7 +153,7 @@ def expand_cad(data: Any, file: str | None, base: Path) -> tuple[Any, CadCase | 
             )
         derived.append(CadPath(k, str(seam.name), start, segments))
         out["paths"][k] = _plain_entry(entries[k], start, segments)
-    return out, CadCase(part, view.part.body, tuple(derived))
+    return out, CadCase(part, view.part.body, tuple(derived), cell="cell" in data)
 
 
 def load_cad(file: str | Path) -> tuple[Any, CadCase | None]:
@@ -177,7 +179,13 @@ def describe_cad(cad: CadCase) -> list[str]:
             if part.exact
             else "a mesh: seam positions and normals as good as its tessellation"
         )
-        + (f"; a workpiece body within {PART_CHORD_ERROR * 1000:g} mm" if cad.body else "")
+        + (
+            f"; a workpiece body of the cell within {PART_CHORD_ERROR * 1000:g} mm"
+            if cad.body and cad.cell
+            else "; not a body of the cell (the case has no cell)"
+            if cad.body
+            else ""
+        )
     ]
     for path in cad.paths:
         summary = path.summary()
@@ -205,16 +213,8 @@ def _tolerance(view: _CaseView, seam: _SeamView) -> float:
 
 def _read_part(model: PartFileModel, base: Path, file: str | None) -> PartModel:
     """The part read from its file, problems located at ``part.file``."""
-    try:
-        from trackplan.io.part_file import load_part
-    except ModuleNotFoundError as exc:  # pragma: no cover - until the readers are merged
-        if exc.name != "trackplan.io.part_file":
-            raise
-        raise CaseError(
-            "reading a part needs trackplan.io.part_file, which this installation lacks",
-            file=file,
-            key="part.file",
-        ) from None
+    from trackplan.io.part_file import load_part  # OCP and trimesh only for a case with a part
+
     path = base / model.file
     try:
         stat = path.stat()
