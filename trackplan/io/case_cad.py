@@ -191,7 +191,10 @@ def describe_cad(cad: CadCase) -> list[str]:
         summary = path.summary()
         kinds = summary["kinds"]
         assert isinstance(kinds, dict)
-        pieces = ", ".join(f"{n} {kind}" for kind, n in kinds.items() if n) or "no pieces"
+        names = {"line": "line", "arc": "arc", "points": "sampled curve"}
+        pieces = ", ".join(
+            f"{n} {names[kind]}{'s' if n > 1 else ''}" for kind, n in kinds.items() if n
+        )
         closed = "closed" if summary["closed"] else "open"
         lines.append(
             f"CAD seam {path.name} (paths[{path.index}]): {summary['length']:.4f} m, "
