@@ -257,3 +257,24 @@ def test_a_closed_edge_among_others_is_a_branch() -> None:
     assert isinstance(part.edge_list[0].circle, Circle)
     with pytest.raises(SeamError, match="closed"):
         derive_seam(part, CadSeam(edges=(1, 3)), TOL)
+
+
+def test_an_arc_turns_the_way_its_edge_runs_whatever_the_sense_of_the_given_axis() -> None:
+    part = pipe_on_plate()
+    given = part.edge_list[0].circle
+    assert given is not None
+    part.edge_list[0].circle = Circle(
+        given.center, -given.axis, given.radius, given.angle, given.start
+    )
+    _, (arc,) = derive_seam(part, _faces(1, 2), TOL)
+    assert isinstance(arc, ArcSpec) and np.allclose(arc.normal, [0, 0, 1])
+    assert arc.angle == pytest.approx(2 * np.pi)
+
+
+def test_a_circle_its_edge_points_leave_is_sampled() -> None:
+    part = pipe_on_plate()
+    given = part.edge_list[0].circle
+    assert given is not None
+    part.edge_list[0].circle = Circle(given.center, given.axis, 0.05, given.angle, given.start)
+    _, (piece,) = derive_seam(part, _faces(1, 2), TOL)
+    assert isinstance(piece, PointsSpec)

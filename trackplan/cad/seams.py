@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trackplan.cad.part import Edge, PartModel
+from trackplan.cad.part import Circle, Edge, PartModel
 from trackplan.paths.specs import ArcSpec, LineSpec, PointsSpec, SegmentSpec
 
 NEAR_DISTANCE = 0.005
@@ -309,15 +309,33 @@ def _segment(
             return PointsSpec(points=np.vstack([middle, end]), normals=constant)
         return _sampled(part, edge, forward, faces, tolerance)
     circle = part.edge_circle(edge.id) if edge.kind == "circle" else None
-    if circle is not None:
+    axis = None if circle is None else _edge_axis(part, edge, circle, tolerance)
+    if circle is not None and axis is not None:
         angle = circle.angle if forward else -circle.angle
-        arc = ArcSpec(np.asarray(circle.center, dtype=float), np.asarray(circle.axis), angle)
+        arc = ArcSpec(np.asarray(circle.center, dtype=float), axis, angle)
         if not faces:
             return arc
         weld = weld_normals(part, faces, begin[None])[0]
         if _turns_with_arc(part, edge, forward, faces, arc, weld, begin):
             return ArcSpec(arc.center, arc.normal, arc.angle, weld)
     return _sampled(part, edge, forward, faces, tolerance)
+
+
+def _edge_axis(part: PartModel, edge: Edge, circle: Circle, tolerance: float) -> np.ndarray | None:
+    """The circle's unit axis in the sense its edge turns (the edge's own points decide), or
+    None when those points leave the circle by more than a tenth of the tolerance."""
+    points = np.asarray(part.edge_points(edge.id, CHORD_FRACTION * tolerance), dtype=float)
+    axis = np.asarray(circle.axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    offset = points - np.asarray(circle.center, dtype=float)
+    height = offset @ axis
+    radial = offset - np.outer(height, axis)
+    off = np.abs(np.linalg.norm(radial, axis=1) - circle.radius).max() + np.abs(height).max()
+    if len(points) < 2 or not off <= CHORD_FRACTION * tolerance + 1e-9:
+        return None
+    e_r = radial[0] / np.linalg.norm(radial[0])
+    turn = float(np.arctan2(radial[1] @ np.cross(axis, e_r), radial[1] @ e_r))
+    return axis if turn >= 0.0 else -axis
 
 
 def _sampled(
