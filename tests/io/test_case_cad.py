@@ -205,6 +205,19 @@ def test_seams_writes_a_case_that_loads_the_same(
     assert np.array_equal(derived.paths[0].start, plain.paths[0].start)
 
 
+def test_seams_refuses_to_overwrite_the_case_or_write_nowhere(
+    tmp_path: Path, parts: dict, capsys: pytest.CaptureFixture[str]
+) -> None:
+    file = _case(tmp_path, cad=FOOT)
+    before = file.read_text(encoding="utf-8")
+    assert main(["seams", str(file), "--out", str(file)]) == ExitCode.BAD_INPUT
+    assert "is the case itself" in capsys.readouterr().err
+    assert file.read_text(encoding="utf-8") == before
+    missing = tmp_path / "no" / "plain.yaml"
+    assert main(["seams", str(file), "--out", str(missing)]) == ExitCode.BAD_INPUT
+    assert "is in no existing folder" in capsys.readouterr().err
+
+
 def test_seams_refuses_a_case_without_cad_seams(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -56,13 +56,23 @@ def seams(
     plain segments, for a user to inspect or edit (docs/cad.md)."""
     from trackplan.io.case_cad import describe_cad, load_cad, plain_case_yaml
     from trackplan.io.case_file import load_case
+    from trackplan.io.run_folder import write_atomically
 
     load_case(case, assume_limits=assume_limits)  # the whole case is valid
     data, cad = load_cad(case)
     if cad is None or not cad.paths:
         error(f"{case}: no paths[i].cad seams to derive (docs/cad.md)")
         return ExitCode.BAD_INPUT
-    out.write_text(plain_case_yaml(data), encoding="utf-8")
+    if out.resolve() == case.resolve() or not out.parent.is_dir():
+        problem = "is the case itself" if out.parent.is_dir() else "is in no existing folder"
+        error(f"--out {out} {problem}: name a new file beside the case")
+        return ExitCode.BAD_INPUT
+    text = plain_case_yaml(data)
+
+    def write(path: Path) -> None:
+        path.write_text(text, encoding="utf-8")
+
+    write_atomically(out, write)
     typer.echo("\n".join([*describe_cad(cad), f"wrote {out}"]))
     return ExitCode.OK
 
