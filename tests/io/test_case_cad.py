@@ -346,3 +346,24 @@ def test_the_stl_export_of_a_shipped_part_gives_the_same_seam(tmp_path: Path, na
 def hand_example() -> list[float]:
     """pipe-fillet.yaml's placement.example."""
     return list(FILLET["placement"]["example"])
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(
+    not READERS or not PARTS.is_dir(),
+    reason="trackplan.io.part_file and cases/parts/ (issue 34's STEP reader and shipped "
+    "parts) are not on this branch yet",
+)
+def test_the_pipe_from_its_step_file_welds_downhand_on_the_positioner(tmp_path: Path) -> None:
+    from trackplan.planning.plan import plan
+
+    data = yaml.safe_load((CASES / "positioner-pipe-flange.yaml").read_text(encoding="utf-8"))
+    assert "downhand" in data  # the checker holds every point to the downhand rule
+    del data["path"]
+    data["part"] = {"file": str(PARTS / "pipe-plate.step")}
+    data["paths"] = [{"name": "flange", "cad": FOOT}]
+    file = tmp_path / "flange.yaml"
+    file.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    case = load_case(file)
+    result = plan(case, np.asarray(case.bounds.example))
+    assert result.feasible, result.message
