@@ -42,6 +42,7 @@ class AnalyticPart:
     is_exact: bool = True
     name: str = "analytic.step"
     queried: list[float] = field(default_factory=list)  # chord errors asked for
+    cached: tuple[tuple[int, ...], tuple[Edge, ...]] | None = None  # edges by edge_list
 
     @property
     def source(self) -> str:
@@ -59,13 +60,17 @@ class AnalyticPart:
 
     @property
     def edges(self) -> tuple[Edge, ...]:
+        key = tuple(id(e) for e in self.edge_list)
+        if self.cached is not None and self.cached[0] == key:
+            return self.cached[1]
         result = []
         for i, e in enumerate(self.edge_list):
             ends = e.curve(np.array([0.0, 1.0]))
-            fine = e.curve(np.linspace(0.0, 1.0, 20001))
+            fine = e.curve(np.linspace(0.0, 1.0, 2001 if e.kind != "line" else 2))
             length = float(np.linalg.norm(np.diff(fine, axis=0), axis=1).sum())
             result.append(Edge(i + 1, e.kind, length, ends[0], ends[1], e.faces))
-        return tuple(result)
+        self.cached = (key, tuple(result))
+        return self.cached[1]
 
     def edge_points(self, edge: int, max_chord_error: float) -> np.ndarray:
         self.queried.append(max_chord_error)

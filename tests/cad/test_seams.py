@@ -278,3 +278,23 @@ def test_a_circle_its_edge_points_leave_is_sampled() -> None:
     part.edge_list[0].circle = Circle(given.center, given.axis, 0.05, given.angle, given.start)
     _, (piece,) = derive_seam(part, _faces(1, 2), TOL)
     assert isinstance(piece, PointsSpec)
+
+
+def test_many_edges_shuffled_and_turned_chain_into_one_polyline() -> None:
+    rng = np.random.default_rng(1)
+    corners = np.cumsum(rng.uniform(0.001, 0.002, size=(501, 3)), axis=0)
+    order = rng.permutation(500)
+    turned = rng.random(500) < 0.5
+    segments = [
+        (tuple(corners[k + 1]), tuple(corners[k])) if turned[k] else
+        (tuple(corners[k]), tuple(corners[k + 1]))
+        for k in order
+    ]  # fmt: skip
+    part = line_edges(*segments)
+    first = int(order[0])
+    start, chain = derive_seam(part, CadSeam(edges=tuple(range(1, 501))), TOL)
+    # the first edge given runs its own way, so the chain runs as that edge does
+    forward = not turned[first]
+    expected = corners if forward else corners[::-1]
+    assert np.allclose(start, expected[0])
+    assert np.allclose([piece.to for piece in chain], expected[1:])  # type: ignore[union-attr]

@@ -114,6 +114,7 @@ def derive_seam(
         gap or a branch, faces whose normals cancel.
     """
     faces: tuple[int, ...] = ()
+    all_edges = part.edges
     if spec.between is not None:
         faces = tuple(_face(part, ref, ("between", i)) for i, ref in enumerate(spec.between))
         if faces[0] == faces[1]:
@@ -130,17 +131,17 @@ def derive_seam(
         assert spec.edges is not None
         ids = tuple(spec.edges)
         for k, edge in enumerate(ids):
-            if not 1 <= edge <= len(part.edges):
+            if not 1 <= edge <= len(all_edges):
                 raise SeamError(
                     ("edges", k),
-                    f"edge {edge} does not exist (the part has {len(part.edges)} edges: "
+                    f"edge {edge} does not exist (the part has {len(all_edges)} edges: "
                     f"trackplan part {part.source} lists them)",
                 )
         if len(set(ids)) < len(ids):
             raise SeamError(("edges",), "an edge is named twice; name each edge once")
         at = ("edges",)
     normal_faces = _normal_faces(part, spec, faces)
-    chain = chain_edges([part.edges[i - 1] for i in ids], at)
+    chain = chain_edges([all_edges[i - 1] for i in ids], at)
     if spec.reverse:
         chain = [(edge, not forward) for edge, forward in reversed(chain)]
     first, forward = chain[0]
@@ -209,9 +210,10 @@ def chain_edges(
             raise SeamError(at, f"edge {edge.id} is closed: it makes a seam on its own")
     degree = np.bincount(node)
     if degree.max() > 2:
-        where = ends[int(np.flatnonzero(node == int(np.argmax(degree)))[0])]
-        meeting = [e.id for e, pair in zip(edges, node.reshape(-1, 2), strict=True)
-                   if int(np.argmax(degree)) in pair]  # fmt: skip
+        branch = int(np.argmax(degree))
+        where = ends[int(np.flatnonzero(node == branch)[0])]
+        pairs = node.reshape(-1, 2)
+        meeting = [edge.id for edge, pair in zip(edges, pairs, strict=True) if branch in pair]
         raise SeamError(
             at,
             f"edges {', '.join(map(str, meeting))} meet at one point "
@@ -220,13 +222,17 @@ def chain_edges(
         )
     pairs = node.reshape(-1, 2)
     open_ends = np.flatnonzero(degree == 1)
+    touching: dict[int, list[int]] = {}
+    for k, (a, b) in enumerate(pairs.tolist()):
+        touching.setdefault(a, []).append(k)
+        touching.setdefault(b, []).append(k)
     # walk from the first edge forwards, then prepend backwards from its start
     chain: list[tuple[Edge, bool]] = [(edges[0], True)]
     used = {0}
     for direction in (1, 0):
         current = int(pairs[0, direction])
         while True:
-            nxt = [k for k in range(len(edges)) if k not in used and current in pairs[k]]
+            nxt = [k for k in touching[current] if k not in used]
             if not nxt:
                 break
             k = nxt[0]
@@ -255,15 +261,16 @@ def chain_edges(
 
 def _cluster(points: np.ndarray) -> np.ndarray:
     """A node number per point: points within :data:`CHAIN_GAP` share one."""
-    distance = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2)
-    near = distance <= CHAIN_GAP
-    node = np.full(len(points), -1, dtype=int)
-    count = 0
-    for i in range(len(points)):
-        if node[i] < 0:
-            node[near[i] & (node < 0)] = count
-            count += 1
-    return node
+    # imported here: a case without cad: seams never needs scipy's spatial module
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(points).query_pairs(CHAIN_GAP, output_type="ndarray")
+    graph = coo_matrix(
+        (np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(points), len(points))
+    )
+    return np.asarray(connected_components(graph, directed=False)[1], dtype=int)
 
 
 def _nearest_gap(ends: np.ndarray, chained: list[int], apart: list[int]) -> float:
@@ -398,13 +405,14 @@ def seam_summary(start: np.ndarray, segments: tuple[SegmentSpec, ...]) -> dict[s
             radial = current - segment.center
             radial = radial - (radial @ axis) * axis
             length += float(np.linalg.norm(radial) * abs(segment.angle))
-            current = segment.center + _rotate(current - segment.center, axis,
-                                               np.array([segment.angle]))[0]  # fmt: skip
+            turned = _rotate(current - segment.center, axis, np.array([segment.angle]))
+            current = segment.center + turned[0]
         else:
             path = np.vstack([current, segment.points])
-            straight = segment.normals is not None and len(segment.points) == 2 and np.allclose(
-                segment.normals[0], segment.normals[1]
-            ) and _collinear(path)  # fmt: skip
+            normals = segment.normals
+            constant = normals is not None and len(segment.points) == 2
+            constant = constant and normals is not None and np.allclose(normals[0], normals[1])
+            straight = constant and _collinear(path)
             kinds["line" if straight else "points"] += 1
             length += float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
             current = np.asarray(segment.points[-1], dtype=float)
