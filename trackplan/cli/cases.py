@@ -1,5 +1,5 @@
-"""Commands on inputs: ``validate`` (case files), ``robots`` (built-in robots),
-``positioners`` (built-in positioners), ``cases``."""
+"""Commands on inputs: ``validate`` (case files), ``seams`` (a case's CAD seams as plain
+segments), ``robots`` (built-in robots), ``positioners`` (built-in positioners), ``cases``."""
 
 from __future__ import annotations
 
@@ -26,12 +26,55 @@ def validate(
 ) -> ExitCode:
     """Check case files and their robots; print a summary of each valid case."""
     from trackplan.cli.summaries import describe_case
+    from trackplan.io.case_cad import describe_cad, load_cad
 
     loaded = load_each(cases, assume_limits=assume_limits)
     for file, case in loaded:
         if case is not None:
             typer.echo("\n".join(describe_case(case, file)))
+            cad = load_cad(file)[1] if case.source is not None else None
+            if cad is not None:
+                typer.echo("\n".join(describe_cad(cad)))
     return ExitCode.OK if all(case is not None for _, case in loaded) else ExitCode.BAD_INPUT
+
+
+@app.command()
+def seams(
+    case: Annotated[Path, typer.Argument(help="A case file with cad: seams.", show_default=False)],
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            help="The case file to write: every seam as plain segments with its weld normals "
+            "(write it beside the case: relative file names are kept).",
+            show_default=False,
+        ),
+    ],
+    assume_limits: AssumeLimitsOption = False,
+) -> ExitCode:
+    """Derive the seams of a case's part (paths[i].cad) and write the case with them as
+    plain segments, for a user to inspect or edit (docs/cad.md)."""
+    from trackplan.io.case_cad import describe_cad, load_cad, plain_case_yaml
+    from trackplan.io.case_file import load_case
+    from trackplan.io.run_folder import write_atomically
+
+    load_case(case, assume_limits=assume_limits)  # the whole case is valid
+    data, cad = load_cad(case)
+    if cad is None or not cad.paths:
+        error(f"{case}: no paths[i].cad seams to derive (docs/cad.md)")
+        return ExitCode.BAD_INPUT
+    if out.resolve() == case.resolve() or not out.parent.is_dir():
+        problem = "is the case itself" if out.parent.is_dir() else "is in no existing folder"
+        error(f"--out {out} {problem}: name a new file beside the case")
+        return ExitCode.BAD_INPUT
+    text = plain_case_yaml(data)
+
+    def write(path: Path) -> None:
+        path.write_text(text, encoding="utf-8")
+
+    write_atomically(out, write)
+    typer.echo("\n".join([*describe_cad(cad), f"wrote {out}"]))
+    return ExitCode.OK
 
 
 @app.command()

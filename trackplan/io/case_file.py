@@ -27,6 +27,7 @@ from trackplan.case import (
 )
 from trackplan.choices import OBJECTIVE_KINDS, Method, Penalty, Timing
 from trackplan.io.case_axes import axes_problems, load_positioner_chain, with_axes
+from trackplan.io.case_cad import expand_cad, with_part_body
 from trackplan.io.case_schema import (
     CaseModel,
     ObjectiveModel,
@@ -61,9 +62,6 @@ from trackplan.robots.model import Robot
 
 PAPER_WEIGHTS = (0.3, 0.2, 0.2, 0.1, 0.1, 0.1)
 """C_i of the paper's Eq. 8 for a 6-joint arm (the paper prints five; the sixth is 0.1)."""
-
-
-# --------------------------------------------------------------------------- loading
 
 
 def load_case(file: str | Path, *, assume_limits: bool = False) -> Case:
@@ -137,11 +135,11 @@ def load_case_data(
     Parameters
     ----------
     data
-        The YAML document as loaded: a mapping in the case file format.
-    file
-        The file the data came from, for messages and :attr:`Case.source`.
-    base_dir
-        Folder that relative robot and points file names start from.
+        The YAML document as loaded: a mapping in the case file format (``cad:`` seams are
+        derived from the part first, :func:`trackplan.io.case_cad.expand_cad`).
+    file, base_dir
+        The file the data came from (messages, :attr:`Case.source`) and the folder that
+        relative robot, points and part file names start from.
     assume_limits
         As for :func:`load_case`.
 
@@ -155,6 +153,7 @@ def load_case_data(
         See :func:`load_case`.
     """
     base = Path(base_dir)
+    data, cad = expand_cad(data, file, base)  # cad: seams as plain start and segments
     several = isinstance(data, dict) and "paths" in data
     raise_first(misplaced_tool(data), data, file)
     model = validate_model(CaseModel if several else SinglePathCaseModel, data, file)
@@ -208,9 +207,9 @@ def load_case_data(
     if model.paths is not None:
         case = _with_seams(case, model, paths)
     case = with_axes(case, model, load_positioner_chain(model, base, file, assume_limits))
-    if model.cell is None:
-        return case
-    return dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
+    if model.cell is not None:
+        case = dataclasses.replace(case, cell=build_cell(model.cell, base, file, robot))
+    return with_part_body(case, cad)
 
 
 def _size_problems(

@@ -173,12 +173,84 @@ def _csv_safe_name(name: str) -> str:
     return name
 
 
+class FaceRefModel(StrictModel):
+    """A face of the part: ``{face: ID}`` or ``{near: [x, y, z]}`` (m, the nearest face)."""
+
+    face: int | None = None
+    near: Vec3 | None = None
+
+    @model_validator(mode="after")
+    def _one_way(self) -> FaceRefModel:
+        if (self.face is None) == (self.near is None):
+            raise PydanticCustomError(
+                "face_ref", "expected exactly one of face (an id) or near ([x, y, z], m)"
+            )
+        return self
+
+
+class CadNormalModel(StrictModel):
+    """``cad.normal``: one face's normal (``face`` or ``near``) or the bisector of two
+    faces' normals (``between``)."""
+
+    face: int | None = None
+    near: Vec3 | None = None
+    between: Annotated[list[FaceRefModel], Field(min_length=2, max_length=2)] | None = None
+
+    @model_validator(mode="after")
+    def _one_way(self) -> CadNormalModel:
+        if sum(value is not None for value in (self.face, self.near, self.between)) != 1:
+            raise PydanticCustomError(
+                "cad_normal", "expected exactly one of face, near or between (two faces)"
+            )
+        return self
+
+
+class CadSeamModel(StrictModel):
+    """``paths[i].cad``: a seam from the part's CAD model (instead of start and segments)."""
+
+    between: Annotated[list[FaceRefModel], Field(min_length=2, max_length=2)] | None = None
+    edges: Annotated[list[Annotated[int, Field(ge=1)]], Field(min_length=1)] | None = None
+    joint: Literal["fillet", "face"] | None = None
+    normal: CadNormalModel | None = None
+    reverse: bool = False
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> CadSeamModel:
+        if (self.between is None) == (self.edges is None):
+            raise PydanticCustomError(
+                "cad_kind",
+                "expected exactly one of between (two faces) or edges (edge ids)",
+            )
+        if self.joint is not None and self.between is None:
+            raise PydanticCustomError(
+                "cad_joint", "joint applies to between; with edges give normal: {face: ID}"
+            )
+        if self.joint is not None and self.normal is not None:
+            raise PydanticCustomError(
+                "cad_joint", "give joint or normal, not both (normal names the faces itself)"
+            )
+        return self
+
+
+class PartFileModel(StrictModel):
+    """``part``: the part's CAD model (STEP or mesh), relative to the case file."""
+
+    file: NonEmptyStr
+    scale: Positive | None = None
+    body: bool = True
+    feature_angle: Annotated[float, Field(gt=0, lt=3.1416)] = 0.349
+
+
 class SeamModel(PathModel):
-    """One entry of ``paths``: a named path, its task overrides, whether it may be reversed."""
+    """One entry of ``paths``: a named path, its task overrides, whether it may be reversed.
+
+    ``cad``: the seam from the part's CAD model; :mod:`trackplan.io.case_cad` derives its
+    ``start`` and ``segments`` before the case is validated."""
 
     name: Annotated[NonEmptyStr, AfterValidator(_csv_safe_name)]
     task: SeamTaskModel | None = None
     reversible: bool = True
+    cad: CadSeamModel | None = None
 
 
 class PlacementModel(StrictModel):
@@ -225,6 +297,7 @@ class CaseModel(StrictModel):
     tcp: TcpModel | None = None
     path: PathModel | None = None
     paths: Annotated[list[SeamModel], Field(min_length=1)] | None = None
+    part: PartFileModel | None = None
     sequence: Literal["optimize", "given"] | None = None
     approach: NonNegative | None = None
     home: Annotated[list[Coordinate], Field(min_length=1)] | None = None
