@@ -15,6 +15,8 @@ import numpy as np
 
 from trackplan.case import Case
 from trackplan.planning.result import PlanResult
+from trackplan.report.cycle import has_moves, sequence_section
+from trackplan.report.cycle_view import cycle_view_spec
 from trackplan.report.html_case import case_section
 from trackplan.report.html_markup import esc, grid, html_page
 from trackplan.report.html_result import (
@@ -34,6 +36,12 @@ from trackplan.run_files import REPORT_FILE
 _esc, _grid = esc, grid  # moved to html_markup; importers outside this package keep working
 
 _PLOT_CAPTIONS = {
+    "cycle.png": (
+        "Cycle",
+        "Left: the tool point from above, each seam in its colour (the arrow half-way shows "
+        "the welding direction), approach, retract and air moves dashed. Right: the cycle's "
+        "timeline, one row per seam and one for the moves.",
+    ),
     "joints.png": (
         "Joint trajectories",
         "Rows: position, velocity, acceleration and jerk (backward differences at Ts, robot "
@@ -120,7 +128,7 @@ def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
             f"{esc(result.message)}</p></section>"
         )
     div = plotly_div(
-        robot_view_spec(result, case, n_frames=n_frames),
+        cycle_view_spec(robot_view_spec(result, case, n_frames=n_frames), result, case),
         VIEW_ID,
         config={"displaylogo": False, "responsive": True},
         post_script=_QUIET_INTERRUPTS,
@@ -197,8 +205,9 @@ def report_page(
             f"<h1>{esc(case.name)}: {verdict}</h1>",
             f"<p>{verdict_badge(result)} {esc(result.message)}</p>",
             bounds_line(optimizer_info),
-            '<nav><a href="#case">Case</a><a href="#result">Result</a><a href="#plots">Plots</a>'
-            '<a href="#view">3D view</a></nav>',
+            '<nav><a href="#case">Case</a><a href="#result">Result</a>'
+            + ('<a href="#sequence">Sequence</a>' if has_moves(result, case) else "")
+            + '<a href="#plots">Plots</a><a href="#view">3D view</a></nav>',
             case_section(result, case),
             '<section id="result"><h2>Result</h2>',
             '<div class="cols"><div><h3>Key figures</h3>',
@@ -212,6 +221,7 @@ def report_page(
             margins_table(result, case),
             violations_table(result),
             "</section>",
+            sequence_section(result, case),
             _plots_section(plots),
             view,
         ]

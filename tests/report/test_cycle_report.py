@@ -1,0 +1,127 @@
+"""The report of a case of several seams joined by moves: every section a single seam's
+report has (3D view, joint plots, margins, speed, clearance) plus the cycle and the sequence.
+
+The bracket (``cases/bracket-4-fillets.yaml``) is planned once per session (about 10 s
+once numba's kernels are cached): the tests are slow.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from trackplan.planning.result import MOVE_KINDS, SEAM
+from trackplan.report.cycle import sequence_section
+from trackplan.report.cycle_view import cycle_view_spec
+from trackplan.report.robot_view import NOMINAL_TRACE, PATH_TRACE, ROBOT_TRACE, robot_view_spec
+from trackplan.report.scene import tracking_error
+from trackplan.report.speed_plot import speed_figure
+
+pytestmark = pytest.mark.slow
+
+
+def _gids(figure, gid):
+    return [a for ax in figure.axes for a in ax.get_children() if a.get_gid() == gid]
+
+
+def test_the_report_of_several_seams_has_every_section(bracket, bracket_result, bracket_report):
+    plots, report = bracket_report
+    names = [path.name for path in plots]
+    assert names == ["cycle.png", "joints.png", "speed.png", "clearance.png"]
+    html = report.read_text(encoding="utf-8")
+    for anchor in (
+        'id="view"',
+        'id="plot-cycle"',
+        'id="plot-joints"',
+        'id="plot-speed"',
+        'id="plot-clearance"',
+        'id="sequence"',
+        'href="#sequence"',
+        "<h3>Margins</h3>",
+    ):
+        assert anchor in html, anchor
+    assert "Plotly.newPlot" in html
+    # the joint margins of the whole cycle, one column per joint
+    margins = html[html.index("<h3>Margins</h3>") :]
+    for j in range(bracket.robot.n_dof):
+        assert f"joint {j + 1}" in margins
+
+
+def test_the_sequence_table_lists_every_seam_in_welding_order(bracket, bracket_result):
+    section = sequence_section(bracket_result, bracket)
+    rows = re.findall(r"<tr>(.*?)</tr>", section, re.S)
+    seam_rows = [r for r in rows if re.search(r"<td[^>]*>\d+</td>", r)][: len(bracket.seams)]
+    welded = [seam.name for seam in bracket_result.seams]
+    assert len(welded) == len(bracket.seams) == 4
+    for order, (row, name) in enumerate(zip(seam_rows, welded, strict=True)):
+        assert f">{order + 1}<" in row and f">{name}<" in row
+        assert "feasible" in row
+    assert "cycle time" in section and "welding (seam time)" in section
+    # the totals add up (to the table's 4 digits)
+    assert bracket_result.seam_time + bracket_result.air_time == pytest.approx(
+        bracket_result.duration, abs=1e-6
+    )
+    assert f"{bracket_result.duration:.4g} s" in section
+
+
+def test_a_single_seam_has_no_sequence_section(corner, corner_result):
+    assert sequence_section(corner_result, corner) == ""
+
+
+def test_the_3d_view_draws_every_seam_and_every_move(bracket, bracket_result):
+    spec = cycle_view_spec(robot_view_spec(bracket_result, bracket, 20), bracket_result, bracket)
+    names = [trace["name"] for trace in spec["data"]]
+    assert PATH_TRACE not in names and NOMINAL_TRACE not in names
+    position = bracket_result.trajectory.tool_position
+    for span in bracket_result.spans:
+        if span.kind != SEAM:
+            continue
+        label = f"seam {span.label}" + (" (reversed)" if span.reversed else "")
+        trace = spec["data"][names.index(label)]
+        drawn = np.column_stack([trace["x"], trace["y"], trace["z"]]).astype(float)
+        # the seam's trace runs from its first sample to its last (10 µm rounding)
+        np.testing.assert_allclose(drawn[0], position[span.first], atol=2e-5)
+        np.testing.assert_allclose(drawn[-1], position[span.last], atol=2e-5)
+        assert f"{NOMINAL_TRACE}: {span.label}" in names
+    for kind in MOVE_KINDS:
+        trace = spec["data"][names.index(f"{kind} moves")]
+        n_spans = sum(span.kind == kind for span in bracket_result.spans)
+        assert sum(x is None for x in trace["x"]) == n_spans - 1  # one gap between spans
+        assert trace["line"]["dash"] == "dash"
+    # the animation still drives the robot: every frame updates the robot trace
+    robot = names.index(ROBOT_TRACE)
+    assert all(robot in frame["traces"] for frame in spec["frames"])
+    assert all(frame["data"][0]["name"] == ROBOT_TRACE for frame in spec["frames"])
+
+
+def test_the_report_embeds_the_cycle_view(bracket_report):
+    _, report = bracket_report
+    html = report.read_text(encoding="utf-8")
+    assert '"name":"air moves"' in html.replace(": ", ":")
+    assert '"name":"seam boss"' in html.replace(": ", ":")
+
+
+def test_the_speed_plot_marks_the_seams_and_the_moves(bracket, bracket_result):
+    figure = speed_figure(bracket_result, bracket)
+    labels = sorted(text.get_text() for text in _gids(figure, "seam-label"))
+    assert labels == sorted(bracket.seam_names)
+    n_moves = sum(span.kind in MOVE_KINDS for span in bracket_result.spans)
+    assert len(_gids(figure, "move")) == 2 * n_moves  # on both axes
+    # each seam's own rated speed over its span: the boss is welded at 15 mm/s
+    rated = _gids(figure, "rated-speed")
+    levels = sorted({float(s[0][0][1]) for line in rated for s in [line.get_segments()]})
+    assert levels == pytest.approx([15.0, 20.0], abs=1e-9)
+
+
+def test_the_tracking_error_is_each_seams_and_none_on_the_moves(bracket, bracket_result):
+    error = tracking_error(bracket_result, bracket)
+    for span in bracket_result.spans:
+        inner = error[span.first + 1 : span.last]
+        if span.kind == SEAM:
+            assert np.isfinite(inner).all()
+            # within the tolerance, as the checker found (1 µm for the rounding)
+            assert np.max(inner) <= bracket.task.tolerance + 1e-6
+        else:
+            assert np.isnan(inner).all()
