@@ -125,3 +125,57 @@ def test_the_tracking_error_is_each_seams_and_none_on_the_moves(bracket, bracket
             assert np.max(inner) <= bracket.task.tolerance + 1e-6
         else:
             assert np.isnan(inner).all()
+
+
+def test_the_joint_plot_shades_the_moves_of_a_cycle_only(bracket, bracket_result, corner_result):
+    from trackplan.report.joints_plot import joints_figure, move_samples
+
+    figure = joints_figure(bracket_result, bracket, rows=(0,))
+    bands = _gids(figure, "move")
+    assert len(bands) == bracket.robot.n_dof  # one polygon per panel
+    moving = move_samples(bracket_result)
+    air = next(span for span in bracket_result.spans if span.kind == "air")
+    assert moving[air.first : air.last + 1].all()
+    assert not moving[bracket_result.spans[1].first + 1 : bracket_result.spans[1].last].any()
+    assert not move_samples(corner_result).any()
+
+
+def test_the_key_figures_of_a_cycle_compare_welding_with_each_seams_rated_speed(
+    bracket, bracket_result
+):
+    from trackplan.report.html_result import figures_table
+
+    html = figures_table(bracket_result, bracket)
+    ideal = sum(
+        seam.plan.path_length / bracket.seams[seam.index].task.rated_speed
+        for seam in bracket_result.seams
+    )
+    # boss 188.5 mm at 15 mm/s, the rest 400 mm at 20 mm/s
+    assert ideal == pytest.approx(0.06 * np.pi / 0.015 + 0.4 / 0.02, rel=1e-3)
+    assert "Σ L / v_r over the seams" in html and f"{ideal:.4g} s" in html
+
+
+def test_slow_downs_of_a_cycle_name_their_seam_and_sit_in_its_span(bracket, bracket_result):
+    import dataclasses
+
+    from trackplan.report.html_result import slowdowns_table
+    from trackplan.report.speed_plot import slowdown_times
+    from trackplan.timing import SlowDown
+
+    # a made-up slow-down 2 cm into the second seam welded
+    slow = SlowDown(0.02, 0.04, 0.01, 0.02, "joint 4 velocity")
+    second = bracket_result.seams[1]
+    seams = list(bracket_result.seams)
+    seams[1] = dataclasses.replace(second, plan=dataclasses.replace(second.plan, slowdowns=(slow,)))
+    result = dataclasses.replace(bracket_result, seams=tuple(seams), slowdowns=(slow,))
+    html = slowdowns_table(result)
+    assert ">seam</th>" in html and f">{second.name}</td>" in html
+    ((t0, t1),) = slowdown_times(result)
+    span = next(p for p in result.spans if p.kind == SEAM and p.seam == second.index)
+    trajectory = result.trajectory
+    assert span.first * trajectory.sample_time < t0 < t1 < span.last * trajectory.sample_time
+    # where the seam's own arc length reaches 2 cm and 4 cm (one sample)
+    rows = slice(span.first, span.last + 1)
+    for t, s in ((t0, 0.02), (t1, 0.04)):
+        k = np.searchsorted(trajectory.s[rows], s)
+        assert t == pytest.approx(trajectory.t[rows][k], abs=trajectory.sample_time)

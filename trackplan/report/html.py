@@ -47,7 +47,8 @@ _PLOT_CAPTIONS = {
         "Rows: position, velocity, acceleration and jerk (backward differences at Ts, robot "
         "at rest before the first sample); one column per joint. Dashed lines are the limits; "
         "red markers are samples beyond a limit and red bands the violation windows the "
-        "checker reported. Each panel gives its margin (unused fraction of the limit) above it.",
+        "checker reported. Each panel gives its margin (unused fraction of the limit) above it; "
+        "grey bands, for seams joined by moves, are the approach, retract and air moves.",
     ),
     "path.png": (
         "Path and placement",
@@ -62,7 +63,9 @@ _PLOT_CAPTIONS = {
         "Top: Cartesian tool speed against the rated speed and the corner speed cap, slow-downs "
         "shaded and numbered as in the slow-down table (neighbours too close to label apart "
         "share a label, 3–5), their reasons in the legend. Bottom: distance of the tool point "
-        "from the nominal path (sharp corners kept) against the tolerance ρ.",
+        "from the nominal path (sharp corners kept) against the tolerance ρ. For seams joined by "
+        "moves: each seam named over its span with its own rated speed, cap and tolerance, the "
+        "moves shaded grey.",
     ),
     "clearance.png": (
         "Clearance",
