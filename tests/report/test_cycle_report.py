@@ -179,3 +179,14 @@ def test_slow_downs_of_a_cycle_name_their_seam_and_sit_in_its_span(bracket, brac
     for t, s in ((t0, 0.02), (t1, 0.04)):
         k = np.searchsorted(trajectory.s[rows], s)
         assert t == pytest.approx(trajectory.t[rows][k], abs=trajectory.sample_time)
+
+
+def test_the_case_section_lists_every_seam_as_written(bracket, bracket_result):
+    from trackplan.report.html_case import case_section
+
+    html = case_section(bracket_result, bracket)
+    for seam in bracket.seams:
+        assert f">{seam.name}</th>" in html  # the first column of a row
+    assert "15 mm/s" in html and "20 mm/s" in html  # the boss's own rated speed, the rest's
+    # every segment as written: 1 + 1 + 1 (the boss's arc) + 2 (the gusset's lines)
+    assert html.count(">line<") + html.count(">arc<") == 5
