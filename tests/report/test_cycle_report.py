@@ -15,6 +15,7 @@ import pytest
 from trackplan.planning.result import MOVE_KINDS, SEAM
 from trackplan.report.cycle import sequence_section
 from trackplan.report.cycle_view import cycle_view_spec
+from trackplan.report.html_markup import num
 from trackplan.report.robot_view import NOMINAL_TRACE, PATH_TRACE, ROBOT_TRACE, robot_view_spec
 from trackplan.report.scene import tracking_error
 from trackplan.report.speed_plot import speed_figure
@@ -58,6 +59,8 @@ def test_the_sequence_table_lists_every_seam_in_welding_order(bracket, bracket_r
     for order, (row, name) in enumerate(zip(seam_rows, welded, strict=True)):
         assert f">{order + 1}<" in row and f">{name}<" in row
         assert "feasible" in row
+        own = bracket_result.seam_checks[order]
+        assert f">{num(own.max_tracking_error, scale=1e3, unit='mm')}<" in row
     assert "cycle time" in section and "welding (seam time)" in section
     # the totals add up (to the table's 4 digits)
     assert bracket_result.seam_time + bracket_result.air_time == pytest.approx(

@@ -98,8 +98,9 @@ def has_moves(result: PlanResult, case: Case) -> bool:
 def sequence_section(result: PlanResult, case: Case) -> str:
     """The sequence of a plan whose seams are joined by moves (:func:`has_moves`), or
     nothing for one seam alone: per seam in welding order its order, direction, IK
-    branch, start, duration, length, verdict and worst margin (its own plan's joint limits
-    and its task checks); then the totals (welding, approach, retract and air, cycle).
+    branch, start, duration, length, largest tracking error, share run at the rated speed,
+    verdict and worst margin (its own plan's joint limits and its task checks); then the
+    totals (welding, approach, retract and air, cycle).
 
     Returns
     -------
@@ -125,6 +126,8 @@ def sequence_section(result: PlanResult, case: Case) -> str:
                 num(span.first * sample_time, unit="s"),
                 num((span.last - span.first) * sample_time, unit="s"),
                 num(plan.path_length, scale=1e3, unit="mm"),
+                num(own.max_tracking_error, scale=1e3, unit="mm"),
+                percent(plan.rated_speed_fraction),
                 (verdict, "ok" if verdict == "feasible" else "bad"),
                 (percent(margin), margin_class(margin)),
             ]
@@ -137,6 +140,8 @@ def sequence_section(result: PlanResult, case: Case) -> str:
         "start",
         "duration",
         "length",
+        "max tracking error",
+        "at rated speed",
         "verdict",
         "worst margin",
     ]
