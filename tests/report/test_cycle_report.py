@@ -44,6 +44,8 @@ def test_the_report_of_several_seams_has_every_section(bracket, bracket_result, 
     ):
         assert anchor in html, anchor
     assert "Plotly.newPlot" in html
+    view = html[html.index('<section id="view">') :]
+    assert "The robot runs the whole cycle" in view
     # the joint margins of the whole cycle, one column per joint
     margins = html[html.index("<h3>Margins</h3>") :]
     for j in range(bracket.robot.n_dof):

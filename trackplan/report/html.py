@@ -29,6 +29,7 @@ from trackplan.report.html_result import (
     violations_table,
 )
 from trackplan.report.html_search import bounds_line, optimizer_section
+from trackplan.report.machine_view import moves_the_part
 from trackplan.report.plotly_html import plotly_div
 from trackplan.report.robot_view import VIEW_ID, robot_view_spec
 from trackplan.run_files import REPORT_FILE
@@ -122,6 +123,16 @@ def _external_note(case: Case) -> str:
     return esc("".join(notes))
 
 
+def _cycle_note(result: PlanResult, case: Case) -> str:
+    """What the 3D view shows of seams joined by moves (escaped HTML), else nothing."""
+    if not has_moves(result, case) or moves_the_part(case):  # cycle_view_spec's condition
+        return ""
+    return esc(
+        " The robot runs the whole cycle: each seam in its colour of the cycle plot, its "
+        "nominal path dashed in the same colour, the approach, retract and air moves dashed grey."
+    )
+
+
 def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
     """The report's 3D view section: the robot following the path (plotly.js embedded), or
     a note when there is no trajectory. ``n_frames`` animation frames."""
@@ -140,7 +151,8 @@ def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
         '<section id="view"><h2>3D view</h2><p class="muted">The robot drawn from its DH chain '
         "(links between frame origins, a marker per joint) follows the placed path. Drag to "
         "rotate, scroll to zoom, ▶ play or move the time slider; click legend entries to show "
-        f"or hide the path, frames and reach shell.{_external_note(case)}</p>{div}</section>"
+        f"or hide the path, frames and reach shell.{_external_note(case)}"
+        f"{_cycle_note(result, case)}</p>{div}</section>"
     )
 
 
