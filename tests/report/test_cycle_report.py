@@ -114,6 +114,13 @@ def test_the_speed_plot_marks_the_seams_and_the_moves(bracket, bracket_result):
     assert labels == sorted(bracket.seam_names)
     n_moves = sum(span.kind in MOVE_KINDS for span in bracket_result.spans)
     assert len(_gids(figure, "move")) == 2 * n_moves  # on both axes
+    # the axis fits the welding; the moves' peak speed is in the legend
+    fastest = 1e3 * float(np.max(bracket_result.trajectory.speed))
+    top = figure.axes[0].get_ylim()[1]
+    assert top < fastest
+    assert top >= 1e3 * max(bracket.task.rated_speed, bracket.task.corner_speed)
+    legend = [t.get_text() for t in figure.axes[0].get_legend().get_texts()]
+    assert f"moves: up to {fastest:.4g} mm/s, off the axis" in legend
     # each seam's own rated speed over its span: the boss is welded at 15 mm/s
     rated = _gids(figure, "rated-speed")
     levels = sorted({float(s[0][0][1]) for line in rated for s in [line.get_segments()]})

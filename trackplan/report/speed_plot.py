@@ -10,6 +10,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.planning.result import SEAM, PlanResult
 from trackplan.report.figure_style import Canvas, mark_violations, new_figure, status_line
+from trackplan.report.joints_plot import move_samples
 from trackplan.report.path_plots import PlotKinematics
 from trackplan.report.scene import tracking_error, violation_samples
 
@@ -84,11 +85,21 @@ def speed_figure(
             for k, (_, _, t0, t1) in enumerate(seams):
                 ax_speed.hlines(levels[k], t0, t1, label=text if k == 0 else None, gid=gid, **style)
     ax_speed.set_ylabel("tool speed [mm/s]")
+    # a cycle's axis fits the welding: its moves run far faster and would flatten the seams
+    welding = trajectory.speed if seams is None else trajectory.speed[~move_samples(result)]
     top = max(
         *(max(each.rated_speed, each.corner_speed) for each in tasks),
-        float(np.max(trajectory.speed, initial=0.0)),
+        float(np.max(welding, initial=0.0)),
     )
-    ax_speed.set_ylim(0.0, 1.15e3 * top)
+    headroom = 1.15 if seams is None else 1.35  # a cycle's seam names stand over the speeds
+    ax_speed.set_ylim(0.0, headroom * 1e3 * top)
+    fastest = float(np.max(trajectory.speed, initial=0.0))
+    if fastest > headroom * top:  # said in the legend, clear of the slow-down numbers
+        from matplotlib.patches import Patch
+
+        peak = Patch(visible=False, label=f"moves: up to {1e3 * fastest:.4g} mm/s, off the axis")
+        peak.set_gid("move-peak")
+        ax_speed.add_artist(peak)
     if trajectory.n_samples and result.slowdowns:
         _mark_slowdowns(ax_speed, result, slowdown_times(result))
 
@@ -197,7 +208,7 @@ def _mark_seams(
     for _, label, t0, t1 in seams:
         ax_speed.text(
             0.5 * (t0 + t1),
-            0.9,  # under the slow-down numbers, above the welding speed
+            0.91,  # under the slow-down numbers, above the welding speed (headroom)
             label,
             transform=transform,
             ha="center",
