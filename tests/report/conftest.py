@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -204,3 +205,31 @@ def report_file(tmp_path_factory, corner: Case, corner_result: PlanResult):
         corner_result, corner, out_dir, history, REPORT_INFO, n_frames=REPORT_FRAMES
     )
     return report
+
+
+BRACKET_CASE = Path(__file__).resolve().parents[2] / "cases" / "bracket-4-fillets.yaml"
+"""A case of four seams joined by approach, retract and air moves, with a cell."""
+
+
+@pytest.fixture(scope="session")
+def bracket() -> Case:
+    from trackplan.io.case_file import load_case
+
+    return load_case(BRACKET_CASE)
+
+
+@pytest.fixture(scope="session")
+def bracket_result(bracket: Case) -> PlanResult:
+    """The four seams planned once at the case's example placement."""
+    return plan(bracket, bracket.bounds.example)
+
+
+@pytest.fixture(scope="session")
+def bracket_report(tmp_path_factory, bracket: Case, bracket_result: PlanResult):
+    """The bracket's report files, written as a run writes them: (plots, report.html)."""
+    from trackplan.report.run_report import write_run_report
+
+    out_dir = tmp_path_factory.mktemp("bracket-report")
+    return write_run_report(
+        bracket_result, bracket, out_dir, parallel=False, n_frames=REPORT_FRAMES
+    )

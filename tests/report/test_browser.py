@@ -132,3 +132,39 @@ def test_report_view_animates_without_errors(browser, report_file, tmp_path, cor
     assert screenshot.stat().st_size > 10_000
     page.close()
     assert not problems, problems
+
+
+@pytest.mark.slow
+def test_the_report_of_several_seams_loads_without_errors(browser, bracket, bracket_report):
+    _, report = bracket_report
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    page.set_default_timeout(120_000)
+    problems: list[str] = []
+    page.on("console", lambda m: problems.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda error: problems.append(str(error)))
+    page.on(
+        "request",
+        lambda r: problems.append(f"network request {r.url}") if r.url.startswith("http") else None,
+    )
+    page.goto(report.as_uri())
+    page.wait_for_function(
+        f"() => {{ const gd = document.getElementById('{VIEW_ID}');"
+        " return gd && gd.data && gd._transitionData && gd._transitionData._frames.length > 0; }"
+    )
+    names = page.evaluate(f"() => document.getElementById('{VIEW_ID}').data.map((t) => t.name)")
+    assert ROBOT_TRACE in names
+    assert {"approach moves", "retract moves", "air moves"} <= set(names)
+    assert sum(name.startswith("seam ") for name in names) == len(bracket.seams)
+    # the sections a single seam's report has, and the sequence, are on the page
+    for anchor in ("view", "sequence", "plot-joints", "plot-speed", "plot-clearance"):
+        assert page.locator(f"#{anchor}").count() == 1, anchor
+    start = np.array(page.evaluate(ROBOT_XYZ, ROBOT_TRACE)).T
+    page.evaluate(
+        "async ([id, name]) => { await Plotly.animate(document.getElementById(id), [name],"
+        " {mode: 'immediate', frame: {duration: 0, redraw: true}, transition: {duration: 0}}); }",
+        [VIEW_ID, frame_name(REPORT_FRAMES // 2)],
+    )
+    moved = np.array(page.evaluate(ROBOT_XYZ, ROBOT_TRACE)).T
+    assert np.max(np.abs(moved - start)) > 0.01  # the robot follows the cycle
+    page.close()
+    assert not problems, problems

@@ -1,23 +1,21 @@
-"""The plot and report of a plan whose seams are joined by moves: the cycle seen from above
-and its timeline.
+"""What the report adds for a plan whose seams are joined by moves: the cycle's plot and
+the sequence.
 
 ``cycle.png``: left, the tool point's path in the robot base frame seen from above, every
 seam in its own colour (an arrow half-way shows the welding direction) and the
 approach, retract and air moves dashed; right, a Gantt-like timeline of the cycle, one row
-per seam plus one for the moves. ``report.html`` embeds it with the per-seam figures.
+per seam plus one for the moves. :func:`sequence_section` is the report's sequence table.
+The rest of such a run's report is every run's (``docs/results.md``).
 """
 
 from __future__ import annotations
 
-import base64
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from trackplan.case import Case
-from trackplan.planning.result import AIR, APPROACH, RETRACT, PlanResult
-from trackplan.report.figures import _new_figure
-from trackplan.report.html import _esc, _grid, html_page
-from trackplan.run_files import REPORT_FILE
+from trackplan.planning.result import AIR, APPROACH, MOVE_KINDS, RETRACT, SEAM, PlanResult
+from trackplan.report.figure_style import new_figure
+from trackplan.report.html_markup import Cell, esc, grid, key_values, margin_class, num, percent
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -44,7 +42,7 @@ def cycle_figure(result: PlanResult, case: Case) -> Figure:
         Two axes: the top view (``gid="seam"`` lines per seam, ``gid="move"`` dashed lines)
         and the timeline (``gid="bar"`` bars).
     """
-    figure = _new_figure(11.0, 4.6)
+    figure = new_figure(11.0, 4.6)
     top, gantt = figure.subplots(1, 2, width_ratios=[1.0, 1.4])
     position = result.trajectory.tool_position
     sample_time = result.trajectory.sample_time
@@ -90,108 +88,95 @@ def cycle_figure(result: PlanResult, case: Case) -> Figure:
 
 def has_moves(result: PlanResult, case: Case) -> bool:
     """Whether the plan joins its seams with moves (approach, retract or air spans, or a
-    case of several seams, an approach or a home, planned or not): its report is the
-    cycle's (:func:`write_seams_report`)."""
+    case of several seams, an approach or a home, planned or not): its report adds the
+    cycle's plot and the sequence."""
     sequencing = case.sequencing
     joined = len(case.seams) > 1 or sequencing.approach > 0 or sequencing.home is not None
     return joined or any(span.kind in MOVE_COLORS for span in result.spans)
 
 
-def write_seams_report(
-    result: PlanResult, case: Case, out_dir: Path, info: dict | None = None
-) -> list[Path]:
-    """Write ``cycle.png`` and ``report.html`` (self-contained: the plot as a data URI).
-
-    Parameters
-    ----------
-    result
-        The cycle.
-    case
-        Its case.
-    out_dir
-        Directory to write into.
-    info
-        The ``result.json`` content, for the tables (seams, moves, search).
+def sequence_section(result: PlanResult, case: Case) -> str:
+    """The sequence of a plan whose seams are joined by moves (:func:`has_moves`), or
+    nothing for one seam alone: per seam in welding order its order, direction, IK
+    branch, start, duration, length, largest tracking error, share run at the rated speed,
+    verdict and worst margin (its own plan's joint limits and its task checks); then the
+    totals (welding, approach, retract and air, cycle).
 
     Returns
     -------
-    list of pathlib.Path
-        The files written.
+    str
+        HTML: ``<section id="sequence">`` with two tables.
     """
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    written: list[Path] = []
-    plot = ""
-    if result.trajectory.n_samples:
-        figure = cycle_figure(result, case)
-        path = out_dir / CYCLE_PLOT
-        figure.savefig(path)
-        written.append(path)
-        data = base64.b64encode(path.read_bytes()).decode("ascii")
-        plot = (
-            f'<figure id="plot-cycle"><img alt="the cycle" src="data:image/png;base64,{data}">'
-            "<figcaption>Left: the tool point from above, each seam in its colour (the arrow "
-            "half-way shows the welding direction), approach, retract and air moves dashed. "
-            f"Right: the cycle's timeline. (file: {CYCLE_PLOT})</figcaption></figure>"
+    if not has_moves(result, case):
+        return ""
+    sample_time = result.trajectory.sample_time
+    rows: list[list[Cell]] = []
+    for order, (seam, own) in enumerate(zip(result.seams, result.seam_checks, strict=True)):
+        span = next(p for p in result.spans if p.kind == SEAM and p.seam == seam.index)
+        plan = seam.plan
+        margins = [m for m in (plan.check.worst_margin(), own.worst_margin()) if m == m]
+        margin = min(margins, default=float("nan"))  # NaN: no margin counts
+        verdict = "feasible" if own.success and plan.check.success else "infeasible"
+        rows.append(
+            [
+                str(order + 1),
+                esc(seam.name),
+                "reversed" if seam.reversed else "forward",
+                str(plan.branch),
+                num(span.first * sample_time, unit="s"),
+                num((span.last - span.first) * sample_time, unit="s"),
+                num(plan.path_length, scale=1e3, unit="mm"),
+                num(own.max_tracking_error, scale=1e3, unit="mm"),
+                percent(plan.rated_speed_fraction),
+                (verdict, "ok" if verdict == "feasible" else "bad"),
+                (percent(margin), margin_class(margin)),
+            ]
         )
-    info = info or {}
-    seams = [
-        [
-            _esc(row["name"]),
-            "reversed" if row["reversed"] else "forward",
-            f"{row['t_start']:.3f}",
-            f"{row['duration']:.3f}",
-            f"{row['objective']:.4f}",
-            f"{1e3 * row['max_tracking_error']:.3f}",
-            f"{100 * row['rated_speed_fraction']:.1f}",
-            str(len(row["slowdowns"])),
-        ]
-        for row in info.get("seams", [])
+    header = [
+        "#",
+        "seam",
+        "direction",
+        "branch",
+        "start",
+        "duration",
+        "length",
+        "max tracking error",
+        "at rated speed",
+        "verdict",
+        "worst margin",
     ]
-    seam_table = _grid(
+    moves = [span for span in result.spans if span.kind in MOVE_KINDS]
+    totals = key_values(
         [
-            "seam",
-            "direction",
-            "start s",
-            "duration s",
-            "J",
-            "tracking mm",
-            "at rated speed %",
-            "slow-downs",
-        ],
-        seams,
+            ("welding (seam time)", num(result.seam_time, unit="s")),
+            (
+                "approach, retract and air",
+                f"{num(result.air_time, unit='s')} in {len(moves)} moves",
+            ),
+            ("cycle time", num(result.duration, unit="s")),
+            ("sequence", esc(_sequence_text(result, case))),
+        ]
     )
-    figures = _grid(
-        ["figure", "value"],
-        [
-            ["cycle time", f"{result.duration:.3f} s"],
-            ["welding", f"{result.seam_time:.3f} s"],
-            ["approach, retract and air", f"{result.air_time:.3f} s"],
-            ["J (Eq. 8, whole cycle)", f"{result.objective:.4f}"],
-            ["placement", ", ".join(f"{v:.4f}" for v in result.placement)],
-            ["sequence", _esc(_sequence_text(info))],
-        ],
+    unplanned = "".join(
+        f"<li>{esc(name)}: {esc(plan.message)}</li>" for name, plan in result.unplanned.items()
     )
-    violations = "".join(f"<li>{_esc(v.message)}</li>" for v in result.check.violations[:20])
-    verdict = "feasible" if result.feasible else "infeasible"
-    body = (
-        f"<h1>{_esc(case.name)}: {verdict}</h1><p>{_esc(result.message)}</p>"
-        f'<section id="result"><h2>Cycle</h2>{figures}{plot}'
-        f"<h2>Seams</h2>{seam_table}"
-        + (f"<h2>Violations</h2><ul>{violations}</ul>" if violations else "")
+    return (
+        '<section id="sequence"><h2>Sequence</h2><p class="muted">The seams in the order '
+        "welded; the margin is the least unused fraction of a joint limit or a task bound "
+        "over the seam's own plan. Times in the whole cycle.</p>"
+        + grid(header, rows)
+        + "<h3>Total</h3>"
+        + totals
+        + (f"<h3>Not planned</h3><ul>{unplanned}</ul>" if unplanned else "")
         + "</section>"
     )
-    page = html_page(f"trackplan report: {case.name}", body)
-    report = out_dir / REPORT_FILE
-    report.write_text(page, encoding="utf-8")
-    written.append(report)
-    return written
 
 
-def _sequence_text(info: dict) -> str:
-    """``rib-left ← , rib-right →`` from the ``sequence`` of result.json."""
-    steps = info.get("sequence", [])
-    return ", ".join(f"{s['seam']} {'←' if s['reversed'] else '→'}" for s in steps) or "-"
+def _sequence_text(result: PlanResult, case: Case) -> str:
+    """``rib-left ←, rib-right →``: the seams in welding order and their directions."""
+    names = case.seam_names
+    steps = result.sequence.visits
+    return ", ".join(f"{names[v.seam]} {'←' if v.reversed else '→'}" for v in steps) or "–"
 
 
-__all__ = ["CYCLE_PLOT", "cycle_figure", "has_moves", "write_seams_report"]
+__all__ = ["CYCLE_PLOT", "MOVE_COLORS", "cycle_figure", "has_moves", "sequence_section"]

@@ -20,6 +20,7 @@ import numpy as np
 from trackplan.case import Case
 from trackplan.planning.result import PlanResult
 from trackplan.report.convergence_plot import convergence_canvas, convergence_figure
+from trackplan.report.cycle import CYCLE_PLOT, cycle_figure, has_moves
 from trackplan.report.figure_style import BandedFigure, Canvas, PlotBuilder, new_figure, save_png
 from trackplan.report.joints_plot import JOINT_BANDS, joints_canvas, joints_figure
 from trackplan.report.path_plots import (
@@ -73,6 +74,10 @@ def plot_figures(
     order; the builders draw with ``kinematics`` (:func:`plot_kinematics`, computed here
     when not given) and start no compiled kernel, each on its blank figure from
     ``canvases`` (:func:`blank_canvases`, which it takes out of the dict) when there is one.
+
+    A plan whose seams are joined by moves (:func:`~trackplan.report.cycle.has_moves`)
+    gets ``cycle.png`` first, and neither ``path.png`` nor ``tool.png`` (they show one
+    seam's path; the 3D view shows every seam and move).
     """
     if kinematics is None:
         kinematics = plot_kinematics(result, case)
@@ -81,20 +86,23 @@ def plot_figures(
     def joints_band(k: int, rows: Sequence[int]) -> Figure:
         return joints_figure(result, case, rows, blank(f"joints.png/{k}", None))
 
-    builders: dict[str, PlotBuilder] = {
-        "joints.png": BandedFigure(
-            tuple(partial(joints_band, k, rows) for k, rows in enumerate(JOINT_BANDS))
-        ),
-        "path.png": lambda: path_figure(
+    cycle = has_moves(result, case)
+    builders: dict[str, PlotBuilder] = {}
+    if cycle and result.trajectory.n_samples:  # seams joined by moves: the cycle first
+        builders[CYCLE_PLOT] = lambda: cycle_figure(result, case)
+    builders["joints.png"] = BandedFigure(
+        tuple(partial(joints_band, k, rows) for k, rows in enumerate(JOINT_BANDS))
+    )
+    if not cycle:  # one seam's path and placement: the 3D view shows a cycle's
+        builders["path.png"] = lambda: path_figure(
             result, case, kinematics=kinematics, canvas=blank("path.png", None)
-        ),
-        "speed.png": lambda: speed_figure(result, case, kinematics, blank("speed.png", None)),
-    }
+        )
+    builders["speed.png"] = lambda: speed_figure(result, case, kinematics, blank("speed.png", None))
     if result.check.cell is not None and result.trajectory.n_samples:
         from trackplan.report.cell_figures import clearance_figure
 
         builders["clearance.png"] = lambda: clearance_figure(result)
-    if shows_tool(case):
+    if shows_tool(case) and not cycle:
         builders["tool.png"] = lambda: tool_figure(result, case, kinematics=kinematics)
     if history:
         builders["convergence.png"] = lambda: convergence_figure(

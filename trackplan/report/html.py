@@ -15,6 +15,8 @@ import numpy as np
 
 from trackplan.case import Case
 from trackplan.planning.result import PlanResult
+from trackplan.report.cycle import has_moves, sequence_section
+from trackplan.report.cycle_view import cycle_view_spec
 from trackplan.report.html_case import case_section
 from trackplan.report.html_markup import esc, grid, html_page
 from trackplan.report.html_result import (
@@ -27,6 +29,7 @@ from trackplan.report.html_result import (
     violations_table,
 )
 from trackplan.report.html_search import bounds_line, optimizer_section
+from trackplan.report.machine_view import moves_the_part
 from trackplan.report.plotly_html import plotly_div
 from trackplan.report.robot_view import VIEW_ID, robot_view_spec
 from trackplan.run_files import REPORT_FILE
@@ -34,12 +37,19 @@ from trackplan.run_files import REPORT_FILE
 _esc, _grid = esc, grid  # moved to html_markup; importers outside this package keep working
 
 _PLOT_CAPTIONS = {
+    "cycle.png": (
+        "Cycle",
+        "Left: the tool point from above, each seam in its colour (the arrow half-way shows "
+        "the welding direction), approach, retract and air moves dashed. Right: the cycle's "
+        "timeline, one row per seam and one for the moves.",
+    ),
     "joints.png": (
         "Joint trajectories",
         "Rows: position, velocity, acceleration and jerk (backward differences at Ts, robot "
         "at rest before the first sample); one column per joint. Dashed lines are the limits; "
         "red markers are samples beyond a limit and red bands the violation windows the "
-        "checker reported. Each panel gives its margin (unused fraction of the limit) above it.",
+        "checker reported. Each panel gives its margin (unused fraction of the limit) above it; "
+        "grey bands, for seams joined by moves, are the approach, retract and air moves.",
     ),
     "path.png": (
         "Path and placement",
@@ -54,7 +64,9 @@ _PLOT_CAPTIONS = {
         "Top: Cartesian tool speed against the rated speed and the corner speed cap, slow-downs "
         "shaded and numbered as in the slow-down table (neighbours too close to label apart "
         "share a label, 3–5), their reasons in the legend. Bottom: distance of the tool point "
-        "from the nominal path (sharp corners kept) against the tolerance ρ.",
+        "from the nominal path (sharp corners kept) against the tolerance ρ. For seams joined by "
+        "moves: each seam named over its span with its own rated speed, cap and tolerance, the "
+        "moves shaded grey.",
     ),
     "clearance.png": (
         "Clearance",
@@ -111,6 +123,16 @@ def _external_note(case: Case) -> str:
     return esc("".join(notes))
 
 
+def _cycle_note(result: PlanResult, case: Case) -> str:
+    """What the 3D view shows of seams joined by moves (escaped HTML), else nothing."""
+    if not has_moves(result, case) or moves_the_part(case):  # cycle_view_spec's condition
+        return ""
+    return esc(
+        " The robot runs the whole cycle: each seam in its colour of the cycle plot, its "
+        "nominal path dashed in the same colour, the approach, retract and air moves dashed grey."
+    )
+
+
 def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
     """The report's 3D view section: the robot following the path (plotly.js embedded), or
     a note when there is no trajectory. ``n_frames`` animation frames."""
@@ -120,7 +142,7 @@ def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
             f"{esc(result.message)}</p></section>"
         )
     div = plotly_div(
-        robot_view_spec(result, case, n_frames=n_frames),
+        cycle_view_spec(robot_view_spec(result, case, n_frames=n_frames), result, case),
         VIEW_ID,
         config={"displaylogo": False, "responsive": True},
         post_script=_QUIET_INTERRUPTS,
@@ -129,7 +151,8 @@ def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
         '<section id="view"><h2>3D view</h2><p class="muted">The robot drawn from its DH chain '
         "(links between frame origins, a marker per joint) follows the placed path. Drag to "
         "rotate, scroll to zoom, ▶ play or move the time slider; click legend entries to show "
-        f"or hide the path, frames and reach shell.{_external_note(case)}</p>{div}</section>"
+        f"or hide the path, frames and reach shell.{_external_note(case)}"
+        f"{_cycle_note(result, case)}</p>{div}</section>"
     )
 
 
@@ -197,8 +220,9 @@ def report_page(
             f"<h1>{esc(case.name)}: {verdict}</h1>",
             f"<p>{verdict_badge(result)} {esc(result.message)}</p>",
             bounds_line(optimizer_info),
-            '<nav><a href="#case">Case</a><a href="#result">Result</a><a href="#plots">Plots</a>'
-            '<a href="#view">3D view</a></nav>',
+            '<nav><a href="#case">Case</a><a href="#result">Result</a>'
+            + ('<a href="#sequence">Sequence</a>' if has_moves(result, case) else "")
+            + '<a href="#plots">Plots</a><a href="#view">3D view</a></nav>',
             case_section(result, case),
             '<section id="result"><h2>Result</h2>',
             '<div class="cols"><div><h3>Key figures</h3>',
@@ -212,6 +236,7 @@ def report_page(
             margins_table(result, case),
             violations_table(result),
             "</section>",
+            sequence_section(result, case),
             _plots_section(plots),
             view,
         ]

@@ -84,17 +84,20 @@ def case_section(result: PlanResult, case: Case) -> str:
         ],
         joint_rows,
     )
-    segments: list[list[Cell]] = [
-        [str(i + 1), *((esc(text), "text") for text in _describe_segment(s))]
-        for i, s in enumerate(case.segments)
-    ]
-    path_html = key_values(
-        [
-            ("start", f"{vector(case.start)} m"),
-            ("segments", str(len(case.segments))),
-            ("nominal length", num(result.path_length, unit="m")),
+    if case.paths:
+        path_html = _seams_html(result, case)
+    else:
+        segments: list[list[Cell]] = [
+            [str(i + 1), *((esc(text), "text") for text in _describe_segment(s))]
+            for i, s in enumerate(case.segments)
         ]
-    ) + grid(["#", "kind", "geometry (definition frame)"], segments)
+        path_html = key_values(
+            [
+                ("start", f"{vector(case.start)} m"),
+                ("segments", str(len(case.segments))),
+                ("nominal length", num(result.path_length, unit="m")),
+            ]
+        ) + grid(["#", "kind", "geometry (definition frame)"], segments)
     task_html = key_values(
         [
             ("rated speed v_r", num(task.rated_speed, scale=1e3, unit="mm/s")),
@@ -131,6 +134,32 @@ def case_section(result: PlanResult, case: Case) -> str:
         f'<div class="cols"><div><h3>Path</h3>{path_html}</div><div><h3>Task</h3>{task_html}</div>'
         f"<div><h3>Placement search</h3>{search_html}</div></div></section>"
     )
+
+
+def _seams_html(result: PlanResult, case: Case) -> str:
+    """The seams of a case file's ``paths:`` as written: per segment its seam, the seam's
+    start and rated speed, and the segment; with the sequence mode and approach distance."""
+    rows: list[list[Cell]] = []
+    for seam in case.seams:
+        for i, segment in enumerate(seam.segments):
+            first = i == 0
+            rows.append(
+                [
+                    (esc(seam.name), "text") if first else "",
+                    f"{vector(seam.start)} m" if first else "",
+                    num(seam.task.rated_speed, scale=1e3, unit="mm/s") if first else "",
+                    *((esc(text), "text") for text in _describe_segment(segment)),
+                ]
+            )
+    sequencing = case.sequencing
+    return key_values(
+        [
+            ("seams", str(len(case.seams))),
+            ("nominal length", f"{num(result.path_length, unit='m')} (all seams)"),
+            ("sequence", esc(sequencing.sequence)),
+            ("approach", num(sequencing.approach, scale=1e3, unit="mm")),
+        ]
+    ) + grid(["seam", "start", "rated speed", "kind", "geometry (definition frame)"], rows)
 
 
 def _external_html(case: Case) -> str:

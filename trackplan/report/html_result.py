@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.planning.result import LIMIT_KINDS, PlanResult
+from trackplan.planning.result import LIMIT_KINDS, SEAM, PlanResult
+from trackplan.report.cycle import has_moves
 from trackplan.report.html_markup import (
     Cell,
     esc,
@@ -31,6 +32,20 @@ def figures_table(result: PlanResult, case: Case) -> str:
     task = case.task
     ideal = result.path_length / task.rated_speed if task.rated_speed > 0 else float("nan")
     x = result.placement
+    ideal_row = (
+        "L / v_r (no ramps, no corners)",
+        f"{num(ideal, unit='s')}; duration is "
+        f"{num(result.duration / ideal if ideal else float('nan'))} × that",
+    )
+    if has_moves(result, case):  # each seam at its own rated speed, against the welding time
+        ideal = sum(
+            seam.plan.path_length / case.seams[seam.index].task.rated_speed for seam in result.seams
+        )
+        ideal_row = (
+            "Σ L / v_r over the seams",
+            f"{num(ideal, unit='s')}; welding takes "
+            f"{num(result.seam_time / ideal if ideal else float('nan'))} × that",
+        )
     rows = [
         ("verdict", verdict_badge(result)),
         ("message", esc(result.message)),
@@ -42,11 +57,7 @@ def figures_table(result: PlanResult, case: Case) -> str:
         ("objective J (Eq. 8)", num(result.objective, 6)),
         ("duration", num(result.duration, unit="s")),
         ("path length", num(result.path_length, unit="m")),
-        (
-            "L / v_r (no ramps, no corners)",
-            f"{num(ideal, unit='s')}; duration is "
-            f"{num(result.duration / ideal if ideal else float('nan'))} × that",
-        ),
+        ideal_row,
         _rated_speed_row(result, task.rated_speed),
         ("min corner speed", num(result.min_corner_speed, scale=1e3, unit="mm/s")),
         (
@@ -233,9 +244,11 @@ def slowdowns_table(result: PlanResult) -> str:
     """The slow-downs below the rated speed, numbered as ``speed.png`` labels them."""
     if not result.slowdowns:
         return "<h3>Slow-downs</h3><p>None: every straight piece runs at the rated speed.</p>"
+    seams = _slowdown_seams(result)
     rows: list[list[Cell]] = [
         [
             str(k + 1),  # the number speed.png labels it with
+            *([(esc(seams[k]), "text")] if seams else []),
             num(s.s_start, unit="m"),
             num(s.s_end, unit="m"),
             num(s.speed, scale=1e3, unit="mm/s"),
@@ -244,9 +257,17 @@ def slowdowns_table(result: PlanResult) -> str:
         ]
         for k, s in enumerate(result.slowdowns)
     ]
-    return "<h3>Slow-downs</h3>" + grid(
-        ["#", "from s", "to s", "speed", "rated", "forced by"], rows
-    )
+    header = ["#", *(["seam"] if seams else []), "from s", "to s", "speed", "rated", "forced by"]
+    return "<h3>Slow-downs</h3>" + grid(header, rows)
+
+
+def _slowdown_seams(result: PlanResult) -> list[str]:
+    """The seam of each of ``result.slowdowns`` (every seam's in welding order, ``s`` along
+    its own seam) when the plan has moves between seams, else none."""
+    if not any(span.kind != SEAM for span in result.spans):
+        return []
+    names = [seam.name for seam in result.seams for _ in seam.plan.slowdowns]
+    return names if len(names) == len(result.slowdowns) else []
 
 
 def references_table(result: PlanResult) -> str:

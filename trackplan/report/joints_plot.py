@@ -13,7 +13,7 @@ import numpy as np
 
 from trackplan.case import Case
 from trackplan.planning.checker import RELATIVE_SLACK
-from trackplan.planning.result import LIMIT_KINDS, PlanResult
+from trackplan.planning.result import LIMIT_KINDS, MOVE_KINDS, PlanResult
 from trackplan.report.figure_style import (
     DPI,
     SYMLOG_RATIO,
@@ -103,6 +103,16 @@ def joints_canvas(n: int, rows: Sequence[int]) -> Canvas:
     return figure, axes
 
 
+def move_samples(result: PlanResult) -> np.ndarray:
+    """Which samples lie on an approach, retract or air move (``result.spans``), shape (N,),
+    bool; all False for one seam alone."""
+    moving = np.zeros(result.trajectory.n_samples, dtype=bool)
+    for span in result.spans:
+        if span.kind in MOVE_KINDS:
+            moving[span.first : span.last + 1] = True
+    return moving
+
+
 def joints_figure(
     result: PlanResult,
     case: Case,
@@ -117,6 +127,7 @@ def joints_figure(
     positions. Samples beyond a limit are red markers (``gid="violation"``) and every
     violation window the checker reported is a red band (``gid="violation-window"``).
     Each panel states its margin (unused fraction of the limit) above its right corner.
+    The approach, retract and air moves between seams are grey bands (``gid="move"``).
     A panel whose data exceed the limits by more than 20 times gets a symmetric-log axis
     (linear within ±limit).
 
@@ -160,6 +171,7 @@ def joints_figure(
         axes[0, 0].set_xlim(*t_limits)
         axes[0, 0].set_xticks(inside_ticks(MaxNLocator(nbins=5), *t_limits))
     half = 0.5 * trajectory.sample_time
+    moving = move_samples(result)
     for band_row, row in enumerate(rows):
         kind = LIMIT_KINDS[row]
         values = joint_series(trajectory, kind)
@@ -205,6 +217,18 @@ def joints_figure(
                         label="violation window",
                         gid="violation-window",
                     )
+            if moving.any():  # the moves between seams, one grey polygon per panel
+                ax.fill_between(
+                    trajectory.t,
+                    0.0,
+                    1.0,
+                    where=moving,
+                    transform=ax.get_xaxis_transform(),
+                    color="0.5",
+                    alpha=0.12,
+                    lw=0,
+                    gid="move",
+                )
             if margins is not None and j < len(margins) and np.isfinite(margins[j]):
                 # above the panel, clear of the data (a boxed label inside cost a tenth
                 # of the figure)

@@ -1,7 +1,7 @@
 """The plots and ``report.html`` of one run, on two cores when the machine has them.
 
-A plan whose seams are joined by moves (approach, retract, air) gets the cycle's plot and
-tables (:mod:`trackplan.report.cycle`) instead of the per-seam plots.
+Every run gets the same report; a plan whose seams are joined by moves (approach, retract,
+air) gets the cycle's plot and sequence too (:mod:`trackplan.report.cycle`).
 
 Drawing the PNG plots is most of a report's cost: :func:`write_run_report` draws them in
 two processes (:func:`~trackplan.report.drawing.draw_plots`) and builds the 3D view while
@@ -19,9 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.io.results import plan_summary
 from trackplan.planning.result import PlanResult
-from trackplan.report.cycle import has_moves, write_seams_report
 from trackplan.report.drawing import can_fork, draw_plots
 from trackplan.report.figures import plot_figures, plot_kinematics
 from trackplan.report.html import report_page, view_section
@@ -79,12 +77,6 @@ def write_run_report(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    if has_moves(result, case):  # seams joined by moves: the cycle plot and its tables
-        if meanwhile is not None:
-            meanwhile()
-        info = {**plan_summary(result, case), **(optimizer_info or {})}
-        written = write_seams_report(result, case, out_dir, info)
-        return written[:-1], written[-1]
     kinematics = plot_kinematics(result, case)  # numba's kernels run here, not in the worker
     builders = plot_figures(result, case, history, kinematics)
     plots = [(out_dir / name, plot) for name, plot in builders.items()]

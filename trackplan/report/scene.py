@@ -152,7 +152,9 @@ def path_points(result: PlanResult, case: Case) -> tuple[np.ndarray, np.ndarray]
 
 
 def tracking_error(result: PlanResult, case: Case) -> np.ndarray:
-    """Distance of the tool point from the nominal path (sharp corners kept) per sample.
+    """Distance of the tool point from the nominal path (sharp corners kept) per sample;
+    with several seams or moves between them, from the nominal path of the seam being
+    welded, NaN on the moves.
 
     Returns
     -------
@@ -162,7 +164,16 @@ def tracking_error(result: PlanResult, case: Case) -> np.ndarray:
     if result.trajectory.n_samples == 0:
         return np.zeros(0)
     points_part, _ = path_points(result, case)
-    return NominalPath.from_specs(case.start, case.segments).project(points_part)[1]
+    seams = [span for span in result.spans if span.kind == "seam"]
+    if len(seams) == len(result.spans) <= 1:  # one seam alone
+        return NominalPath.from_specs(case.start, case.segments).project(points_part)[1]
+    error = np.full(len(points_part), np.nan)  # NaN on the moves between seams
+    for span in seams:
+        seam = case.seams[case.seam_names.index(span.label)]
+        rows = slice(span.first, span.last + 1)
+        path = NominalPath.from_specs(seam.start, seam.segments)
+        error[rows] = path.project(points_part[rows])[1]
+    return error
 
 
 def frame_indices(n_samples: int, n_frames: int) -> np.ndarray:

@@ -8,8 +8,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from trackplan.case import Case
-from trackplan.planning.result import PlanResult
+from trackplan.planning.result import SEAM, PlanResult
 from trackplan.report.figure_style import Canvas, mark_violations, new_figure, status_line
+from trackplan.report.joints_plot import move_samples
 from trackplan.report.path_plots import PlotKinematics
 from trackplan.report.scene import tracking_error, violation_samples
 
@@ -65,41 +66,67 @@ def speed_figure(
     ax_speed.plot(
         t, 1e3 * trajectory.speed, color="tab:blue", lw=1.2, label="tool speed", gid="speed"
     )
-    ax_speed.axhline(
-        1e3 * task.rated_speed,
-        ls="--",
-        color="tab:green",
-        label=f"rated speed vᵣ = {1e3 * task.rated_speed:.4g} mm/s",
-        gid="rated-speed",
-    )
-    ax_speed.axhline(
-        1e3 * task.corner_speed,
-        ls=":",
-        color="tab:orange",
-        lw=1.5,
-        label=f"corner speed cap vₜᵐᵃˣ = {1e3 * task.corner_speed:.4g} mm/s",
-        gid="corner-speed",
-    )
+    seams = seam_spans(result, case)
+    tasks = [task] if seams is None else [case.seams[k].task for k, *_ in seams]
+    for label, style, attribute, gid in (
+        ("rated speed vᵣ", {"ls": "--", "color": "tab:green"}, "rated_speed", "rated-speed"),
+        (
+            "corner speed cap vₜᵐᵃˣ",
+            {"ls": ":", "color": "tab:orange", "lw": 1.5},
+            "corner_speed",
+            "corner-speed",
+        ),
+    ):
+        levels = [1e3 * getattr(each, attribute) for each in tasks]
+        text = f"{label} = {', '.join(dict.fromkeys(f'{v:.4g}' for v in levels))} mm/s"
+        if seams is None:
+            ax_speed.axhline(levels[0], label=text, gid=gid, **style)
+        else:  # each seam's own, over its span
+            for k, (_, _, t0, t1) in enumerate(seams):
+                ax_speed.hlines(levels[k], t0, t1, label=text if k == 0 else None, gid=gid, **style)
     ax_speed.set_ylabel("tool speed [mm/s]")
-    top = max(task.rated_speed, task.corner_speed, float(np.max(trajectory.speed, initial=0.0)))
-    ax_speed.set_ylim(0.0, 1.15e3 * top)
+    # a cycle's axis fits the welding: its moves run far faster and would flatten the seams
+    welding = trajectory.speed if seams is None else trajectory.speed[~move_samples(result)]
+    top = max(
+        *(max(each.rated_speed, each.corner_speed) for each in tasks),
+        float(np.max(welding, initial=0.0)),
+    )
+    headroom = 1.15 if seams is None else 1.35  # a cycle's seam names stand over the speeds
+    ax_speed.set_ylim(0.0, headroom * 1e3 * top)
+    fastest = float(np.max(trajectory.speed, initial=0.0))
+    if fastest > headroom * top:  # said in the legend, clear of the slow-down numbers
+        from matplotlib.patches import Patch
+
+        peak = Patch(visible=False, label=f"moves: up to {1e3 * fastest:.4g} mm/s, off the axis")
+        peak.set_gid("move-peak")
+        ax_speed.add_artist(peak)
     if trajectory.n_samples and result.slowdowns:
-        _mark_slowdowns(ax_speed, result, t)
+        _mark_slowdowns(ax_speed, result, slowdown_times(result))
 
     error = tracking_error(result, case) if kinematics is None else kinematics.tracking_error
     ax_error.plot(
         t, 1e3 * error, color="tab:purple", lw=1.2, label="tracking error", gid="tracking-error"
     )
-    ax_error.axhline(
-        1e3 * task.tolerance,
-        ls="--",
-        color="0.3",
-        label=f"tolerance ρ = {1e3 * task.tolerance:.4g} mm",
-        gid="tolerance",
-    )
+    tolerances = [1e3 * each.tolerance for each in tasks]
+    text = f"tolerance ρ = {', '.join(dict.fromkeys(f'{v:.4g}' for v in tolerances))} mm"
+    if seams is None:
+        ax_error.axhline(tolerances[0], ls="--", color="0.3", label=text, gid="tolerance")
+    else:
+        for k, (_, _, t0, t1) in enumerate(seams):
+            ax_error.hlines(
+                tolerances[k],
+                t0,
+                t1,
+                ls="--",
+                color="0.3",
+                label=text if k == 0 else None,
+                gid="tolerance",
+            )
+        _mark_seams(ax_speed, ax_error, result, seams)
     ax_error.set_ylabel("tracking error [mm]")
     ax_error.set_xlabel("time [s]")
-    ax_error.set_ylim(0.0, 1.15e3 * max(task.tolerance, float(np.max(error, initial=0.0))))
+    largest = float(np.max(error, initial=0.0, where=np.isfinite(error)))
+    ax_error.set_ylim(0.0, 1.15 * max(*tolerances, 1e3 * largest))
 
     # the speed cap depends on where the tool is (corner or straight): mark what the
     # checker reported rather than guess the cap here
@@ -121,7 +148,79 @@ SLOWDOWN_REASONS = 6
 the report's slow-down table."""
 
 
-def _mark_slowdowns(ax: Axes, result: PlanResult, t: np.ndarray) -> None:
+def seam_spans(result: PlanResult, case: Case) -> list[tuple[int, str, float, float]] | None:
+    """The seams of a plan joined by moves as ``(index as written, label, t start,
+    t end)`` in welding order (s), or None for one seam alone (no moves)."""
+    spans = result.spans
+    if len(spans) <= 1 and all(span.kind == SEAM for span in spans):
+        return None
+    sample_time = result.trajectory.sample_time
+    names = case.seam_names
+    return [
+        (names.index(span.label), span.label, span.first * sample_time, span.last * sample_time)
+        for span in spans
+        if span.kind == SEAM
+    ]
+
+
+def slowdown_times(result: PlanResult) -> list[tuple[float, float]]:
+    """When each of ``result.slowdowns`` happens, ``(t start, t end)`` in s: its arc
+    length ``s`` looked up on the trajectory's, within its seam's span for a plan of
+    several seams (``s`` runs along each seam on its own there)."""
+    trajectory = result.trajectory
+    t = trajectory.t
+    times: list[tuple[float, float]] = []
+    if len(result.spans) <= 1:
+        for d in result.slowdowns:
+            t0, t1 = np.interp([d.s_start, d.s_end], trajectory.s, t)
+            times.append((float(t0), float(t1)))
+        return times
+    for seam in result.seams:
+        span = next(p for p in result.spans if p.kind == SEAM and p.seam == seam.index)
+        rows = slice(span.first, span.last + 1)
+        s_span = np.maximum.accumulate(trajectory.s[rows])  # s never runs back in a seam
+        for d in seam.plan.slowdowns:
+            t0, t1 = np.interp([d.s_start, d.s_end], s_span, t[rows])
+            times.append((float(t0), float(t1)))
+    return times
+
+
+def _mark_seams(
+    ax_speed: Axes, ax_error: Axes, result: PlanResult, seams: list[tuple[int, str, float, float]]
+) -> None:
+    """Mark the cycle on both axes: each move between seams shaded grey (``gid="move"``),
+    each seam's name over its span on the speed axes (``gid="seam-label"``)."""
+    from matplotlib.transforms import blended_transform_factory
+
+    sample_time = result.trajectory.sample_time
+    for k, span in enumerate(p for p in result.spans if p.kind != SEAM):
+        for ax in (ax_speed, ax_error):
+            ax.axvspan(
+                span.first * sample_time,
+                span.last * sample_time,
+                color="0.5",
+                alpha=0.12,
+                lw=0,
+                gid="move",
+                label="approach, retract, air" if k == 0 and ax is ax_speed else None,
+            )
+    transform = blended_transform_factory(ax_speed.transData, ax_speed.transAxes)
+    for _, label, t0, t1 in seams:
+        ax_speed.text(
+            0.5 * (t0 + t1),
+            0.91,  # under the slow-down numbers, above the welding speed (headroom)
+            label,
+            transform=transform,
+            ha="center",
+            va="top",
+            fontsize=7,
+            color="0.15",
+            clip_on=True,
+            gid="seam-label",
+        )
+
+
+def _mark_slowdowns(ax: Axes, result: PlanResult, spans: list[tuple[float, float]]) -> None:
     """Shade the slow-downs of ``result`` on the speed axes ``ax`` and number them (1, 2, …
     in the order of ``result.slowdowns``, as the report's table and the summary list them).
 
@@ -134,11 +233,6 @@ def _mark_slowdowns(ax: Axes, result: PlanResult, t: np.ndarray) -> None:
     from matplotlib.patches import Patch
     from matplotlib.transforms import blended_transform_factory
 
-    trajectory = result.trajectory
-    spans = [
-        np.interp([slowdown.s_start, slowdown.s_end], trajectory.s, t)
-        for slowdown in result.slowdowns
-    ]
     for k, (t0, t1) in enumerate(spans):
         ax.axvspan(
             t0,
