@@ -32,8 +32,9 @@ MESH_PAGE_BYTES = 3_000_000
 """Most bytes the robot's animated meshes take in the page (all frames)."""
 SOLID_DECIMALS = 3
 """Decimals of the solids' coordinates, m (1 mm: they are sent in every frame)."""
-BYTES_PER_VERTEX = 3 * 7
-"""About the bytes of one vertex in one frame (``-0.123,`` per coordinate)."""
+BYTES_PER_VERTEX = 3 * 8
+"""Bytes of one vertex in one frame, at most (``-0.123,`` per coordinate, and the rest of
+the trace)."""
 MESHES_TRACE = "robot (URDF meshes)"
 """Name of the first mesh trace; the others are named after their links."""
 SOLIDS_TRACE = "robot (link capsules)"
@@ -83,6 +84,19 @@ def mesh_budget(n_frames: int, page_bytes: int = MESH_PAGE_BYTES) -> int:
     (a closed mesh has about half as many vertices as triangles)."""
     vertices = page_bytes // (BYTES_PER_VERTEX * max(1, n_frames))
     return int(max(4, min(MAX_TRIANGLES, 2 * vertices)))
+
+
+def _fitted(visuals: tuple[LinkVisual, ...], n_frames: int, page_bytes: int) -> tuple:
+    """The visuals decimated to :func:`mesh_budget`, then further until their vertices over
+    ``n_frames`` frames take at most ``page_bytes``."""
+    budget = mesh_budget(n_frames, page_bytes)
+    for _ in range(8):
+        kept = decimate_visuals(visuals, budget)
+        size = sum(len(v.vertices) for v in kept) * n_frames * BYTES_PER_VERTEX
+        if size <= page_bytes or budget <= 4:
+            return kept
+        budget = max(4, int(0.95 * budget * page_bytes / size))
+    return kept
 
 
 def _posed(parts: list[_Part], frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -175,15 +189,17 @@ def robot_look(case: Case, frames: np.ndarray, page_bytes: int = MESH_PAGE_BYTES
     visuals = case.robot.visuals
     if visuals:
         look.kind = "meshes"
-        kept = decimate_visuals(visuals, mesh_budget(len(frames), page_bytes))
+        kept = _fitted(visuals, len(frames), page_bytes)
         by_color: dict[str, list[LinkVisual]] = {}
         for visual in kept:
             by_color.setdefault(visual.color, []).append(visual)
         for g, (color, group) in enumerate(by_color.items()):
             parts = [_Part(v.frame, v.vertices, v.faces) for v in group]
             vertices, faces = _posed(parts, frames)
+            # one legend entry shows and hides them all; hovering names the links
             name = MESHES_TRACE if g == 0 else "robot: " + ", ".join(v.name for v in group)
-            look.builders.append(_builder(vertices, faces, _solid_style(name, color)))
+            style = _solid_style(name, color, showlegend=g == 0)
+            look.builders.append(_builder(vertices, faces, style))
             drawn.append(vertices.reshape(-1, 3))
             look.triangles += len(faces)
         if case.cell is not None and links is not None:  # what the check measures

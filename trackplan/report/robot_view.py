@@ -48,7 +48,7 @@ if TYPE_CHECKING:
 #: The id of the plotly div in report.html.
 VIEW_ID = "robot-view"
 #: Names of the traces the animation updates.
-ROBOT_TRACE = "robot"
+ROBOT_TRACE = "robot joints"
 TRAIL_TRACE = "tool trail"
 PATH_TRACE = "planned path"
 NOMINAL_TRACE = "nominal path"

@@ -8,8 +8,9 @@ drawn in the report's 3D view and never checked for collisions (the capsules are
 
 Meshes are decimated to a triangle budget by :func:`decimate`: trimesh's quadric
 decimation when the optional ``fast_simplification`` package is installed, else vertex
-clustering (vertices snapped to a grid and merged with trimesh, degenerate and repeated
-triangles dropped), which needs nothing beyond trimesh and numpy.
+clustering (the vertices in each cell of a grid merged into their mean, the
+triangles that collapse and repeated ones dropped with trimesh; the finest grid that meets
+the budget), which needs nothing beyond trimesh and numpy.
 """
 
 from __future__ import annotations
@@ -115,8 +116,8 @@ def _has_fast_simplification() -> bool:
 
 
 def _cluster(mesh: object, target: int) -> tuple[np.ndarray, np.ndarray]:
-    """Vertex clustering: the finest grid (cells halved per step of a bisection on the cell
-    size) whose merged mesh has at most ``target`` triangles."""
+    """Vertex clustering: the finest grid (found by bisection on the cell size) whose merged
+    mesh has at most ``target`` triangles."""
     import trimesh
 
     assert isinstance(mesh, trimesh.Trimesh)
@@ -137,13 +138,19 @@ def _cluster(mesh: object, target: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _clustered(mesh: object, cell: float) -> tuple[np.ndarray, np.ndarray]:
-    """The mesh with its vertices snapped to a grid of side ``cell`` and merged."""
+    """The mesh with the vertices in each grid cell of side ``cell`` merged into their mean."""
     import trimesh
 
     assert isinstance(mesh, trimesh.Trimesh)
-    snapped = np.round(np.asarray(mesh.vertices) / cell) * cell
-    clustered = trimesh.Trimesh(snapped, np.asarray(mesh.faces), process=False)
-    clustered.merge_vertices(merge_tex=True, merge_norm=True)
+    vertices = np.asarray(mesh.vertices)
+    keys = np.floor(vertices / cell).astype(np.int64)
+    _, inverse = trimesh.grouping.unique_rows(keys)
+    count = np.bincount(inverse)
+    merged = (
+        np.stack([np.bincount(inverse, weights=vertices[:, axis]) for axis in range(3)], axis=1)
+        / count[:, None]
+    )
+    clustered = trimesh.Trimesh(merged, inverse[np.asarray(mesh.faces)], process=False)
     clustered.update_faces(clustered.nondegenerate_faces())
     clustered.update_faces(clustered.unique_faces())
     clustered.remove_unreferenced_vertices()
