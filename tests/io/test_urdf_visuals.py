@@ -1,4 +1,4 @@
-"""A URDF's <visual> meshes read onto the robot (trackplan.io.urdf_visuals) and decimated."""
+"""A URDF's <visual> meshes read onto the robot (trackplan.io.urdf_geometry), decimated."""
 
 from __future__ import annotations
 

@@ -31,9 +31,8 @@ from trackplan.io.robot_schema import (
     payload_problems,
 )
 from trackplan.io.urdf import read_urdf_chain
-from trackplan.io.urdf_geometry import read_urdf_link_geometry
+from trackplan.io.urdf_geometry import read_urdf_link_geometry, read_urdf_visuals
 from trackplan.io.urdf_inertials import read_urdf_inertials
-from trackplan.io.urdf_visuals import read_urdf_visuals
 from trackplan.io.yaml_input import (
     Problem,
     raise_first,
