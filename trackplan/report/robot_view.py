@@ -1,11 +1,12 @@
 """Interactive 3D view of the robot following the path (plotly animation).
 
-The robot is drawn from its DH chain as links between consecutive frame origins (base,
-DH frames 1..n, tool) with a marker at each joint, on a subsampled trajectory. A time
-slider and play/pause buttons drive plotly animation frames that update only the robot
-and the tool trail. With a work cell, obstacles and the placed workpiece are drawn as
-solids, the robot's link and tool capsules follow the animation, and the closest approach
-is a red segment between the nearest points.
+The robot is drawn as it looks (:mod:`trackplan.report.robot_solids`: its URDF meshes, else
+solids of its capsules, a thick line only without either) with a marker at each joint, on
+a subsampled trajectory; the base, part and tool frames are drawn and named. A time slider
+and play/pause buttons drive plotly animation frames that update only the robot, the tool
+frame and the tool trail. With a work cell, obstacles and the placed workpiece are drawn as
+solids, the tool's capsules follow the animation, and the closest approach is a red
+segment between the nearest points.
 
 :func:`robot_view_spec` builds the figure as plain JSON-ready data (lists, dicts, numbers),
 which the report serialises directly: building plotly's validated objects for every
@@ -162,9 +163,11 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
     """The robot following the placed path, as plotly figure data (plain JSON-ready values).
 
     Static traces: the nominal path placed in the base frame (dashed), the planned tool
-    path, base and part frame axes, and the outer reach shell of the placement origin.
-    Animated traces: the robot (links and joints, ``name="robot"``) and the tool trail.
-    The axes are fixed with equal scale so the scene does not jump between frames.
+    path, base and part frame axes and names, and the outer reach shell of the placement
+    origin. Animated traces: the robot's joints (:data:`ROBOT_TRACE`, first), its meshes or
+    solids (:func:`~trackplan.report.robot_solids.robot_look`), the tool frame's axes and the
+    tool trail. The axes are fixed with equal scale, fitted to everything drawn (the cell's
+    bodies too), so the scene does not jump between frames.
     Coordinates are rounded to 10 µm; gaps are ``None``.
 
     Parameters
