@@ -14,15 +14,18 @@ from trackplan.case import Case
 from trackplan.io.urdf_robot import robot_from_urdf_file
 from trackplan.planning.result import PlanResult
 from trackplan.report.robot_solids import (
+    CAPSULES_TRACE,
     LINES_NOTE,
     MESH_PAGE_BYTES,
     MESHES_TRACE,
     SOLIDS_TRACE,
+    TOOL_SOLIDS_TRACE,
     mesh_budget,
     robot_look,
 )
 from trackplan.report.robot_view import ROBOT_TRACE, robot_view_spec
 from trackplan.report.scene import frame_indices
+from trackplan.robots.collision import Capsules
 from trackplan.robots.model import Robot
 from trackplan.robots.visuals import MAX_TRIANGLES, n_triangles
 
@@ -203,3 +206,27 @@ def test_a_meshed_robot_report_opens_fast_without_errors(
     assert not problems, problems
     assert rendered <= 2.0, f"the 3D view took {rendered:.2f} s to open (page {loaded:.2f} s)"
     assert report.stat().st_size < 12e6
+
+
+def test_in_a_cell_the_meshes_keep_the_checked_capsules_a_click_away(meshed_robot, corner):
+    from trackplan.io.case_file import load_case
+    from trackplan.robots.kinematics import joint_frames
+
+    cell_case = load_case(Path(__file__).resolve().parents[2] / "cases" / "paper-corner-cell.yaml")
+    assert cell_case.cell is not None
+    torch = Capsules(np.zeros(1), [[[0.0, 0.0, -0.2], [0.0, 0.0, 0.0]]], [0.02], ("torch",))
+    cell_case = dataclasses.replace(cell_case, cell=dataclasses.replace(cell_case.cell, tool=torch))
+    robot = dataclasses.replace(meshed_robot, collision=corner.robot.collision)
+    case = dataclasses.replace(cell_case, robot=robot)
+    q = np.zeros((3, robot.n_dof))
+    look = robot_look(case, joint_frames(robot, q))
+    traces = [build(0) for build in look.builders]
+    by_name = {t["name"]: t for t in traces}
+    assert by_name[MESHES_TRACE].get("visible", True) is True
+    assert by_name[CAPSULES_TRACE]["visible"] == "legendonly"  # what the check measures
+    assert by_name[TOOL_SOLIDS_TRACE].get("visible", True) is True
+    # without meshes the capsules are the robot's look, opaque
+    plain = robot_look(cell_case, joint_frames(cell_case.robot, q))
+    assert plain.kind == "capsules"
+    names = [build(0)["name"] for build in plain.builders]
+    assert names == [SOLIDS_TRACE, TOOL_SOLIDS_TRACE]

@@ -30,7 +30,7 @@ from trackplan.report.machine_view import (
     machine_layers,
     moves_the_part,
 )
-from trackplan.report.robot_solids import LINES_NOTE, RobotLook, robot_look
+from trackplan.report.robot_solids import LINES_NOTE, SOLIDS_TRACE, RobotLook, robot_look
 from trackplan.report.scene import (
     FRAME_STYLES,
     equal_limits,
@@ -54,6 +54,7 @@ TRAIL_TRACE = "tool trail"
 PATH_TRACE = "planned path"
 NOMINAL_TRACE = "nominal path"
 TOOL_FRAME = "tool frame"
+CAPSULES_TRACE = SOLIDS_TRACE  # a robot without meshes: the solids of the capsules checked
 CLOSEST_TRACE = "closest approach"
 DECIMALS = 5  # 10 µm: keeps the page small, far below anything visible
 
