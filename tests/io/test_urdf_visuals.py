@@ -86,3 +86,51 @@ def test_the_robot_visuals_are_decimated_to_a_total_budget():
     kept = decimate_visuals(visuals, 400, quadric=False)
     assert n_triangles(kept) <= 400
     assert [v.name for v in kept] == [v.name for v in visuals]  # every link keeps a mesh
+
+
+@pytest.mark.parametrize("kind", ["obj", "dae"])
+def test_obj_and_dae_visual_meshes_are_read(tmp_path, kind):
+    if kind == "dae":
+        pytest.importorskip("collada", reason="trimesh reads DAE with pycollada")
+    copy = tmp_path / "robot"
+    shutil.copytree(FIXTURE, copy)
+    mesh = trimesh.load(copy / "meshes" / "l2.stl", force="mesh")
+    mesh.export(copy / "meshes" / f"l2.{kind}")
+    urdf = copy / "meshed_robot.urdf"
+    urdf.write_text(urdf.read_text().replace("meshes/l2.stl", f"meshes/l2.{kind}"))
+    robot = robot_from_urdf_file(urdf, assume_limits=True)
+    assert robot.visuals is not None
+    upper_arm = next(v for v in robot.visuals if v.name == "l2")
+    assert upper_arm.n_triangles == len(mesh.faces)
+    reference = robot_from_urdf_file(URDF, assume_limits=True).visuals
+    assert reference is not None
+    expected = next(v for v in reference if v.name == "l2")
+    # the same surface, placed the same way (the formats may order the vertices differently)
+    np.testing.assert_allclose(
+        upper_arm.vertices.min(axis=0), expected.vertices.min(axis=0), atol=1e-6
+    )
+    np.testing.assert_allclose(
+        upper_arm.vertices.max(axis=0), expected.vertices.max(axis=0), atol=1e-6
+    )
+
+
+def test_box_cylinder_and_sphere_visuals_are_tessellated(tmp_path):
+    copy = tmp_path / "robot"
+    shutil.copytree(FIXTURE, copy)
+    urdf = copy / "meshed_robot.urdf"
+    text = urdf.read_text()
+    for name, shape in (
+        ("l0", '<box size="0.2 0.3 0.4"/>'),
+        ("l3", '<cylinder radius="0.05" length="0.4"/>'),
+        ("l5", '<sphere radius="0.05"/>'),
+    ):
+        text = text.replace(f'<mesh filename="meshes/{name}.stl"/>', shape)
+    urdf.write_text(text)
+    robot = robot_from_urdf_file(urdf, assume_limits=True)
+    assert robot.visuals is not None
+    by_link = {visual.name: visual for visual in robot.visuals}
+    box = by_link["l0"].vertices  # centred 0.25 m below the base frame
+    np.testing.assert_allclose(box.min(axis=0), [-0.1, -0.15, -0.45], atol=1e-9)
+    np.testing.assert_allclose(box.max(axis=0), [0.1, 0.15, -0.05], atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(by_link["l5"].vertices, axis=1), 0.05, atol=1e-9)
+    assert by_link["l3"].n_triangles > 20
