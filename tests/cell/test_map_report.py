@@ -85,5 +85,6 @@ def test_report_draws_the_cell(case) -> None:
     assert {"obstacles", "workpiece", CLOSEST_TRACE, CAPSULES_TRACE} <= set(names)
     capsules = names.index(CAPSULES_TRACE)
     assert all(capsules in frame.traces for frame in figure.frames)
-    first, last = figure.frames[0].data[-1], figure.frames[-1].data[-1]
+    column = list(figure.frames[0].traces).index(capsules)
+    first, last = figure.frames[0].data[column], figure.frames[-1].data[column]
     assert not np.allclose(first.x, last.x)  # the capsules move with the robot

@@ -77,16 +77,18 @@ def test_report_tables(page, corner_result):
 def test_robot_view_animates_the_dh_chain(corner, corner_result):
     figure = robot_view_figure(corner_result, corner, n_frames=25)
     assert len(figure.frames) == 25
-    robot_index = [trace.name for trace in figure.data].index(ROBOT_TRACE)
+    names = [trace.name for trace in figure.data]
+    robot_index, trail_index = names.index(ROBOT_TRACE), names.index(TRAIL_TRACE)
     idx = frame_indices(corner_result.trajectory.n_samples, 25)
     for k in (0, 12, 24):
         frame = figure.frames[k]
-        assert list(frame.traces) == [robot_index, robot_index + 1]
+        # the robot (its joints, then its solids), the tool frame and the trail
+        assert list(frame.traces) == list(range(robot_index, trail_index + 1))
         robot = frame.data[0]
         expected = chain_points(corner.robot, corner_result.trajectory.q[idx[k]])
         drawn = np.column_stack([robot.x, robot.y, robot.z])
         np.testing.assert_allclose(drawn, expected, atol=1e-5)
-        assert len(frame.data[1].x) == k + 1  # the trail grows with time
+        assert len(frame.data[-1].x) == k + 1  # the trail grows with time
     ranges = [figure.layout.scene[f"{axis}axis"].range for axis in "xyz"]
     widths = [high - low for low, high in ranges]
     np.testing.assert_allclose(widths, widths[0])

@@ -287,8 +287,15 @@ def test_arm_only_report_has_no_external_axes(corner, corner_result):
     view = robot_view_spec(corner_result, corner, n_frames=4)
     names = {trace["name"] for trace in view["data"]}
     assert not names & {RAIL_TRACE, POSITIONER_TRACE, POSITIONER_CAPSULES_TRACE, WORKPIECE_TRACE}
-    # the fixed part's path and frame are static; the robot and its trail are animated
-    assert len(view["frames"][0]["traces"]) == 2
+    # the fixed part's path and frame are static; the robot (joints, capsule solids), the
+    # tool frame's three axes and the trail are animated
+    animated = [view["data"][i]["name"] for i in view["frames"][0]["traces"]]
+    assert animated == [
+        ROBOT_TRACE,
+        "robot (link capsules)",
+        *["tool frame (x, y, z)"] * 3,
+        "tool trail",
+    ]
     assert external_axes_table(corner_result, corner) == ""
     assert downhand_rows(corner_result, corner) == []
 

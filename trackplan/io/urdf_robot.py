@@ -31,7 +31,7 @@ from trackplan.io.robot_schema import (
     payload_problems,
 )
 from trackplan.io.urdf import read_urdf_chain
-from trackplan.io.urdf_geometry import read_urdf_link_geometry
+from trackplan.io.urdf_geometry import read_urdf_link_geometry, read_urdf_visuals
 from trackplan.io.urdf_inertials import read_urdf_inertials
 from trackplan.io.yaml_input import (
     Problem,
@@ -60,9 +60,13 @@ def robot_from_urdf_file(file: str | Path, *, assume_limits: bool = False) -> Ro
     robot = _urdf_robot(
         chain, chain.name, LimitsModel(), np.eye(4), "", [], assume_limits, str(file)
     )
-    capsules = read_urdf_link_geometry(file, chain.joint_names).capsules
-    robot = replace(robot, dynamics=urdf_dynamics(file, chain, None, None, str(file)))
-    return replace(robot, collision=capsules) if len(capsules) else robot
+    geometry = read_urdf_link_geometry(file, chain.joint_names)
+    robot = replace(
+        robot,
+        dynamics=urdf_dynamics(file, chain, None, None, str(file)),
+        visuals=read_urdf_visuals(file, geometry.link_frames),
+    )
+    return replace(robot, collision=geometry.capsules) if len(geometry.capsules) else robot
 
 
 def load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Robot:
@@ -103,7 +107,16 @@ def load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Ro
     dynamics = urdf_dynamics(base / model.urdf, chain, model, data, file)
     collision = _urdf_collision(model, base / model.urdf, chain, data, file)
     controller = controller_convention(model.controller, n)
-    return replace(robot, dynamics=dynamics, collision=collision, controller=controller)
+    frames = read_urdf_link_geometry(
+        base / model.urdf, chain.joint_names, model.base_link, collisions=False
+    ).link_frames
+    return replace(
+        robot,
+        dynamics=dynamics,
+        collision=collision,
+        controller=controller,
+        visuals=read_urdf_visuals(base / model.urdf, frames),
+    )
 
 
 def _urdf_collision(

@@ -148,8 +148,8 @@ def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
         post_script=_QUIET_INTERRUPTS,
     )
     return (
-        '<section id="view"><h2>3D view</h2><p class="muted">The robot drawn from its DH chain '
-        "(links between frame origins, a marker per joint) follows the placed path. Drag to "
+        '<section id="view"><h2>3D view</h2><p class="muted">The robot, drawn with its URDF '
+        "meshes or as solids of its collision capsules, follows the placed path. Drag to "
         "rotate, scroll to zoom, ▶ play or move the time slider; click legend entries to show "
         f"or hide the path, frames and reach shell.{_external_note(case)}"
         f"{_cycle_note(result, case)}</p>{div}</section>"

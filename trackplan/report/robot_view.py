@@ -1,11 +1,12 @@
 """Interactive 3D view of the robot following the path (plotly animation).
 
-The robot is drawn from its DH chain as links between consecutive frame origins (base,
-DH frames 1..n, tool) with a marker at each joint, on a subsampled trajectory. A time
-slider and play/pause buttons drive plotly animation frames that update only the robot
-and the tool trail. With a work cell, obstacles and the placed workpiece are drawn as
-solids, the robot's link and tool capsules follow the animation, and the closest approach
-is a red segment between the nearest points.
+The robot is drawn as it looks (:mod:`trackplan.report.robot_solids`: its URDF meshes, else
+solids of its capsules, a thick line only without either) with a marker at each joint, on
+a subsampled trajectory; the base, part and tool frames are drawn and named. A time slider
+and play/pause buttons drive plotly animation frames that update only the robot, the tool
+frame and the tool trail. With a work cell, obstacles and the placed workpiece are drawn as
+solids, the tool's capsules follow the animation, and the closest approach is a red
+segment between the nearest points.
 
 :func:`robot_view_spec` builds the figure as plain JSON-ready data (lists, dicts, numbers),
 which the report serialises directly: building plotly's validated objects for every
@@ -24,12 +25,12 @@ from trackplan.case import Case
 from trackplan.frames import placement_transform
 from trackplan.planning.result import PlanResult
 from trackplan.report.machine_view import (
-    animated_mesh,
     arm_frames,
     cell_chain_points,
     machine_layers,
     moves_the_part,
 )
+from trackplan.report.robot_solids import LINES_NOTE, SOLIDS_TRACE, RobotLook, robot_look
 from trackplan.report.scene import (
     FRAME_STYLES,
     equal_limits,
@@ -48,11 +49,12 @@ if TYPE_CHECKING:
 #: The id of the plotly div in report.html.
 VIEW_ID = "robot-view"
 #: Names of the traces the animation updates.
-ROBOT_TRACE = "robot"
+ROBOT_TRACE = "robot joints"
 TRAIL_TRACE = "tool trail"
 PATH_TRACE = "planned path"
 NOMINAL_TRACE = "nominal path"
-CAPSULES_TRACE = "link capsules"
+TOOL_FRAME = "tool frame"
+CAPSULES_TRACE = SOLIDS_TRACE  # a robot without meshes: the solids of the capsules checked
 CLOSEST_TRACE = "closest approach"
 DECIMALS = 5  # 10 µm: keeps the page small, far below anything visible
 
@@ -67,21 +69,18 @@ def frame_name(k: int) -> str:
     return f"frame-{k:04d}"
 
 
-def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list, Callable]:
-    """Static traces of the cell (obstacles, workpiece, closest approach) and the builder of
-    the animated link-capsule trace."""
+def _cell_traces(result: PlanResult, case: Case) -> tuple[list, np.ndarray]:
+    """Static traces of the cell (obstacles, workpiece, closest approach) and the vertices
+    of its bodies but planes, shape (M, 3), m (for the view's limits)."""
+    from trackplan.cell.model import Shape
     from trackplan.cell.screening import CellGeometry
-    from trackplan.report.cell_scene import (
-        body_mesh,
-        closest_approach,
-        merge,
-        robot_capsules_mesh,
-    )
+    from trackplan.report.cell_scene import body_mesh, closest_approach, merge
 
     assert case.cell is not None
     geometry = CellGeometry.from_cell(case.cell, case.robot)
     T_base_part = placement_transform(result.placement)
     traces: list = []
+    drawn: list[np.ndarray] = [np.zeros((0, 3))]
     # with a positioner the workpiece moves with it (machine_view)
     workpiece = () if moves_the_part(case) else case.cell.workpiece
     for label, bodies, T, color, opacity in (
@@ -92,6 +91,8 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
             continue
         vertices, faces = merge([body_mesh(body, T) for body in bodies])
         traces.append(_mesh_trace(vertices, faces, label, color, opacity))
+        solid = [body for body in bodies if body.shape is not Shape.PLANE]
+        drawn += [body_mesh(body, T)[0] for body in solid]
     closest = closest_approach(geometry, case.machine, result)
     if closest is not None:
         points, label = closest
@@ -107,21 +108,7 @@ def _cell_traces(result: PlanResult, case: Case, idx: np.ndarray) -> tuple[list,
                 "hoverinfo": "text",
             }
         )
-    frames = arm_frames(case, result.trajectory.q[idx])
-
-    style = {
-        "name": CAPSULES_TRACE,
-        "showlegend": True,
-        "color": "#4c72b0",
-        "opacity": 0.35,
-        "hoverinfo": "skip",
-    }
-
-    def capsules_trace(k: int) -> dict:
-        vertices, faces = robot_capsules_mesh(geometry, frames[k])
-        return animated_mesh(vertices, faces, k, style, 3)
-
-    return traces, capsules_trace
+    return traces, np.vstack(drawn)
 
 
 def _mesh_trace(
@@ -177,9 +164,11 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
     """The robot following the placed path, as plotly figure data (plain JSON-ready values).
 
     Static traces: the nominal path placed in the base frame (dashed), the planned tool
-    path, base and part frame axes, and the outer reach shell of the placement origin.
-    Animated traces: the robot (links and joints, ``name="robot"``) and the tool trail.
-    The axes are fixed with equal scale so the scene does not jump between frames.
+    path, base and part frame axes and names, and the outer reach shell of the placement
+    origin. Animated traces: the robot's joints (:data:`ROBOT_TRACE`, first), its meshes or
+    solids (:func:`~trackplan.report.robot_solids.robot_look`), the tool frame's axes and the
+    tool trail. The axes are fixed with equal scale, fitted to everything drawn (the cell's
+    bodies too), so the scene does not jump between frames.
     Coordinates are rounded to 10 µm; gaps are ``None``.
 
     Parameters
@@ -223,21 +212,31 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
 
     trail = _xyz(tool)
 
+    frames = arm_frames(case, trajectory.q[idx])  # (F, n + 2, 4, 4), cell frame
+    look = robot_look(case, frames)
+
     def robot_trace(k: int) -> dict:
-        return {
-            "type": "scatter3d",
-            **_xyz(chains[k]),
-            "mode": "lines+markers",
-            "name": ROBOT_TRACE,
-            "line": {"color": "#5a6b8c", "width": 8},
-            "marker": {
-                "size": joint_sizes,
-                "color": joint_colors,
-                "line": {"color": "white", "width": 1},
-            },
-            "hovertext": ["base", *robot.joint_names, "tool"],
-            "hoverinfo": "text",
-        }
+        return _robot_trace(chains[k], look, joint_sizes, joint_colors, robot.joint_names)
+
+    tool_frames = _tool_frame_lines(frames[:, -1], 0.5 * axis_length)
+
+    def tool_axis(axis: int) -> Callable[[int], dict]:
+        colors, dash = FRAME_STYLES[TOOL_FRAME]
+
+        def build(k: int) -> dict:
+            return {
+                "type": "scatter3d",
+                **_xyz(tool_frames[k, axis]),
+                "mode": "lines",
+                "name": f"{TOOL_FRAME} (x, y, z)",
+                "legendgroup": TOOL_FRAME,
+                "showlegend": axis == 0,
+                "line": {"color": colors[axis], "width": 5, "dash": dash},
+                "hovertext": f"{TOOL_FRAME} {'xyz'[axis]}",
+                "hoverinfo": "text",
+            }
+
+        return build
 
     def trail_trace(k: int) -> dict:
         return {
@@ -278,6 +277,7 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
             "hoverinfo": "skip",
         },
     ]
+    static.append(_frame_names(T_base_part, moves_the_part(case)))
     for label, T in (("base frame", np.eye(4)), ("part frame", T_base_part)):
         lines = triad_lines(T, axis_length if label == "base frame" else 0.6 * axis_length)
         colors, dash = FRAME_STYLES[label]
@@ -305,21 +305,23 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
         0.6 * axis_length,
     )
     static += layers.static
-    builders: list[Callable[[int], dict]] = [robot_trace]
+    # the joints' trace first: the browser tests read it as each frame's data[0]
+    builders: list[Callable[[int], dict]] = [robot_trace, *look.builders]
+    builders += [tool_axis(axis) for axis in range(3)]
     if moves_the_part(case):
         builders += layers.builders
     else:
         static += fixed_part
         builders.append(trail_trace)
+    cell_points = np.zeros((0, 3))
     if case.cell is not None:
-        cell_static, capsules_trace = _cell_traces(result, case, idx)
+        cell_static, cell_points = _cell_traces(result, case)
         static += cell_static
-        builders.append(capsules_trace)
     animated = [build(0) for build in builders]
     first_animated = len(static)
     animated_ids = [first_animated + i for i in range(len(builders))]
 
-    frames = [
+    animation = [
         {
             "name": frame_name(k),
             "data": [build(k) for build in builders],
@@ -379,7 +381,16 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
     }
     fixed = [] if moves_the_part(case) else [points_base, nominal]
     limits = equal_limits(
-        np.vstack([chains.reshape(-1, 3), *fixed, layers.points, [[0.0, 0.0, 0.0]]])
+        np.vstack(
+            [
+                chains.reshape(-1, 3),
+                *fixed,
+                layers.points,
+                look.points,
+                cell_points,
+                [[0.0, 0.0, 0.0]],
+            ]
+        )
     )
     scene_axes = {
         f"{axis}axis": {
@@ -407,4 +418,53 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
         "sliders": [slider],
         "updatemenus": [buttons],
     }
-    return {"data": [*static, *animated], "layout": layout, "frames": frames}
+    return {"data": [*static, *animated], "layout": layout, "frames": animation}
+
+
+def _robot_trace(
+    chain: np.ndarray,
+    look: RobotLook,
+    sizes: list[int],
+    colors: list[str],
+    joint_names: tuple[str, ...],
+) -> dict:
+    """The robot's joints (markers) over its meshes or solids; without either, a thick line
+    through its frames, the legend saying why."""
+    trace = {
+        "type": "scatter3d",
+        **_xyz(chain),
+        "mode": "markers",
+        "name": ROBOT_TRACE,
+        "marker": {"size": sizes, "color": colors, "line": {"color": "white", "width": 1}},
+        "hovertext": ["base", *joint_names, "tool"],
+        "hoverinfo": "text",
+    }
+    if look.kind == "lines":
+        trace |= {
+            "mode": "lines+markers",
+            "line": {"color": "#5a6b8c", "width": 14},
+            "legendgroup": "robot",
+            "legendgrouptitle": {"text": LINES_NOTE},
+        }
+    return trace
+
+
+def _tool_frame_lines(T_tool: np.ndarray, length: float) -> np.ndarray:
+    """The tool frame's axes at each animation frame, shape (F, 3, 3, 3)."""
+    return np.stack([triad_lines(T, max(length, 1e-3)) for T in T_tool])
+
+
+def _frame_names(T_base_part: np.ndarray, part_moves: bool) -> dict:
+    """The base and part frames' names written at their origins."""
+    points = [np.zeros(3)] if part_moves else [np.zeros(3), T_base_part[:3, 3]]
+    return {
+        "type": "scatter3d",
+        **_xyz(np.array(points)),
+        "mode": "text",
+        "text": ["base frame", "part frame"][: len(points)],
+        "textposition": "bottom center",
+        "textfont": {"size": 11, "color": "#333"},
+        "name": "frame names",
+        "showlegend": False,
+        "hoverinfo": "skip",
+    }

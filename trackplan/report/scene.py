@@ -268,11 +268,12 @@ def sphere_wireframe(radius: float, n_meridians: int = 12, n_parallels: int = 7)
 FRAME_STYLES = {
     "base frame": (("#8b0000", "#006400", "#00008b"), "solid"),
     "part frame": (("#ff8c69", "#66cd66", "#6ca6ff"), "dash"),
+    "tool frame": (("#ff0000", "#00b000", "#0000ff"), "solid"),
 }
 """Colours of the x, y and z axes (dark and light red, green, blue) and the line style of
-the robot's base frame and of the part (path definition) frame, in every view: the two
-frames are told apart by colour, style and legend entry. Tool frames keep the plain
-red, green and blue."""
+the robot's base frame, of the part (path definition) frame and of the tool frame, in
+every view: the frames are told apart by colour, style and legend entry; the tool frame
+has the plain red, green and blue."""
 
 
 def triad_lines(T: np.ndarray, length: float) -> np.ndarray:

@@ -27,6 +27,7 @@ from trackplan.robots._kernels import fk_flat
 from trackplan.robots.collision import Capsules
 from trackplan.robots.controller import ControllerConvention
 from trackplan.robots.dynamics_parameters import RobotDynamics
+from trackplan.robots.visuals import LinkVisual
 
 LIMIT_KINDS = ("position", "velocity", "acceleration", "jerk")
 DH_COLUMNS = ("d", "a", "alpha", "offset")
@@ -120,6 +121,10 @@ class Robot:
         How the robot's controller counts the joints and where its world frame is
         (:class:`~trackplan.robots.controller.ControllerConvention`); None: as the model
         (:attr:`convention` gives the identity then).
+    visuals
+        How the links look: triangle meshes on frames 0 (base) to n
+        (:class:`~trackplan.robots.visuals.LinkVisual`), read from a URDF's ``<visual>``
+        elements; None when the robot has none (the report then draws its capsules).
     """
 
     name: str
@@ -140,6 +145,7 @@ class Robot:
     placement_reach: tuple[float, float] | None = None
     collision: Capsules | None = None
     controller: ControllerConvention | None = None
+    visuals: tuple[LinkVisual, ...] | None = None
 
     def __post_init__(self) -> None:
         origins = np.array(self.origins, dtype=float)
@@ -179,6 +185,10 @@ class Robot:
             )
         if self.collision is not None and np.any(self.collision.frame > n):
             raise CaseError(f"link capsules must be on frames 0..{n}", key="collision")
+        if self.visuals is not None:
+            object.__setattr__(self, "visuals", tuple(self.visuals))
+            if any(not 0 <= visual.frame <= n for visual in self.visuals):
+                raise CaseError(f"link visuals must be on frames 0..{n}", key="visuals")
         if self.controller is not None and self.controller.n_dof != n:
             raise CaseError(
                 f"the controller convention must have {n} joints, got {self.controller.n_dof}",
