@@ -2,7 +2,7 @@
 
 Every sample is screened by the compiled kernel; where a pair's distance decides
 (:func:`pair_distances`) it is recomputed by the exact library (:mod:`trackplan.cell.exact`).
-Screened distances never exceed the exact ones (equal for primitives, bounding boxes for
+Screened distances never exceed the exact ones (equal for primitives, enclosing boxes for
 meshes), so a pair screened farther than the band cannot break the clearance.
 """
 
@@ -38,7 +38,7 @@ def pair_distances(
     and of every stretch of overlap (the screening equals the exact distance for
     primitives to 1e-6 m when apart; overlapping, the exact value is the penetration depth
     and the screened one a grade), at its overall minimum, and, for meshes (screened as
-    their bounding boxes), at every sample within the band.
+    boxes that enclose them), at every sample within the band.
 
     Parameters
     ----------

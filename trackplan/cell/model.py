@@ -26,7 +26,11 @@ class Shape(enum.IntEnum):
     CYLINDER = 2  # axis z, radius, half length
     SPHERE = 3  # centre at the origin, radius
     CAPSULE = 4  # axis z, radius, half length
-    MESH = 5  # triangle mesh; screened as its bounding box
+    MESH = 5  # triangle mesh; screened as the boxes that enclose its triangles
+
+
+MAX_SCREENING_BOXES = 64
+"""Most boxes a mesh body is screened as (:meth:`Body.screening_boxes`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,10 +75,40 @@ class Body:
     def screening_box(self) -> tuple[np.ndarray, np.ndarray]:
         """A mesh's axis-aligned bounding box in its body frame, as (T_frame_box, half extents).
 
-        The screening kernel sees a mesh as this box, which encloses it: screened
-        distances to a mesh are never larger than the exact ones.
+        It encloses the mesh: a distance to it is never larger than to the mesh.
         """
-        low, high = self.vertices.min(axis=0), self.vertices.max(axis=0)
+        return self._box(self.vertices)
+
+    def screening_boxes(
+        self, max_boxes: int = MAX_SCREENING_BOXES
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """A mesh as at most ``max_boxes`` axis-aligned boxes that enclose its triangles, as
+        (T_frame_box, half extents) each: the leaves of a median split of the triangles'
+        centroids along the longest side, every leaf's box around its own triangles. The
+        screening kernel sees a mesh as these boxes: a screened distance is never larger than
+        the exact one, and, unlike one bounding box around the whole mesh, a tool working
+        in a corner of a large part is not inside them."""
+        triangles = self.vertices[self.faces]  # (F, 3, 3)
+        if not len(triangles):
+            return [self.screening_box()]
+        leaves = [np.arange(len(triangles))]
+        centroids = triangles.mean(axis=1)
+        while len(leaves) < max_boxes:
+            sizes = [len(leaf) for leaf in leaves]
+            k = int(np.argmax(sizes))
+            if sizes[k] <= 1:
+                break
+            leaf = leaves.pop(k)
+            points = centroids[leaf]
+            axis = int(np.argmax(np.ptp(points, axis=0)))
+            order = leaf[np.argsort(points[:, axis], kind="stable")]
+            half = len(order) // 2
+            leaves += [order[:half], order[half:]]
+        return [self._box(triangles[leaf].reshape(-1, 3)) for leaf in leaves]
+
+    def _box(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The axis-aligned box (body frame) around points (K, 3), placed in its frame."""
+        low, high = points.min(axis=0), points.max(axis=0)
         T_body_box = np.eye(4)
         T_body_box[:3, 3] = 0.5 * (low + high)
         return self.T_frame_body @ T_body_box, 0.5 * (high - low)

@@ -19,7 +19,7 @@ With a machine every frame is in the cell frame (the arm's base frame with the t
 ``T_cell_carrier(q) · T_carrier_part`` at each sample (:func:`cell_frames`,
 :func:`part_placements`).
 
-Meshes go to the kernel as their bounding boxes, so a screened distance is never larger
+Meshes go to the kernel as boxes enclosing their triangles, so a screened distance is never larger
 than the exact one; every other shape is screened exactly.
 """
 
@@ -146,11 +146,18 @@ class CellGeometry:
     n_obstacles
         How many of ``bodies`` are obstacles.
     kind, size
-        Shape code (O,) and parameters (O, 3) of each body as screened (meshes as boxes).
+        Shape code (S,) and parameters (S, 3) of each screened shape: a primitive body as
+        itself, a mesh as the boxes of :meth:`~trackplan.cell.model.Body.screening_boxes`;
+        the obstacles' first.
     T_frame_screen
-        Pose of each screened body in its frame, shape (O, 4, 4).
+        Pose of each screened shape in its body's frame, shape (S, 4, 4).
+    screen_owner
+        The body of each screened shape, shape (S,), int.
     pair_capsule, pair_body
         The capsule–body pairs checked, shape (P,) each.
+    screen_pair_capsule, screen_pair_body, screen_pair_start
+        The pairs the kernel screens, capsule and screened shape, shape (P',) each: those of
+        pair p from ``screen_pair_start[p]`` (shape (P,)) on, its distance their least.
     self_pairs
         The capsule–capsule pairs checked, shape (Q, 2): the arm's own pairs, then the
         positioner's capsules against the arm's.
@@ -168,8 +175,12 @@ class CellGeometry:
     kind: np.ndarray
     size: np.ndarray
     T_frame_screen: np.ndarray
+    screen_owner: np.ndarray
     pair_capsule: np.ndarray
     pair_body: np.ndarray
+    screen_pair_capsule: np.ndarray
+    screen_pair_body: np.ndarray
+    screen_pair_start: np.ndarray
     self_pairs: np.ndarray
     n_frames: int
     n_positioner_frames: int = 0
@@ -203,15 +214,16 @@ class CellGeometry:
         capsules = links + positioner + tool + clipped
         bodies = (*cell.obstacles, *cell.workpiece)
         n_obstacles = len(cell.obstacles)
-        kind = np.empty(len(bodies), dtype=np.int64)
-        size = np.zeros((len(bodies), 3))
-        T_screen = np.empty((len(bodies), 4, 4))
+        screened: list[tuple[np.ndarray, np.ndarray, int, int]] = []
         for o, body in enumerate(bodies):
             if body.shape is Shape.MESH:
-                T_screen[o], size[o] = body.screening_box()
-                kind[o] = Shape.BOX
+                screened += [(T, half, Shape.BOX, o) for T, half in body.screening_boxes()]
             else:
-                T_screen[o], size[o], kind[o] = body.T_frame_body, body.size, body.shape
+                screened.append((body.T_frame_body, body.size, int(body.shape), o))
+        T_screen = np.array([entry[0] for entry in screened]).reshape(-1, 4, 4)
+        size = np.array([entry[1] for entry in screened]).reshape(-1, 3)
+        kind = np.array([entry[2] for entry in screened], dtype=np.int64)
+        owner = np.array([entry[3] for entry in screened], dtype=np.int64)
         n_links = len(links)
         moving_links = np.flatnonzero(links.frame > 0)  # the base stands in the cell
         link_index = np.arange(n_links)
@@ -230,6 +242,16 @@ class CellGeometry:
             np.stack(np.meshgrid(positioner_moving, obstacles, indexing="ij"), -1),
         ]
         pair = np.concatenate([p.reshape(-1, 2) for p in pairs]).astype(np.int64)
+        # every pair with a body, once per screened shape of that body
+        shapes = [np.flatnonzero(owner == o) for o in range(len(bodies))]
+        counts = np.array([len(shapes[o]) for o in pair[:, 1]], dtype=np.int64)
+        screen_capsule = np.repeat(pair[:, 0], counts)
+        screen_body = (
+            np.concatenate([shapes[o] for o in pair[:, 1]]).astype(np.int64)
+            if len(pair)
+            else np.zeros(0, dtype=np.int64)
+        )
+        screen_start = (np.cumsum(counts) - counts).astype(np.int64)
         moving = np.concatenate([links.frame, tool.frame])
         arm_index = np.concatenate([link_index, tool_index])
         self_pairs = np.concatenate(
@@ -248,8 +270,12 @@ class CellGeometry:
             kind=kind,
             size=size,
             T_frame_screen=T_screen,
+            screen_owner=owner,
             pair_capsule=np.ascontiguousarray(pair[:, 0]),
             pair_body=np.ascontiguousarray(pair[:, 1]),
+            screen_pair_capsule=np.ascontiguousarray(screen_capsule),
+            screen_pair_body=np.ascontiguousarray(screen_body),
+            screen_pair_start=np.ascontiguousarray(screen_start),
             self_pairs=np.ascontiguousarray(self_pairs),
             n_frames=arm.n_dof + 2,
             n_positioner_frames=_n_positioner_frames(robot),
@@ -271,7 +297,7 @@ class CellGeometry:
         return out
 
     def world_to_body(self, T_base_part: np.ndarray) -> np.ndarray:
-        """World → screened-body transforms for placements, shape (G, O, 3, 4).
+        """World → screened-shape transforms for placements, shape (G, S, 3, 4).
 
         Parameters
         ----------
@@ -280,15 +306,13 @@ class CellGeometry:
         """
         T_base_part = np.asarray(T_base_part, dtype=float).reshape(-1, 4, 4)
         n_groups = len(T_base_part)
-        T_world_body = np.broadcast_to(
-            self.T_frame_screen, (n_groups, len(self.bodies), 4, 4)
-        ).copy()
-        if len(self.bodies) > self.n_obstacles:
-            T_world_body[:, self.n_obstacles :] = (
-                T_base_part[:, None] @ self.T_frame_screen[self.n_obstacles :]
-            )
+        n_shapes = len(self.T_frame_screen)
+        T_world_body = np.broadcast_to(self.T_frame_screen, (n_groups, n_shapes, 4, 4)).copy()
+        on_part = self.screen_owner >= self.n_obstacles  # the workpiece's shapes
+        if on_part.any():
+            T_world_body[:, on_part] = T_base_part[:, None] @ self.T_frame_screen[on_part]
         R = np.swapaxes(T_world_body[..., :3, :3], -1, -2)
-        out = np.empty((n_groups, len(self.bodies), 3, 4))
+        out = np.empty((n_groups, n_shapes, 3, 4))
         out[..., :3] = R
         out[..., 3] = -np.einsum("...ij,...j->...i", R, T_world_body[..., :3, 3])
         return out
@@ -317,7 +341,7 @@ class CellGeometry:
         frames = np.ascontiguousarray(np.asarray(frames, dtype=float)[..., :3, :])
         n_samples = len(frames)
         group = np.zeros(n_samples, np.int64) if group is None else np.asarray(group, np.int64)
-        return _kernels.screen_pairs(
+        shapes, own = _kernels.screen_pairs(
             frames,
             self.capsules.frame,
             self.capsules.segment,
@@ -326,10 +350,14 @@ class CellGeometry:
             self.size,
             self.world_to_body(T_base_part),
             group,
-            self.pair_capsule,
-            self.pair_body,
+            self.screen_pair_capsule,
+            self.screen_pair_body,
             self.self_pairs,
         )
+        if len(self.screen_pair_capsule) == len(self.pair_capsule):  # one shape per body
+            return shapes, own
+        # a pair's distance: the least over its body's screened shapes
+        return np.minimum.reduceat(shapes, self.screen_pair_start, axis=1), own
 
     def screen_joints(
         self,
