@@ -172,7 +172,7 @@ def check(
     segment
         The ``segment`` label of every sample, shape (N,) (trajectory.csv's column: a
         seam's name or ``approach``, ``retract``, ``air``); default every sample on the
-        case's one seam.
+        case's one seam, welded the way the samples run when the seam is reversible.
 
     Returns
     -------
@@ -199,6 +199,8 @@ def check(
         spans: tuple[Span, ...] = (
             Span(kind=SEAM, label=seams[0].name, first=0, last=len(q) - 1, seam=0),
         )
+        if seams[0].reversible and len(q):  # welded either way: the samples say which
+            spans = spans_from_segments(case, X, q, np.full(len(q), seams[0].name, dtype=object))
     else:
         spans = spans_from_segments(case, X, q, segment)
     report, _ = check_spans(case, X, q, sample_time, spans, timing=timing)

@@ -116,7 +116,8 @@ def sequence_section(result: PlanResult, case: Case) -> str:
         plan = seam.plan
         margins = [m for m in (plan.check.worst_margin(), own.worst_margin()) if m == m]
         margin = min(margins, default=float("nan"))  # NaN: no margin counts
-        verdict = "feasible" if own.success and plan.check.success else "infeasible"
+        passed = own.success and plan.check.success
+        verdict = "feasible" if passed else "infeasible"
         rows.append(
             [
                 str(order + 1),
@@ -128,7 +129,7 @@ def sequence_section(result: PlanResult, case: Case) -> str:
                 num(plan.path_length, scale=1e3, unit="mm"),
                 num(own.max_tracking_error, scale=1e3, unit="mm"),
                 percent(plan.rated_speed_fraction),
-                (verdict, "ok" if verdict == "feasible" else "bad"),
+                (verdict, "ok" if passed else "bad"),
                 (percent(margin), margin_class(margin)),
             ]
         )
