@@ -176,6 +176,16 @@ def test_the_part_is_a_workpiece_body_of_the_cell(tmp_path: Path, parts: dict) -
     file.write_text(yaml.safe_dump(data), encoding="utf-8")
     case = load_case(file)
     assert case.cell is not None and case.cell.workpiece == ()
+    # without a cell block the part is the body of a cell of its own
+    del data["cell"]
+    data["part"]["body"] = True
+    file.write_text(yaml.safe_dump(data), encoding="utf-8")
+    case = load_case(file)
+    assert case.cell is not None and [b.name for b in case.cell.workpiece] == ["part"]
+    assert case.cell.tool_contact == 0.0 and case.cell.obstacles == ()
+    data["part"]["body"] = False
+    file.write_text(yaml.safe_dump(data), encoding="utf-8")
+    assert load_case(file).cell is None
 
 
 def test_validate_prints_each_cad_seam(
@@ -183,7 +193,10 @@ def test_validate_prints_each_cad_seam(
 ) -> None:
     assert main(["validate", str(_case(tmp_path, cad=FOOT))]) == ExitCode.OK
     out = capsys.readouterr().out
-    assert "part pipe.step: 3 faces, 2 edges, exact (STEP B-rep); not a body of the cell" in out
+    assert (
+        "part pipe.step: 3 faces, 2 edges, exact (STEP B-rep); a workpiece body of the cell "
+        "within 0.5 mm (a cell of the part alone: the case has no cell)"
+    ) in out
     assert f"CAD seam foot (paths[0]): {2 * np.pi * 0.06:.4f} m, 1 arc, closed" in out
 
 
@@ -232,7 +245,9 @@ def test_a_cad_case_plans_feasibly_like_the_hand_written_one(tmp_path: Path, par
     from trackplan.planning.plan import plan
 
     hand = load_case(CASES / "pipe-fillet.yaml")
-    derived = load_case(_case(tmp_path, cad=FOOT))
+    # like for like: the hand-written case has no part body (its UR5e has no torch, and its
+    # wrist reaches into the part at the seam: with the part as a body that is a collision)
+    derived = load_case(_case(tmp_path, part={"file": "pipe.step", "body": False}, cad=FOOT))
     X = np.asarray(hand.bounds.example)
     ours, theirs = plan(derived, X), plan(hand, X)
     assert ours.feasible and theirs.feasible
@@ -309,7 +324,8 @@ def test_shipped_parts_give_the_analytic_seams_and_plan_feasibly(tmp_path: Path,
     from trackplan.planning.plan import plan
 
     cad, placement = SHIPPED[name]
-    file = _case(tmp_path, part={"file": str(PARTS / name)}, cad=cad)
+    # the part not a body: pipe-fillet's UR5e has no torch, its wrist is at the seam
+    file = _case(tmp_path, part={"file": str(PARTS / name), "body": False}, cad=cad)
     case = load_case(file)
     distance, angle = _analytic_error(name, case.paths[0].start, case.paths[0].segments)
     assert distance <= 1e-5 and angle <= 0.1  # 0.01 mm, 0.1° (issue 34's acceptance)

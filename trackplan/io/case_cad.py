@@ -24,7 +24,7 @@ from pydantic import BaseModel, ConfigDict
 from trackplan.cad.part import PartModel
 from trackplan.cad.seams import CadSeam, FaceRef, SeamError, derive_seam, seam_summary
 from trackplan.case import Case
-from trackplan.cell.model import Body, Shape
+from trackplan.cell.model import Body, Cell, Shape
 from trackplan.errors import CaseError
 from trackplan.io.case_schema import MIN_TOLERANCE, CadSeamModel, FaceRefModel, PartFileModel
 from trackplan.io.yaml_input import (
@@ -90,7 +90,7 @@ class CadCase:
     body: bool
     paths: tuple[CadPath, ...]
     cell: bool = False
-    """Whether the case has a ``cell`` (the part is a body of it only then)."""
+    """Whether the case has a ``cell`` (else the part is the body of a cell of its own)."""
 
 
 def expand_cad(data: Any, file: str | None, base: Path) -> tuple[Any, CadCase | None]:
@@ -181,10 +181,9 @@ def describe_cad(cad: CadCase) -> list[str]:
         )
         + (
             f"; a workpiece body of the cell within {PART_CHORD_ERROR * 1000:g} mm"
-            if cad.body and cad.cell
-            else "; not a body of the cell (the case has no cell)"
+            + ("" if cad.cell else " (a cell of the part alone: the case has no cell)")
             if cad.body
-            else ""
+            else "; not a body of the cell (part.body: false)"
         )
     ]
     for path in cad.paths:
@@ -318,12 +317,15 @@ def _floats(values: Any) -> list[float]:
 
 def with_part_body(case: Case, cad: CadCase | None) -> Case:
     """The case with the part's tessellation (within :data:`PART_CHORD_ERROR`) as a
-    workpiece mesh body of its cell, when the part is a body and the case has a cell."""
-    if cad is None or not cad.body or case.cell is None:
+    workpiece mesh body of its cell when the part is a body: of the case's cell, or of a cell
+    of the part alone (the robot's own link capsules, the default clearance) when the case
+    has none."""
+    if cad is None or not cad.body:
         return case
     mesh = cad.part.tessellation(PART_CHORD_ERROR)
     body = Body(BODY_NAME, Shape.MESH, np.eye(4), vertices=mesh.vertices, faces=mesh.triangles)
-    cell = dataclasses.replace(case.cell, workpiece=(*case.cell.workpiece, body))
+    own = case.cell if case.cell is not None else Cell()
+    cell = dataclasses.replace(own, workpiece=(*own.workpiece, body))
     return dataclasses.replace(case, cell=cell)
 
 
