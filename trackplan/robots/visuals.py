@@ -144,7 +144,8 @@ def _clustered(mesh: object, cell: float) -> tuple[np.ndarray, np.ndarray]:
     assert isinstance(mesh, trimesh.Trimesh)
     vertices = np.asarray(mesh.vertices)
     keys = np.floor(vertices / cell).astype(np.int64)
-    _, inverse = trimesh.grouping.unique_rows(keys)
+    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
     count = np.bincount(inverse)
     merged = (
         np.stack([np.bincount(inverse, weights=vertices[:, axis]) for axis in range(3)], axis=1)
