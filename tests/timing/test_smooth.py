@@ -20,8 +20,15 @@ WRIST_TURN_CASES = {"paper-circle-seam-fixed", "paper-circle-seam-free"}
 """Their seam frame turns the tool once about its axis: at a constant spin no placement has a
 joint path on the PUMA560; tests/search/test_spin.py plans and checks them with the spin
 chosen."""
+SLOW_CELLS = ("cad-", "positioner-", "track-")
+"""Shipped welding cells and CAD parts: their draws are slow tests (their own acceptance tests
+run in the fast tier's place: tests/axes, tests/cad)."""
 SHIPPED_PATHS = [
-    (file.stem, seam)
+    pytest.param(
+        file.stem,
+        seam,
+        marks=[pytest.mark.slow] if file.stem.startswith(SLOW_CELLS) else [],
+    )
     for file in sorted(CASES.glob("*.yaml"))
     if file.stem not in WRIST_TURN_CASES
     for seam in range(len(load_case(file).seams))
