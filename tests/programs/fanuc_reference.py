@@ -23,12 +23,14 @@ from trackplan.robots.model import Robot
 def turn(angle_deg: float) -> int:
     """The turn number of one joint angle (deg), counting whole turns away from 0."""
     count = 0
-    while angle_deg >= 180.0:
-        angle_deg -= 360.0
-        count += 1
-    while angle_deg <= -180.0:
-        angle_deg += 360.0
-        count -= 1
+    if angle_deg >= 180.0:  # one way only: a half turn counts away from 0 (180° is +1)
+        while angle_deg >= 180.0:
+            angle_deg -= 360.0
+            count += 1
+    else:
+        while angle_deg <= -180.0:
+            angle_deg += 360.0
+            count -= 1
     return count
 
 
