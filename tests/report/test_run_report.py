@@ -177,6 +177,7 @@ def _wild(corner_result):
     )
 
 
+@pytest.mark.slow  # 8.5 s: the fast tier keeps the other report tests
 @pytest.mark.parametrize("which", ["planted violation", "symlog jerk", "no trajectory"])
 def test_plots_on_blank_figures_made_beforehand_are_the_same_pixels(
     which, corner, corner_result, unreachable_result

@@ -31,6 +31,7 @@ def test_run_seeds_start_with_the_seed_and_are_stable():
     assert run_seeds(5, 6)[:3] == three  # more restarts keep the earlier runs
 
 
+@pytest.mark.slow  # 4 s of searches
 def test_restarts_contain_the_single_run_and_never_do_worse(case, geometry):
     single = optimize(case, seed=2, restarts=1, geometry=geometry)
     several = optimize(case, seed=2, restarts=3, geometry=geometry)
