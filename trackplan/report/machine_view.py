@@ -247,26 +247,32 @@ def machine_layers(
 def _part_frame_builders(T_part: np.ndarray, length: float) -> list[TraceBuilder]:
     """The part frame's three axes, one trace each, moving with the part."""
     label = "part frame"
-    colors, dash = FRAME_STYLES[label]
     lines = np.stack([triad_lines(T, max(length, 1e-3)) for T in T_part])  # (F, 3, 3, 3)
 
     def axis_builder(axis: int) -> TraceBuilder:
         def build(k: int) -> dict:
-            return {
-                "type": "scatter3d",
-                **_xyz(lines[k, axis]),
-                "mode": "lines",
-                "name": f"{label} (x, y, z)",
-                "legendgroup": label,
-                "showlegend": axis == 0,
-                "line": {"color": colors[axis], "width": 5, "dash": dash},
-                "hovertext": f"{label} {'xyz'[axis]}",
-                "hoverinfo": "text",
-            }
+            return frame_axis_trace(lines[k, axis], label, axis)
 
         return build
 
     return [axis_builder(axis) for axis in range(3)]
+
+
+def frame_axis_trace(line: np.ndarray, label: str, axis: int) -> dict:
+    """One axis (0, 1, 2: x, y, z) of a named frame as a plotly line, in the frame's style
+    (:data:`~trackplan.report.scene.FRAME_STYLES`); ``line`` its two points (2, 3), m."""
+    colors, dash = FRAME_STYLES[label]
+    return {
+        "type": "scatter3d",
+        **_xyz(line),
+        "mode": "lines",
+        "name": f"{label} (x, y, z)",
+        "legendgroup": label,
+        "showlegend": axis == 0,
+        "line": {"color": colors[axis], "width": 5, "dash": dash},
+        "hovertext": f"{label} {'xyz'[axis]}",
+        "hoverinfo": "text",
+    }
 
 
 def animated_mesh(

@@ -27,6 +27,7 @@ from trackplan.planning.result import PlanResult
 from trackplan.report.machine_view import (
     arm_frames,
     cell_chain_points,
+    frame_axis_trace,
     machine_layers,
     moves_the_part,
 )
@@ -221,20 +222,8 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
     tool_frames = _tool_frame_lines(frames[:, -1], 0.5 * axis_length)
 
     def tool_axis(axis: int) -> Callable[[int], dict]:
-        colors, dash = FRAME_STYLES[TOOL_FRAME]
-
         def build(k: int) -> dict:
-            return {
-                "type": "scatter3d",
-                **_xyz(tool_frames[k, axis]),
-                "mode": "lines",
-                "name": f"{TOOL_FRAME} (x, y, z)",
-                "legendgroup": TOOL_FRAME,
-                "showlegend": axis == 0,
-                "line": {"color": colors[axis], "width": 5, "dash": dash},
-                "hovertext": f"{TOOL_FRAME} {'xyz'[axis]}",
-                "hoverinfo": "text",
-            }
+            return frame_axis_trace(tool_frames[k, axis], TOOL_FRAME, axis)
 
         return build
 
