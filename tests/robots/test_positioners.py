@@ -145,15 +145,17 @@ def test_skyhook_500_is_the_motopos_d500b_c00_of_its_data_sheet() -> None:
     )
 
 
-def test_the_skyhook_table_stays_clear_of_its_drive_housing_over_the_axis_ranges() -> None:
-    chain = builtin_positioner("skyhook-500")
+def base_table_gaps(name: str, n_tilt: int, n_turn: int) -> list[float]:
+    """Gaps (m) between a built-in positioner's base capsules (frame 0) and its table's
+    (frame 2) on an n_tilt × n_turn grid over both axis ranges."""
+    chain = builtin_positioner(name)
     capsules = chain.collision
     assert capsules is not None
     base = np.flatnonzero(capsules.frame == 0)
     table = np.flatnonzero(capsules.frame == 2)
     gaps = []
-    for tilt in np.linspace(chain.q_min[0], chain.q_max[0], 13):
-        for turn in np.linspace(chain.q_min[1], chain.q_max[1], 9):
+    for tilt in np.linspace(chain.q_min[0], chain.q_max[0], n_tilt):
+        for turn in np.linspace(chain.q_min[1], chain.q_max[1], n_turn):
             frames = joint_frames(chain, np.array([tilt, turn]))
             ends = np.einsum("kij,kpj->kpi", frames[capsules.frame, :3, :3], capsules.segment)
             ends += frames[capsules.frame, :3, 3][:, None, :]
@@ -162,6 +164,11 @@ def test_the_skyhook_table_stays_clear_of_its_drive_housing_over_the_axis_ranges
                 for i in base
                 for j in table
             ]
+    return gaps
+
+
+def test_the_skyhook_table_stays_clear_of_its_drive_housing_over_the_axis_ranges() -> None:
+    gaps = base_table_gaps("skyhook-500", 13, 9)
     assert min(gaps) > 0.45  # docs/positioner.md: 0.52 m at the closest
 
 
@@ -354,20 +361,5 @@ def test_the_api_serves_positioners(tmp_path: Path) -> None:
 
 
 def test_the_d500_foot_stays_clear_of_its_table_over_the_axis_ranges() -> None:
-    chain = builtin_positioner("two-axis-500")
-    capsules = chain.collision
-    assert capsules is not None
-    base = np.flatnonzero(capsules.frame == 0)
-    table = np.flatnonzero(capsules.frame == 2)
-    gaps = []
-    for tilt in np.linspace(chain.q_min[0], chain.q_max[0], 19):
-        for turn in np.linspace(chain.q_min[1], chain.q_max[1], 13):
-            frames = joint_frames(chain, np.array([tilt, turn]))
-            ends = np.einsum("kij,kpj->kpi", frames[capsules.frame, :3, :3], capsules.segment)
-            ends += frames[capsules.frame, :3, 3][:, None, :]
-            gaps += [
-                segment_segment(*ends[i], *ends[j]) - capsules.radius[i] - capsules.radius[j]
-                for i in base
-                for j in table
-            ]
+    gaps = base_table_gaps("two-axis-500", 19, 13)
     assert min(gaps) > 0.02  # docs/positioner.md: 2.6 cm at the closest

@@ -199,25 +199,22 @@ class StepPart:
 
     def _face(self, face: int) -> Any:
         """The TopoDS_Face of an id; CaseError for an id that does not exist."""
-        count = self._face_map.Extent()
-        if not isinstance(face, int | np.integer) or not 1 <= face <= count:
-            raise CaseError(
-                f"face {face} does not exist: the part has faces 1 to {count} "
-                "(`trackplan part FILE` lists them)",
-                file=self._source,
-            )
-        return self._occ.TopoDS.Face(self._face_map.FindKey(int(face)))
+        return self._occ.TopoDS.Face(self._shape_of(self._face_map, face, "face"))
 
     def _edge(self, edge: int) -> Any:
         """The TopoDS_Edge of an id; CaseError for an id that does not exist."""
-        count = self._edge_map.Extent()
-        if not isinstance(edge, int | np.integer) or not 1 <= edge <= count:
+        return self._occ.TopoDS.Edge(self._shape_of(self._edge_map, edge, "edge"))
+
+    def _shape_of(self, shapes: Any, number: int, what: str) -> Any:
+        """The shape numbered ``number`` (from 1) of an indexed map of faces or edges."""
+        count = shapes.Extent()
+        if not isinstance(number, int | np.integer) or not 1 <= number <= count:
             raise CaseError(
-                f"edge {edge} does not exist: the part has edges 1 to {count} "
+                f"{what} {number} does not exist: the part has {what}s 1 to {count} "
                 "(`trackplan part FILE` lists them)",
                 file=self._source,
             )
-        return self._occ.TopoDS.Edge(self._edge_map.FindKey(int(edge)))
+        return shapes.FindKey(int(number))
 
     def _reversed(self, shape: Any) -> bool:
         return bool(shape.Orientation() == self._occ.TopAbs_Orientation.TopAbs_REVERSED)
