@@ -30,6 +30,7 @@ from trackplan.robots._path_kernels import (
     room_bounds,
 )
 from trackplan.robots.families import AUX_SIZE, N_BRANCHES, IKFamily, ik_family
+from trackplan.robots.families.numeric import numeric_seeds as numeric_seeds
 from trackplan.robots.ik_numeric import chain_arrays
 from trackplan.robots.model import Robot
 from trackplan.robots.thread_sharing import ThreadSharing, path_threads
@@ -63,37 +64,6 @@ threads take the pieces in turn."""
 _NEWTON_TOL = 1e-10
 _MARCH_MAX_ITER = 100  # first pose from a seed, and the coarse march
 _FINE_MAX_ITER = 30  # every pose, seeded within a coarse step of its solution
-
-
-def numeric_seeds(robot: Robot) -> np.ndarray:
-    """The eight seed configurations that define the numerical branches.
-
-    Branch ``b = 4·s + 2·e + w`` starts from the middle of the joint range plus
-    ``(π·s, −π/4, ±π/3, 0, ±π/2, 0)`` on joints 1 to 6 (+π/3 for e = 0, +π/2 for w = 0;
-    joints past the sixth stay in the middle); a joint that lands outside its limits is
-    moved by a multiple of 2π into them where possible. Away from the usual singular
-    configurations of 6R arms (stretched elbow, q5 = 0), they sample the shoulder, elbow
-    and wrist alternatives of most industrial arms.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (8, n), rad.
-    """
-    n = robot.n_dof
-    b = np.arange(N_BRANCHES)
-    shoulder, elbow, wrist = (b >> 2) & 1, (b >> 1) & 1, b & 1
-    pattern = np.zeros((N_BRANCHES, max(n, 6)))
-    pattern[:, 0] = np.pi * shoulder
-    pattern[:, 1] = -np.pi / 4
-    pattern[:, 2] = (1 - 2 * elbow) * np.pi / 3
-    pattern[:, 4] = (1 - 2 * wrist) * np.pi / 2
-    middle = 0.5 * (robot.q_min + robot.q_max)
-    seeds = middle + pattern[:, :n]
-    shifted = seeds + 2 * np.pi * np.ceil((robot.q_min - seeds) / (2 * np.pi))  # lowest ≥ q_min
-    outside = (seeds < robot.q_min) | (seeds > robot.q_max)
-    moved: np.ndarray = np.where(outside & (shifted <= robot.q_max), shifted, seeds)
-    return moved
 
 
 def branch_paths(

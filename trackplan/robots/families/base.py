@@ -60,21 +60,67 @@ class ClosedFormIK:
         return reached
 
 
-class IKFamily(Protocol):
-    """What the path IK needs from a family of arms.
+@dataclass(frozen=True)
+class RedundancyParameter:
+    """The free parameter of a redundant (7-joint) arm's IK.
+
+    A pose of a 7-joint arm has a one-parameter family of solutions on each branch; one
+    value of this parameter per pose picks one of them. The planner chooses it along the
+    path as a free profile (``docs/robots.md``, "Redundancy").
 
     Attributes
     ----------
     name
-        ``"opw"``, ``"ur"`` or ``"numeric"``.
+        ``"arm angle"`` (the elbow's angle about the shoulder–wrist line, S-R-S arms) or
+        ``"joint k"`` (k 1-based: that joint's own position).
+    lower, upper
+        The parameter's natural range, rad: [−π, π] for the arm angle, the joint's
+        position limits for a joint.
+    joint
+        The joint it is (0-based), or None for the arm angle.
+    """
+
+    name: str
+    lower: float
+    upper: float
+    joint: int | None = None
+
+
+class IKFamily(Protocol):
+    """What the path IK needs from a family of arms.
+
+    Two kinds of family:
+
+    - **closed form** (``closed_form`` True: OPW, UR, S-R-S, Panda): :meth:`solve_flat`
+      gives the :attr:`n_branches` labelled solutions of every pose, a label keeping its
+      meaning along a path until a singularity; the path IK solves every pose on a
+      branch.
+    - **tracked** (``closed_form`` False: the CRX family, numeric): :meth:`seed_solutions`
+      gives the distinct solutions of one pose (up to :attr:`n_branches`); the path IK
+      starts a branch at each solution of the path's first pose and follows it by
+      warm-started Newton steps (a cuspidal arm changes solution without a singularity,
+      so labels do not keep their meaning along a path).
+
+    A redundant family (:attr:`redundancy` not None) takes the value of its free
+    parameter at every pose (``free``, shape (N,), rad); the others take ``free=None``.
+
+    Attributes
+    ----------
+    name
+        ``"opw"``, ``"ur"``, ``"srs"``, ``"panda"``, ``"crx"`` or ``"numeric"``.
     closed_form
-        True when :meth:`solve_flat` gives all eight branches in closed form; False for
-        the numeric family, whose branches are seeds
-        (:func:`trackplan.robots.path_ik.numeric_seeds`).
+        True when :meth:`solve_flat` gives every branch in closed form.
+    n_branches
+        K: labelled solutions per pose (closed form; unused columns are never valid), or
+        most distinct solutions tracked from a path's first pose.
+    redundancy
+        The free parameter of a 7-joint family, else None.
     """
 
     name: str
     closed_form: bool
+    n_branches: int
+    redundancy: RedundancyParameter | None
 
     def parameters(self) -> dict[str, object]:
         """The derived parameters, for display (lengths m, angles rad)."""
@@ -88,42 +134,47 @@ class IKFamily(Protocol):
         self,
         T_base_tool: np.ndarray,
         *,
+        free: np.ndarray | None = None,
         with_aux: bool = True,
         out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """All branches of a flat batch of tool poses (N, 4, 4).
+        """All branches of a flat batch of tool poses (N, 4, 4) (closed form only).
 
-        ``with_aux=False`` skips the branch quantities (aux is then (1, 8, 5) scratch).
-        ``out``: C-contiguous arrays (q, valid, aux) of the shapes below to write into
-        and return instead of new ones (with_aux is then ignored).
+        ``free``: the redundancy parameter per pose, shape (N,), rad (redundant families
+        only). ``with_aux=False`` skips the branch quantities (aux is then (1, K, 5)
+        scratch). ``out``: C-contiguous arrays (q, valid, aux) of the shapes below to write
+        into and return instead of new ones (with_aux is then ignored).
 
         Returns
         -------
         q
-            Shape (N, 8, 6), rad in (−π, π], NaN where not valid.
+            Shape (N, K, n), rad in (−π, π], NaN where not valid.
         valid
-            Shape (N, 8), bool.
+            Shape (N, K), bool (joint limits not applied).
         aux
-            Shape (N, 8, :data:`AUX_SIZE`): the branch-defining quantities, NaN out of reach.
+            Shape (N, K, :data:`AUX_SIZE`): the branch-defining quantities, NaN out of reach.
         """
         ...
 
     def solve_branch(
-        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
+        self,
+        T_base_tool: np.ndarray,
+        branch: int,
+        *,
+        free: np.ndarray | None = None,
+        with_aux: bool = False,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """One branch of a flat batch of tool poses (N, 4, 4): what :meth:`solve_flat`
-        gives for that branch, solving that branch only.
-
-        ``with_aux=True`` keeps the branch quantities (else aux is (1, 5) scratch).
+        gives for that branch, solving that branch only (closed form only).
 
         Returns
         -------
         q
-            Shape (N, 6), rad in (−π, π], NaN where not valid.
+            Shape (N, n), rad in (−π, π], NaN where not valid.
         valid
             Shape (N,), bool.
         aux
-            Shape (N, :data:`AUX_SIZE`): that branch's quantities of :meth:`solve_flat`.
+            Shape (N, :data:`AUX_SIZE`) (``with_aux``), else (1, AUX_SIZE) scratch.
         """
         ...
 
@@ -133,16 +184,48 @@ class IKFamily(Protocol):
         p_base_tool: np.ndarray,
         branch: int,
         *,
+        free: np.ndarray | None = None,
         with_aux: bool,
         wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`solve_branch` of poses given by their rotations (N, 3, 3), or one rotation
         (3, 3) for all, and positions (N, 3), m: no (N, 4, 4) array needed.
 
-        ``wind_to = (s, s_grid, q_grid)`` (shapes (N,), (G,), (G, 6)) then holds the
+        ``wind_to = (s, s_grid, q_grid)`` (shapes (N,), (G,), (G, n)) then holds the
         joints of a missed pose at those of the reachable pose before it and moves each
         joint by the multiple of 2π nearest the linear interpolation of ``q_grid`` at ``s``,
         in the same compiled pass (``hold_and_wind`` of ``families/_kernels.py``).
+        """
+        ...
+
+    def seed_solutions(
+        self,
+        T_base_tool: np.ndarray,
+        q_min: np.ndarray,
+        q_max: np.ndarray,
+        *,
+        free: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The distinct IK solutions of each pose inside the position limits (every family).
+
+        Parameters
+        ----------
+        T_base_tool
+            Tool poses, shape (N, 4, 4), m.
+        q_min, q_max
+            Position limits, shape (n,), rad: a solution is moved by multiples of 2π
+            into them where it fits, and dropped where it does not.
+        free
+            The redundancy parameter per pose, shape (N,), rad (redundant families).
+
+        Returns
+        -------
+        q
+            Shape (N, K, n), rad; NaN where not ``found``. Solutions that agree to 1e-6
+            rad in every joint are one; they fill the columns in a fixed order (a closed
+            form's branch order; a tracked family's own), the found ones first.
+        found
+            Shape (N, K), bool.
         """
         ...
 
@@ -158,6 +241,8 @@ class FusedClosedForm:
     """
 
     closed_form = True
+    n_branches = N_BRANCHES
+    redundancy: RedundancyParameter | None = None
     _all_branches: Callable[..., None]
     _one_branch: Callable[..., None]
     _geometry: np.ndarray
@@ -167,13 +252,16 @@ class FusedClosedForm:
         self,
         T_base_tool: np.ndarray,
         *,
+        free: np.ndarray | None = None,
         with_aux: bool = True,
         out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """All eight branches of poses (N, 4, 4), m: q (N, 8, 6) rad, valid (N, 8) bool,
-        aux (N, 8, AUX_SIZE); ``with_aux=False`` skips the branch quantities (aux is then
-        (1, 8, AUX_SIZE) scratch); ``out`` (q, valid, aux) of those shapes are written
-        instead of new arrays (the kernel releases the GIL: threads may solve at once)."""
+        """All eight branches of poses (N, 4, 4), m (``free`` must be None: no
+        redundancy): q (N, 8, 6) rad, valid (N, 8) bool, aux (N, 8, AUX_SIZE);
+        ``with_aux=False`` skips the branch quantities (aux is then (1, 8, AUX_SIZE)
+        scratch); ``out`` (q, valid, aux) of those shapes are written instead of new
+        arrays (the kernel releases the GIL: threads may solve at once)."""
+        _no_free(free)
         T = np.ascontiguousarray(T_base_tool, dtype=float)
         n_poses = T.shape[0]
         if out is not None:
@@ -188,12 +276,20 @@ class FusedClosedForm:
         return q, valid, aux
 
     def solve_branch(
-        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
+        self,
+        T_base_tool: np.ndarray,
+        branch: int,
+        *,
+        free: np.ndarray | None = None,
+        with_aux: bool = False,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, 6), valid (N,), aux (N, 5) (or
-        (1, 5) scratch without ``with_aux``), the values :meth:`solve_flat` gives for it."""
+        """Branch ``branch`` of poses (N, 4, 4) alone (``free`` must be None): q (N, 6),
+        valid (N,), aux (N, 5) (or (1, 5) scratch without ``with_aux``), the values
+        :meth:`solve_flat` gives for it."""
         T = np.asarray(T_base_tool, dtype=float)
-        return self.solve_branch_parts(T[:, :3, :3], T[:, :3, 3], branch, with_aux=with_aux)
+        return self.solve_branch_parts(
+            T[:, :3, :3], T[:, :3, 3], branch, free=free, with_aux=with_aux
+        )
 
     def solve_branch_parts(
         self,
@@ -201,6 +297,7 @@ class FusedClosedForm:
         p_base_tool: np.ndarray,
         branch: int,
         *,
+        free: np.ndarray | None = None,
         with_aux: bool,
         wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -214,6 +311,7 @@ class FusedClosedForm:
             q (N, 6) rad (NaN where not valid, unless wound), valid (N,) bool, aux
             (N, AUX_SIZE).
         """
+        _no_free(free)
         R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
         p = np.ascontiguousarray(p_base_tool, dtype=float)
         n_poses = p.shape[0]
@@ -238,6 +336,94 @@ class FusedClosedForm:
             read_only(q_grid),
         )
         return q, valid, aux
+
+    def seed_solutions(
+        self,
+        T_base_tool: np.ndarray,
+        q_min: np.ndarray,
+        q_max: np.ndarray,
+        *,
+        free: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The eight branches of poses (N, 4, 4) inside the limits, deduplicated
+        (:func:`closed_form_seeds`)."""
+        return closed_form_seeds(self, T_base_tool, q_min, q_max, free)
+
+
+class SolvesFlat(Protocol):
+    """Anything with :meth:`IKFamily.solve_flat` (a closed-form family)."""
+
+    def solve_flat(
+        self,
+        T_base_tool: np.ndarray,
+        *,
+        free: np.ndarray | None = None,
+        with_aux: bool = True,
+        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """All branches of poses (N, 4, 4): q (N, K, n), valid (N, K), aux."""
+        ...
+
+
+def closed_form_seeds(
+    family: SolvesFlat,
+    T_base_tool: np.ndarray,
+    q_min: np.ndarray,
+    q_max: np.ndarray,
+    free: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`IKFamily.seed_solutions` of a closed-form family: its branches of each pose,
+    each joint moved by the multiple of 2π that puts it in its limits (the lowest that
+    fits), a branch dropped where a joint fits nowhere or it repeats an earlier branch
+    (within :data:`SAME_SOLUTION`), in branch order.
+
+    Returns
+    -------
+    q, found
+        Shapes (N, K, n) (NaN where not found) and (N, K).
+    """
+    q, valid, _ = family.solve_flat(
+        np.ascontiguousarray(T_base_tool, dtype=float), free=free, with_aux=False
+    )
+    return wrap_and_deduplicate(q, valid, q_min, q_max)
+
+
+SAME_SOLUTION = 1e-6
+"""Largest joint difference (rad) between two solutions of one pose that are the same."""
+
+
+def wrap_and_deduplicate(
+    q: np.ndarray, valid: np.ndarray, q_min: np.ndarray, q_max: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Solutions (N, K, n) with their validity (N, K): each joint moved into [q_min, q_max]
+    by the lowest multiple of 2π that fits, the solutions that fit nowhere or repeat an
+    earlier column (every joint within :data:`SAME_SOLUTION`) dropped, the rest moved to
+    the front in their order.
+
+    Returns
+    -------
+    q, found
+        Shapes (N, K, n) (NaN where not found) and (N, K), bool.
+    """
+    two_pi = 2.0 * np.pi
+    lifted = q + two_pi * np.ceil((q_min - q) / two_pi)  # the lowest ≥ q_min
+    fits = valid & np.all(lifted <= q_max, axis=-1)
+    lifted = np.where(fits[..., None], lifted, np.nan)
+    n_k = q.shape[1]
+    same = np.all(np.abs(lifted[:, :, None] - lifted[:, None, :]) <= SAME_SOLUTION, axis=-1)
+    earlier = np.tril(np.ones((n_k, n_k), dtype=bool), -1)  # [k, j]: j before k
+    repeat = np.any(same & earlier & fits[:, None, :], axis=-1)
+    found = fits & ~repeat
+    order = np.argsort(~found, axis=1, kind="stable")  # found first, in order
+    rows = np.arange(len(q))[:, None]
+    ordered = np.where(found[rows, order][..., None], lifted[rows, order], np.nan)
+    return ordered, found[rows, order]
+
+
+def _no_free(free: np.ndarray | None) -> None:
+    """Refuse a redundancy parameter given to a family without redundancy."""
+    if free is not None:
+        raise ValueError("this IK family has no redundancy parameter: pass free=None")
 
 
 _NO_GRID = (np.empty(0), np.empty(0), np.empty((0, 6)))

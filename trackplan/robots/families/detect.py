@@ -35,7 +35,7 @@ def _detect(robot: Robot) -> IKFamily:
     if opw is not None:
         return OPWFamily(robot, opw)
     ur = ur_from_chain(robot)
-    return URFamily(robot, ur) if ur is not None else NumericFamily(robot.n_dof)
+    return URFamily(robot, ur) if ur is not None else NumericFamily(robot)
 
 
 def solve_ik(robot: Robot, T_base_tool: np.ndarray) -> ClosedFormIK:

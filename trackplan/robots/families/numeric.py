@@ -10,6 +10,14 @@ from __future__ import annotations
 import numpy as np
 
 from trackplan.errors import CaseError
+from trackplan.robots.families.base import (
+    N_BRANCHES,
+    RedundancyParameter,
+    _no_free,
+    wrap_and_deduplicate,
+)
+from trackplan.robots.ik_numeric import solve_ik_numeric
+from trackplan.robots.model import Robot
 
 REDUNDANCY_RULE = (
     "continuous minimum-norm steps: each sample is solved by damped least squares "
@@ -25,9 +33,12 @@ class NumericFamily:
 
     name = "numeric"
     closed_form = False
+    n_branches = N_BRANCHES
+    redundancy: RedundancyParameter | None = None
 
-    def __init__(self, n_dof: int):
-        self.n_dof = n_dof
+    def __init__(self, robot: Robot):
+        self.robot = robot
+        self.n_dof = robot.n_dof
 
     def parameters(self) -> dict[str, object]:
         """The redundancy rule for chains of more than six joints, else nothing."""
@@ -41,6 +52,7 @@ class NumericFamily:
         self,
         T_base_tool: np.ndarray,
         *,
+        free: np.ndarray | None = None,
         with_aux: bool = True,
         out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -52,7 +64,12 @@ class NumericFamily:
         )
 
     def solve_branch(
-        self, T_base_tool: np.ndarray, branch: int, *, with_aux: bool = False
+        self,
+        T_base_tool: np.ndarray,
+        branch: int,
+        *,
+        free: np.ndarray | None = None,
+        with_aux: bool = False,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
         return self.solve_flat(T_base_tool)
@@ -63,8 +80,63 @@ class NumericFamily:
         p_base_tool: np.ndarray,
         branch: int,
         *,
+        free: np.ndarray | None = None,
         with_aux: bool,
         wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
         return self.solve_flat(np.empty((0, 4, 4)))
+
+    def seed_solutions(
+        self,
+        T_base_tool: np.ndarray,
+        q_min: np.ndarray,
+        q_max: np.ndarray,
+        *,
+        free: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The distinct solutions of poses (N, 4, 4) that damped Newton reaches from the
+        eight seeds of :func:`numeric_seeds`, inside the
+        limits, deduplicated (:func:`~trackplan.robots.families.base.wrap_and_deduplicate`).
+
+        Returns
+        -------
+        q, found
+            Shapes (N, 8, n) (NaN where not found) and (N, 8).
+        """
+        _no_free(free)
+        T = np.asarray(T_base_tool, dtype=float)
+        seeds = numeric_seeds(self.robot)  # (8, n)
+        solved = solve_ik_numeric(self.robot, T[:, None], seeds[None], tol=1e-10)
+        return wrap_and_deduplicate(solved.q, solved.success, q_min, q_max)
+
+
+def numeric_seeds(robot: Robot) -> np.ndarray:
+    """The eight seed configurations that define the numerical branches.
+
+    Branch ``b = 4·s + 2·e + w`` starts from the middle of the joint range plus
+    ``(π·s, −π/4, ±π/3, 0, ±π/2, 0)`` on joints 1 to 6 (+π/3 for e = 0, +π/2 for w = 0;
+    joints past the sixth stay in the middle); a joint that lands outside its limits is
+    moved by a multiple of 2π into them where possible. Away from the usual singular
+    configurations of 6R arms (stretched elbow, q5 = 0), they sample the shoulder, elbow
+    and wrist alternatives of most industrial arms.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (8, n), rad.
+    """
+    n = robot.n_dof
+    b = np.arange(N_BRANCHES)
+    shoulder, elbow, wrist = (b >> 2) & 1, (b >> 1) & 1, b & 1
+    pattern = np.zeros((N_BRANCHES, max(n, 6)))
+    pattern[:, 0] = np.pi * shoulder
+    pattern[:, 1] = -np.pi / 4
+    pattern[:, 2] = (1 - 2 * elbow) * np.pi / 3
+    pattern[:, 4] = (1 - 2 * wrist) * np.pi / 2
+    middle = 0.5 * (robot.q_min + robot.q_max)
+    seeds = middle + pattern[:, :n]
+    shifted = seeds + 2 * np.pi * np.ceil((robot.q_min - seeds) / (2 * np.pi))  # lowest ≥ q_min
+    outside = (seeds < robot.q_min) | (seeds > robot.q_max)
+    moved: np.ndarray = np.where(outside & (shifted <= robot.q_max), shifted, seeds)
+    return moved
