@@ -237,11 +237,14 @@ def newton_into(
     tol: float,
     max_iter: int,
     work: np.ndarray,
+    locked: int = -1,
 ) -> tuple[bool, int, float, float]:  # pragma: no cover - compiled
     """Kernel: damped Newton on one pose, q (n,) updated in place from the seed.
 
-    ``work`` is scratch of length :func:`work_size`. Returns (success, iterations,
-    position error m, orientation error rad) of the final q.
+    ``work`` is scratch of length :func:`work_size`. ``locked`` ≥ 0 holds that joint at
+    its value in q (its Jacobian column is zero: the others solve the pose, a 7-joint
+    arm's redundancy given by that joint). Returns (success, iterations, position error
+    m, orientation error rad) of the final q.
     """
     n = chain.shape[0]
     m = min(n, 6)
@@ -268,6 +271,9 @@ def newton_into(
     at += m * m + m
     axes = work[at : at + 6 * n].reshape((n, 6))
     fk_jacobian_into(chain, tool, q, T, J, axes)
+    if locked >= 0:
+        for r in range(6):
+            J[r, locked] = 0.0
     perr, oerr = pose_error_into(T_target, T, e)
     cost = perr * perr + oerr * oerr
     nu = _NU_START
@@ -282,6 +288,9 @@ def newton_into(
         for i in range(n):
             q_try[i] = q[i] + scale * dq[i]
         fk_jacobian_into(chain, tool, q_try, T_try, J_try, axes)
+        if locked >= 0:
+            for r in range(6):
+                J_try[r, locked] = 0.0
         perr_try, oerr_try = pose_error_into(T_target, T_try, e_try)
         cost_try = perr_try * perr_try + oerr_try * oerr_try
         if cost_try < cost:

@@ -89,6 +89,8 @@ def numeric_paths(
     tol: float,
     march_iter: int,
     fine_iter: int,
+    locked: int,
+    free: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
     """Kernel: numerical joint paths from seeds, marched coarsely then solved everywhere.
 
@@ -104,6 +106,10 @@ def numeric_paths(
         Poses to march through, shape (B, M), bool (first and last included).
     tol, march_iter, fine_iter
         Newton tolerance (m and rad) and iteration limits of the march and the fine solve.
+    locked, free
+        A 7-joint arm's redundancy: joint ``locked`` (≥ 0) is held at ``free[b, m]`` at
+        pose m of candidate b, shape (B, M), rad, and the others solve the pose; −1 (and
+        an empty ``free``): no joint is held.
 
     Returns
     -------
@@ -143,7 +149,11 @@ def numeric_paths(
                 if coarse[b, m]:
                     for j in range(n):
                         path[m, j] = current[j]
-                    ok = newton_into(chain, tool, T[b, m], path[m], tol, march_iter, work)[0]
+                    if locked >= 0:
+                        path[m, locked] = free[b, m]
+                    ok = newton_into(chain, tool, T[b, m], path[m], tol, march_iter, work, locked)[
+                        0
+                    ]
                     reach[b, k, m] = ok
                     if ok:
                         for j in range(n):
@@ -158,14 +168,19 @@ def numeric_paths(
                     w = (m - m0) / (m1 - m0)
                     for j in range(n):
                         path[m, j] = (1.0 - w) * path[m0, j] + w * path[m1, j]
-                    solved = newton_into(chain, tool, T[b, m], path[m], tol, fine_iter, work)
+                    if locked >= 0:
+                        path[m, locked] = free[b, m]
+                    solved = newton_into(
+                        chain, tool, T[b, m], path[m], tol, fine_iter, work, locked
+                    )
                     reach[b, k, m] = solved[0]
             previous = 0.0
             for m in range(n_poses):
                 fk_jacobian_into(chain, tool, path[m], T_k, J, axes)
-                det = singularity_measure(J, square)
+                det = singularity_measure(J, square, locked)
                 magnitude[b, k, m, 0] = abs(det)
-                if m > 0 and n == 6 and reach[b, k, m] and reach[b, k, m - 1]:
+                square_jacobian = n == 6 or (n == 7 and locked >= 0)
+                if m > 0 and square_jacobian and reach[b, k, m] and reach[b, k, m - 1]:
                     if det * previous <= 0.0:
                         crossing[b, k, m] = SINGULAR
                 previous = det
@@ -173,13 +188,19 @@ def numeric_paths(
 
 
 @njit(cache=True, error_model="numpy")
-def singularity_measure(J: np.ndarray, square: np.ndarray) -> float:  # pragma: no cover - compiled
-    """Kernel: det J for a 6 × 6 Jacobian, else sqrt(det(J Jᵀ)); ``square`` is (6, 6) scratch."""
+def singularity_measure(
+    J: np.ndarray, square: np.ndarray, locked: int = -1
+) -> float:  # pragma: no cover - compiled
+    """Kernel: det J for a 6 × 6 Jacobian (or a 6 × 7 one without the ``locked`` column),
+    else sqrt(det(J Jᵀ)); ``square`` is (6, 6) scratch."""
     n = J.shape[1]
+    square_jacobian = n == 6 or (n == 7 and locked >= 0)
     for i in range(6):
         for j in range(6):
             if n == 6:
                 square[i, j] = J[i, j]
+            elif square_jacobian:
+                square[i, j] = J[i, j if j < locked else j + 1]
             else:
                 acc = 0.0
                 for c in range(n):
@@ -202,7 +223,7 @@ def singularity_measure(J: np.ndarray, square: np.ndarray) -> float:  # pragma: 
             factor = square[r, col] / square[col, col]
             for c in range(col, 6):
                 square[r, c] -= factor * square[col, c]
-    return det if n == 6 else math.sqrt(abs(det))
+    return det if square_jacobian else math.sqrt(abs(det))
 
 
 @njit(cache=True, error_model="numpy")

@@ -154,6 +154,8 @@ def branch_paths(
             _NEWTON_TOL,
             _MARCH_MAX_ITER,
             _FINE_MAX_ITER,
+            -1,
+            np.empty((0, 0)),
         )
         channel_kind = np.array([SINGULAR])
     else:
