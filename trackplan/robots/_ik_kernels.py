@@ -57,6 +57,45 @@ def newton_batch(
 
 
 @njit(cache=True, error_model="numpy")
+def track_batch(
+    chain: np.ndarray,
+    tool: np.ndarray,
+    R: np.ndarray,
+    p: np.ndarray,
+    q: np.ndarray,
+    free: np.ndarray,
+    locked: int,
+    tol: float,
+    max_iter: int,
+    success: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Kernel: each row of q (N, n), a reference near the solution, solved in place for the
+    pose (R[k] or R[0] when R holds one rotation, p[k]) by :func:`newton_into`, joint
+    ``locked`` (≥ 0) held at ``free[k]``; a pose not solved repeats the solved row before
+    it (the reference where none is)."""
+    work = np.empty(work_size_kernel(chain.shape[0]))
+    target = np.zeros((4, 4))
+    target[3, 3] = 1.0
+    n = q.shape[1]
+    last = -1
+    for k in range(q.shape[0]):
+        rotation = R[k] if R.shape[0] > 1 else R[0]
+        for i in range(3):
+            for j in range(3):
+                target[i, j] = rotation[i, j]
+            target[i, 3] = p[k, i]
+        if locked >= 0:
+            q[k, locked] = free[k]
+        ok = newton_into(chain, tool, target, q[k], tol, max_iter, work, locked)[0]
+        success[k] = ok
+        if ok:
+            last = k
+        elif last >= 0:
+            for j in range(n):
+                q[k, j] = q[last, j]
+
+
+@njit(cache=True, error_model="numpy")
 def fk_jacobian_into(
     chain: np.ndarray,
     tail: np.ndarray,

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trackplan.errors import CaseError
-from trackplan.robots._ik_kernels import newton_batch
+from trackplan.robots._ik_kernels import newton_batch, track_batch
 from trackplan.robots.model import Robot
 
 
@@ -161,3 +161,59 @@ def check_poses_and_joints(
     except ValueError:
         raise CaseError(f"poses {T.shape} and {q_name} {joints.shape} do not broadcast") from None
     return T, joints, lead
+
+
+TRACK_MAX_ITER = 30
+"""Most Newton iterations per pose when tracking from a nearby reference."""
+
+
+def track_poses(
+    robot: Robot,
+    R_base_tool: np.ndarray,
+    p_base_tool: np.ndarray,
+    reference: np.ndarray,
+    free: np.ndarray | None = None,
+    locked: int = -1,
+    tol: float = 1e-10,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Solve poses by damped Newton, each from its own reference configuration.
+
+    The poses of a planned trajectory lie between the poses of a joint path already
+    solved (the planning grid): its joints interpolated at each pose are within a grid
+    step of the solution, so Newton from there stays on the branch the grid followed.
+
+    Parameters
+    ----------
+    robot
+        Any chain.
+    R_base_tool
+        Tool rotations, shape (M, 3, 3), or one for every pose, (3, 3).
+    p_base_tool
+        Tool positions, shape (M, 3), m.
+    reference
+        Start configuration of each pose, shape (M, n), rad.
+    free, locked
+        A 7-joint arm's held joint (index ≥ 0) and its value at every pose, shape (M,),
+        rad; −1 and None: no joint is held.
+    tol
+        Position (m) and orientation (rad) tolerance.
+
+    Returns
+    -------
+    q
+        Shape (M, n), rad: continuous from the references; a pose not solved repeats the
+        solved pose before it.
+    success
+        Shape (M,), bool.
+    """
+    R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
+    p = np.ascontiguousarray(p_base_tool, dtype=float).reshape(-1, 3)
+    q = np.array(reference, dtype=float, order="C")
+    held = np.empty(0) if free is None else np.ascontiguousarray(free, dtype=float)
+    if locked >= 0 and held.shape != (len(q),):
+        raise CaseError(f"free must have shape ({len(q)},) when joint {locked + 1} is held")
+    success = np.empty(len(q), dtype=np.bool_)
+    track_batch(
+        *chain_arrays(robot), R, p, q, held, int(locked), float(tol), TRACK_MAX_ITER, success
+    )
+    return q, success

@@ -29,7 +29,7 @@ from trackplan.robots._path_kernels import (
     numeric_paths,
     room_bounds,
 )
-from trackplan.robots.families import AUX_SIZE, N_BRANCHES, IKFamily, ik_family
+from trackplan.robots.families import AUX_SIZE, IKFamily, ik_family
 from trackplan.robots.families.numeric import numeric_seeds as numeric_seeds
 from trackplan.robots.ik_numeric import chain_arrays
 from trackplan.robots.model import Robot
@@ -76,6 +76,7 @@ def branch_paths(
     *,
     screen: bool = False,
     sharing: ThreadSharing | None = None,
+    free: np.ndarray | None = None,
 ) -> tuple[
     np.ndarray,
     np.ndarray,
@@ -100,6 +101,12 @@ def branch_paths(
     it is returned alone (K = 1): the same branch and analysis as from all eight. Otherwise
     all eight are solved and analysed. A given branch is solved alone.
 
+    ``free`` is a redundant family's parameter at every pose: shape (B, M), the same for
+    every branch, or (B, K, M), one profile per branch (each branch then solved alone).
+    A tracked family (or ``method="numeric"``) starts branch k at the k-th distinct
+    solution of each candidate's first pose (:meth:`IKFamily.seed_solutions`); a branch
+    with no such solution reaches no pose.
+
     Returns
     -------
     q, reach, switch, report, values, ok, candidates, step, method, windings, winding
@@ -110,56 +117,56 @@ def branch_paths(
     T = np.ascontiguousarray(T_base_tool, dtype=float)
     if T.ndim != 4 or T.shape[-2:] != (4, 4) or T.shape[1] < 1:
         raise CaseError(f"T_base_tool must have shape (B, M, 4, 4), got {T.shape}")
-    candidates = _candidate_branches(branch, T.shape[0])
+    family = ik_family(robot)
+    n_k = family.n_branches
+    candidates = _candidate_branches(branch, T.shape[0], n_k)
     step = _max_step(max_step, robot.n_dof)
     if threads is not None and not threads >= 1:
         raise CaseError(f"threads must be None or ≥ 1, got {threads!r}")
     n_cand = T.shape[0]
     n = robot.n_dof
-    family = ik_family(robot)
+    free = _free_values(family, free, T.shape[:2], n_k)
     if method == "auto":
         method = "closed_form" if family.closed_form else "numeric"
     if method == "closed_form":
+        if not family.closed_form:
+            raise CaseError(f"the {family.name} IK family has no closed form: use method numeric")
+        if free is not None and free.ndim == 3:  # a profile per branch: each solved alone
+            paths = per_branch_paths(family, robot, T, candidates, step, free)
+            q, reach, switch, report, values, windings, winding = paths
+            ok = _usable(report, values)
+            return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
         if screen and branch is None:
             # the subset's poses bound each branch's margin from above as all poses do
             sub = np.ascontiguousarray(T[:, ::SCREEN_STRIDE]).reshape(-1, 4, 4)
-            q_sub, valid_sub, _ = family.solve_flat(sub, with_aux=False)
-            shape = (n_cand, -1, N_BRANCHES)
+            free_sub = None if free is None else np.ascontiguousarray(free[:, ::SCREEN_STRIDE])
+            q_sub, valid_sub, _ = family.solve_flat(
+                sub, free=None if free_sub is None else free_sub.ravel(), with_aux=False
+            )
+            shape = (n_cand, -1, n_k)
             bound = room_bounds(
                 q_sub.reshape(*shape, n), valid_sub.reshape(shape), robot.q_min, robot.q_max
             )
             best = np.argmax(bound, axis=1)
-            rival = np.where(np.arange(N_BRANCHES) == best[:, None], -np.inf, bound).max(axis=1)
+            rival = np.where(np.arange(n_k) == best[:, None], -np.inf, bound).max(axis=1)
             first = np.ascontiguousarray(best[:, None])
             q, reach, switch, report, values, windings, winding = one_branch_paths(
-                family, robot, T, best, step
+                family, robot, T, best, step, free
             )
             ok = _usable(report, values)
             if np.all(ok[:, 0] & (values[:, 0, F_MARGIN] > rival + _ROOM_SLACK)):
                 return q, reach, switch, report, values, ok, first, step, method, windings, winding
         if branch is None:
-            paths = all_branch_paths(family, robot, T, candidates, step, threads, sharing)
+            paths = all_branch_paths(family, robot, T, candidates, step, threads, sharing, free)
         else:
-            paths = one_branch_paths(family, robot, T, candidates[:, 0], step)
+            paths = one_branch_paths(family, robot, T, candidates[:, 0], step, free)
         q, reach, switch, report, values, windings, winding = paths
         ok = _usable(report, values)
         return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
-    if method == "numeric":
-        seeds = np.ascontiguousarray(numeric_seeds(robot)[candidates])
-        q, reach, magnitude, crossing = numeric_paths(
-            *chain_arrays(robot),
-            T,
-            seeds,
-            _coarse_poses(T),
-            _NEWTON_TOL,
-            _MARCH_MAX_ITER,
-            _FINE_MAX_ITER,
-            -1,
-            np.empty((0, 0)),
-        )
-        channel_kind = np.array([SINGULAR])
-    else:
+    if method != "numeric":
         raise CaseError(f"method must be auto, closed_form or numeric, got {method!r}")
+    q, reach, magnitude, crossing = tracked_paths(family, robot, T, candidates, free)
+    channel_kind = np.array([SINGULAR])
     switch, report, values, windings, winding = analyse_paths(
         q, reach, magnitude, channel_kind, crossing, robot.q_min.copy(), robot.q_max.copy(), step
     )
@@ -167,8 +174,118 @@ def branch_paths(
     return q, reach, switch, report, values, ok, candidates, step, method, windings, winding
 
 
+def tracked_paths(
+    family: IKFamily,
+    robot: Robot,
+    T: np.ndarray,
+    candidates: np.ndarray,
+    free: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Joint paths that follow, by warm-started Newton, the distinct solutions of each
+    candidate's first pose (:meth:`IKFamily.seed_solutions`; columns ``candidates``).
+
+    Parameters
+    ----------
+    family, robot
+        The IK family and its robot.
+    T
+        Tool poses, shape (B, M, 4, 4), m, C-contiguous.
+    candidates
+        The solution (branch) of each column, shape (B, K), int.
+    free
+        The redundancy parameter, shape (B, M) or (B, K, M), rad, or None.
+
+    Returns
+    -------
+    q, reach, magnitude, crossing
+        As :func:`~trackplan.robots._path_kernels.numeric_paths`, shapes (B, K, M, n),
+        (B, K, M), (B, K, M, 1), (B, K, M); a column without a first solution reaches no
+        pose.
+    """
+    n_cand, n_poses = T.shape[:2]
+    n_k = candidates.shape[1]
+    locked = -1 if family.redundancy is None else family.redundancy.joint
+    if family.redundancy is not None and locked is None:
+        raise CaseError(f"the {family.name} IK family is not tracked by a held joint")
+    locked = -1 if locked is None else int(locked)
+    if free is None:
+        per_column = np.empty((n_cand, n_k, 0))
+    elif free.ndim == 2:
+        per_column = np.broadcast_to(free[:, None], (n_cand, n_k, n_poses))
+    else:
+        per_column = free
+    rows = np.arange(n_cand)[:, None]
+    q = np.empty((n_cand, n_k, n_poses, robot.n_dof))
+    reach = np.empty((n_cand, n_k, n_poses), dtype=np.bool_)
+    magnitude = np.empty((n_cand, n_k, n_poses, 1))
+    crossing = np.empty((n_cand, n_k, n_poses), dtype=np.int8)
+    coarse = _coarse_poses(T)
+    chain = chain_arrays(robot)
+    middle = 0.5 * (robot.q_min + robot.q_max)
+    # one profile per column: the first pose's solutions under each column's first value
+    distinct_free = free is not None and free.ndim == 3
+    for k in range(n_k) if distinct_free else [None]:
+        first_free = None
+        if free is not None:
+            first_free = np.ascontiguousarray(per_column[:, k if k is not None else 0, 0])
+        seeds, found = family.seed_solutions(
+            np.ascontiguousarray(T[:, 0]), robot.q_min, robot.q_max, free=first_free
+        )
+        chosen = seeds[rows, candidates]
+        has = found[rows, candidates]
+        chosen = np.where(has[..., None], chosen, middle)  # followed, then marked unreached
+        columns = range(n_k) if k is None else [k]
+        for c in columns:
+            held = np.ascontiguousarray(per_column[:, c]) if free is not None else np.empty((0, 0))
+            out = numeric_paths(
+                *chain,
+                T,
+                np.ascontiguousarray(chosen[:, c : c + 1]),
+                coarse,
+                _NEWTON_TOL,
+                _MARCH_MAX_ITER,
+                _FINE_MAX_ITER,
+                locked,
+                held,
+            )
+            q[:, c], reach[:, c], magnitude[:, c], crossing[:, c] = (x[:, 0] for x in out)
+            reach[~has[:, c], c] = False
+    return q, reach, magnitude, crossing
+
+
+def _free_values(
+    family: IKFamily, free: np.ndarray | None, lead: tuple[int, ...], n_k: int
+) -> np.ndarray | None:
+    """The redundancy parameter as float (B, M) or (B, K, M), checked against the family.
+
+    Raises
+    ------
+    CaseError
+        When a redundant family gets none, another family gets one, or the shape is wrong.
+    """
+    if family.redundancy is None:
+        if free is not None:
+            raise CaseError(f"the {family.name} IK family has no redundancy parameter")
+        return None
+    if free is None:
+        raise CaseError(
+            f"the {family.name} IK family needs its {family.redundancy.name} at every pose"
+        )
+    values = np.ascontiguousarray(free, dtype=float)
+    if values.shape not in (lead, (lead[0], n_k, lead[1])):
+        raise CaseError(
+            f"free must have shape {lead} or {(lead[0], n_k, lead[1])}, got {values.shape}"
+        )
+    return values
+
+
 def one_branch_paths(
-    family: IKFamily, robot: Robot, T: np.ndarray, branches: np.ndarray, step: np.ndarray
+    family: IKFamily,
+    robot: Robot,
+    T: np.ndarray,
+    branches: np.ndarray,
+    step: np.ndarray,
+    free: np.ndarray | None = None,
 ) -> tuple[np.ndarray, ...]:
     """:func:`all_branch_paths` of one closed-form branch per candidate, solved alone
     (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch`, the bits of that branch
@@ -186,19 +303,41 @@ def one_branch_paths(
         The branch of each candidate, shape (B,), int.
     step
         The step limit per joint, shape (n,), rad.
+    free
+        The redundancy parameter, shape (B, M), rad, or None.
 
     Returns
     -------
     q, reach, switch, report, values, windings, winding
         As :func:`all_branch_paths` with K = 1.
     """
-    solved = [family.solve_branch(T[b], int(k), with_aux=True) for b, k in enumerate(branches)]
+    solved = [
+        family.solve_branch(T[b], int(k), free=None if free is None else free[b], with_aux=True)
+        for b, k in enumerate(branches)
+    ]
     q_all, valid, aux = (np.stack([found[i] for found in solved])[:, :, None] for i in range(3))
     only = np.zeros((len(branches), 1), dtype=np.int64)
     paths = _analysis_arrays(len(branches), 1, T.shape[1], robot.n_dof)
     limits = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
     analyse_closed_form(q_all, valid, aux, only, *limits, step, *paths)
     return paths
+
+
+def per_branch_paths(
+    family: IKFamily,
+    robot: Robot,
+    T: np.ndarray,
+    candidates: np.ndarray,
+    step: np.ndarray,
+    free: np.ndarray,
+) -> tuple[np.ndarray, ...]:
+    """:func:`all_branch_paths` of a redundant closed-form family with one profile of its
+    parameter per candidate and branch, ``free`` (B, K, M): each column solved alone."""
+    columns = [
+        one_branch_paths(family, robot, T, candidates[:, k], step, free[:, k])
+        for k in range(candidates.shape[1])
+    ]
+    return tuple(np.concatenate(parts, axis=1) for parts in zip(*columns, strict=True))
 
 
 def all_branch_paths(
@@ -209,6 +348,7 @@ def all_branch_paths(
     step: np.ndarray,
     threads: int | None,
     sharing: ThreadSharing | None = None,
+    free: np.ndarray | None = None,
 ) -> tuple[np.ndarray, ...]:
     """The candidate branches' closed-form joint paths, analysed
     (:func:`~trackplan.robots._path_kernels.analyse_closed_form` of all eight branches'
@@ -235,6 +375,8 @@ def all_branch_paths(
     sharing
         The caller's record of whether sharing pays, consulted and updated when
         ``threads`` is None; None: :func:`path_threads` threads, nothing recorded.
+    free
+        The redundancy parameter, shape (B, M), rad, or None.
 
     Returns
     -------
@@ -246,15 +388,17 @@ def all_branch_paths(
     paths = _analysis_arrays(n_cand, candidates.shape[1], n_poses, robot.n_dof)
     size = max(1, PIECE_POSES // n_poses)  # candidates per piece
     flat = T.reshape(-1, 4, 4)
+    flat_free = None if free is None else free.reshape(-1)
+    n_k = family.n_branches
     pieces = deque(range(0, n_cand, size))
     q_min, q_max = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
 
     def work(timed: bool = True) -> float:  # the thread's CPU time, s (0 untimed)
         started = time.thread_time() if timed else 0.0
         rows = size * n_poses
-        q_rows = np.empty((rows, N_BRANCHES, robot.n_dof))
-        valid_rows = np.empty((rows, N_BRANCHES), dtype=np.bool_)
-        aux_rows = np.empty((rows, N_BRANCHES, AUX_SIZE))
+        q_rows = np.empty((rows, n_k, robot.n_dof))
+        valid_rows = np.empty((rows, n_k), dtype=np.bool_)
+        aux_rows = np.empty((rows, n_k, AUX_SIZE))
         while True:
             try:
                 start = pieces.popleft()
@@ -263,8 +407,11 @@ def all_branch_paths(
             stop = min(start + size, n_cand)
             rows = (stop - start) * n_poses
             out = (q_rows[:rows], valid_rows[:rows], aux_rows[:rows])
-            q_all, valid, aux = family.solve_flat(flat[start * n_poses : stop * n_poses], out=out)
-            shape = (stop - start, n_poses, N_BRANCHES)
+            part = slice(start * n_poses, stop * n_poses)
+            q_all, valid, aux = family.solve_flat(
+                flat[part], free=None if flat_free is None else flat_free[part], out=out
+            )
+            shape = (stop - start, n_poses, n_k)
             analyse_closed_form(
                 q_all.reshape(*shape, -1),
                 valid.reshape(shape),
@@ -319,17 +466,17 @@ def _usable(report: np.ndarray, values: np.ndarray) -> np.ndarray:
     return usable
 
 
-def _candidate_branches(branch: int | np.ndarray | None, n_cand: int) -> np.ndarray:
-    """Branches to try per candidate, shape (B, K), int64."""
+def _candidate_branches(branch: int | np.ndarray | None, n_cand: int, n_k: int) -> np.ndarray:
+    """Branches to try per candidate (of the family's ``n_k``), shape (B, K), int64."""
     if branch is None:
-        return np.ascontiguousarray(np.broadcast_to(np.arange(N_BRANCHES), (n_cand, N_BRANCHES)))
+        return np.ascontiguousarray(np.broadcast_to(np.arange(n_k), (n_cand, n_k)))
     chosen = np.asarray(branch)
     if chosen.ndim == 0:
         chosen = np.full(n_cand, chosen)
     if chosen.shape != (n_cand,) or not np.issubdtype(chosen.dtype, np.integer):
         raise CaseError(f"branch must be None, an int or an int array ({n_cand},), got {branch!r}")
-    if np.any((chosen < 0) | (chosen >= N_BRANCHES)):
-        raise CaseError(f"branch must be in 0…{N_BRANCHES - 1}, got {chosen.tolist()}")
+    if np.any((chosen < 0) | (chosen >= n_k)):
+        raise CaseError(f"branch must be in 0…{n_k - 1}, got {chosen.tolist()}")
     return np.ascontiguousarray(chosen.astype(np.int64)[:, None])
 
 

@@ -55,7 +55,8 @@ from trackplan.robots._path_kernels import (
     SINGULAR,
     WRIST,
 )
-from trackplan.robots.families import N_BRANCHES, ik_family
+from trackplan.robots.families import ik_family
+from trackplan.robots.ik_numeric import track_poses
 from trackplan.robots.model import Robot
 from trackplan.robots.path_branches import _NEWTON_TOL as _NEWTON_TOL  # planning/checker.py
 from trackplan.robots.path_branches import DEFAULT_MAX_STEP as DEFAULT_MAX_STEP
@@ -184,6 +185,7 @@ def solve_path_ik(
     method: str = "auto",
     threads: int | None = None,
     sharing: ThreadSharing | None = None,
+    free: np.ndarray | None = None,
 ) -> PathIK:
     """Joint paths of candidate pose paths on one IK branch each.
 
@@ -213,6 +215,9 @@ def solve_path_ik(
         when ``threads`` is None: a caller that solves many batches (the search) keeps one.
         None: one thread per core this process may run on (:func:`path_threads`), nothing
         recorded.
+    free
+        A redundant arm's IK parameter (:attr:`IKFamily.redundancy`) at every pose, shape
+        (B, M), rad, or one profile per branch, (B, K, M); None for other arms.
 
     Returns
     -------
@@ -224,7 +229,15 @@ def solve_path_ik(
         When the shapes, the branch, max_step or the method are invalid.
     """
     paths = branch_paths(
-        robot, T_base_tool, branch, max_step, method, threads, screen=True, sharing=sharing
+        robot,
+        T_base_tool,
+        branch,
+        max_step,
+        method,
+        threads,
+        screen=True,
+        sharing=sharing,
+        free=free,
     )
     q, reach, switch, report, values, ok = paths[:6]
     candidates, step, method, windings, winding = paths[6:]
@@ -262,6 +275,7 @@ def solve_path_ik_branches(
     method: str = "auto",
     threads: int | None = None,
     sharing: ThreadSharing | None = None,
+    free: np.ndarray | None = None,
 ) -> PathIKBranches:
     """Joint paths of candidate pose paths on every IK branch, in one batched call.
 
@@ -273,7 +287,7 @@ def solve_path_ik_branches(
         Tool poses in the base frame, shape (B, M, 4, 4), metres.
     max_step
         As for :func:`solve_path_ik`.
-    method, threads, sharing
+    method, threads, sharing, free
         As for :func:`solve_path_ik`.
 
     Returns
@@ -286,11 +300,11 @@ def solve_path_ik_branches(
         When the shapes, max_step or the method are invalid.
     """
     q, reach, switch, report, values, ok, _, _, method, windings, winding = branch_paths(
-        robot, T_base_tool, None, max_step, method, threads, sharing=sharing
+        robot, T_base_tool, None, max_step, method, threads, sharing=sharing, free=free
     )
     return PathIKBranches(
         q=q,
-        branches=np.arange(N_BRANCHES),
+        branches=np.arange(q.shape[1]),
         reachable=reach,
         switch=switch,
         success=ok,
@@ -305,7 +319,11 @@ def solve_path_ik_branches(
 
 
 def branch_joints(
-    robot: Robot, T_base_tool: np.ndarray, branch: int, reference: np.ndarray
+    robot: Robot,
+    T_base_tool: np.ndarray,
+    branch: int,
+    reference: np.ndarray,
+    free: np.ndarray | None = None,
 ) -> np.ndarray:
     """Joint positions of poses on one known branch, each on the winding nearest a reference.
 
@@ -327,6 +345,8 @@ def branch_joints(
         The IK branch (closed-form branch or numeric seed), 0 … 7.
     reference
         Joint positions each result is wound nearest to, shape (M, n), rad.
+    free
+        A redundant arm's IK parameter at every pose, shape (M,), rad, or None.
 
     Returns
     -------
@@ -335,7 +355,9 @@ def branch_joints(
     """
     T = np.asarray(T_base_tool, dtype=float)
     at = np.arange(len(reference), dtype=float)  # interpolating at the nodes: the reference
-    return branch_joints_along(robot, T[:, :3, :3], T[:, :3, 3], branch, at, at, reference)
+    return branch_joints_along(
+        robot, T[:, :3, :3], T[:, :3, 3], branch, at, at, reference, free=free
+    )
 
 
 def branch_joints_along(
@@ -346,6 +368,8 @@ def branch_joints_along(
     s: np.ndarray,
     s_grid: np.ndarray,
     q_grid: np.ndarray,
+    *,
+    free: np.ndarray | None = None,
 ) -> np.ndarray:
     """:func:`branch_joints` of poses given by their parts, the reference interpolated from
     a grid, in one pass.
@@ -355,7 +379,9 @@ def branch_joints_along(
     closed-form family reads the rotations and positions as they are
     (:meth:`~trackplan.robots.families.base.IKFamily.solve_branch_parts`: no (M, 4, 4)
     array) and holds and winds the joints in the same compiled pass (``hold_and_wind`` of
-    ``families/_kernels.py``); numeric IK winds them after its path IK.
+    ``families/_kernels.py``). A tracked family solves each pose by Newton from the
+    reference (:func:`~trackplan.robots.ik_numeric.track_poses`): the grid's joint path,
+    within a grid step of the solution, keeps the branch the grid followed.
 
     Parameters
     ----------
@@ -371,6 +397,8 @@ def branch_joints_along(
         Where each pose lies on the grid's axis, shape (M,) (arc length, m).
     s_grid, q_grid
         The reference: strictly increasing grid (G,) and joint positions there (G, n), rad.
+    free
+        A redundant arm's IK parameter at every pose, shape (M,), rad, or None.
 
     Returns
     -------
@@ -381,17 +409,15 @@ def branch_joints_along(
     if family.closed_form:
         grid = (s, s_grid, q_grid)
         return family.solve_branch_parts(
-            R_base_tool, p_base_tool, branch, with_aux=False, wind_to=grid
+            R_base_tool, p_base_tool, branch, free=free, with_aux=False, wind_to=grid
         )[0]
-    T = np.zeros((len(p_base_tool), 4, 4))
-    T[:, :3, :3] = R_base_tool
-    T[:, :3, 3] = p_base_tool
-    T[:, 3, 3] = 1.0
-    q = solve_path_ik(robot, T[None], branch=branch).q[0]  # missed poses held
     q_grid = np.asarray(q_grid, dtype=float)
     reference = np.column_stack([np.interp(s, s_grid, column) for column in q_grid.T])
-    wound: np.ndarray = q - 2 * np.pi * np.round((q - reference) / (2 * np.pi))
-    return wound
+    locked = -1
+    if family.redundancy is not None and family.redundancy.joint is not None:
+        locked = family.redundancy.joint
+    q, _ = track_poses(robot, R_base_tool, p_base_tool, reference, free, locked)
+    return q
 
 
 def _choose(ok: np.ndarray, first_problem: np.ndarray, margin: np.ndarray) -> np.ndarray:
