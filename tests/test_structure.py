@@ -34,9 +34,9 @@ def test_a_plan_makes_one_pose_pass_and_one_ik_pass_on_its_grid(monkeypatch):
         calls.append(("poses", len(positions)))
         return real_parts(X, positions, R_part_tool)
 
-    def branch_ik(robot, R, p, *args):  # the samples: their branch only
+    def branch_ik(robot, R, p, *args, **kwargs):  # the samples: their branch only
         calls.append(("ik", len(p)))
-        return real_branch(robot, R, p, *args)
+        return real_branch(robot, R, p, *args, **kwargs)
 
     monkeypatch.setattr(jointpath, "tool_poses", poses)
     monkeypatch.setattr(jointpath, "solve_path_ik", ik)

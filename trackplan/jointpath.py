@@ -19,6 +19,8 @@ from trackplan.axes.profile import AxesProfile
 from trackplan.derived import derived
 from trackplan.frames import placement_transform, tool_pose_parts, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
+from trackplan.profiles import Profile
+from trackplan.robots.families import ik_family
 from trackplan.robots.machine import Machine, arm_of
 from trackplan.robots.model import Robot
 from trackplan.robots.path_ik import PathIK, branch_joints_along, solve_path_ik
@@ -63,6 +65,9 @@ class JointPath:
         The path IK over the grid and its stencils (branch, status, message, margin).
     axes
         The external axes along the path (a machine's), or None for a robot.
+    redundancy
+        A redundant arm's free parameter along the path (:attr:`IKFamily.redundancy`:
+        the arm angle, or a joint), rad over s ∈ [0, length]; None for other arms.
     """
 
     robot: Robot | Machine
@@ -77,6 +82,7 @@ class JointPath:
     dddq: np.ndarray
     ik: PathIK
     axes: AxesProfile | None = None
+    redundancy: Profile | None = None
 
     @classmethod
     def solve(
@@ -87,6 +93,7 @@ class JointPath:
         tool: ToolOrientation,
         branch: int | None = None,
         axes: AxesProfile | None = None,
+        redundancy: Profile | None = None,
     ) -> JointPath:
         """Poses and path IK of the planning grid, in one pose pass and one IK pass.
 
@@ -104,6 +111,9 @@ class JointPath:
             Force an IK branch; default: the usable one with the largest margin.
         axes
             A machine's external axes along the path (track, positioner), m and rad.
+        redundancy
+            A redundant arm's free parameter along the path, rad (required for one:
+            :func:`trackplan.redundancy.choose_redundancy` chooses it).
 
         Returns
         -------
@@ -122,13 +132,30 @@ class JointPath:
         external = _external(robot, axes, grid.points.ravel())
         if external is not None:
             poses = _machine(robot).base_carrier_at(external) @ poses
-        ik = solve_path_ik(arm, poses[None], branch=branch)
+        free = _free(arm, redundancy, grid.points.ravel())
+        ik = solve_path_ik(
+            arm, poses[None], branch=branch, free=None if free is None else free[None]
+        )
         q_points = ik.q[0].reshape(*grid.points.shape, arm.n_dof)
         if external is not None:
             q_points = np.concatenate([q_points, external.reshape(*grid.points.shape, -1)], axis=-1)
         dq, ddq, dddq = stencil_derivatives(q_points, grid.offset, grid.h)
         q = q_points[np.arange(len(grid.s)), grid.offset]
-        return cls(robot, geometry, placement, tool, grid.s, grid.zone, q, dq, ddq, dddq, ik, axes)
+        return cls(
+            robot,
+            geometry,
+            placement,
+            tool,
+            grid.s,
+            grid.zone,
+            q,
+            dq,
+            ddq,
+            dddq,
+            ik,
+            axes,
+            redundancy,
+        )
 
     @property
     def arm(self) -> Robot:
@@ -172,15 +199,7 @@ class JointPath:
 
     def poses(self, s: np.ndarray) -> np.ndarray:
         """Tool poses in the arm's base frame at arc lengths ``s`` (M,), shape (M, 4, 4)."""
-        s_path, position, tangent = self.geometry.planned.points(np.asarray(s, dtype=float))
-        rotations = _rotations(self.tool, s_path, tangent)
-        position = _woven(self.geometry, self.tool, s_path, position, tangent, rotations)
-        poses = tool_poses(self.placement, position, rotations)
-        external = _external(self.robot, self.axes, np.asarray(s, dtype=float))
-        if external is None:
-            return poses
-        carried: np.ndarray = _machine(self.robot).base_carrier_at(external) @ poses
-        return carried
+        return placed_tool_poses(self.robot, self.geometry, self.placement, self.tool, self.axes, s)
 
     def joints(self, s: np.ndarray) -> np.ndarray:
         """Joint positions at arc lengths ``s`` by IK on this path's branch.
@@ -207,9 +226,10 @@ class JointPath:
         R_base_tool, p_base_tool = tool_pose_parts(self.placement, position, rotations)
         grid, q_grid = self._distinct_grid
         external = _external(self.robot, self.axes, s)
+        free = _free(self.arm, self.redundancy, s)
         if external is None:
             return branch_joints_along(
-                self.arm, R_base_tool, p_base_tool, self.branch, s, grid, q_grid
+                self.arm, R_base_tool, p_base_tool, self.branch, s, grid, q_grid, free=free
             )
         carrier = _machine(self.robot).base_carrier_at(external)
         R_base_tool = carrier[:, :3, :3] @ R_base_tool
@@ -223,6 +243,7 @@ class JointPath:
             s,
             grid,
             np.ascontiguousarray(q_grid[:, :n_arm]),
+            free=free,
         )
         return np.concatenate([q_arm, external], axis=1)
 
@@ -284,6 +305,53 @@ def _external(robot: Robot | Machine, axes: AxesProfile | None, s: np.ndarray) -
             f"a machine with {robot.n_external} external axes needs their profile, got {found}"
         )
     return axes.values(s)
+
+
+def placed_tool_poses(
+    robot: Robot | Machine,
+    geometry: PathGeometry,
+    placement: np.ndarray,
+    tool: ToolOrientation,
+    axes: AxesProfile | None,
+    s: np.ndarray,
+) -> np.ndarray:
+    """Tool poses of a placed path in the arm's base frame at arc lengths ``s`` (M,).
+
+    The weave is added and, for a machine, the part is carried by the external axes
+    ``axes`` (required then).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (M, 4, 4), m.
+    """
+    s = np.asarray(s, dtype=float)
+    s_path, position, tangent = geometry.planned.points(s)
+    rotations = _rotations(tool, s_path, tangent)
+    position = _woven(geometry, tool, s_path, position, tangent, rotations)
+    poses = tool_poses(np.asarray(placement, dtype=float), position, rotations)
+    external = _external(robot, axes, s)
+    if external is None:
+        return poses
+    carried: np.ndarray = _machine(robot).base_carrier_at(external) @ poses
+    return carried
+
+
+def _free(arm: Robot, redundancy: Profile | None, s: np.ndarray) -> np.ndarray | None:
+    """A redundant arm's free parameter at arc lengths ``s`` (M,), shape (M,), rad; None for
+    other arms.
+
+    Raises
+    ------
+    ValueError
+        When a redundant arm comes without its profile.
+    """
+    parameter = ik_family(arm).redundancy
+    if parameter is None:
+        return None
+    if redundancy is None:
+        raise ValueError(f"{arm.name} is redundant: its {parameter.name} profile is required")
+    return redundancy.value(s)
 
 
 def _machine(robot: Robot | Machine) -> Machine:

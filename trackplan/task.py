@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from trackplan.choices import Timing, choose
+from trackplan.redundancy.spec import RedundancySpec
 from trackplan.tool import ToolSpec
 from trackplan.tool.weave import Weave
 
@@ -34,6 +35,9 @@ class Task:
         written).
     weave
         The torch's weave across the seam (:class:`~trackplan.tool.weave.Weave`), or None.
+    redundancy
+        How a redundant (7-joint) arm's free parameter is chosen along the seam
+        (:class:`~trackplan.redundancy.RedundancySpec`); other arms ignore it.
     """
 
     rated_speed: float
@@ -43,6 +47,7 @@ class Task:
     tool: ToolSpec = field(default_factory=ToolSpec)
     timing: Timing = Timing.SMOOTH
     weave: Weave | None = None
+    redundancy: RedundancySpec = field(default_factory=RedundancySpec)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "timing", choose(Timing, self.timing, "task.timing"))

@@ -243,7 +243,8 @@ def test_numeric_mode_flags_a_singularity_crossing(puma):
 
 
 def test_seven_joint_arm_plans_numerically_and_continuously():
-    """A redundant URDF arm: numeric path IK, seeded sample to sample, continuous."""
+    """A redundant URDF arm: numeric path IK with joint 3 held along a given profile,
+    tracked sample to sample, continuous, joint 3 where the profile puts it."""
     from pathlib import Path
 
     from trackplan.io.robot_file import load_robot
@@ -255,12 +256,17 @@ def test_seven_joint_arm_plans_numerically_and_continuously():
     q_mid = np.array([0.3, -0.5, 0.8, 0.4, 0.6, -0.3, 0.2])
     T_mid = forward_kinematics(robot, q_mid)
     T = line(T_mid[:3, 3], np.array([0.2, 1.0, -0.3]), T_mid[:3, :3], 0.1, 200)[None]
-    result = solve_path_ik(robot, T)
+    free = np.linspace(0.8, 0.9, T.shape[1])[None]  # joint 3 along the path
+    result = solve_path_ik(robot, T, free=free)
     assert result.method == "numeric"
     assert result.success[0], result.message[0]
     assert_follows(robot, result, T, tol=1e-9)
     assert np.abs(np.diff(result.q[0], axis=0)).max() < 0.02
-    assert "continuous" in robot_info(robot)["redundancy_rule"]
+    wound = (result.q[0, :, 2] - free[0] + np.pi) % (2 * np.pi) - np.pi
+    np.testing.assert_allclose(wound, 0.0, atol=1e-12)
+    assert robot_info(robot)["redundancy"]["parameter"] == "joint 3"
+    with pytest.raises(CaseError, match="needs its joint 3"):
+        solve_path_ik(robot, T)
 
 
 def test_windings_of_wide_joints_are_enumerated_and_the_widest_margin_kept(puma):
@@ -352,9 +358,13 @@ def test_branch_joints_of_a_numeric_robot_are_its_path_ik():
     )
     T_mid = forward_kinematics(robot, np.array([0.3, -0.5, 0.8, 0.4, 0.6, -0.3, 0.2]))
     T = line(T_mid[:3, 3], np.array([0.2, 1.0, -0.3]), T_mid[:3, :3], 0.1, 50)
-    path = solve_path_ik(robot, T[None], branch=1)
-    found = branch_joints(robot, T, 1, path.q[0] - 2 * np.pi)
-    np.testing.assert_allclose(found, path.q[0] - 2 * np.pi, rtol=0, atol=1e-12)
+    free = np.full(len(T), 0.8)  # joint 3 held
+    path = solve_path_ik(robot, T[None], branch=0, free=free[None])
+    assert path.success[0], path.message[0]
+    shift = np.where(np.arange(7) == 2, 0.0, 2 * np.pi)  # the held joint is the profile's
+    found = branch_joints(robot, T, 0, path.q[0] - shift, free=free)
+    # both are Newton solutions of the poses to 1e-10 (m, rad) from nearby starts
+    np.testing.assert_allclose(found, path.q[0] - shift, rtol=0, atol=1e-8)
 
 
 @pytest.mark.parametrize("robot_name", ["puma", "ur"])

@@ -121,6 +121,13 @@ def robots(
         out.print(link_capsules_line(robot))
         for note in robot.assumptions:
             out.print(f"assumption: {escape(note)}")
+        redundancy = info.get("redundancy")
+        if isinstance(redundancy, dict):
+            low, high = redundancy["range"]
+            out.print(
+                f"redundancy: the {redundancy['parameter']} in [{low:.4f}, {high:.4f}] rad, "
+                "chosen along each seam (task.redundancy)"
+            )
         if "redundancy_rule" in info:
             out.print(f"redundancy: {escape(str(info['redundancy_rule']))}")
         return ExitCode.OK

@@ -28,6 +28,7 @@ from trackplan.case import (
 from trackplan.choices import OBJECTIVE_KINDS, Method, Penalty, Timing
 from trackplan.io.case_axes import axes_problems, load_positioner_chain, with_axes
 from trackplan.io.case_cad import expand_cad, with_part_body
+from trackplan.io.case_redundancy import as_redundancy
 from trackplan.io.case_schema import (
     CaseModel,
     ObjectiveModel,
@@ -264,6 +265,7 @@ def _case(
             sample_time=task.sample_time,
             tool=as_spec(task.tool, task.tool_rpy),
             timing=Timing(task.timing),
+            redundancy=as_redundancy(task.redundancy),
         ),
         bounds=PlacementBounds(
             lower=_array(ranges[:, 0]),
@@ -393,6 +395,9 @@ def _with_seams(
                     corner_speed=corner,
                     tolerance=task.tolerance if own.tolerance is None else own.tolerance,
                     tool=tool,
+                    redundancy=(
+                        task.redundancy if own.redundancy is None else as_redundancy(own.redundancy)
+                    ),
                 ),
                 reversible=seam.reversible,
             )

@@ -12,6 +12,7 @@ from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 from pydantic_core import PydanticCustomError
 
 from trackplan.io.case_axes import DownhandModel, PositionerModel, TrackModel, WeaveModel
+from trackplan.io.case_redundancy import RedundancyModel
 from trackplan.io.case_tcp import TcpModel
 from trackplan.io.cell_file import CellModel
 from trackplan.io.points_file import MIN_POINTS
@@ -149,6 +150,7 @@ class TaskModel(StrictModel):
     tool: ToolModel | None = None
     timing: Literal["smooth", "paper"] = "smooth"
     weave: WeaveModel | None = None
+    redundancy: RedundancyModel | None = None
 
 
 class SeamTaskModel(StrictModel):
@@ -160,6 +162,7 @@ class SeamTaskModel(StrictModel):
     tool_rpy: Vec3 | None = None
     tool: ToolModel | None = None
     weave: WeaveModel | None = None  # null turns the case's weave off for this seam
+    redundancy: RedundancyModel | None = None
 
 
 def _csv_safe_name(name: str) -> str:

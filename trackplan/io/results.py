@@ -19,7 +19,9 @@ from trackplan.frames import rpy_from_matrix
 from trackplan.io.csv_table import format_table, write_csv_table
 from trackplan.io.run_folder import HASH_KEY, file_sha256
 from trackplan.io.sizes import MAX_TRAJECTORY_BYTES, max_samples
+from trackplan.jointpath import JointPath
 from trackplan.planning.result import SEAM, CheckReport, PlanResult, Trajectory
+from trackplan.robots.families import ik_family
 from trackplan.robots.machine import machine_of
 from trackplan.run_files import RESULT_FILE, TRAJECTORY_FILE
 from trackplan.timing.protocol import SlowDown
@@ -250,6 +252,7 @@ def result_summary(result: PlanResult, joint_names: tuple[str, ...]) -> dict:
         "max_orientation_error": float(check.max_orientation_error),
         "tool": result.joint_path.tool.spec.describe(),
         "spin": result.joint_path.tool.spin.as_dict(),
+        "redundancy": redundancy_record(result.joint_path),
         "rated_speed_fraction": float(result.rated_speed_fraction),
         "min_corner_speed": float(result.min_corner_speed),
         **_energy_summary(result),
@@ -509,6 +512,7 @@ def seams_summary(result: PlanResult, case: Case) -> dict:
                 "max_orientation_error": float(own.max_orientation_error),
                 "branch": int(plan.branch),
                 "spin": plan.joint_path.tool.spin.as_dict(),
+                "redundancy": redundancy_record(plan.joint_path),
                 "feasible": bool(own.success),
                 "slowdowns": [slowdown_record(d) for d in plan.slowdowns],
                 "weave": None if plan.weave is None else plan.weave.as_dict(),
@@ -556,3 +560,14 @@ def read_segments(file: Path) -> np.ndarray | None:
         return None
     column = header.index(SEGMENT_COLUMN)
     return np.array([line.split(",")[column] for line in lines[1:] if line.strip()])
+
+
+def redundancy_record(joint_path: JointPath) -> dict[str, object] | None:
+    """A redundant arm's free parameter along a seam for result.json: ``parameter`` (its
+    name), then ``value`` (a constant, rad) or ``knots``, ``coefficients``, ``degree`` (a
+    B-spline over the seam's arc length, m and rad); None for other arms."""
+    if joint_path.redundancy is None:
+        return None
+    parameter = ik_family(joint_path.arm).redundancy
+    name = "free parameter" if parameter is None else parameter.name
+    return {"parameter": name, **joint_path.redundancy.as_dict()}

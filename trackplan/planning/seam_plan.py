@@ -19,15 +19,19 @@ from trackplan.case import Case
 from trackplan.derived import derived
 from trackplan.errors import CaseError
 from trackplan.frames import as_placement, placement_transform, vector_norms
-from trackplan.jointpath import JointPath
+from trackplan.jointpath import JointPath, placed_tool_poses
 from trackplan.motion import JointSamples
 from trackplan.paths.path_geometry import PathGeometry, PathMode
+from trackplan.paths.screening_grid import screening_grid
 from trackplan.planning.checker import TrackingReference, check_motion
 from trackplan.planning.energy import motion_energy
 from trackplan.planning.objectives import joint_travel
 from trackplan.planning.result import CheckReport, PlanResult, Trajectory
 from trackplan.planning.tool_zones import transition_zones
-from trackplan.robots.machine import Machine, machine_of
+from trackplan.profiles import Profile
+from trackplan.redundancy import choose_redundancy
+from trackplan.robots.families import ik_family
+from trackplan.robots.machine import Machine, arm_of, machine_of
 from trackplan.robots.model import Robot
 from trackplan.status import Status
 from trackplan.task import Task
@@ -218,11 +222,56 @@ def plan_seam(
             chosen = choose_axes(machine_of(machine), geometry, case.task.tool, X, None)
             assert isinstance(chosen, AxesProfile)
         axes = chosen if isinstance(machine, Machine) else None
-    joint_path = JointPath.solve(machine, geometry, X, tool, branch, axes)
+    redundancy = None
+    if ik_family(arm_of(machine)).redundancy is not None:
+        redundancy, branch = choose_seam_redundancy(case, geometry, X, tool, axes, branch)
+    joint_path = JointPath.solve(machine, geometry, X, tool, branch, axes, redundancy)
     if failure is not None:
         planned = _planned(case, joint_path, law, geometry)
         return replace(planned, success=False, status=failure.status, message=failure.message)
     return _planned(case, joint_path, law, geometry)
+
+
+def choose_seam_redundancy(
+    case: Case,
+    geometry: PathGeometry,
+    X: np.ndarray,
+    tool: ToolOrientation,
+    axes: AxesProfile | None,
+    branch: int | None,
+) -> tuple[Profile, int]:
+    """A redundant arm's free parameter along a seam at placement X, and the branch.
+
+    Chosen on the seam's screening grid as the placement search chooses it
+    (:func:`~trackplan.redundancy.choose_redundancy`), for the case's steering
+    (``task.redundancy``) and travel weights. Without a given branch, the branch whose
+    path is usable with the largest margin (else the one whose first problem comes
+    latest), as :func:`~trackplan.robots.path_ik.solve_path_ik` chooses one.
+
+    Returns
+    -------
+    tuple
+        The profile (rad over the seam's arc length) and the branch.
+    """
+    arm = arm_of(case.machine)
+    s = screening_grid(geometry)
+    poses = placed_tool_poses(case.machine, geometry, X, tool, axes, s)
+    weights = case.travel_weights[: arm.n_dof]
+    length = geometry.planned.length
+    choice = choose_redundancy(arm, poses[None], s, length, case.task.redundancy, weights)
+    paths = choice.paths
+    if branch is None:
+        order = np.lexsort(
+            (
+                -paths.margin[0],
+                np.where(paths.success[0], 0, -paths.first_problem[0]),
+                ~paths.success[0],
+            )
+        )
+        column = int(order[0])
+    else:
+        column = int(np.flatnonzero(paths.branches == branch)[0])
+    return choice.profile(0, column), int(paths.branches[column])
 
 
 def _planned(case: Case, joint_path: JointPath, law: TimeLaw, geometry: PathGeometry) -> PlanResult:

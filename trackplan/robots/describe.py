@@ -19,8 +19,8 @@ def robot_info(robot: Robot) -> dict[str, object]:
         ``name``, ``joints``, ``family`` (opw, ur or numeric), ``parameters`` (the
         derived family parameters, m and rad), ``reach`` (m), ``source``, ``assumptions``
         (limits that were assumed, one sentence each), ``link_capsules`` (how many
-        capsules model the links, 0 for none) and, for chains of more than six joints,
-        ``redundancy_rule``.
+        capsules model the links, 0 for none) and, for a redundant arm, ``redundancy`` (its
+        free parameter's name and natural range, rad; longer chains: ``redundancy_rule``).
     """
     family = ik_family(robot)
     info: dict[str, object] = {
@@ -35,6 +35,11 @@ def robot_info(robot: Robot) -> dict[str, object]:
         "assumptions": list(robot.assumptions),
         "link_capsules": 0 if robot.collision is None else len(robot.collision),
     }
-    if robot.n_dof > 6:
+    if family.redundancy is not None:
+        info["redundancy"] = {
+            "parameter": family.redundancy.name,
+            "range": [family.redundancy.lower, family.redundancy.upper],
+        }
+    elif robot.n_dof > 6:
         info["redundancy_rule"] = REDUNDANCY_RULE
     return info

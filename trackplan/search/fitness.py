@@ -61,9 +61,13 @@ from trackplan.case import Case, Objective
 from trackplan.choices import Penalty
 from trackplan.frames import placement_transform, tool_poses
 from trackplan.paths.path_geometry import PathGeometry
+from trackplan.paths.screening_grid import CURVED_POSES as CURVED_POSES
+from trackplan.paths.screening_grid import SCREEN_POSES, screening_grid
 from trackplan.planning.objectives import ScreenInput, screen_objective
 from trackplan.planning.result import PlanResult
+from trackplan.redundancy import choose_redundancy
 from trackplan.robots.dynamics.rne import holding_torque_ratio
+from trackplan.robots.families import ik_family
 from trackplan.robots.machine import Machine, carried_poses
 from trackplan.robots.path_ik import solve_path_ik_branches
 from trackplan.robots.thread_sharing import ThreadSharing
@@ -85,13 +89,6 @@ from trackplan.tool import ToolOrientation, spin_rotations, spin_values
 if TYPE_CHECKING:  # the cell's compiled screening only for cases with a cell
     from trackplan.cell.screening import CellGeometry
 
-SCREEN_POSES = 150
-"""Target number of poses of the screening grid along the planned path. 100 poses screen a
-third faster and keep the paper cases' J, but miss what varies between poses: with the
-GA, the free-spin circle ends 3.5 % higher (seeds 1, 2) and the payload case's holding
-torque peaks slip between poses (every screened optimum failed the final torque check)."""
-CURVED_POSES = 9
-"""Poses at least in every curved zone (arcs, corner blends) of the screening grid."""
 AXES_LEVEL = 2.5
 """Graded violation of a candidate whose external axes cannot keep the downhand rule:
 ``2.5 + min(1, reached / π)`` (in [2.5, 3.5]), ``reached`` the angle over the bound where
@@ -107,19 +104,6 @@ CELL_STRIDE = 3
 """The clearance is screened on every third pose of the screening grid (about 2 cm apart on
 the paper's corner path): the search's cost of the cell stays within 2× (``python -m
 benchmarks collision``); the final plan is checked exactly at every sample."""
-
-
-def screening_grid(geometry: PathGeometry, n_poses: int = SCREEN_POSES) -> np.ndarray:
-    """Coarse arc lengths covering the planned path, shape (M,), m.
-
-    A grid of about ``n_poses`` points with every zone boundary
-    (:meth:`PathGeometry.grid`), plus :data:`CURVED_POSES` points across each curved zone
-    so that short corner blends are represented.
-    """
-    planned = geometry.planned
-    s = [geometry.grid(planned.length / max(n_poses - 1, 1))]
-    s += [np.linspace(s0, s1, CURVED_POSES) for s0, s1, kind in planned.zones if kind == "curved"]
-    return np.unique(np.concatenate(s))
 
 
 def plan_candidate(
@@ -271,7 +255,16 @@ class PlacementFitness:
         external, failed = self.external_axes(X[:, :6], X[:, 6 + n_spin :])
         if external is not None:
             poses = carried_poses(self.case.machine, external, poses)
-        paths = solve_path_ik_branches(self.case.robot, poses, sharing=self.sharing)
+        arm = self.case.robot
+        if ik_family(arm).redundancy is None:
+            paths = solve_path_ik_branches(arm, poses, sharing=self.sharing)
+        else:  # the free parameter chosen per candidate and branch, as a plan chooses it
+            length = self.geometry.planned.length
+            spec = self.case.task.redundancy
+            weights = self.weights[: arm.n_dof]
+            paths = choose_redundancy(
+                arm, poses, self.s_grid, length, spec, weights, sharing=self.sharing
+            ).paths
         n_poses = len(self.s_grid)
         unreachable = 1.0 - paths.reachable_fraction
         switches = paths.n_switches / n_poses

@@ -2,7 +2,9 @@
 
 The path IK (:mod:`trackplan.robots.path_ik`) solves them by damped Newton
 (:mod:`trackplan.robots.ik_numeric`), seeded sample to sample; a branch is a seed.
-A 7-joint arm resolves its redundancy by the rule :data:`REDUNDANCY_RULE`.
+A 7-joint arm's redundancy is one of its joints (:data:`DEFAULT_FREE_JOINT` unless the robot
+file says which), whose profile along the path the planner chooses; longer chains resolve it
+by the rule :data:`REDUNDANCY_RULE`.
 """
 
 from __future__ import annotations
@@ -16,8 +18,13 @@ from trackplan.robots.families.base import (
     _no_free,
     wrap_and_deduplicate,
 )
-from trackplan.robots.ik_numeric import solve_ik_numeric
+from trackplan.robots.ik_numeric import solve_ik_numeric, track_poses
 from trackplan.robots.model import Robot
+
+DEFAULT_FREE_JOINT = 2
+"""The joint (0-based) that carries a 7-joint arm's redundancy in the numeric family: the
+third, the upper arm's roll of the usual anthropomorphic arms, which moves the elbow about
+the shoulder–wrist line much as the arm angle does."""
 
 REDUNDANCY_RULE = (
     "continuous minimum-norm steps: each sample is solved by damped least squares "
@@ -36,13 +43,23 @@ class NumericFamily:
     n_branches = N_BRANCHES
     redundancy: RedundancyParameter | None = None
 
-    def __init__(self, robot: Robot):
+    def __init__(self, robot: Robot, free_joint: int | None = None):
         self.robot = robot
         self.n_dof = robot.n_dof
+        if robot.n_dof == 7:
+            k = DEFAULT_FREE_JOINT if free_joint is None else int(free_joint)
+            if not 0 <= k < 7:
+                raise CaseError(f"free_joint must be 1 … 7, got {k + 1}", key="ik.free_joint")
+            self.redundancy = RedundancyParameter(
+                f"joint {k + 1}", float(robot.q_min[k]), float(robot.q_max[k]), joint=k
+            )
 
     def parameters(self) -> dict[str, object]:
-        """The redundancy rule for chains of more than six joints, else nothing."""
-        return {"redundancy": REDUNDANCY_RULE} if self.n_dof > 6 else {}
+        """The joint that carries a 7-joint arm's redundancy (1-based), the minimum-norm
+        rule of longer chains, else nothing."""
+        if self.redundancy is not None and self.redundancy.joint is not None:
+            return {"free_joint": self.redundancy.joint + 1}
+        return {"redundancy": REDUNDANCY_RULE} if self.n_dof > 7 else {}
 
     def describe_branch(self, branch: int) -> str:
         """``"seed b"``."""
@@ -104,11 +121,26 @@ class NumericFamily:
         q, found
             Shapes (N, 8, n) (NaN where not found) and (N, 8).
         """
-        _no_free(free)
         T = np.asarray(T_base_tool, dtype=float)
         seeds = numeric_seeds(self.robot)  # (8, n)
-        solved = solve_ik_numeric(self.robot, T[:, None], seeds[None], tol=1e-10)
-        return wrap_and_deduplicate(solved.q, solved.success, q_min, q_max)
+        if self.redundancy is None:
+            _no_free(free)
+            solved = solve_ik_numeric(self.robot, T[:, None], seeds[None], tol=1e-10)
+            return wrap_and_deduplicate(solved.q, solved.success, q_min, q_max)
+        if free is None:
+            raise ValueError(f"the numeric family needs its {self.redundancy.name} per pose")
+        n_poses, n_seeds = len(T), len(seeds)
+        reference = np.tile(seeds, (n_poses, 1))  # row p·8 + k
+        q, success = track_poses(
+            self.robot,
+            np.repeat(T[:, :3, :3], n_seeds, axis=0),
+            np.repeat(T[:, :3, 3], n_seeds, axis=0),
+            reference,
+            np.repeat(np.asarray(free, dtype=float), n_seeds),
+            self.redundancy.joint if self.redundancy.joint is not None else -1,
+        )
+        shape = (n_poses, n_seeds)
+        return wrap_and_deduplicate(q.reshape(*shape, -1), success.reshape(shape), q_min, q_max)
 
 
 def numeric_seeds(robot: Robot) -> np.ndarray:
