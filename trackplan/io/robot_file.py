@@ -81,9 +81,12 @@ from trackplan.io.robot_schema import (
     ROBOT_FILE_SUFFIXES,
     RobotFileModel,
     ToolModel,
+    checked_family,
     collision_problems,
     controller_convention,
     controller_problems,
+    ik_choice,
+    ik_problems,
     link_capsules,
 )
 from trackplan.io.robot_schema import PayloadModel as PayloadModel
@@ -173,6 +176,7 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
     problems += _dynamics_problems(model)
     problems += collision_problems(model.collision, len(model.joints), {})
     problems += controller_problems(model.controller, len(model.joints))
+    problems += ik_problems(model.ik, len(model.joints))
     raise_first(problems, data, file)
     tool = model.tool or ToolModel()
     columns = {
@@ -180,7 +184,7 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
         for key in ("d", "a", "alpha", "offset", "velocity", "acceleration", "jerk")
     }
     position = np.array([joint.position for joint in model.joints], dtype=float)
-    return Robot.from_dh(
+    robot = Robot.from_dh(
         name=model.name,
         d=columns["d"],
         a=columns["a"],
@@ -196,7 +200,9 @@ def load_robot_text(text: str, file: str | None = None, *, assume_limits: bool =
         dynamics=_dynamics(model, columns),
         collision=link_capsules(model.collision, {}),
         controller=controller_convention(model.controller, len(model.joints)),
+        ik=ik_choice(model.ik),
     )
+    return checked_family(robot, file)
 
 
 def _dynamics_problems(model: RobotFileModel) -> list[Problem]:

@@ -15,6 +15,7 @@ import numpy as np
 from pydantic import Field, PlainValidator
 from pydantic_core import PydanticCustomError
 
+from trackplan.errors import CaseError
 from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_bounds import (
     MAX_ANGLE,
@@ -48,6 +49,8 @@ from trackplan.robots.dynamics_parameters import (
     inertia_matrix,
     inertia_problem,
 )
+from trackplan.robots.families import ik_family
+from trackplan.robots.model import IKChoice, Robot
 
 ROBOT_FILE_SUFFIXES = (".yaml", ".yml", ".urdf")
 ASSUMED_ACCELERATION_TIME = 0.25
@@ -246,6 +249,49 @@ def controller_convention(
     )
 
 
+class IKModel(StrictModel):
+    """The ``ik:`` block: the IK family (``auto`` detects it) and, for a 7-joint arm in the
+    numeric family, the joint (1-based) that carries the redundancy."""
+
+    family: Literal["auto", "opw", "ur", "srs", "panda", "crx", "numeric"] = "auto"
+    free_joint: Annotated[int, Field(ge=1)] | None = None
+
+
+def ik_problems(ik: IKModel | None, n_dof: int) -> list[Problem]:
+    """A ``free_joint`` past the chain, or given to an arm that is not a 7-joint one."""
+    if ik is None or ik.free_joint is None:
+        return []
+    if n_dof != 7:
+        return [(("ik", "free_joint"), f"only a 7-joint arm has a free joint; this has {n_dof}")]
+    if ik.free_joint > n_dof:
+        return [(("ik", "free_joint"), f"expected a joint 1 … {n_dof}, got {ik.free_joint}")]
+    return []
+
+
+def checked_family(robot: Robot, file: str | None) -> Robot:
+    """The robot, after its ``ik.family`` (when not ``auto``) was checked to fit its chain.
+
+    Raises
+    ------
+    CaseError
+        Naming the file and ``ik.family`` when the chain does not have that structure.
+    """
+    if robot.ik.family != "auto":
+        try:
+            ik_family(robot)
+        except CaseError as error:
+            raise CaseError(error.message, file=file, key=error.key) from None
+    return robot
+
+
+def ik_choice(ik: IKModel | None) -> IKChoice:
+    """The :class:`~trackplan.robots.model.IKChoice` of a validated ``ik:`` block."""
+    if ik is None:
+        return IKChoice()
+    free = None if ik.free_joint is None else ik.free_joint - 1
+    return IKChoice(family=ik.family, free_joint=free)
+
+
 class URDFRobotFileModel(StrictModel):
     """Schema of a robot file that points at a URDF."""
 
@@ -263,6 +309,7 @@ class URDFRobotFileModel(StrictModel):
     assumptions: list[str] = Field(default_factory=list)
     collision: Collision | None = None
     controller: ControllerModel | None = None
+    ik: IKModel | None = None
 
 
 class RobotFileModel(StrictModel):
@@ -276,6 +323,7 @@ class RobotFileModel(StrictModel):
     payload: PayloadModel | None = None
     collision: Collision | None = None
     controller: ControllerModel | None = None
+    ik: IKModel | None = None
 
 
 def payload_problems(payload: PayloadModel, loc: tuple[str | int, ...]) -> list[Problem]:

@@ -24,9 +24,12 @@ from trackplan.io.robot_schema import (
     URDFDynamicsModel,
     URDFRobotFileModel,
     as_payload,
+    checked_family,
     collision_problems,
     controller_convention,
     controller_problems,
+    ik_choice,
+    ik_problems,
     link_capsules,
     payload_problems,
 )
@@ -91,6 +94,7 @@ def load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Ro
         if (values := getattr(model.limits, key)) is not None and len(values) != n
     ]
     problems += controller_problems(model.controller, n)
+    problems += ik_problems(model.ik, n)
     raise_first(problems, data, file)
     tool = model.tool or ToolModel()
     T_tool = pose_matrix(np.array(tool.xyz), rpy_matrix(np.array(tool.rpy)))
@@ -110,13 +114,15 @@ def load_urdf_robot_file(data: Any, file: str | None, assume_limits: bool) -> Ro
     frames = read_urdf_link_geometry(
         base / model.urdf, chain.joint_names, model.base_link, collisions=False
     ).link_frames
-    return replace(
+    robot = replace(
         robot,
         dynamics=dynamics,
         collision=collision,
         controller=controller,
         visuals=read_urdf_visuals(base / model.urdf, frames),
+        ik=ik_choice(model.ik),
     )
+    return checked_family(robot, file)
 
 
 def _urdf_collision(

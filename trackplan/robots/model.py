@@ -77,6 +77,27 @@ def rz(theta: float) -> np.ndarray:
     return np.array([[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0, 0, 0, 1.0]])
 
 
+IK_FAMILIES = ("auto", "opw", "ur", "srs", "panda", "crx", "numeric")
+"""The IK family names a robot file's ``ik.family`` takes (``docs/robots.md``)."""
+
+
+@dataclass(frozen=True)
+class IKChoice:
+    """A robot file's ``ik:`` block: which IK family solves the arm.
+
+    Attributes
+    ----------
+    family
+        One of :data:`IK_FAMILIES`; ``auto`` detects it from the chain.
+    free_joint
+        For a 7-joint arm in the numeric family, the joint (0-based) that carries the
+        redundancy; None: the family's default.
+    """
+
+    family: str = "auto"
+    free_joint: int | None = None
+
+
 @dataclass(frozen=True, eq=False)
 class Robot:
     """A serial robot of revolute joints.
@@ -125,6 +146,8 @@ class Robot:
         How the links look: triangle meshes on frames 0 (base) to n
         (:class:`~trackplan.robots.visuals.LinkVisual`), read from a URDF's ``<visual>``
         elements; None when the robot has none (the report then draws its capsules).
+    ik
+        Which IK family solves the arm (a robot file's ``ik:`` block; default: detected).
     """
 
     name: str
@@ -146,6 +169,7 @@ class Robot:
     collision: Capsules | None = None
     controller: ControllerConvention | None = None
     visuals: tuple[LinkVisual, ...] | None = None
+    ik: IKChoice = field(default_factory=IKChoice)
 
     def __post_init__(self) -> None:
         origins = np.array(self.origins, dtype=float)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from trackplan.derived import derived
@@ -29,13 +31,48 @@ def ik_family(robot: Robot) -> IKFamily:
     return derived(robot, "ik family", lambda: _detect(robot))
 
 
+CLOSED_FORMS: dict[str, tuple[Callable[[Robot], object | None], Callable[..., IKFamily]]] = {
+    "opw": (opw_from_chain, OPWFamily),
+    "ur": (ur_from_chain, URFamily),
+}
+"""The structured families, tried in this order: how to derive each one's parameters from a
+chain (None when the chain is not of the family) and the family built from them."""
+
+
 def _detect(robot: Robot) -> IKFamily:
-    """OPW, else UR, else numeric."""
-    opw = opw_from_chain(robot)
-    if opw is not None:
-        return OPWFamily(robot, opw)
-    ur = ur_from_chain(robot)
-    return URFamily(robot, ur) if ur is not None else NumericFamily(robot)
+    """The family the robot file names (``ik.family``), else the first of
+    :data:`CLOSED_FORMS` whose structure the chain has, else numeric.
+
+    Raises
+    ------
+    CaseError
+        When the named family does not fit the chain.
+    """
+    choice = robot.ik
+    if choice.family == "numeric":
+        return NumericFamily(robot, choice.free_joint)
+    if choice.family != "auto":
+        if choice.family not in CLOSED_FORMS:
+            raise CaseError(
+                f"unknown IK family {choice.family!r}: expected one of auto, "
+                f"{', '.join(CLOSED_FORMS)}, numeric",
+                key="ik.family",
+            )
+        derive, family = CLOSED_FORMS[choice.family]
+        params = derive(robot)
+        if params is None:
+            raise CaseError(
+                f"the chain of {robot.name} does not have the {choice.family} structure "
+                "(without ik.family, trackplan robots FILE shows the detected one): "
+                "use ik.family auto or numeric",
+                key="ik.family",
+            )
+        return family(robot, params)
+    for derive, family in CLOSED_FORMS.values():
+        params = derive(robot)
+        if params is not None:
+            return family(robot, params)
+    return NumericFamily(robot, choice.free_joint)
 
 
 def solve_ik(robot: Robot, T_base_tool: np.ndarray) -> ClosedFormIK:
