@@ -163,6 +163,11 @@ def check_poses_and_joints(
     return T, joints, lead
 
 
+NEWTON_TOL = 1e-10
+"""Position (m) and orientation (rad) tolerance of every Newton solve of the path IK: the
+tracked families' branches and the samples they are solved at. The checker derives its
+tool-point tolerance and speed slack from it (``planning/check_task.py``)."""
+
 TRACK_MAX_ITER = 30
 """Most Newton iterations per pose when tracking from a nearby reference."""
 
@@ -174,7 +179,7 @@ def track_poses(
     reference: np.ndarray,
     free: np.ndarray | None = None,
     locked: int = -1,
-    tol: float = 1e-10,
+    tol: float = NEWTON_TOL,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Solve poses by damped Newton, each from its own reference configuration.
 

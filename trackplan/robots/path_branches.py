@@ -31,7 +31,7 @@ from trackplan.robots._path_kernels import (
 )
 from trackplan.robots.families import AUX_SIZE, IKFamily, ik_family
 from trackplan.robots.families.numeric import numeric_seeds as numeric_seeds
-from trackplan.robots.ik_numeric import chain_arrays
+from trackplan.robots.ik_numeric import NEWTON_TOL, chain_arrays
 from trackplan.robots.model import Robot
 from trackplan.robots.thread_sharing import ThreadSharing, path_threads
 
@@ -61,7 +61,7 @@ solved and analysed a few at a time (whole candidates, about this many poses), s
 piece's eight-branch solutions (some 200 kB) are analysed while still in the core's cache;
 threads take the pieces in turn."""
 
-_NEWTON_TOL = 1e-10
+_NEWTON_TOL = NEWTON_TOL
 _MARCH_MAX_ITER = 100  # first pose from a seed, and the coarse march
 _FINE_MAX_ITER = 30  # every pose, seeded within a coarse step of its solution
 
