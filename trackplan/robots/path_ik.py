@@ -18,13 +18,18 @@ than its change to a neighbour (it reaches about zero between consecutive poses)
 where the wrist vector reverses between poses k − 1 and k, the path crosses that
 singularity.
 
-Other robots use :mod:`trackplan.robots.ik_numeric`. Branch b is defined by the seed
-``seed_b`` of :func:`numeric_seeds`: the first pose is solved from it, a coarse subset of
-the poses (one every :data:`~trackplan.robots.path_branches.COARSE_STEP` of combined travel)
-is marched sequentially with warm starts, and all M poses are then solved at once by Newton
-seeded with the linear interpolation of the coarse solution. Two seeds may reach the same
-solution; the branches are then equal. A singularity crossing shows as a sign change of det
-J (6 joints) or a touch of zero of the manipulability sqrt(det(J Jᵀ)).
+Tracked families (the CRX family, numeric IK: :mod:`trackplan.robots.ik_numeric`) have no
+labelled branches: branch k of a candidate is the k-th distinct solution of its first pose
+inside the limits (:meth:`~trackplan.robots.families.base.IKFamily.seed_solutions`: every
+solution of a semi-closed form, or those damped Newton reaches from a fixed set of starts).
+A coarse subset of the poses (one every :data:`~trackplan.robots.path_branches.COARSE_STEP`
+of combined travel) is marched sequentially with warm starts, and all M poses are then
+solved at once by Newton seeded with the linear interpolation of the coarse solution. A
+singularity crossing shows as a sign change of det J (6 joints, or 7 with one held) or a
+touch of zero of the manipulability sqrt(det(J Jᵀ)).
+
+A redundant family takes its free parameter at every pose (``free``): the arm angle or a
+held joint, chosen along the path by :mod:`trackplan.redundancy`.
 
 Both methods also count as a switch any joint step larger than ``max_step`` between
 consecutive poses (default :data:`DEFAULT_MAX_STEP`).
