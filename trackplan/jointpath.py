@@ -179,7 +179,8 @@ class JointPath:
 
     @property
     def branch(self) -> int:
-        """The IK branch (closed form 0-7, or the numeric seed index)."""
+        """The IK branch (a closed-form label, or the first-pose solution a tracked family
+        follows)."""
         return int(self.ik.branch[0])
 
     @property

@@ -185,8 +185,8 @@ class PlanResult:
     timing
         The time law (``smooth`` or ``paper``).
     branch
-        IK branch used (closed form: 0-7; numeric: the seed index): the first welded
-        seam's (the branch may differ from seam to seam, see :attr:`seams`).
+        IK branch used (closed form: its label; tracked: the solution of the first
+        pose): the first welded seam's (the branch may differ from seam to seam, see :attr:`seams`).
     trajectory
         The sampled trajectory from rest to rest (empty arrays when no trajectory could be
         built); ``s`` is the arc length along the seam being welded (0 on moves).

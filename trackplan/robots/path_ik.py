@@ -85,7 +85,8 @@ class PathIK:
         per joint to sit inside the limits with the largest margin. Unreachable poses
         repeat the last reachable configuration (the first reachable one before it).
     branch
-        Branch used per candidate, shape (B,), int (closed-form branch or numeric seed).
+        Branch used per candidate, shape (B,), int (closed-form label, or the solution of
+        the first pose a tracked family follows).
     reachable
         Shape (B, M), bool: the branch has an IK solution at the pose.
     switch
@@ -144,7 +145,7 @@ class PathIKBranches:
         reaches no pose at all).
     branches
         The branch of each of the K columns, shape (K,), int (closed-form branch or numeric
-        seed index: 0 … 7).
+        the first pose's solution a tracked family follows).
     reachable
         Shape (B, K, M), bool: the branch has an IK solution at the pose.
     switch
@@ -347,7 +348,7 @@ def branch_joints(
     T_base_tool
         Tool poses in the base frame, shape (M, 4, 4), m.
     branch
-        The IK branch (closed-form branch or numeric seed), 0 … 7.
+        The IK branch (closed-form label, or a tracked family's first-pose solution).
     reference
         Joint positions each result is wound nearest to, shape (M, n), rad.
     free
@@ -397,7 +398,7 @@ def branch_joints_along(
     p_base_tool
         Tool positions in the base frame, shape (M, 3), m.
     branch
-        The IK branch (closed-form branch or numeric seed), 0 … 7.
+        The IK branch (closed-form label, or a tracked family's first-pose solution).
     s
         Where each pose lies on the grid's axis, shape (M,) (arc length, m).
     s_grid, q_grid
@@ -456,7 +457,12 @@ def _message(
     max_step: np.ndarray,
 ) -> str:
     """One line about one candidate's branch."""
-    name = ik_family(robot).describe_branch(branch) if method == "closed_form" else f"seed {branch}"
+    family = ik_family(robot)
+    name = (
+        family.describe_branch(branch)
+        if (method == "closed_form") == family.closed_form
+        else f"solution {branch} of the first pose"
+    )
     if status is Status.FEASIBLE:
         margin = values[F_MARGIN]
         return f"branch {branch} ({name}) follows all {n_poses} poses, margin {margin:.3f} rad"

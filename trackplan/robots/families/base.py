@@ -11,7 +11,8 @@ import numpy as np
 from trackplan._kernels import read_only
 
 N_BRANCHES = 8
-"""Number of closed-form solutions of a pose (and of numeric seeds)."""
+"""Number of labelled solutions of a pose of the OPW and UR families (and of the numeric
+family's starting seeds)."""
 
 AUX_SIZE = 5
 """Per pose and branch, the branch-defining quantities a closed-form solver writes: the

@@ -62,8 +62,8 @@ class NumericFamily:
         return {"redundancy": REDUNDANCY_RULE} if self.n_dof > 7 else {}
 
     def describe_branch(self, branch: int) -> str:
-        """``"seed b"``."""
-        return f"seed {branch}"
+        """``"solution b of the first pose"``: the distinct solution the branch follows."""
+        return f"solution {branch} of the first pose"
 
     def solve_flat(
         self,
