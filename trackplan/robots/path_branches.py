@@ -222,34 +222,35 @@ def tracked_paths(
     coarse = _coarse_poses(T)
     chain = chain_arrays(robot)
     middle = 0.5 * (robot.q_min + robot.q_max)
-    # one profile per column: the first pose's solutions under each column's first value
-    distinct_free = free is not None and free.ndim == 3
-    for k in range(n_k) if distinct_free else [None]:
+    # a profile per column: the first pose's solutions under each column's first value
+    groups = (
+        [[k] for k in range(n_k)] if free is not None and free.ndim == 3 else [list(range(n_k))]
+    )
+    for columns in groups:
+        held = np.empty((0, 0))
         first_free = None
         if free is not None:
-            first_free = np.ascontiguousarray(per_column[:, k if k is not None else 0, 0])
+            held = np.ascontiguousarray(per_column[:, columns[0]])
+            first_free = np.ascontiguousarray(held[:, 0])
         seeds, found = family.seed_solutions(
             np.ascontiguousarray(T[:, 0]), robot.q_min, robot.q_max, free=first_free
         )
-        chosen = seeds[rows, candidates]
-        has = found[rows, candidates]
+        chosen = seeds[rows, candidates[:, columns]]
+        has = found[rows, candidates[:, columns]]
         chosen = np.where(has[..., None], chosen, middle)  # followed, then marked unreached
-        columns = range(n_k) if k is None else [k]
-        for c in columns:
-            held = np.ascontiguousarray(per_column[:, c]) if free is not None else np.empty((0, 0))
-            out = numeric_paths(
-                *chain,
-                T,
-                np.ascontiguousarray(chosen[:, c : c + 1]),
-                coarse,
-                _NEWTON_TOL,
-                _MARCH_MAX_ITER,
-                _FINE_MAX_ITER,
-                locked,
-                held,
-            )
-            q[:, c], reach[:, c], magnitude[:, c], crossing[:, c] = (x[:, 0] for x in out)
-            reach[~has[:, c], c] = False
+        out = numeric_paths(
+            *chain,
+            T,
+            np.ascontiguousarray(chosen),
+            coarse,
+            _NEWTON_TOL,
+            _MARCH_MAX_ITER,
+            _FINE_MAX_ITER,
+            locked,
+            held,
+        )
+        q[:, columns], reach[:, columns], magnitude[:, columns], crossing[:, columns] = out
+        reach[:, columns] &= has[..., None]
     return q, reach, magnitude, crossing
 
 
