@@ -141,8 +141,9 @@ def panda_from_chain(robot: Robot) -> PandaParameters | None:
     3–4 and 4–5 meeting axis 4 in one point (d4 = 0) and those of axes 5–6 and 6–7
     meeting axis 6 in one point (d6 = 0). An arm with a4 = a5 = a7 = 0 is S-R-S (its own
     family) and is not taken. The DH frames are built on these lines (every DH z along
-    the chain's axis, except z1 along +z) and the result is checked against the chain's
-    forward kinematics on 64 random configurations to 1e-9.
+    the chain's axis, except z1 along +z and z4, z5, z7 turned where that gives a4 ≥ 0,
+    a5 ≤ 0, a7 ≥ 0: a sign −1) and the result is checked against the chain's forward
+    kinematics on 64 random configurations (in the limits) to 1e-9.
     """
     if robot.n_dof != 7:
         return None
@@ -174,19 +175,27 @@ def panda_from_chain(robot: Robot) -> PandaParameters | None:
         or abs((h6 - o5) @ z[5]) > _TOL * scale  # d6 = 0
     ):
         return None
+    # DH z along the chain's axes, but z4, z5, z7 turned where that makes a4 ≥ 0, a5 ≤ 0
+    # and a7 ≥ 0, as Franka publishes them (each sets the x that a is measured along).
+    a4 = float((f4 - o3) @ np.cross(z[2], z[3]))
+    if a4 < 0.0:
+        z[3], sign[3], a4 = -z[3], -1.0, -a4
+    a5 = float((g5 - f4) @ np.cross(z[4], z[3]))  # α5 = −π/2: x4 = z5 × z4
+    if a5 > 0.0:
+        z[4], sign[4], a5 = -z[4], -1.0, -a5
+    a7 = float((f7 - h6) @ np.cross(z[5], z[6]))
+    if a7 < 0.0:
+        z[6], sign[6], a7 = -z[6], -1.0, -a7
+    if max(abs(a4), abs(a5), abs(a7)) <= _TOL * scale:
+        return None  # S-R-S
     x = [
         np.cross(z[1], z[0]),  # α2 = −π/2: z2 = y1
         np.cross(z[1], z[2]),  # α3 = π/2: z3 = −y2
         np.cross(z[2], z[3]),
-        np.cross(z[4], z[3]),  # α5 = −π/2
+        np.cross(z[4], z[3]),
         np.cross(z[4], z[5]),
         np.cross(z[5], z[6]),
     ]
-    a4 = float((f4 - o3) @ x[2])
-    a5 = float((g5 - f4) @ x[3])
-    a7 = float((f7 - h6) @ x[5])
-    if max(abs(a4), abs(a5), abs(a7)) <= _TOL * scale:
-        return None  # S-R-S
     theta0 = [math.atan2(x[0][1], x[0][0])]
     theta0 += [_angle_about(x[i - 1], x[i], z[i]) for i in range(1, 6)]
     theta0.append(0.0)
