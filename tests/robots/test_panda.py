@@ -200,9 +200,10 @@ def test_one_branch_is_that_branch_of_the_eight(panda, family, rng):
 def test_one_branch_holds_and_winds_near_a_reference(panda, family, rng):
     q = rng.uniform(panda.q_min, panda.q_max, (50, 7))
     T = forward_kinematics(panda, q)
+    T[10:12, :3, 3] = [2.0, 0.0, 0.5]  # out of reach: held at pose 9
     free = q[:, 6].copy()
-    free[10] = 3.0  # far from this pose's q7: the pose is missed on branch b
     q_b, valid_b, _ = family.solve_branch(T, 0, free=free)
+    np.testing.assert_array_equal(np.flatnonzero(~valid_b), [10, 11])
     s = np.linspace(0.0, 1.0, 50)
     grid = q_b[0] + 2 * np.pi * np.array([1, -1, 0, 1, 0, 1, 0])  # whole turns away
     wound, valid, _ = family.solve_branch_parts(
@@ -218,8 +219,8 @@ def test_one_branch_holds_and_winds_near_a_reference(panda, family, rng):
     assert np.all(np.isfinite(wound))
     np.testing.assert_allclose(wrapped(wound[reached] - q_b[reached]), 0.0, atol=1e-12)
     assert np.abs(wound[reached[0]] - grid).max() < np.pi + 1e-9
-    for m in np.flatnonzero(~valid_b & (np.arange(50) > reached[0])):  # held
-        np.testing.assert_allclose(wrapped(wound[m] - wound[m - 1]), 0.0, atol=1e-12)
+    np.testing.assert_allclose(wound[10], wound[9], atol=1e-12)  # held, wound alike
+    np.testing.assert_allclose(wound[11], wound[9], atol=1e-12)
 
 
 def test_branch_quantities_have_their_geometric_meaning(panda, family, rng):
@@ -261,13 +262,20 @@ def test_wrist_vector_reverses_where_a_path_crosses_axis_5_through_the_shoulder(
     assert set(np.argsort(norm)[:2]) == {19, 20}
 
 
-def test_stretched_arm_is_reached_and_far_poses_are_not(panda, family):
+def test_stretched_arm_is_reached_far_and_nan_poses_are_not(panda, family):
     q = np.array([[0.3, 0.4, -0.2, -0.467, 0.1, 1.2, 0.5]])  # θ4 ≈ φ4: nearly stretched
     Q, valid, aux = family.solve_flat(forward_kinematics(panda, q), free=q[:, 6])
     assert valid[0].any() and aux[0, valid[0], 1].max() < 1e-3
     far = pose_matrix(np.array([2.0, 0.0, 0.5]), np.eye(3))[None]
     Q, valid, aux = family.solve_flat(far, free=np.zeros(1))
     assert not valid.any() and np.isnan(Q).all() and np.isnan(aux).all()
+    nan_pose = forward_kinematics(panda, q)
+    nan_pose[0, 0, 3] = np.nan
+    for T, free in ((nan_pose, q[:, 6]), (forward_kinematics(panda, q), np.array([np.nan]))):
+        Q, valid, aux = family.solve_flat(T, free=free)
+        assert not valid.any() and np.isnan(Q).all() and np.isnan(aux).all()
+        q_b, valid_b, _ = family.solve_branch(T, 2, free=free)
+        assert not valid_b.any() and np.isnan(q_b).all()
     with pytest.raises(ValueError, match="joint 7"):
         family.solve_flat(far)
 

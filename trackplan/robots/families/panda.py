@@ -32,7 +32,10 @@ the rotation); the elbow measure |sin(θ4 − φ4)| (zero with the arm stretched
 the wrist vector ``±√(ρ² − c_z²) / L · z6`` (ρ: the length of O6 − p2 across axis 6, c_z
 its component the elbow puts along z5, L its length), zero where the two θ6 meet — axis 6
 in the plane of axes 3 and 5, or axis 5 through p2 — and reversing (the sign of
-``(z5 × (O6 − p2)) · y3``) where a path passes through the latter.
+``(z5 × (O6 − p2)) · y3``) where a path passes through the latter. There frame 3 turns
+freely about axis 5; y3 is put at −x5. Poses out of reach (and NaN poses or q7) are not
+valid on any branch; joint limits are not applied (:meth:`PandaFamily.seed_solutions`
+applies them).
 """
 
 from __future__ import annotations
