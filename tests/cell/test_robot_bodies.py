@@ -21,6 +21,8 @@ REPO = Path(__file__).resolve().parents[2]
 TS = 0.01
 HALF_PI = np.pi / 2
 HOME = {
+    # Franka's "ready" pose (franka_ros franka_control/config/start_pose.yaml)
+    "franka_panda": [0.0, -HALF_PI / 2, 0.0, -3 * HALF_PI / 2, 0.0, HALF_PI, HALF_PI / 2],
     # KUKA's HOME: A2 = -90° (upper arm up), A3 = +90° (forearm level)
     "kuka_kr6_r700_sixx": [0.0, -HALF_PI, HALF_PI, 0.0, HALF_PI, 0.0],
     "kuka_kr10_r1420": [0.0, -HALF_PI, HALF_PI, 0.0, HALF_PI, 0.0],
