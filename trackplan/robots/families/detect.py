@@ -8,9 +8,10 @@ import numpy as np
 
 from trackplan.derived import derived
 from trackplan.errors import CaseError
-from trackplan.robots.families.base import N_BRANCHES, ClosedFormIK, IKFamily
+from trackplan.robots.families.base import ClosedFormIK, IKFamily
 from trackplan.robots.families.numeric import NumericFamily
 from trackplan.robots.families.opw import OPWFamily, opw_from_chain
+from trackplan.robots.families.panda import PandaFamily, panda_from_chain
 from trackplan.robots.families.ur import URFamily, ur_from_chain
 from trackplan.robots.model import Robot
 
@@ -34,6 +35,7 @@ def ik_family(robot: Robot) -> IKFamily:
 CLOSED_FORMS: dict[str, tuple[Callable[[Robot], object | None], Callable[..., IKFamily]]] = {
     "opw": (opw_from_chain, OPWFamily),
     "ur": (ur_from_chain, URFamily),
+    "panda": (panda_from_chain, PandaFamily),
 }
 """The structured families, tried in this order: how to derive each one's parameters from a
 chain (None when the chain is not of the family) and the family built from them."""
@@ -75,21 +77,24 @@ def _detect(robot: Robot) -> IKFamily:
     return NumericFamily(robot, choice.free_joint)
 
 
-def solve_ik(robot: Robot, T_base_tool: np.ndarray) -> ClosedFormIK:
-    """All eight closed-form IK solutions of tool poses.
+def solve_ik(robot: Robot, T_base_tool: np.ndarray, free: np.ndarray | None = None) -> ClosedFormIK:
+    """Every closed-form IK solution of tool poses.
 
     Parameters
     ----------
     robot
-        A robot of the OPW or UR family.
+        A robot of a closed-form family (OPW, UR, S-R-S, Panda).
     T_base_tool
         Tool poses in the base frame, shape (..., 4, 4), metres. The tool transform
         ``robot.T_flange_tool`` is removed exactly.
+    free
+        A redundant arm's free parameter per pose, shape (...,), rad; None for the others.
 
     Returns
     -------
     ClosedFormIK
-        ``q`` of shape (..., 8, 6) in (−π, π] and ``valid`` of shape (..., 8).
+        ``q`` of shape (..., K, n) in (−π, π] and ``valid`` of shape (..., K), K the
+        family's branches (8).
 
     Raises
     ------
@@ -100,5 +105,8 @@ def solve_ik(robot: Robot, T_base_tool: np.ndarray) -> ClosedFormIK:
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise CaseError(f"T_base_tool must have shape (..., 4, 4), got {T.shape}")
     lead = T.shape[:-2]
-    q, valid, _ = ik_family(robot).solve_flat(T.reshape(-1, 4, 4), with_aux=False)
-    return ClosedFormIK(q.reshape(*lead, N_BRANCHES, 6), valid.reshape(*lead, N_BRANCHES))
+    family = ik_family(robot)
+    flat_free = None if free is None else np.asarray(free, dtype=float).reshape(-1)
+    q, valid, _ = family.solve_flat(T.reshape(-1, 4, 4), free=flat_free, with_aux=False)
+    n_k = family.n_branches
+    return ClosedFormIK(q.reshape(*lead, n_k, robot.n_dof), valid.reshape(*lead, n_k))

@@ -234,6 +234,7 @@ class PandaFamily:
     name = "panda"
     closed_form = True
     n_branches = N_BRANCHES
+    redundancy: RedundancyParameter | None
 
     def __init__(self, robot: Robot, params: PandaParameters):
         self.params = params
