@@ -16,7 +16,7 @@ from trackplan.frames import pose_matrix, rpy_matrix
 from trackplan.io.robot_file import LIBRARY_DIR, builtin_robot
 from trackplan.robots.families.base import branch_bits
 from trackplan.robots.families.srs import SRSFamily, srs_from_chain
-from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
 SRS_PUBLISHED = {  # d_bs, d_se, d_ew, d_wf (m): the vendor packages' joint origins
@@ -200,6 +200,23 @@ def test_arm_angle_sweep_at_fixed_poses(rng) -> None:
         # one arm angle, eight different configurations
         spread = np.abs(wrapped(q_ik[:, :, None] - q_ik[:, None, :])).max(axis=-1)
         assert np.all(spread[:, ~np.eye(8, dtype=bool)] > 1e-6)
+
+
+def test_arm_angle_is_the_arm_planes_angle_from_the_reference_plane(rng) -> None:
+    """Shimizu's definition from the chain's own axis frames: the angle about S→W from the
+    vertical plane through S and W to the plane (S, E, W), modulo π (planes)."""
+    robot, srs = library_arm("yaskawa_sia10d")  # joints l, u, b sit at S, E, W: no offsets
+    q = rng.uniform(robot.q_min, robot.q_max, (500, 7))
+    q = q[np.abs(np.sin(q[:, 3])) > 1e-3]  # the arm plane is defined
+    frames = axis_frames(robot, q)
+    S, E, W = frames[:, 2, :3, 3], frames[:, 4, :3, 3], frames[:, 6, :3, 3]
+    u = (W - S) / np.linalg.norm(W - S, axis=-1, keepdims=True)
+    n_arm = np.cross(E - S, W - S)
+    n_ref = np.cross([0.0, 0.0, 1.0], W - S)
+    psi = np.arctan2(np.sum(u * np.cross(n_ref, n_arm), axis=-1), np.sum(n_ref * n_arm, axis=-1))
+    assert np.abs(wrapped(2.0 * (srs.arm_angle(q) - psi))).max() < 1e-9
+    q[:, 2] = 0.0  # θ3 = 0: the reference arm itself
+    assert np.abs(wrapped(2.0 * srs.arm_angle(q))).max() < 1e-9
 
 
 def test_branch_bits_are_the_signs_of_theta_2_4_6(rng) -> None:
