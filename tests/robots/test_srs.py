@@ -319,6 +319,14 @@ def test_free_is_required_and_broadcast() -> None:
     T = forward_kinematics(robot, np.full((3, 7), 0.3))
     with pytest.raises(ValueError, match="arm angle"):
         srs.solve_flat(T)
+    _, valid, aux = srs.solve_flat(T, free=np.array([0.4, np.nan, np.inf]))
+    assert valid.tolist() == [[True] * 8, [False] * 8, [False] * 8]
+    assert np.isnan(aux[1:]).all()
+    assert srs.solve_branch(T, 5, free=np.array([0.4, np.nan, -np.inf]))[1].tolist() == [
+        True,
+        False,
+        False,
+    ]
     q_scalar = srs.solve_flat(T, free=0.4)[0]
     q_array = srs.solve_flat(T, free=np.full(3, 0.4))[0]
     np.testing.assert_array_equal(q_scalar, q_array)

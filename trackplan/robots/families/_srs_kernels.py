@@ -45,6 +45,8 @@ S_SIGN = 20
 S_SIZE = 27
 N_JOINTS = 7
 N_ARGS = 6  # arctangents per elbow sign: θ1, θ2, θ3, θ5, θ6, θ7
+PSI_LIMIT = 1.0e5
+"""rad: arm angles beyond it (or NaN) reach no pose (the compiled sine's reduction limit)."""
 
 SRSGeometry = tuple[float, float, float, float, float, float, float, float, float]
 """(d_bs, d_se, d_ew, d_wf, bx, by, d_se², d_ew², 2·d_se·d_ew)."""
@@ -259,8 +261,9 @@ def srs_solve(
     q (N, 8, 7), valid (N, 8), aux (N, 8, 5); an ``aux`` of shape (1, 8, 5) is scratch.
 
     Blocks of :data:`BLOCK` poses in three flat passes: the arctangent arguments of both
-    elbow signs (13 a pose; unreachable poses computed through and marked), their
-    arctangents, the joints of the eight branches.
+    elbow signs (13 a pose; unreachable poses, and arm angles that are NaN or beyond
+    :data:`PSI_LIMIT`, computed through and marked), their arctangents, the joints of the
+    eight branches.
     """
     geo = srs_geometry(g)
     jc = srs_joint_constants(g)
@@ -304,7 +307,7 @@ def srs_solve(
                 wrist_entry(P, b, 2, 3, tail_inv),
             )
             cpsi, spsi = sincos(F[b])
-            ok[b] = reached
+            ok[b] = reached and abs(F[b]) <= PSI_LIMIT
             Y[0, b] = s4m
             X[0, b] = c4
             for elbow in range(2):
@@ -430,7 +433,7 @@ def srs_solve_branch(
                 c10, s10, c50, s50, ux, uy, uz, c4, s4m, sgn, ca, sa, c1r, s1r, cpsi, spsi,
                 w00, w01, w02, w10, w11, w12, w20, w21, w22,
             )  # fmt: skip
-            ok[b] = reached
+            ok[b] = reached and abs(F[b]) <= PSI_LIMIT
             Y[0, b] = s4m
             X[0, b] = c4
             for e in range(N_ARGS):
