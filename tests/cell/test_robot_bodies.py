@@ -35,6 +35,10 @@ HOME = {
     "abb_irb2400": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
     "fanuc_m20ia": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
     "puma560": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
+    # the S-R-S arms: shoulder forward, elbow bent 90°, wrist bent back (the iiwa's A4 and
+    # the SIA10D's U turn about -y)
+    "kuka_iiwa14": [0.0, 0.5, 0.0, -HALF_PI, 0.0, 1.0, 0.0],
+    "yaskawa_sia10d": [0.0, 0.5, 0.0, -HALF_PI, 0.0, -1.0, 0.0],
 }
 
 

@@ -19,8 +19,9 @@ from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
 N_POSES = 10_000
-SEVEN_JOINT = {"franka_panda"}  # their families are tested on their own (test_panda.py)
-BUILTINS = tuple(name for name in builtin_names() if name not in SEVEN_JOINT)
+BUILTINS = [  # the OPW and UR arms; the other families are tested on their own
+    name for name in builtin_names() if ik_family(builtin_robot(name)).name in ("opw", "ur")
+]
 OPW_PUBLISHED = {  # a1, a2, b, c1, c2, c3, c4; offsets; sign corrections (opw_kinematics)
     "kuka_kr6_r700_sixx": (
         (0.025, -0.035, 0.0, 0.400, 0.315, 0.365, 0.080),

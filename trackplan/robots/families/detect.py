@@ -12,6 +12,7 @@ from trackplan.robots.families.base import ClosedFormIK, IKFamily
 from trackplan.robots.families.numeric import NumericFamily
 from trackplan.robots.families.opw import OPWFamily, opw_from_chain
 from trackplan.robots.families.panda import PandaFamily, panda_from_chain
+from trackplan.robots.families.srs import SRSFamily, srs_from_chain
 from trackplan.robots.families.ur import URFamily, ur_from_chain
 from trackplan.robots.model import Robot
 
@@ -35,6 +36,7 @@ def ik_family(robot: Robot) -> IKFamily:
 CLOSED_FORMS: dict[str, tuple[Callable[[Robot], object | None], Callable[..., IKFamily]]] = {
     "opw": (opw_from_chain, OPWFamily),
     "ur": (ur_from_chain, URFamily),
+    "srs": (srs_from_chain, SRSFamily),
     "panda": (panda_from_chain, PandaFamily),
 }
 """The structured families, tried in this order: how to derive each one's parameters from a
