@@ -28,12 +28,12 @@ placement make the same one.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from trackplan.profiles import Profile, profile_values
+from trackplan.redundancy._kernels import cheapest_sequences
 from trackplan.redundancy.spec import NODES, RedundancyMode, RedundancySpec
 from trackplan.robots.families import ik_family
 from trackplan.robots.model import Robot
@@ -209,57 +209,41 @@ def _cheapest_sequence(
     count: int,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The cheapest sequence of the constants' values over the stage boundaries, per
-    candidate and branch (dynamic programming; see the module docstring).
+    candidate and branch (dynamic programming, compiled:
+    :func:`~trackplan.redundancy._kernels.cheapest_sequences`; see the module docstring).
+
+    A state (a constant at a boundary) is usable where its path is reached, does not switch
+    and stays inside the limits from the midpoint before the boundary to the one after it;
+    a step moves the parameter at most ``rate`` times the arc length between boundaries and
+    costs the weighted joint travel between the two states' joints (each joint's difference
+    taken modulo 2π).
 
     Returns
     -------
     sequence
-        Shape (B, K, S + 1), rad (the best constant's value where none is found).
+        Shape (B, K, S + 1), rad.
     found
         Shape (B, K), bool: a sequence of usable states exists.
     """
-    n_rows, n_k, n_poses, n = tried.q.shape
+    n_rows, n_k, n_poses, _ = tried.q.shape
     n_cand = n_rows // count
     stages = _stage_indices(n_poses)
-    inside = _inside(tried.q, *limits) & tried.reachable & ~tried.switch
-    usable = _windows(inside, stages).reshape(n_cand, count, n_k, len(stages))
-    usable = np.moveaxis(usable, 1, 2)  # (B, K, R, S + 1)
-    q = np.moveaxis(tried.q[:, :, stages].reshape(n_cand, count, n_k, len(stages), n), 1, 2)
-    q = np.nan_to_num(q)
-    step = np.abs(constants[None, :] - constants[:, None])  # (R', R)
-    reach = rate * np.diff(s[stages]) + _RATE_SLACK  # (S,)
-    cost = np.where(usable[..., 0], 0.0, np.inf)  # (B, K, R)
-    came = np.zeros((n_cand, n_k, len(stages), count), dtype=np.int64)
-    for i in range(1, len(stages)):  # a dozen stages: the arrays are batched
-        moved = q[:, :, None, :, i] - q[:, :, :, None, i - 1]  # (B, K, R', R, n)
-        moved = np.abs((moved + math.pi) % (2 * math.pi) - math.pi) @ weights
-        total = cost[..., :, None] + moved + np.where(step <= reach[i - 1], 0.0, np.inf)
-        came[:, :, i] = np.argmin(total, axis=2)
-        cost = np.min(total, axis=2) + np.where(usable[..., i], 0.0, np.inf)
-    state = np.argmin(cost, axis=2)  # (B, K)
-    found = np.isfinite(np.min(cost, axis=2))
+    reach = rate * np.diff(s[stages]) + _RATE_SLACK
     path = np.empty((n_cand, n_k, len(stages)), dtype=np.int64)
-    path[..., -1] = state
-    for i in range(len(stages) - 1, 0, -1):
-        state = np.take_along_axis(came[:, :, i], state[..., None], axis=2)[..., 0]
-        path[..., i - 1] = state
+    found = np.empty((n_cand, n_k), dtype=np.bool_)
+    cheapest_sequences(
+        np.ascontiguousarray(np.nan_to_num(tried.q, nan=np.inf)),
+        np.ascontiguousarray(tried.reachable & ~tried.switch),
+        np.ascontiguousarray(limits[0], dtype=float),
+        np.ascontiguousarray(limits[1], dtype=float),
+        stages,
+        np.ascontiguousarray(constants, dtype=float),
+        reach,
+        np.ascontiguousarray(weights, dtype=float),
+        path,
+        found,
+    )
     return constants[path], found
-
-
-def _inside(q: np.ndarray, q_min: np.ndarray, q_max: np.ndarray) -> np.ndarray:
-    """Poses whose joints lie inside the limits, shape (B, K, M), bool."""
-    inside: np.ndarray = np.all((q >= q_min) & (q <= q_max), axis=-1)
-    return inside
-
-
-def _windows(ok: np.ndarray, stages: np.ndarray) -> np.ndarray:
-    """Whether every pose of each stage boundary's stretch (from the midpoint before it to
-    the one after it) is ``ok``, shape (B, K, S + 1)."""
-    n_poses = ok.shape[-1]
-    edges = np.concatenate([[0], (stages[1:] + stages[:-1] + 1) // 2, [n_poses]])
-    bad = np.concatenate([np.zeros((*ok.shape[:-1], 1)), np.cumsum(~ok, axis=-1)], axis=-1)
-    windows: np.ndarray = (bad[..., edges[1:]] - bad[..., edges[:-1]]) == 0
-    return windows
 
 
 def _take(paths: PathIKBranches, rows: np.ndarray) -> PathIKBranches:
