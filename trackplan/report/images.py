@@ -339,7 +339,13 @@ def _view_images(
                 )
                 for name, k, title in shots:
                     page.evaluate(_SHOW_FRAME, [VIEW_ID, k, title])
-                    page.locator(f"#{VIEW_ID}").screenshot(path=str(folder / name))
+                    box = page.locator(f"#{VIEW_ID}").bounding_box()
+                    assert box is not None
+                    x, y = round(box["x"]), round(box["y"])  # whole pixels: size exactly
+                    page.screenshot(
+                        path=str(folder / name),
+                        clip={"x": x, "y": y, "width": size[0], "height": size[1]},
+                    )
                     written.append(folder / name)
             finally:
                 browser.close()

@@ -35,8 +35,8 @@ FOOTER_CLASS = "trackplan-footer"
 _CSS = """
 body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans-serif;
        margin: 0 auto; max-width: 1400px; padding: 0 1.5rem 3rem; color: %(text)s; }
-header.trackplan-header { display: flex; gap: 1rem; align-items: baseline;
-       border-bottom: 3px solid %(accent)s; padding: 0.6rem 0 0.3rem; }
+header.trackplan-header { display: flex; gap: 16px; align-items: baseline; line-height: 24px;
+       border-bottom: 3px solid %(accent)s; padding: 10px 0 5px; }
 header.trackplan-header .brand { font-weight: 700; color: %(accent)s; letter-spacing: 0.03em; }
 header.trackplan-header .kind { color: %(muted)s; }
 footer.trackplan-footer { margin-top: 3rem; border-top: 1px solid %(rule)s; padding-top: 0.4rem;
@@ -65,7 +65,9 @@ figcaption { color: #555; font-size: 0.9rem; max-width: 70rem; }
 
 @cache
 def style_sheet() -> str:
-    """The pages' one style sheet (CSS text), in the colours of :data:`COLOURS`."""
+    """The pages' one style sheet (CSS text), in the colours of :data:`COLOURS`. The header
+    is a whole number of pixels high (42 px), so that what follows it keeps the pixel grid
+    it had without a header (the docs' screenshots of a page's parts stay sharp alike)."""
     return _CSS % COLOURS
 
 
@@ -114,6 +116,6 @@ def page(title: str, body: str, kind: str = "report") -> str:
     return (
         '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f'<title>{html.escape(title)}</title><style>{style_sheet()}</style>'
+        f"<title>{html.escape(title)}</title><style>{style_sheet()}</style>"
         f"</head><body>{header(kind)}{body}{footer()}</body></html>\n"
     )
