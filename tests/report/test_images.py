@@ -4,7 +4,9 @@ and the one look of every page (``report/page_style.py``)."""
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -20,6 +22,7 @@ from trackplan.report.html import report_page
 from trackplan.report.images import (
     CHROMIUM_ENV,
     IMAGES_DIR,
+    VIEW_CLOSEST,
     VIEW_SIZE,
     VIEW_START,
     chromium,
@@ -120,9 +123,22 @@ def test_report_rewrites_report_html_and_plots_from_the_run_folder(line_run, cap
     assert f"wrote {line_run / REPORT_FILE}" in capsys.readouterr().out
 
 
-def test_closest_frame_needs_a_cell(corner_result):
+def test_closest_frame_is_the_frame_nearest_the_closest_sample(corner_result):
+    """Of 60 frames spread evenly (first and last sample included), the nearest to the
+    sample the checker found closest; none without a cell or with no finite clearance."""
     assert corner_result.check.cell is None
     assert closest_frame(corner_result, 60) is None
+    n = corner_result.trajectory.n_samples
+    step = (n - 1) / 59  # samples between frames (about 26 here)
+    cases = [(0, 0), (n - 1, 59), (round(30 * step), 30), (round(15.3 * step), 15)]
+    cases += [(round(15.6 * step), 16)]  # past half-way to the next frame
+    for point, frame in cases:
+        cell = SimpleNamespace(min_clearance=0.02, point=point)
+        result = replace(corner_result, check=replace(corner_result.check, cell=cell))
+        assert closest_frame(result, 60) == frame, point
+    cell = SimpleNamespace(min_clearance=np.inf, point=3)
+    result = replace(corner_result, check=replace(corner_result.check, cell=cell))
+    assert closest_frame(result, 60) is None
 
 
 def _drawn_share(file: Path) -> float:
@@ -147,3 +163,28 @@ def test_report_images_draw_the_view_and_every_plot(line_run):
     view = image.imread(written[0])
     assert view.shape[:2] == (VIEW_SIZE[1], VIEW_SIZE[0])
     assert _drawn_share(written[0]) > 0.05  # the robot, the axes and the legend were drawn
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+def test_a_cell_case_gets_the_view_at_its_closest_approach(tmp_path):
+    """paper-corner-cell at cell.md's feasible placement: the view at the start and at the
+    closest approach (titled with the distance), then the plots with clearance.png."""
+    from tests.report.test_screenshots import CELL_PLACEMENT
+    from trackplan.io.case_file import load_case
+    from trackplan.outputs import write_run
+    from trackplan.planning.plan import plan
+
+    try:
+        chromium()
+    except CaseError as error:
+        pytest.skip(f"BROWSER TEST SKIPPED: {error}")
+    case = load_case(CASES / "paper-corner-cell.yaml")
+    run = tmp_path / "run"
+    write_run(run, plan(case, np.array(CELL_PLACEMENT)), case, report=False)
+    written = report_images(run, tmp_path / "images")
+    names = [p.name for p in written]
+    assert names[:2] == [VIEW_START, VIEW_CLOSEST] and "clearance.png" in names
+    start, closest = (image.imread(p) for p in written[:2])
+    assert start.shape[:2] == closest.shape[:2] == (VIEW_SIZE[1], VIEW_SIZE[0])
+    assert np.mean(np.any(start != closest, axis=2)) > 0.001  # the title at least differs
