@@ -111,6 +111,7 @@ def test_bad_report_arguments_are_one_line(tmp_path, capsys, args, words):
     assert len(err.splitlines()) == 1 and words in err
 
 
+@pytest.mark.slow  # about 4 s: the re-plan and three plots
 def test_report_rewrites_report_html_and_plots_from_the_run_folder(line_run, capsys):
     assert not (line_run / REPORT_FILE).exists()  # written without a report
     assert main(["report", str(line_run)]) == ExitCode.OK

@@ -28,11 +28,9 @@ def report(
         typer.Option("--case", help="The case file of the run (default: result.json's)."),
     ] = None,
 ) -> ExitCode:
-    """Rewrite a run's report.html (and plots) from its folder; with --png, write the 3D
-    view (at the start, and at the closest approach to the cell) and the plots as PNG.
+    """Rewrite a run's report from its folder, or with --png write its 3D view and plots.
 
-    The run is planned again where it was planned and must reproduce trajectory.csv, as
-    for `trackplan export` (docs/results.md).
+    The run is planned again and must reproduce trajectory.csv, as for export (results.md).
     """
     from trackplan.report.images import chromium, report_images, rewrite_report
 
