@@ -60,6 +60,7 @@ if TYPE_CHECKING:
     from trackplan.io.robot_file import builtin_robot, load_robot
     from trackplan.planning.plan import check, plan
     from trackplan.planning.result import PlanResult
+    from trackplan.report.images import report_images as report_images
     from trackplan.robots.model import Robot
     from trackplan.search.optimize import SearchResult, optimize
     from trackplan.status import Status
@@ -76,6 +77,8 @@ _EXPORTS = {
     "builtin_positioner": "trackplan.io.positioner_file",
     # a part's CAD model (STEP or mesh), importable from here, outside ``__all__``
     "load_part": "trackplan.io.part_file",
+    # a run's report as still images (``trackplan report RUN --png``), outside ``__all__``
+    "report_images": "trackplan.report.images",
     "plan": "trackplan.planning.plan",
     "check": "trackplan.planning.plan",
     "optimize": "trackplan.search.optimize",

@@ -34,6 +34,7 @@ from trackplan.cli import batch as _batch  # noqa: F401  (registers its commands
 from trackplan.cli import cases as _cases  # noqa: F401
 from trackplan.cli import parts as _parts  # noqa: F401
 from trackplan.cli import plan as _plan  # noqa: F401
+from trackplan.cli import report_images as _report_images  # noqa: F401
 from trackplan.cli import search as _search  # noqa: F401
 from trackplan.cli.common import app, error, refuse_empty_outputs
 from trackplan.cli.signals import Stopped, forget_stops, last_stop, stopped_by_signal

@@ -162,5 +162,7 @@ def write_map_report(pmap: PlacementMap, out_dir: Path) -> list[Path]:
         f"placement are marked. (file: {MAP_FILE})</figcaption></figure></section>"
     )
     page_file = out_dir / MAP_REPORT_FILE
-    page_file.write_text(html_page(f"trackplan placement map: {pmap.case_name}", body), "utf-8")
+    page_file.write_text(
+        html_page(f"trackplan placement map: {pmap.case_name}", body, "placement map"), "utf-8"
+    )
     return [png, page_file]

@@ -133,6 +133,14 @@ def _cycle_note(result: PlanResult, case: Case) -> str:
     )
 
 
+def view_figure(result: PlanResult, case: Case, n_frames: int = 150) -> dict:
+    """The 3D view's figure as plotly.js takes it (``data``, ``layout``, ``frames``): the
+    robot view (:func:`~trackplan.report.robot_view.robot_view_spec`) with the cycle's
+    seams and moves (:func:`~trackplan.report.cycle_view.cycle_view_spec`). The report and
+    the still images (:mod:`trackplan.report.images`) draw this one figure."""
+    return cycle_view_spec(robot_view_spec(result, case, n_frames=n_frames), result, case)
+
+
 def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
     """The report's 3D view section: the robot following the path (plotly.js embedded), or
     a note when there is no trajectory. ``n_frames`` animation frames."""
@@ -142,7 +150,7 @@ def view_section(result: PlanResult, case: Case, n_frames: int = 150) -> str:
             f"{esc(result.message)}</p></section>"
         )
     div = plotly_div(
-        cycle_view_spec(robot_view_spec(result, case, n_frames=n_frames), result, case),
+        view_figure(result, case, n_frames),
         VIEW_ID,
         config={"displaylogo": False, "responsive": True},
         post_script=_QUIET_INTERRUPTS,

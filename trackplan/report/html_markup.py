@@ -1,7 +1,7 @@
 """The HTML building blocks of the report's pages: escaping, numbers, tables, the page.
 
 ``report.html``, a cycle's report and ``map.html`` are all built from these, in one look
-(one style sheet).
+(one style sheet, header and footer: :mod:`trackplan.report.page_style`).
 """
 
 from __future__ import annotations
@@ -10,31 +10,10 @@ import html
 import math
 from collections.abc import Iterable, Sequence
 
+from trackplan.report.page_style import page
+
 Cell = str | tuple[str, str]
 """A table cell: escaped HTML, or (escaped HTML, css class)."""
-
-_CSS = """
-body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans-serif;
-       margin: 0 auto; max-width: 1400px; padding: 0 1.5rem 3rem; color: #222; }
-h1 { margin: 1.2rem 0 0.3rem; font-size: 1.6rem; }
-h2 { border-bottom: 2px solid #ddd; padding-bottom: 0.2rem; margin-top: 2.2rem; }
-h3 { margin: 1.2rem 0 0.4rem; font-size: 1.05rem; }
-h4 { margin: 0.9rem 0 0.3rem; font-size: 0.95rem; }
-nav a { margin-right: 1rem; }
-.verdict { display: inline-block; padding: 0.2rem 0.7rem; border-radius: 4px; font-weight: 600; }
-.ok { background: #e3f4e1; color: #1d6b16; }
-.bad { background: #fbe3e3; color: #a31515; }
-.low { background: #fff3d6; color: #8a5a00; }
-table { border-collapse: collapse; margin: 0.3rem 0 0.8rem; font-size: 0.9rem; }
-th, td { border: 1px solid #ddd; padding: 0.25rem 0.6rem; text-align: right; }
-th { background: #f5f5f5; }
-td.text, th.text { text-align: left; }
-.cols { display: flex; flex-wrap: wrap; gap: 0 2.5rem; align-items: flex-start; }
-figure { margin: 1rem 0 2rem; }
-figure img { max-width: 100%; border: 1px solid #eee; }
-figcaption { color: #555; font-size: 0.9rem; max-width: 70rem; }
-.muted { color: #777; }
-"""
 
 
 def esc(value: object) -> str:
@@ -95,16 +74,12 @@ def grid(header: Sequence[str], rows: Iterable[Sequence[Cell]], row_header: bool
     return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
-def html_page(title: str, body: str) -> str:
+def html_page(title: str, body: str, kind: str = "report") -> str:
     """A self-contained page in the report's look: ``title`` (text) and ``body`` (HTML)
-    with the report's style sheet. ``report.html``, a cycle's report and ``map.html`` are
-    all built with it."""
-    return (
-        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>{esc(title)}</title><style>{_CSS}</style></head>"
-        f"<body>{body}</body></html>\n"
-    )
+    between the shared header and footer, with the one style sheet of
+    :mod:`trackplan.report.page_style`. ``report.html``, a cycle's report and ``map.html``
+    are all built with it; ``kind`` (text) names the page in its header."""
+    return page(title, body, kind)
 
 
 PLACEMENT_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")

@@ -2,7 +2,8 @@
 
 One self-contained page (plotly.js embedded once, nothing fetched): the counts, the best
 robot per part, a robot × part feasibility matrix, the distributions of J and cycle time
-per robot, and the comparison table of every job with links to each run's report.
+per robot, and the comparison table of every job with links to each run's report, in the
+look of every trackplan page (:mod:`trackplan.report.page_style`).
 """
 
 from __future__ import annotations
@@ -13,27 +14,13 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
+from trackplan.report.page_style import page as html_page
 from trackplan.study.jobs import JOBS_DIR, Study
 from trackplan.study.summary import JobRow
 
 SUMMARY_HTML = "summary.html"
 MATRIX_ID = "feasibility-matrix"
 """div id of the feasibility matrix (``summary.html#feasibility-matrix``)."""
-
-_CSS = """
-body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans-serif;
-       margin: 0 auto; max-width: 1400px; padding: 0 1.5rem 3rem; color: #222; }
-h1 { margin: 1.2rem 0 0.3rem; font-size: 1.6rem; }
-h2 { border-bottom: 2px solid #ddd; padding-bottom: 0.2rem; margin-top: 2rem; }
-table { border-collapse: collapse; margin: 0.3rem 0 0.8rem; font-size: 0.85rem; }
-th, td { border: 1px solid #ddd; padding: 0.2rem 0.5rem; text-align: right; }
-th { background: #f5f5f5; }
-.text { text-align: left; }
-.ok { background: #e3f4e1; color: #1d6b16; }
-.bad { background: #fbe3e3; color: #a31515; }
-.cols { display: flex; flex-wrap: wrap; gap: 0 2rem; }
-.muted { color: #777; }
-"""
 
 
 def write_study_report(study: Study, rows: Sequence[JobRow], out_dir: str | Path) -> Path:
@@ -93,12 +80,7 @@ def write_study_report(study: Study, rows: Sequence[JobRow], out_dir: str | Path
             _jobs_table(rows, out_dir),
         ]
     )
-    page = (
-        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>trackplan study: {_esc(study.name)}</title><style>{_CSS}</style></head>"
-        f"<body>{body}</body></html>\n"
-    )
+    page = html_page(f"trackplan study: {study.name}", body, "study")
     path = out_dir / SUMMARY_HTML
     path.write_text(page, encoding="utf-8")
     return path
