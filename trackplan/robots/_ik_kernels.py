@@ -26,6 +26,11 @@ FAST_COST = 1e-4
 """Squared pose error (m² + rad²) below which :func:`newton_into` first tries undamped
 Gauss–Newton steps on a square Jacobian (about 10 mm or 10 mrad): a warm start."""
 
+FAST_MAX_STEP = 0.05
+"""Largest joint change (rad) of an undamped Gauss–Newton step: a larger one comes from an
+ill-conditioned Jacobian near a singularity and could leave the reference's solution for
+another; the damped iterations take such a pose over."""
+
 _PIVOT_MIN = 1e-12  # |pivot| below it: the square Jacobian counts as singular
 
 
@@ -306,7 +311,7 @@ def newton_into(
     A warm start (squared error below :data:`FAST_COST`) on a square Jacobian (n = 6, or
     7 with a joint locked) first takes undamped Gauss–Newton steps
     (:func:`square_solve_into`), each kept only while the error falls and no joint moves
-    more than :data:`MAX_NEWTON_STEP`: from a reference within a few mrad, two steps
+    more than :data:`FAST_MAX_STEP`: from a reference within a few mrad, two steps
     and three evaluations reach 1e-10. Otherwise (or when such a step fails) the damped
     iterations below take over from the last kept configuration.
     """
@@ -350,7 +355,7 @@ def newton_into(
         largest = 0.0
         for i in range(n):
             largest = max(largest, abs(dq[i]))
-        if largest > MAX_NEWTON_STEP:
+        if largest > FAST_MAX_STEP:
             break
         iters += 1
         for i in range(n):

@@ -153,7 +153,7 @@ def track_poses(
     *,
     free_joint: int = DEFAULT_FREE_JOINT,
     tol: float = 1e-10,
-    max_iter: int = 30,
+    max_iter: int = 100,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Solve poses from nearby reference configurations (warm starts), compiled, batched.
 
