@@ -31,6 +31,8 @@ FAST_MAX_STEP = 0.05
 ill-conditioned Jacobian near a singularity and could leave the reference's solution for
 another; the damped iterations take such a pose over."""
 
+_TRACK_STEPS = 5  # evaluations of track_batch's Gauss–Newton before newton_into takes over
+
 _PIVOT_MIN = 1e-12  # |pivot| below it: the square Jacobian counts as singular
 
 
@@ -428,7 +430,10 @@ def track_batch(
     q: np.ndarray,
     ok: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
-    """Kernel: :func:`newton_into` of each pose from its reference configuration.
+    """Kernel: Newton on each pose from its reference configuration.
+
+    :func:`gauss_newton_into` first (a square Jacobian: n = 6, or 7 with ``locked``); a
+    pose it does not solve is solved by :func:`newton_into` from its reference again.
 
     Parameters
     ----------
@@ -446,9 +451,17 @@ def track_batch(
     q, ok
         Outputs (N, n) rad (the last iterate where not ok) and (N,) bool.
     """
-    work = np.empty(work_size_kernel(chain.shape[0]))
+    n = chain.shape[0]
+    work = np.empty(work_size_kernel(n))
     target = np.zeros((4, 4))
     target[3, 3] = 1.0
+    T = np.empty((4, 4))
+    J = np.empty((6, n))
+    axes = np.empty((n, 6))
+    e = np.empty(6)
+    A = np.empty((6, 7))
+    dq = np.empty(n)
+    square = n == 6 or (n == 7 and locked >= 0)
     one_rotation = R.shape[0] == 1
     for i in range(p.shape[0]):
         k = 0 if one_rotation else i
@@ -456,8 +469,68 @@ def track_batch(
             for c in range(3):
                 target[r, c] = R[k, r, c]
             target[r, 3] = p[i, r]
-        for j in range(q.shape[1]):
-            q[i, j] = q_ref[i, j]
+        x = q[i]
+        for j in range(n):
+            x[j] = q_ref[i, j]
         if locked >= 0:
-            q[i, locked] = free[i]
-        ok[i] = newton_into(chain, tool, target, q[i], tol, max_iter, work, locked)[0]
+            x[locked] = free[i]
+        solved = square and gauss_newton_into(
+            chain, tool, target, x, tol, locked, T, J, axes, e, A, dq
+        )
+        if not solved:  # from the reference again, damped where needed
+            for j in range(n):
+                x[j] = q_ref[i, j]
+            if locked >= 0:
+                x[locked] = free[i]
+            solved = newton_into(chain, tool, target, x, tol, max_iter, work, locked)[0]
+        ok[i] = solved
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def gauss_newton_into(
+    chain: np.ndarray,
+    tool: np.ndarray,
+    T_target: np.ndarray,
+    q: np.ndarray,
+    tol: float,
+    locked: int,
+    T: np.ndarray,
+    J: np.ndarray,
+    axes: np.ndarray,
+    e: np.ndarray,
+    A: np.ndarray,
+    dq: np.ndarray,
+) -> bool:  # pragma: no cover - compiled
+    """Kernel: undamped Gauss–Newton on one pose from a warm start, q (n,) in place.
+
+    At most :data:`_TRACK_STEPS` evaluations; each step is taken only while the squared
+    error falls and is below :data:`FAST_COST`, the square Jacobian (n = 6, or 7 without
+    column ``locked``) is regular and no joint moves more than :data:`FAST_MAX_STEP`.
+    The first phase of :func:`newton_into` without its bookkeeping, for the many poses of
+    a path near their references. T (4, 4), J (6, n), axes (n, 6), e (6,), A (6, 7) and
+    dq (n,) are scratch.
+
+    Returns
+    -------
+    bool
+        Both errors within ``tol``; when False, q is left where the steps stopped.
+    """
+    n = chain.shape[0]
+    cost = FAST_COST
+    for _ in range(_TRACK_STEPS):
+        fk_jacobian_into(chain, tool, q, T, J, axes)
+        perr, oerr = pose_error_into(T_target, T, e)
+        if perr <= tol and oerr <= tol:
+            return True
+        new_cost = perr * perr + oerr * oerr
+        if not new_cost < cost or not square_solve_into(J, e, locked, dq, A):
+            return False
+        cost = new_cost
+        largest = 0.0
+        for j in range(n):
+            largest = max(largest, abs(dq[j]))
+        if largest > FAST_MAX_STEP:
+            return False
+        for j in range(n):
+            q[j] += dq[j]
+    return False
