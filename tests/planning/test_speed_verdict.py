@@ -42,7 +42,7 @@ def numeric_kr10(tmp_path_factory):
     file.write_text(text.replace("robot: kuka_kr6_r700_sixx", "robot: kuka_kr10_r1420"))
     case = load_case(file)
     # the robot's IK family, derived once and kept on it: numeric here
-    derived(case.robot, "ik family", lambda: detect.NumericFamily(case.robot.n_dof))
+    derived(case.robot, "ik family", lambda: detect.NumericFamily(case.robot))
     assert isinstance(detect.ik_family(case.robot), detect.NumericFamily)
     return case
 
