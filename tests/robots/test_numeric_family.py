@@ -11,7 +11,7 @@ from trackplan.io.robot_file import builtin_robot
 from trackplan.robots.families import ik_family
 from trackplan.robots.families.numeric import NumericFamily
 from trackplan.robots.ik_numeric import solve_ik_numeric, track_poses
-from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.numeric_seeding import N_SOBOL, start_configurations
 
 MATCH = 1e-6
@@ -76,6 +76,34 @@ def test_solutions_come_in_a_fixed_order(ur, rng):
         distinct = q[found]
         gap = np.abs(distinct[:, None] - distinct[None]).max(axis=-1)
         assert np.all(gap[~np.eye(len(distinct), dtype=bool)] > 1e-6)
+
+
+def signature(robot, q):
+    """The documented structural signature 4·s + 2·e + w of solutions q (..., n), in numpy."""
+    frames = axis_frames(robot, q)[..., 1:-1, :3, :]  # joint i's frame: origin o, axis z
+    z, o = frames[..., 2], frames[..., 3]
+    n = robot.n_dof
+    w, e = o[..., n - 2, :], (3 if n >= 7 else 2)
+    shoulder = np.einsum("...i,...i", z[..., 1, :], np.cross(z[..., 0, :], w - o[..., 0, :]))
+    arm = np.cross(o[..., e, :] - o[..., 1, :], w - o[..., e, :])
+    elbow = np.einsum("...i,...i", z[..., e, :], arm)
+    wrist = np.einsum("...i,...i", z[..., n - 2, :], np.cross(z[..., n - 3, :], z[..., n - 1, :]))
+    return 4 * (shoulder < 0) + 2 * (elbow < 0) + (wrist < 0)
+
+
+@pytest.mark.parametrize("name", ["ur5e", "kinova_gen3"])
+def test_solutions_are_ordered_by_signature_then_margin(name, rng):
+    robot = builtin_robot(name)
+    q, T = random_poses(robot, rng, 30)
+    free = q[:, 2] if robot.n_dof == 7 else None
+    solutions, found = NumericFamily(robot).seed_solutions(T, robot.q_min, robot.q_max, free=free)
+    key = np.where(found, signature(robot, np.nan_to_num(solutions)), 99)
+    margin = np.minimum(solutions - robot.q_min, robot.q_max - solutions).min(axis=-1)
+    step = np.diff(key, axis=1)
+    assert np.all(step >= 0)
+    same = (step == 0) & found[:, 1:]
+    assert np.all(np.diff(margin, axis=1)[same] <= 1e-12)
+    assert len(np.unique(key[found])) >= 4  # several signatures occur
 
 
 def test_starts_are_deterministic_and_cover_the_limits(ur):
@@ -162,6 +190,20 @@ def test_tracking_from_a_nearby_reference(name, rng):
     tiled = track_poses(robot, np.tile(R, (20, 1, 1)), p, np.tile(q[0], (20, 1)), held)
     np.testing.assert_array_equal(one[0], tiled[0])
     assert one[1].all() and tiled[1].all()
+
+
+def test_tracking_chains_without_a_square_jacobian(ur, rng):
+    five = replace_dh(
+        ur,
+        **dict(zip(("d", "a", "alpha", "offset"), ur.dh[:5].T, strict=True)),
+        **{k: getattr(ur, k)[:5] for k in ("q_min", "q_max", "v_max", "a_max", "j_max")},
+    )
+    for robot in (five, seven_joint(ur)):  # damped Newton only (minimum norm for 7)
+        q = rng.uniform(-np.pi, np.pi, (200, robot.n_dof))
+        T = forward_kinematics(robot, q)
+        solved, ok = track_poses(robot, T[:, :3, :3], T[:, :3, 3], q + 1e-3)
+        assert ok.mean() > 0.98
+        assert np.abs(forward_kinematics(robot, solved[ok]) - T[ok]).max() < 1e-9
 
 
 def test_warm_starts_take_two_gauss_newton_steps(ur, rng):
