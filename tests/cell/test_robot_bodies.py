@@ -39,6 +39,8 @@ HOME = {
     # the SIA10D's U turn about -y)
     "kuka_iiwa14": [0.0, 0.5, 0.0, -HALF_PI, 0.0, 1.0, 0.0],
     "yaskawa_sia10d": [0.0, 0.5, 0.0, -HALF_PI, 0.0, -1.0, 0.0],
+    # Kinova's Home of the Gen3: 0°, 15°, 180°, -130°, 0°, 55°, 90°
+    "kinova_gen3": list(np.radians([0.0, 15.0, 180.0, -130.0, 0.0, 55.0, 90.0])),
 }
 
 

@@ -19,6 +19,8 @@ from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
 N_POSES = 10_000
+NUMERIC_BUILTINS = ("kinova_gen3",)
+"""The built-ins without a closed form (the numeric family's example)."""
 BUILTINS = [  # the OPW and UR arms; the other families are tested on their own
     name for name in builtin_names() if ik_family(builtin_robot(name)).name in ("opw", "ur")
 ]
@@ -182,6 +184,8 @@ def tilted(robot: Robot, joint: int, degrees: float, towards: int) -> Robot:
 def test_family_detection_positive_and_negative(puma, ur):
     for name in BUILTINS:
         assert ik_family(builtin_robot(name)).name in ("opw", "ur")
+    for name in NUMERIC_BUILTINS:
+        assert ik_family(builtin_robot(name)).name == "numeric"
     assert ik_family(puma).name == "opw" and ik_family(ur).name == "ur"
     kr6 = builtin_robot("kuka_kr6_r700_sixx")  # axes at q = 0: -z, y, y, -x, y, -x
     for joint, towards in ((0, 0), (1, 0), (2, 0), (3, 1), (4, 0), (5, 1)):

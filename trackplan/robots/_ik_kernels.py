@@ -22,11 +22,24 @@ _NU_START = 1.0  # damping μ = ν · |e|² + μ_min: vanishes with the error (q
 _MU_MIN = 1e-15
 _NU_MAX = 1e12  # ν this large means the error cannot decrease: a local minimum
 
+FAST_COST = 1e-4
+"""Squared pose error (m² + rad²) below which :func:`newton_into` first tries undamped
+Gauss–Newton steps on a square Jacobian (about 10 mm or 10 mrad): a warm start."""
+
+FAST_MAX_STEP = 0.05
+"""Largest joint change (rad) of an undamped Gauss–Newton step: a larger one comes from an
+ill-conditioned Jacobian near a singularity and could leave the reference's solution for
+another; the damped iterations take such a pose over."""
+
+_TRACK_STEPS = 5  # evaluations of track_batch's Gauss–Newton before newton_into takes over
+
+_PIVOT_MIN = 1e-12  # |pivot| below it: the square Jacobian counts as singular
+
 
 def work_size(n_dof: int) -> int:
     """Length of the scratch vector :func:`newton_into` needs for an n-joint chain."""
     m = min(n_dof, 6)
-    return 2 * 16 + 2 * 6 * n_dof + 2 * 6 + 3 * n_dof + m * m + m + 6 * n_dof
+    return 2 * 16 + 2 * 6 * n_dof + 2 * 6 + 3 * n_dof + m * m + m + 6 * n_dof + 6 * 7
 
 
 work_size_kernel = njit(cache=True, error_model="numpy")(work_size)
@@ -54,45 +67,6 @@ def newton_batch(
         n_iter[k] = iters
         errors[k, 0] = perr
         errors[k, 1] = oerr
-
-
-@njit(cache=True, error_model="numpy")
-def track_batch(
-    chain: np.ndarray,
-    tool: np.ndarray,
-    R: np.ndarray,
-    p: np.ndarray,
-    q: np.ndarray,
-    free: np.ndarray,
-    locked: int,
-    tol: float,
-    max_iter: int,
-    success: np.ndarray,
-) -> None:  # pragma: no cover - compiled
-    """Kernel: each row of q (N, n), a reference near the solution, solved in place for the
-    pose (R[k] or R[0] when R holds one rotation, p[k]) by :func:`newton_into`, joint
-    ``locked`` (≥ 0) held at ``free[k]``; a pose not solved repeats the solved row before
-    it (the reference where none is)."""
-    work = np.empty(work_size_kernel(chain.shape[0]))
-    target = np.zeros((4, 4))
-    target[3, 3] = 1.0
-    n = q.shape[1]
-    last = -1
-    for k in range(q.shape[0]):
-        rotation = R[k] if R.shape[0] > 1 else R[0]
-        for i in range(3):
-            for j in range(3):
-                target[i, j] = rotation[i, j]
-            target[i, 3] = p[k, i]
-        if locked >= 0:
-            q[k, locked] = free[k]
-        ok = newton_into(chain, tool, target, q[k], tol, max_iter, work, locked)[0]
-        success[k] = ok
-        if ok:
-            last = k
-        elif last >= 0:
-            for j in range(n):
-                q[k, j] = q[last, j]
 
 
 @njit(cache=True, error_model="numpy")
@@ -268,6 +242,57 @@ def damped_solve_into(
 
 
 @njit(cache=True, error_model="numpy")
+def square_solve_into(
+    J: np.ndarray, e: np.ndarray, locked: int, dq: np.ndarray, A: np.ndarray
+) -> bool:  # pragma: no cover - compiled
+    """Kernel: the Gauss–Newton step ``dq = J⁻¹ e`` of a square Jacobian.
+
+    J (6, n) is square when n = 6, or n = 7 without the column ``locked`` (≥ 0), whose dq
+    is then zero. Gaussian elimination with partial pivoting on A (6, 7) scratch (J and
+    e side by side). Returns False (dq unchanged) when a pivot is below 1e-12: a
+    singular configuration, left to the damped iterations.
+    """
+    n = J.shape[1]
+    for r in range(6):
+        c = 0
+        for j in range(n):
+            if j != locked:
+                A[r, c] = J[r, j]
+                c += 1
+        A[r, 6] = e[r]
+    for col in range(6):
+        pivot = col
+        best = abs(A[col, col])
+        for r in range(col + 1, 6):
+            if abs(A[r, col]) > best:
+                best = abs(A[r, col])
+                pivot = r
+        if not best > _PIVOT_MIN:
+            return False
+        if pivot != col:
+            for c in range(col, 7):
+                A[col, c], A[pivot, c] = A[pivot, c], A[col, c]
+        inv = 1.0 / A[col, col]
+        for r in range(col + 1, 6):
+            factor = A[r, col] * inv
+            for c in range(col + 1, 7):
+                A[r, c] -= factor * A[col, c]
+    for r in range(5, -1, -1):
+        acc = A[r, 6]
+        for c in range(r + 1, 6):
+            acc -= A[r, c] * A[c, 6]
+        A[r, 6] = acc / A[r, r]
+    c = 0
+    for j in range(n):
+        if j == locked:
+            dq[j] = 0.0
+        else:
+            dq[j] = A[c, 6]
+            c += 1
+    return True
+
+
+@njit(cache=True, error_model="numpy")
 def newton_into(
     chain: np.ndarray,
     tool: np.ndarray,
@@ -284,6 +309,13 @@ def newton_into(
     its value in q (its Jacobian column is zero: the others solve the pose, a 7-joint
     arm's redundancy given by that joint). Returns (success, iterations, position error
     m, orientation error rad) of the final q.
+
+    A warm start (squared error below :data:`FAST_COST`) on a square Jacobian (n = 6, or
+    7 with a joint locked) first takes undamped Gauss–Newton steps
+    (:func:`square_solve_into`), each kept only while the error falls and no joint moves
+    more than :data:`FAST_MAX_STEP`: from a reference within a few mrad, two steps
+    and three evaluations reach 1e-10. Otherwise (or when such a step fails) the damped
+    iterations below take over from the last kept configuration.
     """
     n = chain.shape[0]
     m = min(n, 6)
@@ -309,14 +341,47 @@ def newton_into(
     H = work[at : at + m * m].reshape((m, m))
     at += m * m + m
     axes = work[at : at + 6 * n].reshape((n, 6))
+    at += 6 * n
+    A = work[at : at + 42].reshape((6, 7))
     fk_jacobian_into(chain, tool, q, T, J, axes)
     if locked >= 0:
         for r in range(6):
             J[r, locked] = 0.0
     perr, oerr = pose_error_into(T_target, T, e)
     cost = perr * perr + oerr * oerr
-    nu = _NU_START
     iters = 0
+    square = n == 6 or (n == 7 and locked >= 0)
+    while square and cost <= FAST_COST and iters < max_iter and not (perr <= tol and oerr <= tol):
+        if not square_solve_into(J, e, locked, dq, A):
+            break
+        largest = 0.0
+        for i in range(n):
+            largest = max(largest, abs(dq[i]))
+        if largest > FAST_MAX_STEP:
+            break
+        iters += 1
+        for i in range(n):
+            q_try[i] = q[i]
+            q[i] += dq[i]
+        fk_jacobian_into(chain, tool, q, T, J, axes)
+        if locked >= 0:
+            for r in range(6):
+                J[r, locked] = 0.0
+        perr_new, oerr_new = pose_error_into(T_target, T, e)
+        cost_new = perr_new * perr_new + oerr_new * oerr_new
+        if cost_new < cost:
+            perr, oerr, cost = perr_new, oerr_new, cost_new
+            continue
+        for i in range(n):  # no progress: back to the kept q, damped from there
+            q[i] = q_try[i]
+        fk_jacobian_into(chain, tool, q, T, J, axes)
+        if locked >= 0:
+            for r in range(6):
+                J[r, locked] = 0.0
+        perr, oerr = pose_error_into(T_target, T, e)
+        cost = perr * perr + oerr * oerr
+        break
+    nu = _NU_START
     while iters < max_iter and not (perr <= tol and oerr <= tol):
         iters += 1
         damped_solve_into(J, e, nu * cost + _MU_MIN, dq, H, g)
@@ -349,3 +414,123 @@ def newton_into(
             if nu > _NU_MAX:
                 break
     return (perr <= tol and oerr <= tol), iters, perr, oerr
+
+
+@njit(cache=True, error_model="numpy")
+def track_batch(
+    chain: np.ndarray,
+    tool: np.ndarray,
+    R: np.ndarray,
+    p: np.ndarray,
+    q_ref: np.ndarray,
+    locked: int,
+    free: np.ndarray,
+    tol: float,
+    max_iter: int,
+    q: np.ndarray,
+    ok: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Kernel: Newton on each pose from its reference configuration.
+
+    :func:`gauss_newton_into` first (a square Jacobian: n = 6, or 7 with ``locked``); a
+    pose it does not solve is solved by :func:`newton_into` from its reference again.
+
+    Parameters
+    ----------
+    chain, tool
+        From :func:`trackplan.robots.ik_numeric.chain_arrays`.
+    R, p
+        Tool rotations (N, 3, 3) or one for all (1, 3, 3), and positions (N, 3), m.
+    q_ref
+        Warm starts, shape (N, n), rad.
+    locked, free
+        Joint ``locked`` (≥ 0) held at ``free[i]`` (shape (N,), rad) at pose i; −1 and an
+        empty ``free``: none held.
+    tol, max_iter
+        Newton tolerance (m and rad) and iteration limit.
+    q, ok
+        Outputs (N, n) rad (the last iterate where not ok) and (N,) bool.
+    """
+    n = chain.shape[0]
+    work = np.empty(work_size_kernel(n))
+    target = np.zeros((4, 4))
+    target[3, 3] = 1.0
+    T = np.empty((4, 4))
+    J = np.empty((6, n))
+    axes = np.empty((n, 6))
+    e = np.empty(6)
+    A = np.empty((6, 7))
+    dq = np.empty(n)
+    square = n == 6 or (n == 7 and locked >= 0)
+    one_rotation = R.shape[0] == 1
+    for i in range(p.shape[0]):
+        k = 0 if one_rotation else i
+        for r in range(3):
+            for c in range(3):
+                target[r, c] = R[k, r, c]
+            target[r, 3] = p[i, r]
+        x = q[i]
+        for j in range(n):
+            x[j] = q_ref[i, j]
+        if locked >= 0:
+            x[locked] = free[i]
+        solved = square and gauss_newton_into(
+            chain, tool, target, x, tol, locked, T, J, axes, e, A, dq
+        )
+        if not solved:  # from the reference again, damped where needed
+            for j in range(n):
+                x[j] = q_ref[i, j]
+            if locked >= 0:
+                x[locked] = free[i]
+            solved = newton_into(chain, tool, target, x, tol, max_iter, work, locked)[0]
+        ok[i] = solved
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def gauss_newton_into(
+    chain: np.ndarray,
+    tool: np.ndarray,
+    T_target: np.ndarray,
+    q: np.ndarray,
+    tol: float,
+    locked: int,
+    T: np.ndarray,
+    J: np.ndarray,
+    axes: np.ndarray,
+    e: np.ndarray,
+    A: np.ndarray,
+    dq: np.ndarray,
+) -> bool:  # pragma: no cover - compiled
+    """Kernel: undamped Gauss–Newton on one pose from a warm start, q (n,) in place.
+
+    At most :data:`_TRACK_STEPS` evaluations; each step is taken only while the squared
+    error falls and is below :data:`FAST_COST`, the square Jacobian (n = 6, or 7 without
+    column ``locked``) is regular and no joint moves more than :data:`FAST_MAX_STEP`.
+    The first phase of :func:`newton_into` without its bookkeeping, for the many poses of
+    a path near their references. T (4, 4), J (6, n), axes (n, 6), e (6,), A (6, 7) and
+    dq (n,) are scratch.
+
+    Returns
+    -------
+    bool
+        Both errors within ``tol``; when False, q is left where the steps stopped.
+    """
+    n = chain.shape[0]
+    cost = FAST_COST
+    for _ in range(_TRACK_STEPS):
+        fk_jacobian_into(chain, tool, q, T, J, axes)
+        perr, oerr = pose_error_into(T_target, T, e)
+        if perr <= tol and oerr <= tol:
+            return True
+        new_cost = perr * perr + oerr * oerr
+        if not new_cost < cost or not square_solve_into(J, e, locked, dq, A):
+            return False
+        cost = new_cost
+        largest = 0.0
+        for j in range(n):
+            largest = max(largest, abs(dq[j]))
+        if largest > FAST_MAX_STEP:
+            return False
+        for j in range(n):
+            q[j] += dq[j]
+    return False

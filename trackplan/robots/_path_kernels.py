@@ -16,6 +16,7 @@ from numba import njit
 
 from trackplan.robots._ik_kernels import (
     fk_jacobian_into,
+    gauss_newton_into,
     newton_into,
     work_size_kernel,
 )
@@ -111,6 +112,10 @@ def numeric_paths(
         pose m of candidate b, shape (B, M), rad, and the others solve the pose; −1 (and
         an empty ``free``): no joint is held.
 
+    The fine solve tries undamped Gauss–Newton from the interpolation first
+    (:func:`~trackplan.robots._ik_kernels.gauss_newton_into`, square Jacobians), damped
+    Newton from the interpolation again where that does not converge.
+
     Returns
     -------
     q, reach, magnitude, crossing
@@ -129,6 +134,10 @@ def numeric_paths(
     J = np.empty((6, n))
     axes = np.empty((n, 6))
     square = np.empty((6, 6))
+    e = np.empty(6)
+    A = np.empty((6, 7))
+    dq = np.empty(n)
+    square_jacobian = n == 6 or (n == 7 and locked >= 0)
     previous_coarse = np.empty(n_poses, dtype=np.int64)
     next_coarse = np.empty(n_poses, dtype=np.int64)
     for b in range(n_cand):
@@ -170,6 +179,15 @@ def numeric_paths(
                         path[m, j] = (1.0 - w) * path[m0, j] + w * path[m1, j]
                     if locked >= 0:
                         path[m, locked] = free[b, m]
+                    if square_jacobian and gauss_newton_into(
+                        chain, tool, T[b, m], path[m], tol, locked, T_k, J, axes, e, A, dq
+                    ):
+                        reach[b, k, m] = True
+                        continue
+                    for j in range(n):  # from the interpolation again, damped where needed
+                        path[m, j] = (1.0 - w) * path[m0, j] + w * path[m1, j]
+                    if locked >= 0:
+                        path[m, locked] = free[b, m]
                     solved = newton_into(
                         chain, tool, T[b, m], path[m], tol, fine_iter, work, locked
                     )
@@ -179,7 +197,6 @@ def numeric_paths(
                 fk_jacobian_into(chain, tool, path[m], T_k, J, axes)
                 det = singularity_measure(J, square, locked)
                 magnitude[b, k, m, 0] = abs(det)
-                square_jacobian = n == 6 or (n == 7 and locked >= 0)
                 if m > 0 and square_jacobian and reach[b, k, m] and reach[b, k, m - 1]:
                     if det * previous <= 0.0:
                         crossing[b, k, m] = SINGULAR

@@ -12,8 +12,14 @@ iterations are Gauss–Newton and converge quadratically; ν shrinks tenfold aft
 step and grows tenfold after a rejected one. A pose counts as solved when the position
 error is at most ``tol`` metres and the orientation error at most ``tol`` radians.
 
+A warm start (a squared error below 1e-4, about 10 mm or 10 mrad) on a square Jacobian
+first takes undamped Gauss–Newton steps (the 6 × 6 system solved by Gaussian elimination
+with partial pivoting), each kept only while the error falls; :func:`track_poses` solves
+poses from references within a few mrad of the solution this way (the trajectory's samples
+from the grid's joint path), two steps a pose.
+
 The compiled kernels (forward kinematics with the Jacobian, the pose error, one damped
-solve, a Newton solve of one pose) live in :mod:`trackplan.robots._kernels`, shared with
+solve, a Newton solve of one pose) live in :mod:`trackplan.robots._ik_kernels`, shared with
 :mod:`trackplan.robots.path_ik` and :mod:`trackplan.robots.resolved_rate`.
 """
 
@@ -130,6 +136,97 @@ def solve_ik_numeric(
     )
 
 
+DEFAULT_FREE_JOINT = 2
+"""The joint (0-based) a 7-joint arm's numeric IK holds as its redundancy parameter by
+default: joint 3, the upper-arm roll of the S-R-S-like arms (iiwa, Gen3, SIA10D) and the
+Panda's third joint. Held, it leaves a 6R chain with a full-rank 6 × 6 Jacobian over most
+of the workspace (the shoulder and the wrist keep their three axes each), and its value
+swings the elbow about the shoulder–wrist line, as the arm angle does."""
+
+
+NEWTON_TOL = 1e-10
+"""Position (m) and orientation (rad) tolerance of every Newton solve of the path IK: the
+tracked families' branches and the samples they are solved at. The checker derives its
+tool-point tolerance and speed slack from it (``planning/check_task.py``)."""
+
+
+def track_poses(
+    robot: Robot,
+    R_base_tool: np.ndarray,
+    p_base_tool: np.ndarray,
+    q_ref: np.ndarray,
+    free: np.ndarray | None = None,
+    *,
+    free_joint: int = DEFAULT_FREE_JOINT,
+    tol: float = NEWTON_TOL,
+    max_iter: int = 100,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Solve poses from nearby reference configurations (warm starts), compiled, batched.
+
+    Each pose is solved by Newton from its own reference (e.g. the planning grid's joint
+    path interpolated at the sample, within a few mrad): undamped Gauss–Newton steps on
+    the square Jacobian while the error falls, damped steps otherwise (see the module).
+
+    Parameters
+    ----------
+    robot
+        Any chain of 5 to 7 or more joints.
+    R_base_tool
+        Tool rotations, shape (N, 3, 3), or one for every pose, (3, 3).
+    p_base_tool
+        Tool positions in the base frame, shape (N, 3), m.
+    q_ref
+        Reference configurations, shape (N, n), rad.
+    free
+        A 7-joint arm's redundancy: joint ``free_joint`` held at ``free[i]`` at pose i,
+        shape (N,), rad; None holds no joint (a 7-joint arm then takes minimum-norm steps).
+    free_joint
+        The held joint, 0-based (default :data:`DEFAULT_FREE_JOINT`).
+    tol, max_iter
+        Position (m) and orientation (rad) tolerance; most iterations per pose.
+
+    Returns
+    -------
+    q
+        Shape (N, n), rad, continuous with ``q_ref`` (not wrapped); the last iterate where
+        not ok.
+    ok
+        Shape (N,), bool: both errors within ``tol``.
+
+    Raises
+    ------
+    CaseError
+        When a shape does not fit.
+    """
+    n = robot.n_dof
+    p = np.ascontiguousarray(p_base_tool, dtype=float)
+    R = np.ascontiguousarray(R_base_tool, dtype=float)
+    R = R.reshape(1, 3, 3) if R.shape == (3, 3) else R
+    reference = np.ascontiguousarray(q_ref, dtype=float)
+    count = p.shape[0] if p.ndim == 2 else -1
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise CaseError(f"p_base_tool must have shape (N, 3), got {p.shape}")
+    if R.ndim != 3 or R.shape[1:] != (3, 3) or R.shape[0] not in (1, count):
+        raise CaseError(f"R_base_tool must have shape ({count}, 3, 3) or (3, 3), got {R.shape}")
+    if reference.shape != (count, n):
+        raise CaseError(f"q_ref must have shape ({count}, {n}), got {reference.shape}")
+    if free is None:
+        locked, held = -1, np.empty(0)
+    else:
+        held = np.ascontiguousarray(free, dtype=float)
+        if held.shape != (count,):
+            raise CaseError(f"free must have shape ({count},), got {held.shape}")
+        if not 0 <= free_joint < n:
+            raise CaseError(f"free_joint must be a joint index in [0, {n - 1}], got {free_joint}")
+        locked = int(free_joint)
+    q = np.empty((count, n))
+    ok = np.empty(count, dtype=np.bool_)
+    track_batch(
+        *chain_arrays(robot), R, p, reference, locked, held, float(tol), int(max_iter), q, ok
+    )
+    return q, ok
+
+
 def check_poses_and_joints(
     robot: Robot, T_base_tool: np.ndarray, q: np.ndarray, q_name: str, path: bool = False
 ) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
@@ -161,64 +258,3 @@ def check_poses_and_joints(
     except ValueError:
         raise CaseError(f"poses {T.shape} and {q_name} {joints.shape} do not broadcast") from None
     return T, joints, lead
-
-
-NEWTON_TOL = 1e-10
-"""Position (m) and orientation (rad) tolerance of every Newton solve of the path IK: the
-tracked families' branches and the samples they are solved at. The checker derives its
-tool-point tolerance and speed slack from it (``planning/check_task.py``)."""
-
-TRACK_MAX_ITER = 30
-"""Most Newton iterations per pose when tracking from a nearby reference."""
-
-
-def track_poses(
-    robot: Robot,
-    R_base_tool: np.ndarray,
-    p_base_tool: np.ndarray,
-    reference: np.ndarray,
-    free: np.ndarray | None = None,
-    locked: int = -1,
-    tol: float = NEWTON_TOL,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Solve poses by damped Newton, each from its own reference configuration.
-
-    The poses of a planned trajectory lie between the poses of a joint path already
-    solved (the planning grid): its joints interpolated at each pose are within a grid
-    step of the solution, so Newton from there stays on the branch the grid followed.
-
-    Parameters
-    ----------
-    robot
-        Any chain.
-    R_base_tool
-        Tool rotations, shape (M, 3, 3), or one for every pose, (3, 3).
-    p_base_tool
-        Tool positions, shape (M, 3), m.
-    reference
-        Start configuration of each pose, shape (M, n), rad.
-    free, locked
-        A 7-joint arm's held joint (index ≥ 0) and its value at every pose, shape (M,),
-        rad; −1 and None: no joint is held.
-    tol
-        Position (m) and orientation (rad) tolerance.
-
-    Returns
-    -------
-    q
-        Shape (M, n), rad: continuous from the references; a pose not solved repeats the
-        solved pose before it.
-    success
-        Shape (M,), bool.
-    """
-    R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
-    p = np.ascontiguousarray(p_base_tool, dtype=float).reshape(-1, 3)
-    q = np.array(reference, dtype=float, order="C")
-    held = np.empty(0) if free is None else np.ascontiguousarray(free, dtype=float)
-    if locked >= 0 and held.shape != (len(q),):
-        raise CaseError(f"free must have shape ({len(q)},) when joint {locked + 1} is held")
-    success = np.empty(len(q), dtype=np.bool_)
-    track_batch(
-        *chain_arrays(robot), R, p, q, held, int(locked), float(tol), TRACK_MAX_ITER, success
-    )
-    return q, success

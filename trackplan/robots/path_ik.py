@@ -419,11 +419,15 @@ def branch_joints_along(
         )[0]
     q_grid = np.asarray(q_grid, dtype=float)
     reference = np.column_stack([np.interp(s, s_grid, column) for column in q_grid.T])
-    locked = -1
-    if family.redundancy is not None and family.redundancy.joint is not None:
-        locked = family.redundancy.joint
-    q, _ = track_poses(robot, R_base_tool, p_base_tool, reference, free, locked)
-    return q
+    joint = None if family.redundancy is None else family.redundancy.joint
+    held = None if joint is None else free
+    q, ok = track_poses(
+        robot, R_base_tool, p_base_tool, reference, held, free_joint=-1 if joint is None else joint
+    )
+    # a pose not solved repeats the solved pose before it (the reference before any)
+    last = np.maximum.accumulate(np.where(ok, np.arange(len(ok)), -1))
+    held_rows: np.ndarray = np.where((last >= 0)[:, None], q[np.maximum(last, 0)], reference)
+    return held_rows
 
 
 def _choose(ok: np.ndarray, first_problem: np.ndarray, margin: np.ndarray) -> np.ndarray:

@@ -1,10 +1,11 @@
-"""The numeric family: arms without a closed form (any chain of 5, 6 or 7 joints).
+"""The numeric family: arms without a closed form (any chain of 5, 6, 7 or more joints).
 
-The path IK (:mod:`trackplan.robots.path_ik`) solves them by damped Newton
-(:mod:`trackplan.robots.ik_numeric`), seeded sample to sample; a branch is a seed.
-A 7-joint arm's redundancy is one of its joints (:data:`DEFAULT_FREE_JOINT` unless the robot
-file says which), whose profile along the path the planner chooses; longer chains resolve it
-by the rule :data:`REDUNDANCY_RULE`.
+A tracked family (:class:`~trackplan.robots.families.base.IKFamily`): the distinct
+solutions of a pose come from multi-start Newton (:mod:`trackplan.robots.numeric_seeding`),
+and the path IK follows each by warm-started Newton (:mod:`trackplan.robots.ik_numeric`).
+A 7-joint arm's redundancy is one of its joints, held at a value per pose
+(:data:`~trackplan.robots.ik_numeric.DEFAULT_FREE_JOINT` unless chosen); a chain of more
+than seven joints resolves it by the rule :data:`REDUNDANCY_RULE`.
 """
 
 from __future__ import annotations
@@ -16,15 +17,21 @@ from trackplan.robots.families.base import (
     N_BRANCHES,
     RedundancyParameter,
     _no_free,
-    wrap_and_deduplicate,
 )
-from trackplan.robots.ik_numeric import solve_ik_numeric, track_poses
+from trackplan.robots.ik_numeric import (
+    DEFAULT_FREE_JOINT,
+    chain_arrays,
+    track_poses,
+)
 from trackplan.robots.model import Robot
-
-DEFAULT_FREE_JOINT = 2
-"""The joint (0-based) that carries a 7-joint arm's redundancy in the numeric family: the
-third, the upper arm's roll of the usual anthropomorphic arms, which moves the elbow about
-the shoulder–wrist line much as the arm angle does."""
+from trackplan.robots.numeric_seeding import (
+    MAX_ITER,
+    SAME_NUMERIC,
+    SOLVED_TOL,
+    multi_start,
+    select_solutions,
+    start_configurations,
+)
 
 REDUNDANCY_RULE = (
     "continuous minimum-norm steps: each sample is solved by damped least squares "
@@ -32,7 +39,8 @@ REDUNDANCY_RULE = (
     "continuous and moves no joint further than the task needs; the seed starts every "
     "joint at the middle of its range, away from the limits"
 )
-"""How a chain of more than six joints picks one of its infinitely many solutions."""
+"""How a chain of more than seven joints (or a 7-joint chain tracked without a held joint)
+picks one of its infinitely many solutions."""
 
 
 class NumericFamily:
@@ -41,24 +49,57 @@ class NumericFamily:
     name = "numeric"
     closed_form = False
     n_branches = N_BRANCHES
-    redundancy: RedundancyParameter | None = None
+    redundancy: RedundancyParameter | None
 
     def __init__(self, robot: Robot, free_joint: int | None = None):
+        """The numeric family of ``robot``.
+
+        Parameters
+        ----------
+        robot
+            Any chain.
+        free_joint
+            A 7-joint arm's redundancy joint, 0-based (default
+            :data:`~trackplan.robots.ik_numeric.DEFAULT_FREE_JOINT`, joint 3); must be
+            None for other chains.
+
+        Raises
+        ------
+        CaseError
+            When ``free_joint`` is given for a chain that is not 7-joint, or is no joint.
+        """
         self.robot = robot
-        self.n_dof = robot.n_dof
-        if robot.n_dof == 7:
+        self.n_dof = n = robot.n_dof
+        if n != 7:
+            if free_joint is not None:
+                raise CaseError(
+                    f"free_joint applies to 7-joint arms only; this chain has {n} joints: "
+                    "leave it out",
+                    key="robot",
+                )
+            self.redundancy = None
+        else:
             k = DEFAULT_FREE_JOINT if free_joint is None else int(free_joint)
-            if not 0 <= k < 7:
-                raise CaseError(f"free_joint must be 1 … 7, got {k + 1}", key="ik.free_joint")
+            if not 0 <= k < n:
+                raise CaseError(
+                    f"free_joint {k} is no joint of this 7-joint arm: give 0 to 6", key="robot"
+                )
             self.redundancy = RedundancyParameter(
                 f"joint {k + 1}", float(robot.q_min[k]), float(robot.q_max[k]), joint=k
             )
+        self._starts: np.ndarray | None = None
+
+    @property
+    def locked(self) -> int:
+        """The held joint (0-based), −1 for none."""
+        joint = None if self.redundancy is None else self.redundancy.joint
+        return -1 if joint is None else joint
 
     def parameters(self) -> dict[str, object]:
         """The joint that carries a 7-joint arm's redundancy (1-based), the minimum-norm
         rule of longer chains, else nothing."""
-        if self.redundancy is not None and self.redundancy.joint is not None:
-            return {"free_joint": self.redundancy.joint + 1}
+        if self.locked >= 0:
+            return {"free_joint": self.locked + 1}
         return {"redundancy": REDUNDANCY_RULE} if self.n_dof > 7 else {}
 
     def describe_branch(self, branch: int) -> str:
@@ -112,35 +153,87 @@ class NumericFamily:
         *,
         free: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """The distinct solutions of poses (N, 4, 4) that damped Newton reaches from the
-        eight seeds of :func:`numeric_seeds`, inside the
-        limits, deduplicated (:func:`~trackplan.robots.families.base.wrap_and_deduplicate`).
+        """The distinct solutions of poses (N, 4, 4) inside the limits, by multi-start
+        Newton (:mod:`trackplan.robots.numeric_seeding`): from the eight seeds of
+        :func:`numeric_seeds` and 64 scrambled Sobol points, kept where the pose error is
+        at most 1e-10 (m and rad), moved into [q_min, q_max] by multiples of 2π,
+        deduplicated (1e-6 rad), ordered by structural signature (shoulder, elbow, wrist
+        signs), then by margin to the limits; at most :attr:`n_branches`.
+
+        ``free`` (a 7-joint arm): the held joint's value per pose, shape (N,), rad; None
+        holds it at the middle of its range. Other chains: None.
 
         Returns
         -------
         q, found
-            Shapes (N, 8, n) (NaN where not found) and (N, 8).
+            Shapes (N, 8, n) (NaN where not found) and (N, 8), the found first.
         """
-        T = np.asarray(T_base_tool, dtype=float)
-        seeds = numeric_seeds(self.robot)  # (8, n)
-        if self.redundancy is None:
-            _no_free(free)
-            solved = solve_ik_numeric(self.robot, T[:, None], seeds[None], tol=1e-10)
-            return wrap_and_deduplicate(solved.q, solved.success, q_min, q_max)
-        if free is None:
-            raise ValueError(f"the numeric family needs its {self.redundancy.name} per pose")
-        n_poses, n_seeds = len(T), len(seeds)
-        reference = np.tile(seeds, (n_poses, 1))  # row p·8 + k
-        q, success = track_poses(
-            self.robot,
-            np.repeat(T[:, :3, :3], n_seeds, axis=0),
-            np.repeat(T[:, :3, 3], n_seeds, axis=0),
-            reference,
-            np.repeat(np.asarray(free, dtype=float), n_seeds),
-            self.redundancy.joint if self.redundancy.joint is not None else -1,
+        T = np.ascontiguousarray(T_base_tool, dtype=float)
+        held = self._free_values(free, T.shape[0])
+        chain, tail = chain_arrays(self.robot)
+        q, solved, measures = multi_start(
+            chain,
+            tail,
+            T,
+            self.starts(),
+            self.locked,
+            held,
+            3 if self.n_dof >= 7 else 2,
+            SOLVED_TOL,
+            MAX_ITER,
         )
-        shape = (n_poses, n_seeds)
-        return wrap_and_deduplicate(q.reshape(*shape, -1), success.reshape(shape), q_min, q_max)
+        lower = np.ascontiguousarray(q_min, dtype=float)
+        upper = np.ascontiguousarray(q_max, dtype=float)
+        return select_solutions(q, solved, measures, lower, upper, self.n_branches, SAME_NUMERIC)
+
+    def track(
+        self,
+        R_base_tool: np.ndarray,
+        p_base_tool: np.ndarray,
+        q_ref: np.ndarray,
+        free: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`~trackplan.robots.ik_numeric.track_poses` with this family's held joint:
+        poses (R (N, 3, 3) or (3, 3), p (N, 3) m) solved from references q_ref (N, n) rad;
+        ``free`` (N,) rad for a 7-joint arm (None: the references' values of the joint).
+
+        Returns
+        -------
+        q, ok
+            Shapes (N, n) rad and (N,) bool.
+        """
+        if self.locked >= 0 and free is None:
+            free = np.asarray(q_ref, dtype=float)[:, self.locked]
+        _check_free(self.locked, free)
+        joint = self.locked if self.locked >= 0 else DEFAULT_FREE_JOINT
+        return track_poses(self.robot, R_base_tool, p_base_tool, q_ref, free, free_joint=joint)
+
+    def starts(self) -> np.ndarray:
+        """The multi-start configurations, shape (72, n), rad (computed once)."""
+        if self._starts is None:
+            self._starts = start_configurations(
+                numeric_seeds(self.robot), self.robot.q_min, self.robot.q_max
+            )
+        return self._starts
+
+    def _free_values(self, free: np.ndarray | None, count: int) -> np.ndarray:
+        """The held joint's values (count,), or an empty array without a held joint."""
+        _check_free(self.locked, free)
+        if self.locked < 0:
+            return np.empty(0)
+        if free is None:
+            k = self.locked
+            return np.full(count, 0.5 * (self.robot.q_min[k] + self.robot.q_max[k]))
+        held = np.ascontiguousarray(free, dtype=float)
+        if held.shape != (count,):
+            raise ValueError(f"free must have shape ({count},), got {held.shape}")
+        return held
+
+
+def _check_free(locked: int, free: np.ndarray | None) -> None:
+    """Refuse ``free`` for a family without a held joint."""
+    if locked < 0:
+        _no_free(free)
 
 
 def numeric_seeds(robot: Robot) -> np.ndarray:
