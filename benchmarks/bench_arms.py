@@ -121,7 +121,7 @@ def ik_rates(robot: Robot) -> tuple[str, str]:
     if locked >= 0:
         reference[:, locked] = held
     R, p = T_track[:, :3, :3], T_track[:, :3, 3]
-    seconds = best_time(lambda: track_poses(robot, R, p, reference, held, locked), 3)
+    seconds = best_time(lambda: track_poses(robot, R, p, reference, held, free_joint=locked), 3)
     return solve, f"{N_CLOSED / seconds:9.3g}"
 
 
