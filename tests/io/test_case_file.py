@@ -305,7 +305,7 @@ def test_negative_weight(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> 
 def test_unknown_robot_name(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     line = validate_fails(capsys, str(write_case(tmp_path, {"robot": "puma650"})))
     assert "case.yaml: robot: unknown robot 'puma650': use one of abb_irb1600, " in line
-    assert "puma560, ur10e, ur5, ur5e or a path to a robot file" in line
+    assert "puma560, ur10e, ur5, ur5e, yaskawa_sia10d or a path to a robot file" in line
 
 
 def test_missing_case_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
