@@ -208,3 +208,63 @@ def test_the_joints_plot_shows_the_external_axes_over_the_cycle(cycle_result, cy
     (band,) = [c for c in axes[0, 8].collections if c.get_gid() == "move"]
     x = np.concatenate([path.vertices[:, 0] for path in band.get_paths()])
     np.testing.assert_allclose([x.min(), x.max()], t[[air.first, air.last]], atol=1e-9)
+
+
+@pytest.mark.browser
+@pytest.mark.slow  # about 10 s: the report written (its PNGs) and opened in Chromium
+def test_the_cycle_report_on_a_positioner_animates_without_errors(
+    tmp_path, cycle_result, cycle_case
+):
+    sync_api = pytest.importorskip(
+        "playwright.sync_api", reason="BROWSER TEST SKIPPED: the playwright package is missing"
+    )
+    from tests.docs.screenshots import CHROMIUM, CHROMIUM_ARGS
+    from trackplan.report import VIEW_ID
+    from trackplan.report.robot_view import frame_name
+    from trackplan.report.run_report import write_run_report
+
+    if not CHROMIUM.exists():
+        pytest.skip(f"BROWSER TEST SKIPPED: no Chromium at {CHROMIUM}; run `make browser`")
+    _, report = write_run_report(
+        cycle_result, cycle_case, tmp_path, None, None, parallel=False, n_frames=N_FRAMES
+    )
+    drawn = (
+        "(name) => { const t = document.getElementById('" + VIEW_ID + "').data"
+        ".find((t) => t.name === name); return [Array.from(t.x), Array.from(t.y),"
+        " Array.from(t.z)]; }"
+    )
+    with sync_api.sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        page.set_default_timeout(120_000)
+        problems: list[str] = []
+        page.on("console", lambda m: problems.append(m.text) if m.type == "error" else None)
+        page.on("pageerror", lambda error: problems.append(str(error)))
+        page.goto(report.as_uri())
+        page.wait_for_function(
+            f"() => {{ const gd = document.getElementById('{VIEW_ID}');"
+            " return gd && gd._transitionData && gd._transitionData._frames.length > 0; }"
+        )
+        names = page.evaluate(f"() => document.getElementById('{VIEW_ID}').data.map((t) => t.name)")
+        before = {
+            name: np.array(page.evaluate(drawn, name)).T for name in (SEAM_A, POSITIONER_TRACE)
+        }
+        later = N_FRAMES - 2
+        page.evaluate(
+            "async ([id, name]) => { await Plotly.animate(document.getElementById(id), [name],"
+            " {mode: 'immediate', frame: {duration: 0, redraw: true},"
+            " transition: {duration: 0}}); }",
+            [VIEW_ID, frame_name(later)],
+        )
+        after = {name: np.array(page.evaluate(drawn, name)).T for name in before}
+        browser.close()
+    assert not problems, problems
+    assert {SEAM_A, SEAM_B, AIR_MOVES, POSITIONER_TRACE, WORKPIECE_TRACE, RAIL_TRACE} <= set(names)
+    for name, start in before.items():
+        assert np.max(np.abs(after[name] - start)) > 0.01, f"{name} did not move"
+    seam = _animated(_view_of(cycle_result, cycle_case), SEAM_A)[later]
+    np.testing.assert_allclose(after[SEAM_A], _points(seam), atol=1e-9)
+
+
+def _view_of(result: PlanResult, case: Case) -> dict:
+    return cycle_view_spec(robot_view_spec(result, case, n_frames=N_FRAMES), result, case)
