@@ -163,13 +163,15 @@ def cycle_view_spec(spec: dict, result: PlanResult, case: Case) -> dict:
     (:func:`moving_cycle_builders`) take their place after the other animated traces, in
     the first frame's data and in every frame.
     """
-    if not has_moves(result, case) or not result.spans or not spec["frames"]:
+    if not has_moves(result, case) or not result.spans:
         return spec
-    if moves_the_part(case):
-        idx = frame_indices(result.trajectory.n_samples, len(spec["frames"]))
-        return _with_animated(spec, moving_cycle_builders(result, case, idx))
     frames = spec["frames"]
-    animated = set(frames[0]["traces"])
+    if moves_the_part(case):
+        if not frames:
+            return spec
+        idx = frame_indices(result.trajectory.n_samples, len(frames))
+        return _with_animated(spec, moving_cycle_builders(result, case, idx))
+    animated = set(frames[0]["traces"]) if frames else set()
     data = spec["data"]
     static = [trace for i, trace in enumerate(data) if i not in animated]
     moving = [trace for i, trace in enumerate(data) if i in animated]
