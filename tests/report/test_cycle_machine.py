@@ -268,3 +268,30 @@ def test_the_cycle_report_on_a_positioner_animates_without_errors(
 
 def _view_of(result: PlanResult, case: Case) -> dict:
     return cycle_view_spec(robot_view_spec(result, case, n_frames=N_FRAMES), result, case)
+
+
+def test_a_cycle_on_a_track_alone_keeps_its_seams_still_and_moves_the_base(
+    cycle_case, cycle_result
+):
+    on_track = dataclasses.replace(cycle_case, positioner=None)
+    q = cycle_result.trajectory.q[:, :7]  # the arm's joints and the track
+    machine = on_track.machine
+    assert isinstance(machine, Machine)
+    result = dataclasses.replace(
+        cycle_result,
+        trajectory=dataclasses.replace(
+            cycle_result.trajectory, q=q, tool_position=machine.T_carrier_tool(q)[:, :3, 3]
+        ),
+    )
+    view = _view_of(result, on_track)
+    animated = set(view["frames"][0]["traces"])
+    by_name = {trace["name"]: i for i, trace in enumerate(view["data"])}
+    for name in (SEAM_A, SEAM_B, AIR_MOVES, f"{NOMINAL_TRACE}: a", RAIL_TRACE):
+        assert by_name[name] not in animated, f"{name} moves without a positioner"
+    span = result.spans[0]
+    seam = _points(view["data"][by_name[SEAM_A]])
+    own = result.trajectory.tool_position[span.first : span.last + 1]
+    assert np.max(_nearest(seam, own)) < 2e-5
+    idx = frame_indices(result.trajectory.n_samples, N_FRAMES)
+    for qk, frame in zip(q[idx], view["frames"], strict=True):
+        np.testing.assert_allclose(_points(frame["data"][0])[0], qk[6] * TRACK_AXIS, atol=2e-5)
