@@ -6,6 +6,9 @@ only to drive that browser (``playwright install`` is never run: it would downlo
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -168,3 +171,55 @@ def test_the_report_of_several_seams_loads_without_errors(browser, bracket, brac
     assert np.max(np.abs(moved - start)) > 0.01  # the robot follows the cycle
     page.close()
     assert not problems, problems
+
+
+FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
+MESHED_URDF = FIXTURES / "meshed_robot" / "meshed_robot.urdf"
+OPEN_BUDGET = 2.0  # s: the 3D view's first drawing, from the start of the navigation
+OPEN_CEILING = 8.0  # s of wall time: far above what a loaded 2-core machine measures
+DRAWN = f"() => performance.getEntriesByName('{VIEW_ID} drawn').length > 0"
+
+
+def open_times(browser, report: Path, repeats: int = 3) -> list[tuple[float, float]]:
+    """Open ``report`` ``repeats`` times: per opening (wall time, main-thread CPU time), s,
+    from the start of the navigation to the 3D view's first drawing, with no console error.
+
+    The wall time is the page's own mark (``performance.mark('robot-view drawn')``, whose
+    time counts from the navigation's start); the CPU time is Chromium's TaskDuration of the
+    page's main thread in thread ticks, which the other processes of a loaded machine do
+    not inflate.
+    """
+    times = []
+    problems: list[str] = []
+    for _ in range(repeats):
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        page.on("console", lambda m: problems.append(m.text) if m.type == "error" else None)
+        page.on("pageerror", lambda error: problems.append(str(error)))
+        cdp = page.context.new_cdp_session(page)
+        cdp.send("Performance.enable", {"timeDomain": "threadTicks"})
+        page.goto(report.as_uri(), wait_until="commit")
+        page.wait_for_function(DRAWN, timeout=120_000, polling=10)
+        metrics = {m["name"]: m["value"] for m in cdp.send("Performance.getMetrics")["metrics"]}
+        wall = page.evaluate(f"() => performance.getEntriesByName('{VIEW_ID} drawn')[0].startTime")
+        page.wait_for_function(
+            f"() => document.getElementById('{VIEW_ID}')._transitionData._frames.length > 0"
+        )
+        page.close()
+        assert not problems, problems
+        times.append((wall / 1e3, metrics["TaskDuration"]))
+    return times
+
+
+@pytest.mark.slow  # about 15 s: a report written and opened three times
+def test_a_meshed_robot_report_opens_in_two_seconds(browser, tmp_path, corner, corner_result):
+    from trackplan.io.urdf_robot import robot_from_urdf_file
+    from trackplan.report.run_report import write_run_report
+
+    robot = robot_from_urdf_file(MESHED_URDF, assume_limits=True)
+    case = dataclasses.replace(corner, robot=robot)
+    _, report = write_run_report(corner_result, case, tmp_path, None, None, parallel=False)
+    times = open_times(browser, report)
+    walls, cpus = zip(*times, strict=True)
+    note = ", ".join(f"{wall:.2f} s ({cpu:.2f} s CPU)" for wall, cpu in times)
+    assert min(cpus) <= OPEN_BUDGET, f"the 3D view's first drawing took {note}"
+    assert min(walls) <= OPEN_CEILING, f"the 3D view's first drawing took {note}"

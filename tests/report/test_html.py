@@ -10,6 +10,7 @@ import pytest
 
 from tests.report.conftest import REPORT_FRAMES
 from trackplan.report import VIEW_ID, robot_view_figure, write_plots, write_report
+from trackplan.report.plotly_html import frames_element_id
 from trackplan.report.robot_view import ROBOT_TRACE, TRAIL_TRACE, frame_name
 from trackplan.report.scene import chain_points, frame_indices
 
@@ -27,6 +28,17 @@ def plotly_call(page: str, function: str) -> list:
         args.append(value)
         position = re.compile(r"\s*,?\s*").match(page, position).end()
     return args
+
+
+def page_frames(page: str) -> list:
+    """The animation frames of the 3D view: the JSON element added after the first drawing."""
+    match = re.search(
+        rf'<script type="application/json" id="{frames_element_id(VIEW_ID)}">(.*?)</script>',
+        page,
+        re.DOTALL,
+    )
+    assert match, "no animation frames in the page"
+    return json.loads(match.group(1))
 
 
 @pytest.fixture(scope="module")
@@ -48,7 +60,7 @@ def test_report_has_the_view_with_frames_and_slider(page):
     data, layout = plotly_call(page, "newPlot")[:2]
     names = [trace.get("name") for trace in data]
     assert ROBOT_TRACE in names and TRAIL_TRACE in names
-    (frames,) = plotly_call(page, "addFrames")
+    frames = page_frames(page)
     assert len(frames) == REPORT_FRAMES
     assert [f["name"] for f in frames] == [frame_name(k) for k in range(REPORT_FRAMES)]
     (slider,) = layout["sliders"]

@@ -50,7 +50,7 @@ TraceBuilder = Callable[[int], dict]
 _xyz = plotly_xyz
 
 
-def _thin(points: np.ndarray, n_points: int = PART_POINTS) -> np.ndarray:
+def thin_polyline(points: np.ndarray, n_points: int = PART_POINTS) -> np.ndarray:
     """Every k-th point of a polyline (the last kept), at most about ``n_points``."""
     if len(points) <= n_points:
         return points
@@ -188,35 +188,18 @@ def machine_layers(
     if chain.collision is not None and len(chain.collision.radius):
         layers.builders.append(_capsules_builder(chain.collision, frames))
     T_part = part_transforms(result, case, q)  # (F, 4, 4)
-    nominal = _thin(nominal_polyline(case))
+    nominal = thin_polyline(nominal_polyline(case))
     T_carrier = machine.T_cell_carrier(q)
-    planned = _thin(result.trajectory.tool_position)
+    planned = thin_polyline(result.trajectory.tool_position)
     trail = result.trajectory.tool_position[idx]  # the TCP relative to the carrier
-    moving_nominal = np.einsum("fij,kj->fki", T_part[:, :3, :3], nominal) + T_part[:, None, :3, 3]
-    moving_path = (
-        np.einsum("fij,kj->fki", T_carrier[:, :3, :3], planned) + (T_carrier[:, None, :3, 3])
-    )
+    moving_nominal = moving_points(T_part, nominal)
+    moving_path = moving_points(T_carrier, planned)
     drawn += [moving_nominal.reshape(-1, 3), moving_path.reshape(-1, 3)]
-
-    def nominal_trace(k: int) -> dict:
-        return {
-            "type": "scatter3d",
-            **_xyz(moving_nominal[k], PART_DECIMALS),
-            "mode": "lines",
-            "name": names["nominal"],
-            "line": {"color": "#7f7f7f", "width": 3, "dash": "dash"},
-            "hoverinfo": "skip",
-        }
-
-    def path_trace(k: int) -> dict:
-        return {
-            "type": "scatter3d",
-            **_xyz(moving_path[k], PART_DECIMALS),
-            "mode": "lines",
-            "name": names["path"],
-            "line": {"color": "#9467bd", "width": 3},
-            "hoverinfo": "skip",
-        }
+    nominal_style = {
+        "name": names["nominal"],
+        "line": {"color": "#7f7f7f", "width": 3, "dash": "dash"},
+    }
+    path_style = {"name": names["path"], "line": {"color": "#9467bd", "width": 3}}
 
     def trail_trace(k: int) -> dict:
         # the weld so far, carried by the part: the TCP's samples up to frame k relative
@@ -231,17 +214,38 @@ def machine_layers(
             "hoverinfo": "skip",
         }
 
-    layers.builders += [nominal_trace, path_trace, trail_trace]
+    layers.builders += [
+        moving_line_builder(moving_nominal, {**nominal_style, "hoverinfo": "skip"}),
+        moving_line_builder(moving_path, {**path_style, "hoverinfo": "skip"}),
+        trail_trace,
+    ]
     layers.builders += _part_frame_builders(T_part, axis_length)
     if case.cell is not None and case.cell.workpiece:
         from trackplan.report.cell_scene import body_mesh, merge
 
         vertices, faces = merge([body_mesh(body, np.eye(4)) for body in case.cell.workpiece])
-        moving = np.einsum("fij,kj->fki", T_part[:, :3, :3], vertices) + T_part[:, None, :3, 3]
+        moving = moving_points(T_part, vertices)
         drawn.append(moving.reshape(-1, 3))
         layers.builders.append(_mesh_builder(moving, faces, WORKPIECE_TRACE, "#c49a6c", 0.6))
     layers.points = np.vstack(drawn)
     return layers
+
+
+def moving_points(T: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Points (M, 3) fixed in a moving frame, placed with its poses T (F, 4, 4): shape
+    (F, M, 3), m (one matrix product, no loop over frames)."""
+    return np.einsum("fij,kj->fki", T[:, :3, :3], points) + T[:, None, :3, 3]
+
+
+def moving_line_builder(moving: np.ndarray, style: dict[str, object]) -> TraceBuilder:
+    """An animated polyline: its points (F, M, 3) in each frame (NaN rows are gaps), drawn
+    in ``style`` (the trace's name, line, hover and the like), coordinates rounded to
+    :data:`PART_DECIMALS`."""
+
+    def build(k: int) -> dict:
+        return {"type": "scatter3d", **_xyz(moving[k], PART_DECIMALS), "mode": "lines", **style}
+
+    return build
 
 
 def _part_frame_builders(T_part: np.ndarray, length: float) -> list[TraceBuilder]:

@@ -5,6 +5,12 @@ The same markup as :func:`plotly.io.to_html` with ``full_html=False`` (plotly.js
 figure into plotly objects, walks it for numpy arrays and encodes its JSON twice, which took
 longer than drawing a plot for the animated 3D view. Here the data are already JSON-ready
 (lists, dicts, numbers, ``None`` for gaps) and are encoded once.
+
+The animation frames stay off the path to the first picture: they are written as a JSON
+``<script type="application/json">`` element after the drawing script (the browser does not
+execute it) and parsed and added only once the figure is drawn and the page is parsed, so
+that opening the page costs the parsing of the first frame's data alone. The moment the
+figure is first drawn is marked ``performance.mark("<div id> drawn")``.
 """
 
 from __future__ import annotations
@@ -75,9 +81,15 @@ def plotly_div(
     config = {"responsive": True, **(config or {})}
     script = f"Plotly.newPlot({_json(div_id)},{_json(figure.get('data', []))},{_json(layout)},"
     script += f"{_json(config)})"
+    script += f".then(function(){{performance.mark({_json(div_id + ' drawn')});}})"
     frames = figure.get("frames")
+    frames_element = ""
     if frames:
-        script += f".then(function(){{Plotly.addFrames({_json(div_id)},{_json(frames)});}})"
+        frames_id = frames_element_id(div_id)
+        frames_element = (
+            f'<script type="application/json" id="{frames_id}">{_json(frames)}</script>'
+        )
+        script += f".then(function(){{return {_ADD_FRAMES}({_json(div_id)},{_json(frames_id)});}})"
     if post_script:
         script += f".then(function(){{{post_script}}})"
     library = ""
@@ -93,5 +105,22 @@ def plotly_div(
         f'<div style="{size}">{library}'
         f'<div id="{div_id}" class="plotly-graph-div" style="height:100%; width:100%;"></div>'
         f"<script>window.PLOTLYENV=window.PLOTLYENV || {{}};"
-        f"if (document.getElementById({_json(div_id)})) {{{script};}}</script></div>"
+        f"if (document.getElementById({_json(div_id)})) {{{script};}}</script>"
+        f"{frames_element}</div>"
     )
+
+
+def frames_element_id(div_id: str) -> str:
+    """The id of the JSON element holding the animation frames of the figure in ``div_id``."""
+    return f"{div_id}-frames"
+
+
+_ADD_FRAMES = (
+    "(function(id,framesId){return new Promise(function(done){"
+    "var add=function(){var element=document.getElementById(framesId);"
+    "done(Plotly.addFrames(id,JSON.parse(element.textContent)));};"
+    "if(document.readyState==='loading'){document.addEventListener('DOMContentLoaded',add);}"
+    "else{add();}});})"
+)
+"""JavaScript: add the frames of the JSON element once the page is parsed (the element
+follows the drawing script, so it may not be parsed yet when the figure is drawn)."""

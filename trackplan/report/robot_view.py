@@ -266,7 +266,6 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
             "hoverinfo": "skip",
         },
     ]
-    static.append(_frame_names(T_base_part, moves_the_part(case)))
     for label, T in (("base frame", np.eye(4)), ("part frame", T_base_part)):
         lines = triad_lines(T, axis_length if label == "base frame" else 0.6 * axis_length)
         colors, dash = FRAME_STYLES[label]
@@ -401,6 +400,7 @@ def robot_view_spec(result: PlanResult, case: Case, n_frames: int = 150) -> dict
             "aspectmode": "cube",
             "domain": {"x": [0.0, 1.0], "y": [0.14, 1.0]},
             "camera": {"eye": {"x": 1.6, "y": -1.6, "z": 1.0}},
+            "annotations": frame_names(T_base_part, moves_the_part(case)),
         },
         "uirevision": "robot-view",
         "legend": {"x": 0.0, "y": 1.0},
@@ -443,17 +443,25 @@ def _tool_frame_lines(T_tool: np.ndarray, length: float) -> np.ndarray:
     return np.stack([triad_lines(T, max(length, 1e-3)) for T in T_tool])
 
 
-def _frame_names(T_base_part: np.ndarray, part_moves: bool) -> dict:
-    """The base and part frames' names written at their origins."""
+def frame_names(T_base_part: np.ndarray, part_moves: bool) -> list[dict]:
+    """The base and part frames' names written at their origins, as the scene's annotations.
+
+    Annotations are drawn as page text over the WebGL scene; a scatter3d text trace would
+    have plotly.js trace every glyph's outline into triangles when the page opens, which
+    cost about as much as the rest of the 3D view's first drawing in headless Chromium.
+    Without a positioner the part frame is named too (a moving part has no fixed place).
+    """
     points = [np.zeros(3)] if part_moves else [np.zeros(3), T_base_part[:3, 3]]
-    return {
-        "type": "scatter3d",
-        **_xyz(np.array(points)),
-        "mode": "text",
-        "text": ["base frame", "part frame"][: len(points)],
-        "textposition": "bottom center",
-        "textfont": {"size": 11, "color": "#333"},
-        "name": "frame names",
-        "showlegend": False,
-        "hoverinfo": "skip",
-    }
+    names = ["base frame", "part frame"]
+    return [
+        {
+            "x": round(float(p[0]), DECIMALS),
+            "y": round(float(p[1]), DECIMALS),
+            "z": round(float(p[2]), DECIMALS),
+            "text": name,
+            "showarrow": False,
+            "yshift": -12,
+            "font": {"size": 11, "color": "#333"},
+        }
+        for p, name in zip(points, names, strict=False)
+    ]
