@@ -65,5 +65,7 @@ def test_the_cycle_finder_finds_a_planted_cycle():
 
 def test_the_shared_figure_and_page_helpers_import_no_plot_or_page():
     graph = _graph()
-    for low in ("trackplan.report.figure_style", "trackplan.report.html_markup"):
+    for low in ("trackplan.report.figure_style", "trackplan.report.page_style"):
         assert graph[low] == set(), low
+    # the page markup builds on the one page style only
+    assert graph["trackplan.report.html_markup"] == {"trackplan.report.page_style"}

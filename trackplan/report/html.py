@@ -29,7 +29,6 @@ from trackplan.report.html_result import (
     violations_table,
 )
 from trackplan.report.html_search import bounds_line, optimizer_section
-from trackplan.report.machine_view import moves_the_part
 from trackplan.report.plotly_html import plotly_div
 from trackplan.report.robot_view import VIEW_ID, robot_view_spec
 from trackplan.run_files import REPORT_FILE
@@ -125,7 +124,7 @@ def _external_note(case: Case) -> str:
 
 def _cycle_note(result: PlanResult, case: Case) -> str:
     """What the 3D view shows of seams joined by moves (escaped HTML), else nothing."""
-    if not has_moves(result, case) or moves_the_part(case):  # cycle_view_spec's condition
+    if not has_moves(result, case) or not result.spans:  # cycle_view_spec's condition
         return ""
     return esc(
         " The robot runs the whole cycle: each seam in its colour of the cycle plot, its "
