@@ -27,7 +27,6 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.stats import qmc
 
 from trackplan.robots._ik_kernels import fk_jacobian_into, newton_into, work_size_kernel
 
@@ -78,6 +77,8 @@ def start_configurations(
     n = q_min.shape[0]
     middle = 0.5 * (q_min + q_max)
     half = np.minimum(0.5 * (q_max - q_min), np.pi)
+    from scipy.stats import qmc  # a robot without a closed form only (startup time)
+
     unit = qmc.Sobol(d=n, scramble=True, seed=SOBOL_SEED).random_base2(int(math.log2(N_SOBOL)))
     sobol = middle + (2.0 * unit - 1.0) * half
     return np.ascontiguousarray(np.vstack([structured, sobol]))
