@@ -92,6 +92,7 @@ def numeric_paths(
     fine_iter: int,
     locked: int,
     free: np.ndarray,
+    active: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
     """Kernel: numerical joint paths from seeds, marched coarsely then solved everywhere.
 
@@ -111,6 +112,9 @@ def numeric_paths(
         A 7-joint arm's redundancy: joint ``locked`` (≥ 0) is held at ``free[b, m]`` at
         pose m of candidate b, shape (B, M), rad, and the others solve the pose; −1 (and
         an empty ``free``): no joint is held.
+    active
+        Shape (B, K), bool: the paths to follow; an inactive one (its seed is no solution of
+        the first pose) stays at its seed, reaches no pose and is not solved at all.
 
     The fine solve tries undamped Gauss–Newton from the interpolation first
     (:func:`~trackplan.robots._ik_kernels.gauss_newton_into`, square Jacobians), damped
@@ -154,6 +158,13 @@ def numeric_paths(
             path = q[b, k]
             for j in range(n):
                 current[j] = seeds[b, k, j]
+            if not active[b, k]:
+                for m in range(n_poses):
+                    reach[b, k, m] = False
+                    magnitude[b, k, m, 0] = 0.0
+                    for j in range(n):
+                        path[m, j] = current[j]
+                continue
             for m in range(n_poses):  # march the coarse poses with warm starts
                 if coarse[b, m]:
                     for j in range(n):

@@ -237,7 +237,7 @@ def tracked_paths(
         )
         chosen = seeds[rows, candidates[:, columns]]
         has = found[rows, candidates[:, columns]]
-        chosen = np.where(has[..., None], chosen, middle)  # followed, then marked unreached
+        chosen = np.where(has[..., None], chosen, middle)  # not followed: reaches no pose
         out = numeric_paths(
             *chain,
             T,
@@ -248,9 +248,9 @@ def tracked_paths(
             _FINE_MAX_ITER,
             locked,
             held,
+            np.ascontiguousarray(has),
         )
         q[:, columns], reach[:, columns], magnitude[:, columns], crossing[:, columns] = out
-        reach[:, columns] &= has[..., None]
     return q, reach, magnitude, crossing
 
 
