@@ -19,7 +19,7 @@ from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
 N_POSES = 10_000
-BUILTINS = builtin_names()
+BUILTINS = tuple(n for n in builtin_names() if ik_family(builtin_robot(n)).closed_form)
 OPW_PUBLISHED = {  # a1, a2, b, c1, c2, c3, c4; offsets; sign corrections (opw_kinematics)
     "kuka_kr6_r700_sixx": (
         (0.025, -0.035, 0.0, 0.400, 0.315, 0.365, 0.080),

@@ -60,6 +60,10 @@ SUSPICIOUS = 0.05
 N_SUB = 16
 """Intervals a suspicious interval is cut into (twice at most)."""
 
+TOUCH = 1e-12
+"""|F| below this fraction of its largest sampled |F| counts as zero: a double root, where
+two solutions meet (a singular pose), is kept; the FK check drops a false one."""
+
 ROOT_SAME = 1e-10
 """Roots of F closer than this (rad) are one (found twice on overlapping intervals)."""
 
@@ -191,33 +195,34 @@ def _dip(
     y0: float,
     y1: float,
     y2: float,
-) -> float:  # pragma: no cover - compiled
+) -> tuple[float, bool]:  # pragma: no cover - compiled
     """Where F, of one sign s at x0 < x1 < x2 (s·y1 below s·y0 and s·y2), crosses zero
-    near its least value, by successive parabolic interpolation; NaN when the parabolas
-    show a minimum of the same sign (no root pair there)."""
+    near its least value, by successive parabolic interpolation: (that point, True); or
+    (where |F| is least, False) when the parabolas show a minimum of the same sign (no
+    root pair there, or a double root where that least |F| is zero)."""
     s = 1.0 if y1 > 0.0 else -1.0
     y0, y1, y2 = s * y0, s * y1, s * y2
-    for _ in range(30):
+    for _ in range(40):
         d0, d2 = x0 - x1, x2 - x1
         e0, e2 = y0 - y1, y2 - y1
         den = e0 * d2 - e2 * d0
         if den == 0.0:
-            return math.nan
+            break
         # vertex of the parabola through the three points, relative to x1
         step = 0.5 * (e0 * d2 * d2 - e2 * d0 * d0) / den
         if abs(step) < 1e-6 * (x2 - x0):  # the vertex at the middle point: look beside it
             step = 1e-3 * (x2 - x0) if y2 < y0 else -1e-3 * (x2 - x0)
         xv = x1 + step
         if not (x0 < xv < x2):
-            return math.nan
-        # the parabola's value at its vertex, and the function's
+            break
+        # the parabola's value at its vertex
         curv = (e0 / d0 - e2 / d2) / (d0 - d2)
         predicted = y1 - curv * step * step
         if predicted > 0.0 and y1 - predicted <= 1e-3 * y1:
-            return math.nan  # converged to a minimum above zero
+            break  # converged to a minimum above zero
         yv = s * _residual_at(g, R, O6, xv, shoulder)
         if yv <= 0.0:
-            return xv
+            return xv, True
         if yv >= y1:  # the vertex is no better: narrow the triple around x1
             if xv < x1:
                 x0, y0 = xv, yv
@@ -228,8 +233,8 @@ def _dip(
         else:
             x0, y0, x1, y1 = x1, y1, xv, yv
         if x2 - x0 < 1e-12:
-            return math.nan
-    return math.nan
+            break
+    return x1, False
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -260,12 +265,14 @@ def _scan(
     todo: np.ndarray,
     n_todo: int,
     deeper: bool,
+    touch: float,
 ) -> tuple[int, int]:  # pragma: no cover - compiled
     """The roots that samples fs of F at ts (n_pts, ascending) show: each sign change
     refined (:func:`_refine`), each least |F| without a sign change searched for a root
     pair (:func:`_dip`); a suspicious interval (:func:`_suspicious`) is put on ``todo``
     (rows (start, end)) to be sampled finer when ``deeper``, instead of refined here.
-    ``periodic``: the last sample is followed by the first (the whole circle).
+    ``periodic``: the last sample is followed by the first (the whole circle). A |F| at
+    most ``touch`` counts as zero (a double root, F touching zero, is kept so).
 
     Returns
     -------
@@ -274,7 +281,7 @@ def _scan(
     """
     n_int = n_pts if periodic else n_pts - 1
     for j in range(n_int):
-        if n >= roots.shape[0] - 2:
+        if n > roots.shape[0] - 4:
             break
         k = (j + 1) % n_pts
         fa, fb = fs[j], fs[k]
@@ -287,27 +294,27 @@ def _scan(
         if deeper and n_todo < todo.shape[0] and _suspicious(fp, fa, fb, fn):
             todo[n_todo, 0], todo[n_todo, 1] = ta, tb
             n_todo += 1
-        elif fa == 0.0:
-            roots[n] = ta
-            n += 1
-        elif (fa > 0.0) != (fb > 0.0) and fb != 0.0:
-            roots[n] = _refine(g, R, O6, shoulder, ta, fa, tb, fb)
-            n += 1
+        else:
+            if abs(fa) <= touch:  # a root here, or a double root: the FK check decides
+                roots[n] = ta
+                n += 1
+            if (fa > 0.0) != (fb > 0.0):
+                roots[n] = _refine(g, R, O6, shoulder, ta, fa, tb, fb)
+                n += 1
         # least |F| at sample j without a sign change on either side: a hidden pair?
-        if math.isnan(fp) or fa == 0.0 or fb == 0.0:
+        if math.isnan(fp) or abs(fa) <= touch or abs(fb) <= touch:
             continue
         if (fp > 0.0) != (fa > 0.0) or (fb > 0.0) != (fa > 0.0):
             continue
         if not (abs(fa) < abs(fp) and abs(fa) <= abs(fb)):
             continue
         lo = ta - (ts[j] - ts[(j - 1) % n_pts]) % (2.0 * math.pi) if periodic else ts[j - 1]
-        tm = _dip(g, R, O6, shoulder, lo, ta, tb, fp, fa, fb)
-        if math.isnan(tm):
-            continue
+        tm, crossed = _dip(g, R, O6, shoulder, lo, ta, tb, fp, fa, fb)
         fm = _residual_at(g, R, O6, tm, shoulder)
-        if fm == 0.0:
-            roots[n] = tm
-            n += 1
+        if not crossed:
+            if abs(fm) <= touch:  # a double root (F touches zero)
+                roots[n] = tm
+                n += 1
             continue
         roots[n] = _refine(g, R, O6, shoulder, lo, fp, tm, fm)
         roots[n + 1] = _refine(g, R, O6, shoulder, tm, fm, tb, fb)
@@ -338,7 +345,12 @@ def _roots(
     m = cos_t.shape[0]
     for j in range(m):
         F[j] = _residual(g, R, O6, cos_t[j], sin_t[j], shoulder)
-    n, n_todo = _scan(g, R, O6, shoulder, grid, F, m, True, roots, 0, todo, 0, True)
+    scale = 0.0
+    for j in range(m):
+        if not math.isnan(F[j]):
+            scale = max(scale, abs(F[j]))
+    touch = TOUCH * scale
+    n, n_todo = _scan(g, R, O6, shoulder, grid, F, m, True, roots, 0, todo, 0, True, touch)
     sub_t = np.empty(N_SUB + 3)
     sub_f = np.empty(N_SUB + 3)
     done = 0
@@ -350,7 +362,20 @@ def _roots(
             sub_t[k] = ta + (tb - ta) * (k - 1) / N_SUB
             sub_f[k] = _residual_at(g, R, O6, sub_t[k], shoulder)
         n, n_todo = _scan(
-            g, R, O6, shoulder, sub_t, sub_f, N_SUB + 3, False, roots, n, todo, n_todo, level < 2
+            g,
+            R,
+            O6,
+            shoulder,
+            sub_t,
+            sub_f,
+            N_SUB + 3,
+            False,
+            roots,
+            n,
+            todo,
+            n_todo,
+            level < 2,
+            touch,
         )
     for i in range(n):  # into [0, 2π), ascending, repeats dropped
         roots[i] = roots[i] % (2.0 * math.pi)

@@ -115,7 +115,8 @@ def crx_from_chain(robot: Robot) -> CRXParameters | None:
     At q = 0: axis 1 along the base z axis, axes 2 and 3 parallel and perpendicular to
     it, axis 4 perpendicular to axis 3, axis 5 perpendicular to axis 4 and meeting it (in
     O5), axis 6 perpendicular to axis 5 and meeting it (in O6) away from O5 (an arm whose
-    O5 and O6 coincide is OPW). The lengths, offsets and signs follow from the axes as for
+    O5 and O6 coincide is OPW), and O5 in the plane of axes 1 and 4 (no lateral offset b,
+    as on every CRX). The lengths, offsets and signs follow from the axes as for
     :func:`~trackplan.robots.families.opw.opw_from_chain`; the model is then checked
     against the chain's forward kinematics on 64 random configurations (to 1e-9).
     """
@@ -178,6 +179,10 @@ def crx_from_chain(robot: Robot) -> CRXParameters | None:
     c3 = fx * math.sin(t23) + fz * math.cos(t23)
     theta0[2] = t23 - theta0[1]
     b = float((o5 - base) @ y_arm)
+    if abs(b) > tol * scale:
+        # A lateral offset leaves each shoulder's residual undefined where O5 passes within
+        # b of axis 1, and its roots near there are missed: such an arm is left numeric.
+        return None
     F = _rz(theta0[0]) @ _ry(t23)
     z5 = F.T @ z[4]
     theta0[3] = math.atan2(-z5[0], z5[1])
