@@ -51,6 +51,9 @@ N_SAMPLES = 96
 FK_TOL = 1e-9
 """Largest FK error of a returned solution: position (m) and rotation matrix entries."""
 
+ARM_TOL = 1e-6
+"""Largest residual a4 · a5 of an arm at a root of F for the arm to be polished and tried."""
+
 ROOT_TOL = 1e-13
 """Width (rad) of the bracket at which a root of F counts as found."""
 
@@ -397,24 +400,24 @@ def _joints(
     shoulder: int,
     elbow: int,
     theta: np.ndarray,
-) -> bool:  # pragma: no cover - compiled
-    """The model angles θ (6,) of one shoulder and elbow at the root t; False when that
-    arm does not exist there."""
+) -> tuple[bool, float]:  # pragma: no cover - compiled
+    """The model angles θ (6,) of one shoulder and elbow at the angle t, and that arm's
+    residual ``a4 · a5`` (zero at a solution); False when that arm does not exist there."""
     ct, st = math.cos(t), math.sin(t)
     X, Y, Z, a5x, a5y, a5z = _arm_point(g, R, O6, ct, st)
     c1, s1, pu, pw, ok = _shoulder(g, X, Y, Z, shoulder)
     if not ok:
-        return False
+        return False, math.nan
     a2, c2, c3 = g[C_A2], g[C_C2], g[C_C3]
     rho2 = pu * pu + pw * pw
     if rho2 == 0.0:
-        return False
+        return False, math.nan
     rho = math.sqrt(rho2)
     k2 = a2 * a2 + c3 * c3
     along = (c2 * c2 + rho2 - k2) / (2.0 * rho)  # O3 along P, from joint 2
     h2 = c2 * c2 - along * along
     if h2 < -1e-9 * c2 * c2:
-        return False
+        return False, math.nan
     h = math.sqrt(max(h2, 0.0)) * (1.0 if elbow == 0 else -1.0)
     eu, ew = pu / rho, pw / rho
     o3u = along * eu + h * ew
@@ -427,7 +430,7 @@ def _joints(
     A1 = c1 * a5x + s1 * a5y
     wz = s23 * A1 + c23 * a5z
     if abs(wz) > 1e-6:
-        return False
+        return False, math.nan
     wx = c23 * A1 - s23 * a5z
     wy = -s1 * a5x + c1 * a5y
     t1 = math.atan2(s1, c1)
@@ -445,7 +448,41 @@ def _joints(
     t5 = math.atan2(vx, uz)
     theta[0], theta[1], theta[2] = t1, t2, t23 - t2
     theta[3], theta[4], theta[5] = t4, t5, t
-    return True
+    return True, wz
+
+
+@njit(cache=True, error_model="numpy")
+def _polish(
+    g: np.ndarray,
+    R: np.ndarray,
+    O6: np.ndarray,
+    t: float,
+    shoulder: int,
+    elbow: int,
+    theta: np.ndarray,
+) -> tuple[float, bool]:  # pragma: no cover - compiled
+    """A root t of F made a root of its own arm's residual ``a4 · a5`` by a few
+    safeguarded Newton steps (a root of F where both elbows vanish at once is a double
+    root of F, known to only about 1e-8 rad; each elbow's residual has a simple root
+    there), θ (6,) set at it; False when that arm is not a solution near t."""
+    ok, w = _joints(g, R, O6, t, shoulder, elbow, theta)
+    if not ok or abs(w) > ARM_TOL:
+        return t, False
+    for _ in range(8):
+        if abs(w) < 1e-16:
+            break
+        ok, w_h = _joints(g, R, O6, t + 1e-7, shoulder, elbow, theta)
+        if not ok or w_h == w:
+            break
+        t_new = t - w * 1e-7 / (w_h - w)
+        if abs(t_new - t) > 1e-4:
+            break
+        ok, w_new = _joints(g, R, O6, t_new, shoulder, elbow, theta)
+        if not ok or abs(w_new) >= abs(w):
+            break
+        t, w = t_new, w_new
+    ok, w = _joints(g, R, O6, t, shoulder, elbow, theta)
+    return t, ok
 
 
 @njit(cache=True, error_model="numpy")
@@ -565,10 +602,15 @@ def crx_solve(
                     if not dual and sh != s:
                         continue
                     for e in range(2):
-                        if not _joints(g, R, O6, t, sh, e, theta):
+                        ok, w = _joints(g, R, O6, t, sh, e, theta)
+                        if not ok or abs(w) > ARM_TOL:
                             continue
+                        t_arm = t
                         if not _fk_error(g, theta, R, p, Tm) <= tol:
-                            continue
+                            # a double root of F: polish on this arm's own residual
+                            t_arm, ok = _polish(g, R, O6, t, sh, e, theta)
+                            if not ok or not _fk_error(g, theta, R, p, Tm) <= tol:
+                                continue
                         for j in range(6):
                             qj[j] = wrap((theta[j] - theta0[j]) * sign[j])
                         same = False
@@ -584,7 +626,7 @@ def crx_solve(
                         if same:
                             continue
                         cand[n_cand] = qj
-                        cand_t[n_cand] = t
+                        cand_t[n_cand] = t_arm
                         cand_k[n_cand] = 2 * sh + e
                         n_cand += 1
         # order by (root angle, shoulder, elbow): insertion sort of at most a few dozen
