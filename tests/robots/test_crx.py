@@ -115,7 +115,8 @@ def test_every_solution_reproduces_the_pose_and_one_is_q(
     count = valid.sum(axis=1)
     assert np.all(count % 2 == 0) and np.all(count >= 2)  # shoulder pairs (a1 = a2 = 0)
     assert np.all(valid[:, :-1] >= valid[:, 1:])  # found ones first
-    assert np.all(np.diff(np.where(valid, angle, np.inf), axis=1)[valid[:, 1:]] >= 0)
+    step = np.diff(np.where(valid, angle, np.nan), axis=1)  # by root angle, ascending
+    assert np.all(step[~np.isnan(step)] >= 0)
 
 
 def test_solutions_are_distinct(crx: Robot, family: CRXFamily, rng: np.random.Generator) -> None:
@@ -250,3 +251,14 @@ def test_any_crx_geometry_finds_the_configuration(
     # 1e-6 (solutions this close are one): hypothesis finds singular poses (q5 = 0 with
     # the arm up), where a pose fixes the joints only to about the square root of 1e-16
     assert np.nanmin(np.where(valid, distance(Q, qa), np.nan)) <= 1e-6
+
+
+def test_unreachable_poses_have_no_solution(crx: Robot, family: CRXFamily) -> None:
+    T = np.repeat(np.eye(4)[None], 3, axis=0)
+    T[0, :3, 3] = (3.0, 0.0, 0.5)  # beyond the reach (1.67 m)
+    T[1, :3, 3] = (0.0, 0.0, -2.0)
+    T[2, :3, 3] = np.nan
+    Q, valid = family.solutions(T)
+    assert not valid.any() and np.all(np.isnan(Q))
+    seeds, found = family.seed_solutions(T, crx.q_min, crx.q_max)
+    assert not found.any() and seeds.shape == (3, 16, 6)
