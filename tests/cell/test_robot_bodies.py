@@ -34,6 +34,8 @@ HOME = {
     "abb_irb1600": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
     "abb_irb2400": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
     "fanuc_m20ia": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
+    # FANUC CRX: q = 0 is upright too (upper arm up, forearm level)
+    "fanuc_crx10ia_l": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
     "puma560": [0.0, 0.0, 0.0, 0.0, HALF_PI, 0.0],
     # the S-R-S arms: shoulder forward, elbow bent 90°, wrist bent back (the iiwa's A4 and
     # the SIA10D's U turn about -y)

@@ -9,6 +9,7 @@ import numpy as np
 from trackplan.derived import derived
 from trackplan.errors import CaseError
 from trackplan.robots.families.base import ClosedFormIK, IKFamily
+from trackplan.robots.families.crx import CRXFamily, crx_from_chain
 from trackplan.robots.families.numeric import NumericFamily
 from trackplan.robots.families.opw import OPWFamily, opw_from_chain
 from trackplan.robots.families.panda import PandaFamily, panda_from_chain
@@ -33,11 +34,12 @@ def ik_family(robot: Robot) -> IKFamily:
     return derived(robot, "ik family", lambda: _detect(robot))
 
 
-CLOSED_FORMS: dict[str, tuple[Callable[[Robot], object | None], Callable[..., IKFamily]]] = {
+STRUCTURED_FAMILIES: dict[str, tuple[Callable[[Robot], object | None], Callable[..., IKFamily]]] = {
     "opw": (opw_from_chain, OPWFamily),
     "ur": (ur_from_chain, URFamily),
     "srs": (srs_from_chain, SRSFamily),
     "panda": (panda_from_chain, PandaFamily),
+    "crx": (crx_from_chain, CRXFamily),
 }
 """The structured families, tried in this order: how to derive each one's parameters from a
 chain (None when the chain is not of the family) and the family built from them."""
@@ -45,7 +47,7 @@ chain (None when the chain is not of the family) and the family built from them.
 
 def _detect(robot: Robot) -> IKFamily:
     """The family the robot file names (``ik.family``), else the first of
-    :data:`CLOSED_FORMS` whose structure the chain has, else numeric.
+    :data:`STRUCTURED_FAMILIES` whose structure the chain has, else numeric.
 
     Raises
     ------
@@ -56,13 +58,13 @@ def _detect(robot: Robot) -> IKFamily:
     if choice.family == "numeric":
         return NumericFamily(robot, choice.free_joint)
     if choice.family != "auto":
-        if choice.family not in CLOSED_FORMS:
+        if choice.family not in STRUCTURED_FAMILIES:
             raise CaseError(
                 f"unknown IK family {choice.family!r}: expected one of auto, "
-                f"{', '.join(CLOSED_FORMS)}, numeric",
+                f"{', '.join(STRUCTURED_FAMILIES)}, numeric",
                 key="ik.family",
             )
-        derive, family = CLOSED_FORMS[choice.family]
+        derive, family = STRUCTURED_FAMILIES[choice.family]
         params = derive(robot)
         if params is None:
             raise CaseError(
@@ -72,7 +74,7 @@ def _detect(robot: Robot) -> IKFamily:
                 key="ik.family",
             )
         return family(robot, params)
-    for derive, family in CLOSED_FORMS.values():
+    for derive, family in STRUCTURED_FAMILIES.values():
         params = derive(robot)
         if params is not None:
             return family(robot, params)
