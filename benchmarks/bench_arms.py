@@ -10,10 +10,12 @@ prints:
   (:func:`~trackplan.robots.ik_numeric.track_poses`, what the samples of a tracked arm need);
 - ``trackplan.optimize`` of one weld for all (a closed rounded rectangle, 160 × 100 mm with
   20 mm corners, 20 mm/s, 0.5 mm, Ts 4 ms, the torch down and tilted 0.3 rad, the placement
-  box scaled to the robot's reach, the GA of 20 × 10 with seed 1, acceleration and jerk
-  assumed where the robot has none): wall time, verdict, J;
+  box scaled to the robot's reach, every joint weighted 1, the GA of 20 × 10 with seed 1,
+  acceleration and jerk assumed where the robot has none): wall time, verdict, J;
 - for each 7-joint arm the same optimize with its redundancy frozen at the middle of its
-  range (``task.redundancy: {mode: fixed}``), and J frozen / J chosen: what the profile buys.
+  range (``task.redundancy: {mode: fixed}``), and J frozen / J chosen: what the profile buys;
+  then :data:`DRAWS` random placements in the box (seed :data:`SEED`) planned both ways:
+  how many are feasible, and the median and worst J ratio where both are.
 
 The reference of the timing column is the KR6 R700 sixx (an OPW arm) in the same run.
 """
@@ -29,12 +31,16 @@ from benchmarks import best_time
 from trackplan.case import Case
 from trackplan.io.case_file import load_case_text
 from trackplan.io.robot_file import builtin_names, builtin_robot
+from trackplan.planning.plan import plan
 from trackplan.robots.families import ik_family
 from trackplan.robots.ik_numeric import track_poses
 from trackplan.robots.kinematics import forward_kinematics
 from trackplan.robots.model import Robot
 from trackplan.search.optimize import optimize
 
+DRAWS = 20
+"""Random placements per seven-joint arm for the chosen-against-frozen table."""
+SEED = 30
 N_CLOSED = 20_000
 N_TRACKED = 500
 REFERENCE = "kuka_kr6_r700_sixx"
@@ -66,16 +72,19 @@ placement:
   roll: [-0.3, 0.3]
   pitch: [-0.3, 0.3]
   yaw: [-3.14, 3.14]
+objective: {{weights: {weights}}}
 optimizer: {{method: ga, seed: 1, population: 20, budget: 200}}
 """
 
 
 def weld_case(name: str, frozen: bool = False) -> Case:
     """The common weld on robot ``name`` (its redundancy frozen at the middle with ``frozen``)."""
-    reach = builtin_robot(name).reach
+    robot = builtin_robot(name)
+    reach = robot.reach
     redundancy = "  redundancy: {mode: fixed}" if frozen else ""
     text = WELD.format(
         robot=name,
+        weights=[1] * robot.n_dof,
         redundancy=redundancy,
         x0=0.3 * reach,
         x1=0.7 * reach,
@@ -159,6 +168,36 @@ def main() -> None:
             f"{name:<22} {family.name:<8} {robot.n_dof:>2} {solve} {track} {seconds:>10.2f} "
             f"{seconds / reference:>6.2f} {final.status.value:<16} {final.objective:>8.4f} "
             f"{frozen_text:>9} {ratio:>6}",
+            flush=True,
+        )
+
+    redundant_over_draws()
+
+
+def redundant_over_draws() -> None:
+    """Random placements of the weld per seven-joint arm, planned with the redundancy chosen
+    and frozen at its middle: feasible counts and the J ratio where both are feasible."""
+    print(f"\nseven-joint arms at {DRAWS} random placements (seed {SEED}):")
+    print(f"{'robot':<22} {'chosen ok':>9} {'frozen ok':>9} {'J ratio median':>15} {'worst':>6}")
+    for name in builtin_names():
+        if ik_family(builtin_robot(name)).redundancy is None:
+            continue
+        chosen_case, frozen_case = weld_case(name), weld_case(name, frozen=True)
+        bounds = chosen_case.bounds
+        rng = np.random.default_rng(SEED)
+        draws = rng.uniform(bounds.lower, bounds.upper, (DRAWS, 6))
+        chosen = [plan(chosen_case, x) for x in draws]
+        frozen = [plan(frozen_case, x) for x in draws]
+        both = [
+            f.objective / c.objective
+            for c, f in zip(chosen, frozen, strict=True)
+            if c.success and f.success
+        ]
+        median = f"{np.median(both):15.3f}" if both else f"{'-':>15}"
+        worst = f"{np.min(both):6.3f}" if both else f"{'-':>6}"
+        print(
+            f"{name:<22} {sum(c.success for c in chosen):>9} {sum(f.success for f in frozen):>9} "
+            f"{median} {worst}",
             flush=True,
         )
 
