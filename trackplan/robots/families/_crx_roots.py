@@ -90,7 +90,7 @@ def _residual(
         K2 = c2 * c2 + rho2 - c3 * c3
         Pg = X * a5x + Y * a5y + pw * a5z
         Qh = pw * (X * a5x + Y * a5y) - h2 * a5z
-        return h2 * K1 * K1 * Pg * Pg - (4.0 * c2 * c2 * rho2 - K2 * K2) * Qh * Qh
+        return float(h2 * K1 * K1 * Pg * Pg - (4.0 * c2 * c2 * rho2 - K2 * K2) * Qh * Qh)
     c1, s1, pu, pw, ok = _shoulder(g, X, Y, Z, shoulder)
     if not ok:
         return math.nan
@@ -104,7 +104,7 @@ def _residual(
     K2 = c2 * c2 + rho2 - k2
     Pg = pu * gu + pw * gw
     Qg = pw * gu - pu * gw
-    return (X * X + Y * Y) * (K1 * K1 * Pg * Pg - (4.0 * c2 * c2 * rho2 - K2 * K2) * Qg * Qg)
+    return float((X * X + Y * Y) * (K1 * K1 * Pg * Pg - (4.0 * c2 * c2 * rho2 - K2 * K2) * Qg * Qg))
 
 
 @njit(cache=True, error_model="numpy", inline="always")

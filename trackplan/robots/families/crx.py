@@ -35,6 +35,7 @@ import numpy as np
 from trackplan._kernels import read_only
 from trackplan.errors import CaseError
 from trackplan.robots.families import _crx_kernels as kern
+from trackplan.robots.families import _crx_roots as roots
 from trackplan.robots.families.base import RedundancyParameter, wrap_and_deduplicate
 from trackplan.robots.families.opw import _closest_point, _line_distance, _ry, _rz
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
@@ -235,8 +236,8 @@ class CRXFamily:
 
     def __init__(self, robot: Robot, params: CRXParameters):
         self.params = params
-        g = np.empty(kern.C_SIZE)
-        g[: kern.C_THETA0] = (
+        g = np.empty(roots.C_SIZE)
+        g[: roots.C_THETA0] = (
             params.a1,
             params.a2,
             params.b,
@@ -250,8 +251,8 @@ class CRXFamily:
             1.0 if params.dual else 0.0,
             kern.FK_TOL,
         )
-        g[kern.C_THETA0 : kern.C_SIGN] = params.offsets
-        g[kern.C_SIGN :] = params.signs
+        g[roots.C_THETA0 : roots.C_SIGN] = params.offsets
+        g[roots.C_SIGN :] = params.signs
         self._geometry = g
         self._tail_inv = np.ascontiguousarray(np.linalg.inv(params.T_tail @ robot.T_flange_tool))
         t = 2.0 * np.pi * np.arange(kern.N_SAMPLES) / kern.N_SAMPLES

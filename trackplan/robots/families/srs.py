@@ -103,7 +103,10 @@ class SRSParameters:
 
     def theta(self, q: np.ndarray) -> np.ndarray:
         """Model angles θ = sign · q + θ0 of joint positions q (..., 7), rad."""
-        return np.asarray(q, dtype=float) * np.array(self.signs) + np.array(self.offsets)
+        theta: np.ndarray = np.asarray(q, dtype=float) * np.array(self.signs) + np.array(
+            self.offsets
+        )
+        return theta
 
 
 def _zero_angle(v: np.ndarray) -> tuple[float, float]:
