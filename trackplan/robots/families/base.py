@@ -233,21 +233,43 @@ class IKFamily(Protocol):
 
 class FusedClosedForm:
     r"""The solve methods of a closed-form family (:class:`IKFamily`) whose compiled kernels
-    (``families/_opw_kernels.py``, ``families/_ur_kernels.py``) take its parameter array
-    and the inverse of its tool transform.
+    (``families/_opw_kernels.py``, ``_ur_kernels.py``, ``_srs_kernels.py``,
+    ``_panda_kernels.py``) take its parameter array and the inverse of its tool transform.
 
-    A subclass sets ``_geometry`` and ``_tail_inv`` and names its kernels: ``_all_branches``
-    (pose in, eight branches out: ``opw_solve``, ``ur_solve``) and ``_one_branch``
-    (``opw_solve_branch``, ``ur_solve_branch``), as ``staticmethod``\ s.
+    A subclass sets ``_geometry`` and ``_tail_inv``, ``_n_joints`` (6, or 7 for a redundant
+    arm) and names its kernels: ``_all_branches`` (poses in, eight branches out, e.g.
+    ``opw_solve``) and ``_one_branch`` (e.g. ``opw_solve_branch``), as ``staticmethod``\ s.
+    A redundant family (``redundancy`` not None) has kernels that take the free parameter
+    per pose right after the poses (all branches) or the positions (one branch).
     """
 
     closed_form = True
     n_branches = N_BRANCHES
     redundancy: RedundancyParameter | None = None
+    _n_joints = 6
     _all_branches: Callable[..., None]
     _one_branch: Callable[..., None]
     _geometry: np.ndarray
     _tail_inv: np.ndarray
+
+    def _free_arguments(self, free: np.ndarray | None, n_poses: int) -> tuple[np.ndarray, ...]:
+        """The kernels' free-parameter argument: none without redundancy, else the values
+        (N,), C-contiguous (a scalar applies to every pose).
+
+        Raises
+        ------
+        ValueError
+            When the free parameter is missing, or given to a family without one.
+        """
+        if self.redundancy is None:
+            _no_free(free)
+            return ()
+        if free is None:
+            raise ValueError(
+                f"this IK family needs its {self.redundancy.name} per pose: pass free (N,), rad"
+            )
+        values = np.broadcast_to(np.asarray(free, dtype=float), (n_poses,))
+        return (read_only(np.ascontiguousarray(values)),)
 
     def solve_flat(
         self,
@@ -257,22 +279,28 @@ class FusedClosedForm:
         with_aux: bool = True,
         out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """All eight branches of poses (N, 4, 4), m (``free`` must be None: no
-        redundancy): q (N, 8, 6) rad, valid (N, 8) bool, aux (N, 8, AUX_SIZE);
-        ``with_aux=False`` skips the branch quantities (aux is then (1, 8, AUX_SIZE)
-        scratch); ``out`` (q, valid, aux) of those shapes are written instead of new
-        arrays (the kernel releases the GIL: threads may solve at once)."""
-        _no_free(free)
+        """All eight branches of poses (N, 4, 4), m, at the free parameter ``free`` (N,)
+        of a redundant family (None otherwise): q (N, 8, n) rad, valid (N, 8) bool, aux
+        (N, 8, AUX_SIZE); ``with_aux=False`` skips the branch quantities (aux is then
+        (1, 8, AUX_SIZE) scratch); ``out`` (q, valid, aux) of those shapes are written
+        instead of new arrays (the kernel releases the GIL: threads may solve at once)."""
         T = np.ascontiguousarray(T_base_tool, dtype=float)
         n_poses = T.shape[0]
+        free_arguments = self._free_arguments(free, n_poses)
         if out is not None:
             q, valid, aux = out
         else:
-            q = np.empty((n_poses, N_BRANCHES, 6))
+            q = np.empty((n_poses, N_BRANCHES, self._n_joints))
             valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
             aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
         self._all_branches(
-            read_only(self._geometry), read_only(self._tail_inv), read_only(T), q, valid, aux
+            read_only(self._geometry),
+            read_only(self._tail_inv),
+            read_only(T),
+            *free_arguments,
+            q,
+            valid,
+            aux,
         )
         return q, valid, aux
 
@@ -284,9 +312,9 @@ class FusedClosedForm:
         free: np.ndarray | None = None,
         with_aux: bool = False,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Branch ``branch`` of poses (N, 4, 4) alone (``free`` must be None): q (N, 6),
-        valid (N,), aux (N, 5) (or (1, 5) scratch without ``with_aux``), the values
-        :meth:`solve_flat` gives for it."""
+        """Branch ``branch`` of poses (N, 4, 4) alone: q (N, n), valid (N,), aux (N, 5)
+        (or (1, 5) scratch without ``with_aux``), the values :meth:`solve_flat` gives for
+        it."""
         T = np.asarray(T_base_tool, dtype=float)
         return self.solve_branch_parts(
             T[:, :3, :3], T[:, :3, 3], branch, free=free, with_aux=with_aux
@@ -309,18 +337,18 @@ class FusedClosedForm:
         Returns
         -------
         tuple of numpy.ndarray
-            q (N, 6) rad (NaN where not valid, unless wound), valid (N,) bool, aux
+            q (N, n) rad (NaN where not valid, unless wound), valid (N,) bool, aux
             (N, AUX_SIZE).
         """
-        _no_free(free)
         R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
         p = np.ascontiguousarray(p_base_tool, dtype=float)
         n_poses = p.shape[0]
-        q = np.empty((n_poses, 6))
+        free_arguments = self._free_arguments(free, n_poses)
+        q = np.empty((n_poses, self._n_joints))
         valid = np.empty(n_poses, dtype=np.bool_)
         aux = np.empty((n_poses if with_aux else 1, AUX_SIZE))
         if wind_to is None:
-            s, s_grid, q_grid = _NO_GRID
+            s, s_grid, q_grid = np.empty(0), np.empty(0), np.empty((0, self._n_joints))
         else:
             s, s_grid, q_grid = (np.ascontiguousarray(x, dtype=float) for x in wind_to)
         self._one_branch(
@@ -328,6 +356,7 @@ class FusedClosedForm:
             read_only(self._tail_inv),
             read_only(R),
             read_only(p),
+            *free_arguments,
             int(branch),
             q,
             valid,
@@ -425,7 +454,3 @@ def _no_free(free: np.ndarray | None) -> None:
     """Refuse a redundancy parameter given to a family without redundancy."""
     if free is not None:
         raise ValueError("this IK family has no redundancy parameter: pass free=None")
-
-
-_NO_GRID = (np.empty(0), np.empty(0), np.empty((0, 6)))
-"""The kernels' reference arguments when the joints are not wound (s_grid empty)."""

@@ -45,13 +45,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from trackplan._kernels import read_only
 from trackplan.robots.families import _panda_kernels as kern
-from trackplan.robots.families._kernels import AUX_SIZE, N_BRANCHES
 from trackplan.robots.families.base import (
+    FusedClosedForm,
     RedundancyParameter,
     branch_bits,
-    closed_form_seeds,
 )
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
@@ -60,7 +58,6 @@ _TOL = 1e-9  # |sin| of an angle that counts as parallel/perpendicular (and × r
 _N_CHECK = 64
 _CHECK_TOL = 1e-9
 PANDA_ALPHA = (0.0, -np.pi / 2, np.pi / 2, np.pi / 2, -np.pi / 2, np.pi / 2, np.pi / 2)
-_NO_GRID = (np.empty(0), np.empty(0), np.empty((0, kern.N_JOINTS)))
 
 
 @dataclass(frozen=True)
@@ -227,13 +224,14 @@ def panda_from_chain(robot: Robot) -> PandaParameters | None:
     return params
 
 
-class PandaFamily:
+class PandaFamily(FusedClosedForm):
     """The Panda closed form of one robot, joint 7 free
     (:class:`~trackplan.robots.families.base.IKFamily`)."""
 
     name = "panda"
-    closed_form = True
-    n_branches = N_BRANCHES
+    _n_joints = 7
+    _all_branches = staticmethod(kern.panda_solve)
+    _one_branch = staticmethod(kern.panda_solve_branch)
     redundancy: RedundancyParameter | None
 
     def __init__(self, robot: Robot, params: PandaParameters):
@@ -292,117 +290,3 @@ class PandaFamily:
                 ("θ6 = ψ + δ", "θ6 = ψ − δ")[wrist],
             )
         )
-
-    def _free(self, free: np.ndarray | None, n_poses: int) -> np.ndarray:
-        """Joint 7's positions, shape (N,), rad (one value is repeated)."""
-        if free is None:
-            raise ValueError("the Panda family needs joint 7's position per pose: pass free")
-        values = np.ascontiguousarray(np.broadcast_to(np.asarray(free, dtype=float), (n_poses,)))
-        return values
-
-    def solve_flat(
-        self,
-        T_base_tool: np.ndarray,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool = True,
-        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """All eight branches of poses (N, 4, 4), m, joint 7 at ``free`` (N,), rad:
-        q (N, 8, 7) rad, valid (N, 8) bool, aux (N, 8, AUX_SIZE) (``with_aux=False``:
-        (1, 8, AUX_SIZE) scratch); ``out`` (q, valid, aux) of those shapes are written
-        instead of new arrays (the kernel releases the GIL)."""
-        T = np.ascontiguousarray(T_base_tool, dtype=float)
-        n_poses = T.shape[0]
-        values = self._free(free, n_poses)
-        if out is not None:
-            q, valid, aux = out
-        else:
-            q = np.empty((n_poses, N_BRANCHES, kern.N_JOINTS))
-            valid = np.empty((n_poses, N_BRANCHES), dtype=np.bool_)
-            aux = np.empty((n_poses if with_aux else 1, N_BRANCHES, AUX_SIZE))
-        kern.panda_solve(
-            read_only(self._geometry),
-            read_only(self._tail_inv),
-            read_only(T),
-            read_only(values),
-            q,
-            valid,
-            aux,
-        )
-        return q, valid, aux
-
-    def solve_branch(
-        self,
-        T_base_tool: np.ndarray,
-        branch: int,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool = False,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Branch ``branch`` of poses (N, 4, 4) alone, joint 7 at ``free`` (N,): q (N, 7),
-        valid (N,), aux (N, 5) (or (1, 5) scratch without ``with_aux``), the values
-        :meth:`solve_flat` gives for it."""
-        T = np.asarray(T_base_tool, dtype=float)
-        return self.solve_branch_parts(
-            T[:, :3, :3], T[:, :3, 3], branch, free=free, with_aux=with_aux
-        )
-
-    def solve_branch_parts(
-        self,
-        R_base_tool: np.ndarray,
-        p_base_tool: np.ndarray,
-        branch: int,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool,
-        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`solve_branch` of poses given by rotations (N, 3, 3) (or one, (3, 3)) and
-        positions (N, 3), m; ``wind_to`` None, or (s, s_grid, q_grid) to hold and wind the
-        joints (:meth:`IKFamily.solve_branch_parts`).
-
-        Returns
-        -------
-        tuple of numpy.ndarray
-            q (N, 7) rad (NaN where not valid, unless wound), valid (N,) bool, aux
-            (N, AUX_SIZE).
-        """
-        R = np.ascontiguousarray(R_base_tool, dtype=float).reshape(-1, 3, 3)
-        p = np.ascontiguousarray(p_base_tool, dtype=float)
-        n_poses = p.shape[0]
-        values = self._free(free, n_poses)
-        q = np.empty((n_poses, kern.N_JOINTS))
-        valid = np.empty(n_poses, dtype=np.bool_)
-        aux = np.empty((n_poses if with_aux else 1, AUX_SIZE))
-        if wind_to is None:
-            s, s_grid, q_grid = _NO_GRID
-        else:
-            s, s_grid, q_grid = (np.ascontiguousarray(x, dtype=float) for x in wind_to)
-        kern.panda_solve_branch(
-            read_only(self._geometry),
-            read_only(self._tail_inv),
-            read_only(R),
-            read_only(p),
-            read_only(values),
-            int(branch),
-            q,
-            valid,
-            aux,
-            read_only(s),
-            read_only(s_grid),
-            read_only(q_grid),
-        )
-        return q, valid, aux
-
-    def seed_solutions(
-        self,
-        T_base_tool: np.ndarray,
-        q_min: np.ndarray,
-        q_max: np.ndarray,
-        *,
-        free: np.ndarray | None = None,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The eight branches of poses (N, 4, 4), joint 7 at ``free`` (N,), inside the
-        limits, deduplicated (:func:`~trackplan.robots.families.base.closed_form_seeds`)."""
-        return closed_form_seeds(self, T_base_tool, q_min, q_max, free)
