@@ -9,6 +9,7 @@ from typing import Protocol
 import numpy as np
 
 from trackplan._kernels import read_only
+from trackplan.errors import CaseError
 
 N_BRANCHES = 8
 """Number of labelled solutions of a pose of the OPW and UR families (and of the numeric
@@ -378,6 +379,61 @@ class FusedClosedForm:
         """The eight branches of poses (N, 4, 4) inside the limits, deduplicated
         (:func:`closed_form_seeds`)."""
         return closed_form_seeds(self, T_base_tool, q_min, q_max, free)
+
+
+class TrackedFamily:
+    """The closed-form calls of a tracked family (:class:`IKFamily` with ``closed_form``
+    False: the CRX family, numeric IK), refused: its branches are solutions followed along
+    a path from its first pose (:meth:`IKFamily.seed_solutions`), not labels a pose can be
+    solved for."""
+
+    closed_form = False
+    name: str
+
+    def solve_flat(
+        self,
+        T_base_tool: np.ndarray,
+        *,
+        free: np.ndarray | None = None,
+        with_aux: bool = True,
+        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Not available: a tracked family's solutions come from :meth:`seed_solutions`.
+
+        Raises
+        ------
+        CaseError
+            Always.
+        """
+        raise CaseError(
+            f"this robot has no closed-form IK (the {self.name} family: its solutions are "
+            "tracked along a path): use seed_solutions and trackplan.robots.ik_numeric",
+            key="robot",
+        )
+
+    def solve_branch(
+        self,
+        T_base_tool: np.ndarray,
+        branch: int,
+        *,
+        free: np.ndarray | None = None,
+        with_aux: bool = False,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Not available (:meth:`solve_flat`)."""
+        return self.solve_flat(T_base_tool)
+
+    def solve_branch_parts(
+        self,
+        R_base_tool: np.ndarray,
+        p_base_tool: np.ndarray,
+        branch: int,
+        *,
+        free: np.ndarray | None = None,
+        with_aux: bool,
+        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Not available (:meth:`solve_flat`)."""
+        return self.solve_flat(np.empty((0, 4, 4)))
 
 
 class SolvesFlat(Protocol):

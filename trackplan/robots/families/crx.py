@@ -33,10 +33,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from trackplan._kernels import read_only
-from trackplan.errors import CaseError
 from trackplan.robots.families import _crx_kernels as kern
 from trackplan.robots.families import _crx_roots as roots
-from trackplan.robots.families.base import RedundancyParameter, wrap_and_deduplicate
+from trackplan.robots.families.base import (
+    RedundancyParameter,
+    TrackedFamily,
+    wrap_and_deduplicate,
+)
 from trackplan.robots.families.opw import _closest_point, _line_distance, _ry, _rz
 from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
@@ -225,12 +228,11 @@ def crx_from_chain(robot: Robot) -> CRXParameters | None:
     return params
 
 
-class CRXFamily:
+class CRXFamily(TrackedFamily):
     """Every IK solution of a CRX-type arm, tracked along a path
     (:class:`~trackplan.robots.families.base.IKFamily`)."""
 
     name = "crx"
-    closed_form = False
     n_branches = kern.N_MAX
     redundancy: RedundancyParameter | None = None
 
@@ -337,42 +339,3 @@ class CRXFamily:
             raise ValueError("this IK family has no redundancy parameter: pass free=None")
         q, valid = self.solutions(T_base_tool)
         return wrap_and_deduplicate(q, valid, q_min, q_max)
-
-    def solve_flat(
-        self,
-        T_base_tool: np.ndarray,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool = True,
-        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Not available: the CRX family is tracked (see :meth:`seed_solutions`)."""
-        raise CaseError(
-            "this robot has no closed-form IK (a CRX-type arm, cuspidal: its solutions are "
-            "tracked along a path): use seed_solutions and trackplan.robots.ik_numeric",
-            key="robot",
-        )
-
-    def solve_branch(
-        self,
-        T_base_tool: np.ndarray,
-        branch: int,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool = False,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Not available: a CRX branch is a tracked solution (see :meth:`solve_flat`)."""
-        return self.solve_flat(T_base_tool)
-
-    def solve_branch_parts(
-        self,
-        R_base_tool: np.ndarray,
-        p_base_tool: np.ndarray,
-        branch: int,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool,
-        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Not available: a CRX branch is a tracked solution (see :meth:`solve_flat`)."""
-        return self.solve_flat(np.empty((0, 4, 4)))

@@ -16,6 +16,7 @@ from trackplan.errors import CaseError
 from trackplan.robots.families.base import (
     N_BRANCHES,
     RedundancyParameter,
+    TrackedFamily,
     _no_free,
 )
 from trackplan.robots.ik_numeric import (
@@ -43,11 +44,10 @@ REDUNDANCY_RULE = (
 picks one of its infinitely many solutions."""
 
 
-class NumericFamily:
+class NumericFamily(TrackedFamily):
     """Arms solved numerically (:class:`~trackplan.robots.families.base.IKFamily`)."""
 
     name = "numeric"
-    closed_form = False
     n_branches = N_BRANCHES
     redundancy: RedundancyParameter | None
 
@@ -105,45 +105,6 @@ class NumericFamily:
     def describe_branch(self, branch: int) -> str:
         """``"solution b of the first pose"``: the distinct solution the branch follows."""
         return f"solution {branch} of the first pose"
-
-    def solve_flat(
-        self,
-        T_base_tool: np.ndarray,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool = True,
-        out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Not available: numeric IK needs seeds (use :mod:`trackplan.robots.ik_numeric`)."""
-        raise CaseError(
-            "this robot has no closed-form IK (neither OPW nor UR geometry): "
-            "use trackplan.robots.ik_numeric",
-            key="robot",
-        )
-
-    def solve_branch(
-        self,
-        T_base_tool: np.ndarray,
-        branch: int,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool = False,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
-        return self.solve_flat(T_base_tool)
-
-    def solve_branch_parts(
-        self,
-        R_base_tool: np.ndarray,
-        p_base_tool: np.ndarray,
-        branch: int,
-        *,
-        free: np.ndarray | None = None,
-        with_aux: bool,
-        wind_to: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Not available: a numeric branch is a seed (see :meth:`solve_flat`)."""
-        return self.solve_flat(np.empty((0, 4, 4)))
 
     def seed_solutions(
         self,
