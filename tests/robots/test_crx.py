@@ -16,7 +16,7 @@ from trackplan.io.robot_file import LIBRARY_DIR, builtin_robot
 from trackplan.robots.families.crx import CRXFamily, crx_from_chain
 from trackplan.robots.families.opw import opw_from_chain
 from trackplan.robots.ik_numeric import solve_ik_numeric
-from trackplan.robots.kinematics import forward_kinematics
+from trackplan.robots.kinematics import forward_kinematics, jacobian
 from trackplan.robots.model import Robot
 
 CRX = "fanuc_crx10ia_l"
@@ -248,9 +248,12 @@ def test_any_crx_geometry_finds_the_configuration(
     T = forward_kinematics(robot, qa)
     Q, valid = family.solutions(T)
     assert np.all(pose_error(robot, np.nan_to_num(Q), T)[valid] <= 1e-9)
-    # 1e-6 (solutions this close are one): hypothesis finds singular poses (q5 = 0 with
-    # the arm up), where a pose fixes the joints only to about the square root of 1e-16
-    assert np.nanmin(np.where(valid, distance(Q, qa), np.nan)) <= 1e-6
+    # 1e-6 (solutions this close are one); near a singularity (σ_min(J) < 1e-3: hypothesis
+    # finds poses with q4 and q5 near 0) a pose held to 1e-9 fixes the joints only to
+    # about the square root of its error, and 1e-4 rad (0.006°) is allowed
+    sigma = np.linalg.svd(jacobian(robot, qa[0]), compute_uv=False).min()
+    allowed = 1e-6 if sigma >= 1e-3 else 1e-4
+    assert np.nanmin(np.where(valid, distance(Q, qa), np.nan)) <= allowed
 
 
 def test_unreachable_poses_have_no_solution(crx: Robot, family: CRXFamily) -> None:

@@ -27,7 +27,6 @@ Newton steps.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -40,13 +39,8 @@ from trackplan.robots.families.base import (
     TrackedFamily,
     wrap_and_deduplicate,
 )
-from trackplan.robots.families.opw import _closest_point, _line_distance, _ry, _rz
-from trackplan.robots.kinematics import axis_frames, forward_kinematics
+from trackplan.robots.families.opw import _PARALLEL_TOL, _ry, _rz, arm_axes, arm_parameters
 from trackplan.robots.model import Robot
-
-_PARALLEL_TOL = 1e-9  # |sin| of the angle between axes that counts as parallel/perpendicular
-_N_CHECK = 64  # random configurations the derived model must reproduce
-_CHECK_TOL = 1e-9  # m (relative to the reach) and rotation entries
 
 
 @dataclass(frozen=True)
@@ -121,111 +115,44 @@ def crx_from_chain(robot: Robot) -> CRXParameters | None:
     O5), axis 6 perpendicular to axis 5 and meeting it (in O6) away from O5 (an arm whose
     O5 and O6 coincide is OPW), and O5 in the plane of axes 1 and 4 (no lateral offset b,
     as on every CRX). The lengths, offsets and signs follow from the axes as for
-    :func:`~trackplan.robots.families.opw.opw_from_chain`; the model is then checked
-    against the chain's forward kinematics on 64 random configurations (to 1e-9).
+    :func:`~trackplan.robots.families.opw.opw_from_chain` (the shared
+    :func:`~trackplan.robots.families.opw.arm_parameters`, c4 measured from O6); the model
+    is then checked against the chain's forward kinematics on 64 random configurations
+    (to 1e-9).
     """
-    if robot.n_dof != 6:
+    axes = arm_axes(robot)
+    if axes is None:
         return None
-    frames = axis_frames(robot, np.zeros(6))
-    z = frames[1:7, :3, 2]
-    p = frames[1:7, :3, 3]
-    scale = max(robot.reach, 1e-3)
-    ez = np.array([0.0, 0.0, 1.0])
-    tol = _PARALLEL_TOL
-
-    def parallel(u: np.ndarray, v: np.ndarray) -> bool:
-        return bool(np.linalg.norm(np.cross(u, v)) <= tol)
-
-    def perpendicular(u: np.ndarray, v: np.ndarray) -> bool:
-        return bool(abs(u @ v) <= tol)
-
-    if not (
-        parallel(z[0], ez)
-        and perpendicular(z[1], ez)
-        and parallel(z[1], z[2])
-        and perpendicular(z[3], z[2])
-        and perpendicular(z[4], z[3])
-        and perpendicular(z[5], z[4])
-    ):
+    o5, o6 = axes.meet(3, 4), axes.meet(4, 5)
+    if o5 is None or o6 is None:
         return None
-    o5 = _closest_point(p[3], z[3], p[4], z[4])
-    o6 = _closest_point(p[4], z[4], p[5], z[5])
-    if max(_line_distance(o5, p[i], z[i]) for i in (3, 4)) > tol * scale:
-        return None
-    if max(_line_distance(o6, p[i], z[i]) for i in (4, 5)) > tol * scale:
-        return None
-    l5 = float((o6 - o5) @ z[4])
-    if abs(l5) <= tol * scale:
+    tol = _PARALLEL_TOL * axes.scale
+    l5 = float((o6 - o5) @ axes.z[4])
+    if abs(l5) <= tol:
         return None  # the wrist axes meet: OPW
-    sign = np.ones(6)
-    sign[0] = np.sign(z[0] @ ez)
-    base = np.array([p[0, 0], p[0, 1], 0.0])
-    y_arm = z[1]
-    x_arm = np.cross(y_arm, ez)
-    a1 = float((p[1] - base) @ x_arm)
-    facing_back = abs(math.atan2(-y_arm[0], y_arm[1])) > math.pi / 2
-    if a1 < -tol * scale or (abs(a1) <= tol * scale and facing_back):
-        y_arm, x_arm, a1 = -y_arm, -x_arm, -a1
-    sign[1] = np.sign(z[1] @ y_arm)
-    sign[2] = np.sign(z[2] @ y_arm)
-    theta0 = np.zeros(6)
-    theta0[0] = math.atan2(-y_arm[0], y_arm[1])
-    c1 = float(p[1, 2])
-    x3, z3 = float((p[2] - base) @ x_arm), float(p[2, 2])
-    c2 = math.hypot(x3 - a1, z3 - c1)
-    theta0[1] = math.atan2(x3 - a1, z3 - c1)
-    forearm = o5 - p[2]
-    u4 = z[3] if forearm @ z[3] >= 0.0 else -z[3]
-    sign[3] = np.sign(u4 @ z[3])
-    t23 = math.atan2(u4 @ x_arm, u4 @ ez)
-    fx, fz = float(forearm @ x_arm), float(forearm @ ez)
-    a2 = fx * math.cos(t23) - fz * math.sin(t23)
-    c3 = fx * math.sin(t23) + fz * math.cos(t23)
-    theta0[2] = t23 - theta0[1]
-    b = float((o5 - base) @ y_arm)
-    if abs(b) > tol * scale:
+    arm = arm_parameters(robot, axes, o5, o6)
+    if arm is None:
+        return None
+    if abs(arm.b) > tol:
         # A lateral offset leaves each shoulder's residual undefined where O5 passes within
         # b of axis 1, and its roots near there are missed: such an arm is left numeric.
         return None
-    F = _rz(theta0[0]) @ _ry(t23)
-    z5 = F.T @ z[4]
-    theta0[3] = math.atan2(-z5[0], z5[1])
-    G = F @ _rz(theta0[3])
-    z6 = G.T @ z[5]
-    theta0[4] = math.atan2(z6[0], z6[2])
-    flange = frames[-1] @ np.linalg.inv(robot.T_flange_tool)
-    c4 = float((flange[:3, 3] - o6) @ (G @ _ry(theta0[4]))[:, 2])
-    if c4 < 0.0:
-        theta0[4] += math.pi
-        c4 = -c4
-        sign[5] = -1.0
-    theta0 = np.angle(np.exp(1j * theta0))
-    if c2 <= tol * scale or math.hypot(a2, c3) <= tol * scale:
-        return None
     params = CRXParameters(
-        a1=a1,
-        b=b,
-        c1=c1,
-        c2=c2,
-        a2=a2,
-        c3=c3,
+        a1=arm.a1,
+        b=arm.b,
+        c1=arm.c1,
+        c2=arm.c2,
+        a2=arm.a2,
+        c3=arm.c3,
         l5=l5,
-        c4=c4,
-        offsets=tuple(float(v) for v in theta0),
-        signs=tuple(float(v) for v in sign),
-        base=(float(base[0]), float(base[1])),
+        c4=arm.c4,
+        offsets=arm.offsets,
+        signs=arm.signs,
+        base=arm.base,
         T_tail=np.eye(4),
     )
-    shift = np.eye(4)
-    shift[:2, 3] = base[:2]
-    params = replace(params, T_tail=np.linalg.inv(shift @ params.forward(theta0)) @ flange)
-    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (_N_CHECK, 6))
-    expected = forward_kinematics(robot, q) @ np.linalg.inv(robot.T_flange_tool)
-    model = shift @ params.forward(q * sign + theta0) @ params.T_tail
-    error = np.abs(expected - model)
-    if error[..., :3, 3].max() > _CHECK_TOL * scale or error[..., :3, :3].max() > _CHECK_TOL:
-        return None
-    return params
+    params = replace(params, T_tail=arm.tail(params.forward))
+    return params if arm.reproduces(robot, params.forward, params.T_tail) else None
 
 
 class CRXFamily(TrackedFamily):

@@ -26,13 +26,14 @@ put at q4 = 0 (wrist 0) or π away (wrist 1) and joint 6 takes the whole rotatio
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from trackplan.robots.families import _opw_kernels as kern
 from trackplan.robots.families.base import FusedClosedForm, describe_bits
-from trackplan.robots.kinematics import axis_frames
+from trackplan.robots.kinematics import axis_frames, forward_kinematics
 from trackplan.robots.model import Robot
 
 _PARALLEL_TOL = 1e-9  # |sin| of the angle between axes that counts as parallel/perpendicular
@@ -122,22 +123,41 @@ def _line_distance(point: np.ndarray, p: np.ndarray, u: np.ndarray) -> float:
     return float(np.linalg.norm(np.cross(point - p, u)))
 
 
-def opw_from_chain(robot: Robot) -> OPWParameters | None:
-    """The OPW parameters of a 6-joint chain, or None when it is not an OPW arm.
+@dataclass(frozen=True)
+class ArmAxes:
+    """The axes of a 6-joint chain at q = 0 with an ortho-parallel base: axis 1 along the
+    base z axis, axes 2 and 3 parallel and perpendicular to it, each of axes 4, 5, 6
+    perpendicular to the one before (the OPW and the CRX structure).
 
-    The axes at q = 0 are examined: joint 1 along the base z axis, joints 2 and 3
-    parallel and perpendicular to it, joint 4 perpendicular to them, and the axes of
-    joints 4, 5 and 6 meeting in one point. The lengths, offsets and signs follow from the
-    positions of the axes; the result is then checked against the chain's own forward
-    kinematics on random configurations (to 1e-9), so a chain that is only nearly OPW
-    (an axis tilted by a degree) is rejected.
+    Attributes
+    ----------
+    frames
+        The axis frames at q = 0 (:func:`~trackplan.robots.kinematics.axis_frames`).
+    z, p
+        Axis directions and points, shape (6, 3).
+    scale
+        The robot's reach (at least 1 mm), m: lengths below ``tol · scale`` are zero.
     """
+
+    frames: np.ndarray
+    z: np.ndarray
+    p: np.ndarray
+    scale: float
+
+    def meet(self, i: int, j: int) -> np.ndarray | None:
+        """The point where axes i and j (0-based) meet, or None when they pass apart."""
+        point = _closest_point(self.p[i], self.z[i], self.p[j], self.z[j])
+        apart = max(_line_distance(point, self.p[k], self.z[k]) for k in (i, j))
+        return None if apart > _PARALLEL_TOL * self.scale else point
+
+
+def arm_axes(robot: Robot) -> ArmAxes | None:
+    """The :class:`ArmAxes` of a chain, or None when it has not 6 joints or not that
+    structure (to :data:`_PARALLEL_TOL`)."""
     if robot.n_dof != 6:
         return None
     frames = axis_frames(robot, np.zeros(6))
     z = frames[1:7, :3, 2]
-    p = frames[1:7, :3, 3]
-    scale = max(robot.reach, 1e-3)
     ez = np.array([0.0, 0.0, 1.0])
     tol = _PARALLEL_TOL
 
@@ -156,9 +176,89 @@ def opw_from_chain(robot: Robot) -> OPWParameters | None:
         and perpendicular(z[5], z[4])
     ):
         return None
-    wrist = _closest_point(p[3], z[3], p[4], z[4])
-    if max(_line_distance(wrist, p[i], z[i]) for i in (3, 4, 5)) > tol * scale:
-        return None
+    return ArmAxes(frames, z, frames[1:7, :3, 3], max(robot.reach, 1e-3))
+
+
+@dataclass(frozen=True)
+class ArmParameters:
+    """What :func:`arm_parameters` derives of an ortho-parallel arm (lengths m, angles rad).
+
+    Attributes
+    ----------
+    a1, a2, b, c1, c2, c3, c4
+        The OPW lengths (Brandstötter et al. 2014; c4 measured from the given tip).
+    theta0, sign
+        The angle at q = 0 and the sign of each joint, shape (6,): ``θ = sign · q + θ0``.
+    base
+        Position of joint 1's axis in the base x-y plane, shape (2,).
+    flange
+        The flange at q = 0 without the tool, shape (4, 4).
+    """
+
+    a1: float
+    a2: float
+    b: float
+    c1: float
+    c2: float
+    c3: float
+    c4: float
+    theta0: np.ndarray
+    sign: np.ndarray
+    base: tuple[float, float]
+    flange: np.ndarray
+
+    @property
+    def offsets(self) -> tuple[float, ...]:
+        """θ0 per joint, as a tuple."""
+        return tuple(float(v) for v in self.theta0)
+
+    @property
+    def signs(self) -> tuple[float, ...]:
+        """The sign per joint, as a tuple."""
+        return tuple(float(v) for v in self.sign)
+
+    @property
+    def shift(self) -> np.ndarray:
+        """The translation of the base to joint 1's axis, shape (4, 4)."""
+        shift = np.eye(4)
+        shift[:2, 3] = self.base
+        return shift
+
+    def tail(self, forward: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+        """The fixed transform from a model's flange (``forward`` of the angles at q = 0)
+        to the robot's flange, shape (4, 4)."""
+        tail: np.ndarray = np.linalg.inv(self.shift @ forward(self.theta0)) @ self.flange
+        return tail
+
+    def reproduces(
+        self, robot: Robot, forward: Callable[[np.ndarray], np.ndarray], T_tail: np.ndarray
+    ) -> bool:
+        """Whether the model (``forward`` of angles (..., 6) to flange poses, then
+        ``T_tail``) gives the chain's own forward kinematics on :data:`_N_CHECK` random
+        configurations, to :data:`_CHECK_TOL` (m, scaled by the reach, and rad)."""
+        q = np.random.default_rng(0).uniform(-np.pi, np.pi, (_N_CHECK, 6))
+        expected = forward_kinematics(robot, q) @ np.linalg.inv(robot.T_flange_tool)
+        model = self.shift @ forward(q * self.sign + self.theta0) @ T_tail
+        error = np.abs(expected - model)
+        scale = max(robot.reach, 1e-3)
+        return bool(
+            error[..., :3, 3].max() <= _CHECK_TOL * scale and error[..., :3, :3].max() <= _CHECK_TOL
+        )
+
+
+def arm_parameters(
+    robot: Robot, axes: ArmAxes, wrist: np.ndarray, tip: np.ndarray
+) -> ArmParameters | None:
+    """The OPW lengths, offsets, signs and base of an ortho-parallel arm whose axis 4 meets
+    axis 5 at ``wrist`` and whose flange lies along axis 6 from ``tip`` (the wrist centre of
+    an OPW arm, O6 of a CRX), or None when the upper arm or the forearm has no length.
+
+    Returns
+    -------
+    ArmParameters or None
+    """
+    z, p, scale, tol = axes.z, axes.p, axes.scale, _PARALLEL_TOL
+    ez = np.array([0.0, 0.0, 1.0])
     sign = np.ones(6)
     sign[0] = np.sign(z[0] @ ez)
     base = np.array([p[0, 0], p[0, 1], 0.0])
@@ -193,8 +293,8 @@ def opw_from_chain(robot: Robot) -> OPWParameters | None:
     G = F @ _rz(theta0[3])
     z6 = G.T @ z[5]
     theta0[4] = math.atan2(z6[0], z6[2])
-    flange = frames[-1] @ np.linalg.inv(robot.T_flange_tool)
-    c4 = float((flange[:3, 3] - wrist) @ (G @ _ry(theta0[4]))[:, 2])
+    flange = axes.frames[-1] @ np.linalg.inv(robot.T_flange_tool)
+    c4 = float((flange[:3, 3] - tip) @ (G @ _ry(theta0[4]))[:, 2])
     if c4 < 0.0:
         theta0[4] += math.pi
         c4 = -c4
@@ -202,33 +302,45 @@ def opw_from_chain(robot: Robot) -> OPWParameters | None:
     theta0 = np.angle(np.exp(1j * theta0))
     if c2 <= tol * scale or math.hypot(a2, c3) <= tol * scale:
         return None
+    base_xy = (float(base[0]), float(base[1]))
+    return ArmParameters(a1, a2, b, c1, c2, c3, c4, theta0, sign, base_xy, flange)
+
+
+def opw_from_chain(robot: Robot) -> OPWParameters | None:
+    """The OPW parameters of a 6-joint chain, or None when it is not an OPW arm.
+
+    The axes at q = 0 are examined (:func:`arm_axes`): joint 1 along the base z axis,
+    joints 2 and 3 parallel and perpendicular to it, joint 4 perpendicular to them, and the
+    axes of joints 4, 5 and 6 meeting in one point. The lengths, offsets and signs follow
+    from the positions of the axes (:func:`arm_parameters`); the result is then checked
+    against the chain's own forward kinematics on random configurations (to 1e-9), so a
+    chain that is only nearly OPW (an axis tilted by a degree) is rejected.
+    """
+    axes = arm_axes(robot)
+    if axes is None:
+        return None
+    wrist = axes.meet(3, 4)
+    if wrist is None or _line_distance(wrist, axes.p[5], axes.z[5]) > _PARALLEL_TOL * axes.scale:
+        return None
+    arm = arm_parameters(robot, axes, wrist, wrist)
+    if arm is None:
+        return None
     params = OPWParameters(
-        a1=a1,
-        a2=a2,
-        b=b,
-        c1=c1,
-        c2=c2,
-        c3=c3,
-        c4=c4,
-        offsets=tuple(float(v) for v in theta0),
-        signs=tuple(float(v) for v in sign),
-        base=(float(base[0]), float(base[1])),
+        a1=arm.a1,
+        a2=arm.a2,
+        b=arm.b,
+        c1=arm.c1,
+        c2=arm.c2,
+        c3=arm.c3,
+        c4=arm.c4,
+        offsets=arm.offsets,
+        signs=arm.signs,
+        base=arm.base,
         T_tail=np.eye(4),
     )
-    shift = np.eye(4)
-    shift[:2, 3] = base[:2]
-    at_zero = shift @ params.forward(theta0)
-    T_tail = np.linalg.inv(at_zero) @ flange
+    T_tail = arm.tail(params.forward)
     params = OPWParameters(**{**params.__dict__, "T_tail": T_tail})
-    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (_N_CHECK, 6))
-    from trackplan.robots.kinematics import forward_kinematics
-
-    expected = forward_kinematics(robot, q) @ np.linalg.inv(robot.T_flange_tool)
-    model = shift @ params.forward(q * sign + theta0) @ T_tail
-    error = np.abs(expected - model)
-    if error[..., :3, 3].max() > _CHECK_TOL * scale or error[..., :3, :3].max() > _CHECK_TOL:
-        return None
-    return params
+    return params if arm.reproduces(robot, params.forward, T_tail) else None
 
 
 class OPWFamily(FusedClosedForm):
