@@ -312,11 +312,18 @@ def one_branch_paths(
     q, reach, switch, report, values, windings, winding
         As :func:`all_branch_paths` with K = 1.
     """
-    solved = [
-        family.solve_branch(T[b], int(k), free=None if free is None else free[b], with_aux=True)
-        for b, k in enumerate(branches)
-    ]
-    q_all, valid, aux = (np.stack([found[i] for found in solved])[:, :, None] for i in range(3))
+    n_cand, n_poses = T.shape[:2]
+    q_all = np.empty((n_cand, n_poses, 1, robot.n_dof))
+    valid = np.empty((n_cand, n_poses, 1), dtype=np.bool_)
+    aux = np.empty((n_cand, n_poses, 1, AUX_SIZE))
+    for k in np.unique(branches):  # the candidates on one branch in one call
+        rows = np.flatnonzero(branches == k)
+        poses = T[rows].reshape(-1, 4, 4)
+        values = None if free is None else free[rows].reshape(-1)
+        q, ok, quantities = family.solve_branch(poses, int(k), free=values, with_aux=True)
+        q_all[rows, :, 0] = q.reshape(len(rows), n_poses, -1)
+        valid[rows, :, 0] = ok.reshape(len(rows), n_poses)
+        aux[rows, :, 0] = quantities.reshape(len(rows), n_poses, AUX_SIZE)
     only = np.zeros((len(branches), 1), dtype=np.int64)
     paths = _analysis_arrays(len(branches), 1, T.shape[1], robot.n_dof)
     limits = robot.q_min.copy(), robot.q_max.copy()  # writable: one compiled kernel
