@@ -68,6 +68,7 @@ def browser():
         chromium.close()
 
 
+@pytest.mark.slow  # about 9 s: Chromium started, a report opened and animated
 def test_report_view_animates_without_errors(browser, report_file, tmp_path, corner, corner_result):
     page = browser.new_page(viewport={"width": 1400, "height": 1000})
     page.set_default_timeout(120_000)  # a loaded CI machine parses 5 MB of plotly.js slowly
