@@ -58,3 +58,13 @@ def test_the_checker_given_only_the_joints_agrees(sealing):
         case, case.bounds.example, result.trajectory.q, result.trajectory.sample_time
     )
     assert report.success, [v.message for v in report.violations]
+
+
+def test_a_branch_past_the_familys_is_one_line(tmp_path, capsys):
+    from trackplan.cli import main
+
+    case = str(CASES / "iiwa-sealing.yaml")
+    code = main(["plan", case, "--branch", "9", "--out", str(tmp_path), "--no-report"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and "branch" in err[0] and "0…7" in err[0], err

@@ -252,6 +252,11 @@ def choose_seam_redundancy(
     -------
     tuple
         The profile (rad over the seam's arc length) and the branch.
+
+    Raises
+    ------
+    CaseError
+        When the branch given is none of the family's.
     """
     arm = arm_of(case.machine)
     s = screening_grid(geometry)
@@ -270,6 +275,9 @@ def choose_seam_redundancy(
         )
         column = int(order[0])
     else:
+        if branch not in paths.branches:
+            last = int(paths.branches[-1])
+            raise CaseError(f"branch must be in 0…{last}, got {branch}", key="branch")
         column = int(np.flatnonzero(paths.branches == branch)[0])
     return choice.profile(0, column), int(paths.branches[column])
 
