@@ -44,3 +44,10 @@ def test_the_crx_samples_keep_every_limit_and_the_checker_agrees(weld):
     assert np.all(np.abs(np.diff(traj.q, 3, axis=0) / Ts**3) <= robot.j_max * 1.05)
     report = trackplan.check(case, case.bounds.example, traj.q, Ts)
     assert report.success, [v.message for v in report.violations]
+
+
+def test_a_branch_the_first_pose_does_not_have_says_so(weld):
+    case, _ = weld
+    result = trackplan.plan(case, case.bounds.example, branch=15)
+    assert not result.success
+    assert "first pose has no such solution inside the joint limits" in result.message

@@ -471,6 +471,12 @@ def _message(
         margin = values[F_MARGIN]
         return f"branch {branch} ({name}) follows all {n_poses} poses, margin {margin:.3f} rad"
     parts = []
+    if method == "numeric" and report[I_N_UNREACH] == n_poses:
+        # a tracked branch starts at a solution of the first pose: none reached, none exists
+        return (
+            f"branch {branch} ({name}): the path's first pose has no such solution inside "
+            "the joint limits (it has fewer distinct solutions, or none)"
+        )
     if report[I_N_UNREACH] > 0:
         count = report[I_N_UNREACH]
         more = f" ({count} poses in all)" if count > 1 else ""
