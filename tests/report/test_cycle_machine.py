@@ -26,13 +26,13 @@ from tests.report.test_machine_report import (
     _pose,
     _positioner_points,
     _tilt_rotate,
+    with_external_axes,
 )
 from trackplan.case import Case, Seam
 from trackplan.cell.model import Body, Cell, Shape
-from trackplan.derivatives import backward_derivatives
 from trackplan.paths.nominal import NominalPath
 from trackplan.paths.specs import LineSpec
-from trackplan.planning.result import AIR, SEAM, PlanResult, Span, Trajectory
+from trackplan.planning.result import AIR, SEAM, PlanResult, Span
 from trackplan.report.cycle_view import cycle_view_spec
 from trackplan.report.joints_plot import joints_figure
 from trackplan.report.machine_view import (
@@ -74,24 +74,8 @@ def cycle_result(cycle_case: Case, corner_result: PlanResult) -> PlanResult:
     (first third), an air move (second third) and seam b (last third)."""
     machine = cycle_case.machine
     assert isinstance(machine, Machine)
-    old = corner_result.trajectory
-    n = old.n_samples
-    u = np.linspace(0.0, 1.0, n)
-    smooth = u**3 * (10 - 15 * u + 6 * u**2)
-    external = np.column_stack([1.2 * smooth - 0.2, 0.8 * np.sin(np.pi * u), 3.0 * smooth])
-    q = np.hstack([old.q, external])
-    qd, qdd, qddd = backward_derivatives(q, old.sample_time)
-    trajectory = Trajectory(
-        sample_time=old.sample_time,
-        t=old.t,
-        s=old.s,
-        q=q,
-        qd=qd,
-        qdd=qdd,
-        qddd=qddd,
-        tool_position=machine.T_carrier_tool(q)[:, :3, 3],
-        speed=old.speed,
-    )
+    trajectory = with_external_axes(corner_result, machine)
+    n = trajectory.n_samples
     k1, k2 = n // 3, 2 * n // 3
     spans = (
         Span(kind=SEAM, label="a", first=0, last=k1, seam=0),

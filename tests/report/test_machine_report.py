@@ -118,18 +118,16 @@ def cell_case(corner: Case) -> Case:
     )
 
 
-@pytest.fixture(scope="module")
-def cell_result(cell_case: Case, corner_result: PlanResult) -> PlanResult:
-    """The corner result with a track ramp and two positioner sweeps in its joint vector."""
-    machine = cell_case.machine
-    assert isinstance(machine, Machine)
-    old = corner_result.trajectory
+def with_external_axes(result: PlanResult, machine: Machine) -> Trajectory:
+    """The result's trajectory with a track ramp and two positioner sweeps appended to its
+    joint vector (the machine's), its derivatives and tool points recomputed."""
+    old = result.trajectory
     u = np.linspace(0.0, 1.0, old.n_samples)
     smooth = u**3 * (10 - 15 * u + 6 * u**2)
     external = np.column_stack([1.2 * smooth - 0.2, 0.8 * np.sin(np.pi * u), 3.0 * smooth])
     q = np.hstack([old.q, external])
     qd, qdd, qddd = backward_derivatives(q, old.sample_time)
-    trajectory = Trajectory(
+    return Trajectory(
         sample_time=old.sample_time,
         t=old.t,
         s=old.s,
@@ -140,6 +138,14 @@ def cell_result(cell_case: Case, corner_result: PlanResult) -> PlanResult:
         tool_position=machine.T_carrier_tool(q)[:, :3, 3],
         speed=old.speed,
     )
+
+
+@pytest.fixture(scope="module")
+def cell_result(cell_case: Case, corner_result: PlanResult) -> PlanResult:
+    """The corner result with a track ramp and two positioner sweeps in its joint vector."""
+    machine = cell_case.machine
+    assert isinstance(machine, Machine)
+    trajectory = with_external_axes(corner_result, machine)
     return dataclasses.replace(corner_result, trajectory=trajectory)
 
 

@@ -9,9 +9,9 @@ seeds of :func:`~trackplan.robots.families.numeric.numeric_seeds` and
 ``qmc.Sobol``, seed :data:`SOBOL_SEED`). A converged start (position and orientation
 error ≤ :data:`SOLVED_TOL`) is moved by multiples of 2π into the limits (the lowest that
 fits), dropped where it fits nowhere or repeats a solution found before it (every joint
-within :data:`SAME_NUMERIC`), and the distinct ones are ordered by their structural
-signature, then by their margin to the limits (:func:`select_solutions`), at most K kept.
-One compiled call runs all poses × starts (:func:`multi_start`).
+within the caller's ``same``: the families' ``SAME_SOLUTION``), and the distinct ones are
+ordered by their structural signature, then by their margin to the limits
+(:func:`select_solutions`), at most K kept. One compiled call runs all poses × starts (:func:`multi_start`).
 
 The signature is ``4·s + 2·e + w`` with s, e, w = 1 where these measures
 (:func:`structure_measures`) are negative: the shoulder ``z₂ · (z₁ × (w − o₁))`` (zero with
@@ -38,10 +38,6 @@ SOBOL_SEED = 20261207
 
 SOLVED_TOL = 1e-10
 """Largest position (m) and orientation (rad) error of a solution that is kept."""
-
-SAME_NUMERIC = 1e-6
-"""Largest joint difference (rad) between two converged starts that are one solution
-(as :data:`~trackplan.robots.families.base.SAME_SOLUTION`)."""
 
 MAX_ITER = 100
 """Most Newton iterations from one start."""

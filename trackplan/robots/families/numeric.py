@@ -15,6 +15,7 @@ import numpy as np
 from trackplan.errors import CaseError
 from trackplan.robots.families.base import (
     N_BRANCHES,
+    SAME_SOLUTION,
     RedundancyParameter,
     TrackedFamily,
     _no_free,
@@ -27,7 +28,6 @@ from trackplan.robots.ik_numeric import (
 from trackplan.robots.model import Robot
 from trackplan.robots.numeric_seeding import (
     MAX_ITER,
-    SAME_NUMERIC,
     SOLVED_TOL,
     multi_start,
     select_solutions,
@@ -145,7 +145,7 @@ class NumericFamily(TrackedFamily):
         )
         lower = np.ascontiguousarray(q_min, dtype=float)
         upper = np.ascontiguousarray(q_max, dtype=float)
-        return select_solutions(q, solved, measures, lower, upper, self.n_branches, SAME_NUMERIC)
+        return select_solutions(q, solved, measures, lower, upper, self.n_branches, SAME_SOLUTION)
 
     def track(
         self,
