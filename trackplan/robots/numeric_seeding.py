@@ -11,7 +11,8 @@ error ≤ :data:`SOLVED_TOL`) is moved by multiples of 2π into the limits (the 
 fits), dropped where it fits nowhere or repeats a solution found before it (every joint
 within the caller's ``same``: the families' ``SAME_SOLUTION``), and the distinct ones are
 ordered by their structural signature, then by their margin to the limits
-(:func:`select_solutions`), at most K kept. One compiled call runs all poses × starts (:func:`multi_start`).
+(:func:`select_solutions`), at most K kept. One compiled call runs all poses × starts
+(:func:`multi_start`).
 
 The signature is ``4·s + 2·e + w`` with s, e, w = 1 where these measures
 (:func:`structure_measures`) are negative: the shoulder ``z₂ · (z₁ × (w − o₁))`` (zero with
